@@ -1,0 +1,1 @@
+"""Analysis of stick-slip traces and confined-film trajectories."""

@@ -1,0 +1,1 @@
+"""Reduced spring-block models of stick-slip friction."""

@@ -1,0 +1,1 @@
+"""Scenes, the LAMMPS runner, sweeps and comparison reports."""
