@@ -1,0 +1,68 @@
+"""``filmfriction analyze PATH``: analyse a run directory or a CSV trace."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def _positive(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not v > 0 or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number: {text!r}")
+    return v
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "analyze", help="stick-slip events, energy partition, viscosity, structure",
+        description="Analyse a run directory (trace.csv + run.json) or a CSV trace "
+                    "(header with time, spring_force; optional drive_position, "
+                    "wall_position, wall_velocity, gap). Writes analysis.json and "
+                    "analysis_cycles.csv next to the trace.")
+    p.add_argument("path", type=Path, help="run directory or CSV trace")
+    p.add_argument("--json", action="store_true", help="also print the document")
+    p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
+    p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
+    p.add_argument("--area", type=_positive, help="contact area A")
+    p.add_argument("--thickness", type=_positive, help="film thickness D")
+    p.add_argument("--drive-velocity", type=_positive, help="spring-end velocity V")
+    p.add_argument("--units", choices=("lj", "si"), default=None,
+                   help="unit system of the trace (default: run.json's, else lj)")
+    p.add_argument("--skip", type=int, default=None,
+                   help="slips left out of the summaries (default: 1 when >= 3 slips)")
+    p.add_argument("--no-structure", action="store_true",
+                   help="skip the trajectory analyses")
+    p.add_argument("--output", type=Path, default=None,
+                   help="where to write analysis.json (default: next to the trace)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from workflows.cli import UserError
+
+    from .report import analyze, to_json, write_outputs
+    from .trace import read_trace
+
+    try:
+        trace = read_trace(args.path, spring_constant=args.spring_constant,
+                           mass=args.mass, area=args.area, thickness=args.thickness,
+                           drive_velocity=args.drive_velocity, units=args.units)
+        doc, per_cycle = analyze(trace, skip=args.skip,
+                                 structure=not args.no_structure)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
+    json_path, csv_path = write_outputs(doc, per_cycle, out)
+    if args.json:
+        print(to_json(dict(doc, cycles_csv=csv_path.name)))
+    else:
+        s = doc["slips"]
+        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path} and {csv_path.name}",
+              file=sys.stdout)
+        for key, why in doc["skipped"].items():
+            print(f"  skipped {key}: {why}", file=sys.stdout)
+    return 0

@@ -1,0 +1,212 @@
+"""Where the spring's energy goes in each stick-slip cycle (Klein, seed 004).
+
+Per slip y → s:
+
+``spring_released``
+    ΔE_spring = K(x0 − Δx0/2)Δx0, Klein's estimate (spring end fixed).
+``spring_released_exact``
+    ½K(e_y² − e_s²) = (Fs² − Fb²)/(2K) from the trace's own forces.
+``drive_work_slip``
+    Work done by the moving spring end during the slip, ∫F dx_d (zero in
+    Klein's approximation; counted here when the drive is known).
+``film_dissipation``
+    Work the film absorbs during the slip, from the wall's equation of motion
+    M v' = F_spring − F_film: ∫F_film v dt = ∫F_spring v dt − ΔKE_wall.
+    Needs the wall velocity (column, else derivative of the wall position).
+    The integral runs from 10 % of the preceding stick before y to 10 % of
+    the following stick after s (the wall is at rest there, so the margin
+    adds nothing but makes the result insensitive to where exactly y and s
+    fall between samples).
+    Without wall kinematics Klein's Eq. (1) identity is used: everything the
+    spring delivers, ``spring_released_exact + drive_work_slip``, is
+    dissipated viscously (``film_dissipation_method = "klein-eq1"``).
+``ringing_energy``
+    ΔE_osc, the oscillator energy left at re-stick, as Klein estimates it
+    from the largest ringing amplitude: A²/(2K) with A the largest excursion
+    of the force about a straight line fitted to the first quarter of the
+    next stick (0 when A < 4 σ_noise: no ringing resolved).
+``thermostat_heat_cycle`` / ``ledger_residual_cycle``
+    From the MD ledger columns (y → next y), when present.
+
+Fractions as Klein reports them: ``viscous_fraction`` = E_film /
+(E_film + ΔE_osc) (viscous, during the slip) and ``at_stick_fraction`` =
+ΔE_osc / (E_film + ΔE_osc) (lost at the stick).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import trapezoid
+
+from .stickslip import CycleTable, _stats
+
+__all__ = ["EnergyTable", "energy_table", "ledger"]
+
+LEDGER_COLUMNS = ("drive_work", "load_work", "potential_energy",
+                  "kinetic_energy", "spring_energy", "thermostat_heat")
+
+
+@dataclass(frozen=True, eq=False)
+class EnergyTable:
+    """Per-slip energies (see the module docstring for each column)."""
+
+    spring_released: np.ndarray
+    spring_released_exact: np.ndarray
+    drive_work_slip: np.ndarray
+    film_dissipation: np.ndarray
+    wall_ke_change: np.ndarray
+    ringing_energy: np.ndarray
+    viscous_fraction: np.ndarray
+    at_stick_fraction: np.ndarray
+    thermostat_heat_cycle: np.ndarray
+    ledger_residual_cycle: np.ndarray
+    film_dissipation_method: str
+
+    _NAMES = ("spring_released", "spring_released_exact", "drive_work_slip",
+              "film_dissipation", "wall_ke_change", "ringing_energy",
+              "viscous_fraction", "at_stick_fraction", "thermostat_heat_cycle",
+              "ledger_residual_cycle")
+
+    def summary(self, skip: int = 0) -> dict:
+        """``{name: {"mean", "std", "stderr", "n"}}``, NaN ignored."""
+        return {n: _stats(np.asarray(getattr(self, n), float)[skip:])
+                for n in self._NAMES}
+
+    def as_dict(self) -> dict:
+        out = {n: np.asarray(getattr(self, n), float).tolist() for n in self._NAMES}
+        out["film_dissipation_method"] = self.film_dissipation_method
+        return out
+
+
+def _ringing(t, f, s, stop, k, noise, fraction=0.25):
+    """Oscillator energy A²/(2K), A the largest force excursion about the
+    early stick ramp; 0 when A is within 4 σ of the noise."""
+    hi = s + max(int(fraction * (stop - s)), 0)
+    if hi - s < 4:
+        return math.nan
+    tt = t[s:hi] - t[s]
+    coef = np.polyfit(tt, f[s:hi], 1)
+    amp = float(np.max(np.abs(f[s:hi] - np.polyval(coef, tt))))
+    return amp ** 2 / (2 * k) if amp > 4 * noise else 0.0
+
+
+def energy_table(time, spring_force, table: CycleTable, spring_constant: float, *,
+                 mass: float | None = None, wall_velocity=None,
+                 wall_position=None, drive_position=None,
+                 drive_velocity: float | None = None, noise: float = 0.0,
+                 ledger_columns: dict | None = None) -> EnergyTable:
+    """Energy partition of each slip in ``table``.
+
+    Parameters
+    ----------
+    time, spring_force : ndarray
+        The trace.
+    table : CycleTable
+        Slips (y, s indices, Fs, Fb, Δx0).
+    spring_constant : float
+        K.
+    mass : float, optional
+        Wall mass M (needed for the kinetic-energy term).
+    wall_velocity, wall_position : ndarray, optional
+        Wall kinematics; velocity preferred, else the position is
+        differentiated.
+    drive_position : ndarray, optional
+        Spring-end position (drive work during the slip); else
+        ``drive_velocity`` × time is used, else the drive is taken fixed.
+    noise : float
+        Noise standard deviation of the force (subtracted from the ringing).
+    ledger_columns : dict, optional
+        MD ledger columns (``thermostat_heat`` etc.) by name.
+
+    Returns
+    -------
+    EnergyTable
+    """
+    t = np.asarray(time, float)
+    f = np.asarray(spring_force, float)
+    k = float(spring_constant)
+    yi, si = table.yield_index, table.stick_index
+    m = len(table)
+    nan = lambda: np.full(m, math.nan)   # noqa: E731
+    x0 = table.static_force / k
+    dx0 = np.asarray(table.slip_distance, float)
+    released = k * (x0 - dx0 / 2) * dx0
+    exact = (table.static_force ** 2 - table.backward_force ** 2) / (2 * k)
+
+    if drive_position is not None:
+        xd = np.asarray(drive_position, float)
+    elif drive_velocity is not None:
+        xd = drive_velocity * t
+    else:
+        xd = None
+    drive = np.zeros(m)
+    if xd is not None:
+        drive = np.array([trapezoid(f[y:s + 1], xd[y:s + 1]) for y, s in zip(yi, si)])
+
+    v = None
+    if wall_velocity is not None:
+        v = np.asarray(wall_velocity, float)
+    elif wall_position is not None:
+        v = np.gradient(np.asarray(wall_position, float), t)
+    film, dke = nan(), nan()
+    if v is not None:
+        method = "equation-of-motion"
+        starts = np.concatenate([[0], si[:-1]])
+        stops = np.concatenate([yi[1:], [t.size - 1]])
+        lo = yi - ((yi - starts) // 10)
+        hi = si + ((stops - si) // 10)
+        work = np.array([trapezoid(f[a:b + 1] * v[a:b + 1], t[a:b + 1])
+                         for a, b in zip(lo, hi)])
+        dke = 0.5 * mass * (v[hi] ** 2 - v[lo] ** 2) if mass else np.zeros(m)
+        if not mass:
+            method += " (no mass: ΔKE neglected)"
+        film = work - dke
+    else:
+        method = "klein-eq1"
+        film = exact + drive
+
+    ring = nan()
+    for i in range(m):
+        stop = yi[i + 1] if i + 1 < m else t.size
+        ring[i] = _ringing(t, f, si[i], stop, k, noise)
+    total = film + ring
+    with np.errstate(invalid="ignore", divide="ignore"):
+        visc_frac = film / total
+        stick_frac = ring / total
+
+    heat, resid = nan(), nan()
+    cols = ledger_columns or {}
+    if m > 1 and "thermostat_heat" in cols:
+        q = np.asarray(cols["thermostat_heat"], float)
+        heat[:-1] = np.diff(q[yi])
+    if m > 1 and all(c in cols for c in LEDGER_COLUMNS):
+        r = ledger(cols)["residual"]
+        resid[:-1] = np.diff(r[yi])
+    return EnergyTable(released, exact, drive, film, dke, ring, visc_frac,
+                       stick_frac, heat, resid, method)
+
+
+def ledger(columns: dict) -> dict:
+    """Energy ledger of an MD run.
+
+    drive_work + load_work = Δ(potential + kinetic + spring) + thermostat_heat
+    + residual.
+
+    Returns
+    -------
+    dict
+        ``residual`` (array, cumulative, zero at the first sample),
+        ``input`` (drive_work + load_work at the end, relative to the start),
+        ``closure`` (|final residual| / |input|; NaN when no work was done).
+    """
+    c = {n: np.asarray(columns[n], float) for n in LEDGER_COLUMNS}
+    work = c["drive_work"] + c["load_work"]
+    stored = c["potential_energy"] + c["kinetic_energy"] + c["spring_energy"]
+    residual = (work - work[0]) - (stored - stored[0]) - (c["thermostat_heat"]
+                                                          - c["thermostat_heat"][0])
+    total = float(work[-1] - work[0])
+    closure = abs(float(residual[-1])) / abs(total) if total else math.nan
+    return {"residual": residual, "input": total, "closure": closure,
+            "thermostat_heat": float(c["thermostat_heat"][-1] - c["thermostat_heat"][0])}

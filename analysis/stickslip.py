@@ -1,0 +1,500 @@
+"""Stick-slip events in a spring-force trace, in Klein's notation.
+
+A driven spring (constant K, far end moving at V) pulls a wall across a
+confined film.  During *stick* the spring force rises; at the *yield point*
+``y`` the film shear-melts and the wall slips, the force drops, and at the
+*re-stick point* ``s`` the film solidifies and the force rises again.
+
+Per cycle (Klein, seed 004): static force Fs = K x0 at y, backward force Fb
+at s, spring extension at yield x0, slip distance Δx0, slip duration τ_s
+(y → s), stick duration (s → next y) and period τ_ss (y → next y).
+
+Event detection (:func:`detect_slips`) is a hysteresis ("zig-zag") detector:
+a yield is a running maximum of the force that is followed by a drop of more
+than ``h`` before any higher value; the re-stick is the running minimum after
+it that is followed by a rise of more than ``h``.  ``h`` is set from a robust
+estimate of the noise so that a stationary noisy trace gives no events (see
+:func:`detect_slips`).  The regime criterion is in :func:`classify_regime`.
+
+The same functions serve MD traces (LJ units), SFB traces (SI) and
+reduced-model traces: nothing here depends on the unit system.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["CycleTable", "SlipEvents", "cycle_table", "detect_slips",
+           "noise_level", "classify_regime", "ramp_forces", "REGIME_CV_MAX"]
+
+#: Largest coefficient of variation of Fs and of the period still called
+#: periodic ``stick-slip`` (see :func:`classify_regime`).
+REGIME_CV_MAX = 0.2
+
+_COLUMNS = ("yield_time", "stick_time", "static_force", "backward_force",
+            "spring_extension", "slip_distance", "slip_duration",
+            "stick_duration", "period")
+
+
+def _stats(values: np.ndarray) -> dict:
+    finite = values[np.isfinite(values)]
+    n = int(finite.size)
+    mean = float(finite.mean()) if n else math.nan
+    std = float(finite.std(ddof=1)) if n > 1 else math.nan
+    stderr = std / math.sqrt(n) if n > 1 else math.nan
+    return {"mean": mean, "std": std, "stderr": stderr, "n": n}
+
+
+@dataclass(frozen=True, eq=False)
+class CycleTable:
+    """Per-slip values of a stick-slip trace (one row per slip y → s).
+
+    Attributes
+    ----------
+    yield_index, stick_index : ndarray of int
+        Indices of the yield point y and re-stick point s in the trace.
+    yield_time, stick_time : ndarray
+        Times of y and s.
+    static_force : ndarray
+        Fs, spring force at y.
+    backward_force : ndarray
+        Fb, spring force at s.
+    spring_extension : ndarray
+        x0 = Fs / K (NaN without a spring constant).
+    slip_distance : ndarray
+        Δx0: wall displacement y → s when the wall position is known,
+        else (Fs − Fb)/K (exact when the spring end does not move during the
+        slip), else NaN.
+    slip_duration : ndarray
+        τ_s = t(s) − t(y).
+    stick_duration : ndarray
+        t(next y) − t(s); NaN for the last slip.
+    period : ndarray
+        τ_ss = t(next y) − t(y); NaN for the last slip.
+    """
+
+    yield_index: np.ndarray
+    stick_index: np.ndarray
+    yield_time: np.ndarray
+    stick_time: np.ndarray
+    static_force: np.ndarray
+    backward_force: np.ndarray
+    spring_extension: np.ndarray
+    slip_distance: np.ndarray
+    slip_duration: np.ndarray
+    stick_duration: np.ndarray
+    period: np.ndarray
+    spring_constant: float | None = field(default=None)
+
+    def __len__(self) -> int:
+        return int(self.yield_index.size)
+
+    def __getitem__(self, rows) -> "CycleTable":
+        """The table restricted to ``rows`` (a slice or index array); the
+        per-slip values (period, stick duration) are kept as computed."""
+        if isinstance(rows, (int, np.integer)):
+            rows = slice(rows, rows + 1 if rows != -1 else None)
+        names = ("yield_index", "stick_index") + _COLUMNS
+        return replace(self, **{n: np.asarray(getattr(self, n))[rows] for n in names})
+
+    @property
+    def count(self) -> int:
+        """Number of slips."""
+        return len(self)
+
+    def summary(self, skip: int = 0) -> dict:
+        """Mean, sample standard deviation, standard error and count of each
+        per-cycle quantity, ignoring NaN.
+
+        Parameters
+        ----------
+        skip : int
+            Leave out the first ``skip`` slips (e.g. 1 to drop the start-up
+            yield from a relaxed spring, which is larger than the rest).
+
+        Returns
+        -------
+        dict
+            ``{name: {"mean", "std", "stderr", "n"}}``.
+        """
+        return {name: _stats(np.asarray(getattr(self, name), float)[skip:])
+                for name in _COLUMNS[2:]}
+
+    def as_dict(self) -> dict:
+        """Per-cycle columns as lists (JSON-ready; NaN stays NaN)."""
+        out = {"yield_index": self.yield_index.tolist(),
+               "stick_index": self.stick_index.tolist()}
+        out.update({name: np.asarray(getattr(self, name), float).tolist()
+                    for name in _COLUMNS})
+        return out
+
+    def to_csv(self, path) -> Path:
+        """Write one row per slip to ``path`` (empty cells for NaN)."""
+        path = Path(path)
+        names = ("yield_index", "stick_index") + _COLUMNS
+        cols = [np.asarray(getattr(self, n)) for n in names]
+        with path.open("w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(names)
+            for row in zip(*cols):
+                writer.writerow(["" if (isinstance(v, float) and math.isnan(v))
+                                 else repr(v.item()) if hasattr(v, "item") else v
+                                 for v in row])
+        return path
+
+
+def cycle_table(time, spring_force, yield_index, stick_index, *,
+                spring_constant=None, wall_position=None) -> CycleTable:
+    """Tabulate stick-slip cycles from known yield and re-stick indices.
+
+    Parameters
+    ----------
+    time, spring_force : array_like, shape (n,)
+        The trace.
+    yield_index, stick_index : array_like of int, shape (m,)
+        Slip ``i`` runs from ``yield_index[i]`` (y) to ``stick_index[i]`` (s);
+        both increasing, with ``yield_index[i] <= stick_index[i] <=
+        yield_index[i+1]``.
+    spring_constant : float, optional
+        K; gives x0 = Fs/K and, without ``wall_position``, Δx0 = (Fs − Fb)/K.
+    wall_position : array_like, shape (n,), optional
+        Wall (slider) position; gives Δx0 = x(s) − x(y).
+
+    Returns
+    -------
+    CycleTable
+
+    Examples
+    --------
+    >>> t = np.arange(6.0); f = np.array([0, 1, 2, 0.5, 1.5, 2.5])
+    >>> cycle_table(t, f, [2], [3], spring_constant=2.0).slip_distance
+    array([0.75])
+    """
+    t = np.asarray(time, float)
+    f = np.asarray(spring_force, float)
+    if t.shape != f.shape or t.ndim != 1:
+        raise ValueError(f"time and spring_force must be 1-D of equal length, "
+                         f"got {t.shape} and {f.shape}")
+    yi = np.asarray(yield_index, dtype=np.int64).ravel()
+    si = np.asarray(stick_index, dtype=np.int64).ravel()
+    if yi.shape != si.shape:
+        raise ValueError(f"{yi.size} yield points but {si.size} re-stick points")
+    if yi.size:
+        if yi.min() < 0 or si.max() >= t.size:
+            raise ValueError("yield/stick index outside the trace")
+        if np.any(si < yi) or np.any(yi[1:] < si[:-1]):
+            raise ValueError("yield and re-stick indices must alternate: "
+                             "y[i] <= s[i] <= y[i+1]")
+    fs, fb = f[yi], f[si]
+    ty, ts = t[yi], t[si]
+    nan = np.full(yi.size, math.nan)
+    k = None if spring_constant is None else float(spring_constant)
+    x0 = fs / k if k else nan.copy()
+    if wall_position is not None:
+        x = np.asarray(wall_position, float)
+        if x.shape != t.shape:
+            raise ValueError("wall_position must have the length of time")
+        dx0 = x[si] - x[yi]
+    elif k:
+        dx0 = (fs - fb) / k
+    else:
+        dx0 = nan.copy()
+    period = nan.copy()
+    stick = nan.copy()
+    if yi.size > 1:
+        period[:-1] = np.diff(ty)
+        stick[:-1] = ty[1:] - ts[:-1]
+    arrays = dict(yield_index=yi, stick_index=si, yield_time=ty, stick_time=ts,
+                  static_force=fs, backward_force=fb, spring_extension=x0,
+                  slip_distance=dx0, slip_duration=ts - ty,
+                  stick_duration=stick, period=period)
+    for a in arrays.values():
+        a.setflags(write=False)
+    return CycleTable(**arrays, spring_constant=k)
+
+
+# --------------------------------------------------------------------------
+# event detection
+# --------------------------------------------------------------------------
+
+@dataclass(frozen=True, eq=False)
+class SlipEvents:
+    """Slips found by :func:`detect_slips`.
+
+    Attributes
+    ----------
+    yield_index, stick_index : ndarray of int
+        Complete slips y → s (the re-stick is confirmed by a rise of more
+        than ``threshold`` after it).
+    threshold : float
+        Hysteresis ``h`` used (force units).
+    noise : float
+        Estimated (or given) noise standard deviation of the force.
+    unfinished_yield : int or None
+        A yield whose drop was seen but whose re-stick was not confirmed
+        before the end of the trace (not counted as a slip).
+    """
+
+    yield_index: np.ndarray
+    stick_index: np.ndarray
+    threshold: float
+    noise: float
+    unfinished_yield: int | None = None
+
+    @property
+    def count(self) -> int:
+        return int(self.yield_index.size)
+
+
+def _mad_std(x: np.ndarray) -> float:
+    if x.size == 0:
+        return 0.0
+    return 1.4826 * float(np.median(np.abs(x - np.median(x))))
+
+
+def noise_level(spring_force, *, max_lag: int | None = None,
+                plateau: float = 1.15) -> tuple[float, int]:
+    """Robust standard deviation of the fluctuations of a trace.
+
+    Uses second differences at lag L, d = f[i+2L] − 2 f[i+L] + f[i], which
+    vanish on straight stick ramps of any slope; s(L) = MAD(d)/√6 (the
+    median absolute deviation ignores the few differences that straddle a
+    slip).  For white noise s(L) = σ at every L; for correlated (thermal)
+    noise s(L) grows with L until L exceeds the correlation time.  The
+    estimate is s(2L) at the first lag with s(2L)/s(L) < ``plateau``.
+
+    Returns
+    -------
+    sigma : float
+        Noise standard deviation (0 for a noise-free piecewise-linear trace).
+    lag : int
+        Decorrelation lag in samples (1 for white noise).
+    """
+    f = np.asarray(spring_force, float)
+    n = f.size
+    if n < 5:
+        return 0.0, 1
+
+    def s(lag):
+        return _mad_std(f[2 * lag:] - 2 * f[lag:-lag] + f[:-2 * lag]) / math.sqrt(6)
+
+    max_lag = max(1, n // 20) if max_lag is None else max_lag
+    lag, prev = 1, s(1)
+    while 2 * lag <= max_lag and 4 * lag < n:
+        cur = s(2 * lag)
+        if prev == 0.0 or cur < plateau * prev:
+            return (cur if prev else 0.0), lag
+        lag, prev = 2 * lag, cur
+    return prev, lag
+
+
+def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,
+                     size: int) -> int | None:
+    """First index i > start where f[i] is more than h below the running
+    maximum of f[start:i] (``up=False``) or more than h above the running
+    minimum (``up=True``).  Scans in doubling chunks: O(distance)."""
+    n = f.size
+    while True:
+        stop = min(n, start + size)
+        seg = f[start:stop]
+        if up:
+            hit = np.flatnonzero(seg > np.minimum.accumulate(seg) + h)
+        else:
+            hit = np.flatnonzero(seg < np.maximum.accumulate(seg) - h)
+        if hit.size:
+            return start + int(hit[0])
+        if stop == n:
+            return None
+        size *= 2
+
+
+def detect_slips(time, spring_force, *, threshold: float | None = None,
+                 noise: float | None = None, k: float | None = None,
+                 min_drop: float = 0.0, relative_drop: float = 0.1) -> SlipEvents:
+    """Find yield (y) and re-stick (s) points in a noisy spring-force trace.
+
+    Criterion: a slip is a fall of the force by more than ``h`` from a
+    running maximum (the yield y, the highest force before the fall) to a
+    running minimum (the re-stick s, the lowest force before the force rises
+    again by more than ``h``).  By default ``h = k σ`` with σ the robust
+    noise level (:func:`noise_level`) and ``k = 2 √(2 ln N_eff) + 1``,
+    N_eff = N / lag the number of independent noise samples: the largest
+    peak-to-trough excursion of N_eff Gaussian samples is ≈ 2 √(2 ln N_eff) σ,
+    so a stationary noisy trace gives no event.  A floor of 1e-6 of the
+    force range keeps a noise-free trace from counting rounding errors.
+
+    Parameters
+    ----------
+    time, spring_force : array_like, shape (n,)
+        The trace (time must increase; NaN is rejected).
+    threshold : float, optional
+        Hysteresis h in force units (overrides ``noise`` and ``k``).
+    noise : float, optional
+        Noise standard deviation σ (default: estimated).
+    k : float, optional
+        Threshold in units of σ (default: as above).
+    min_drop : float
+        Additionally require Fs − Fb >= min_drop.
+    relative_drop : float
+        Additionally require Fs − Fb >= relative_drop × the largest drop
+        found (default 0.1): ringing after a re-stick, or small stress
+        relaxations during a stick, are not slips.
+
+    Returns
+    -------
+    SlipEvents
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 10, 1001)
+    >>> f = (t % 2.0) + np.random.default_rng(0).normal(0, 0.01, t.size)
+    >>> detect_slips(t, f).count
+    4
+    """
+    t = np.asarray(time, float)
+    f = np.asarray(spring_force, float)
+    if t.ndim != 1 or t.shape != f.shape:
+        raise ValueError(f"time and spring_force must be 1-D of equal length, "
+                         f"got {t.shape} and {f.shape}")
+    bad = ~np.isfinite(f)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"spring_force has {int(bad.sum())} non-finite values "
+                         f"(first at index {first}, time {t[first]!r})")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise ValueError("time must be finite and strictly increasing")
+    empty = np.empty(0, np.int64)
+    if f.size < 3:
+        return SlipEvents(empty, empty, math.inf, 0.0)
+    lag = 1
+    if noise is None:
+        noise, lag = noise_level(f)
+    if threshold is None:
+        n_eff = max(f.size / lag, 2.0)
+        kk = (2.0 * math.sqrt(2.0 * math.log(n_eff)) + 1.0) if k is None else k
+        lo, hi = np.percentile(f, [0.5, 99.5])
+        floor = 1e-6 * max(hi - lo, abs(hi), abs(lo), np.finfo(float).tiny)
+        threshold = max(kk * noise, floor)
+    h = float(threshold)
+
+    yields, sticks = [], []
+    unfinished = None
+    p, n, size = 0, f.size, 1024
+    while p < n - 1:
+        i = _first_excursion(f, p, h, up=False, size=size)
+        if i is None:
+            break
+        y = p + int(np.argmax(f[p:i]))
+        j = _first_excursion(f, y, h, up=True, size=size)
+        if j is None:
+            unfinished = y
+            break
+        s = y + int(np.argmin(f[y:j]))
+        if y > 0 and f[y] - f[s] >= min_drop:   # y == 0: slip began before the trace
+            yields.append(y)
+            sticks.append(s)
+        size = max(256, 2 * (j - p))
+        p = s
+    yi, si = np.asarray(yields, np.int64), np.asarray(sticks, np.int64)
+    if yi.size:
+        drop = f[yi] - f[si]
+        keep = drop >= relative_drop * drop.max()
+        yi, si = yi[keep], si[keep]
+    return SlipEvents(yi, si, h, float(noise), unfinished)
+
+
+def classify_regime(table: CycleTable, max_cv: float = REGIME_CV_MAX) -> str:
+    """Sliding regime from the detected slips.
+
+    * ``smooth`` — fewer than 2 slips (none, or a single start-up yield
+      followed by steady sliding);
+    * ``stick-slip`` — at least 2 slips and, leaving out the first slip
+      (start-up from a relaxed spring) when 3 or more were found, the
+      coefficients of variation of the static force Fs and of the period τ_ss
+      are both <= ``max_cv`` (0.2) (a CV that cannot be computed for lack
+      of cycles does not count against it);
+    * ``irregular`` — at least 2 slips that fail the CV test.
+    """
+    n = len(table)
+    if n < 2:
+        return "smooth"
+    skip = 1 if n >= 3 else 0
+    for name in ("static_force", "period"):
+        st = _stats(np.asarray(getattr(table, name), float)[skip:])
+        if st["n"] >= 2 and st["mean"] != 0:
+            if st["std"] / abs(st["mean"]) > max_cv:
+                return "irregular"
+    return "stick-slip"
+
+
+def _line(t: np.ndarray, f: np.ndarray, lo: int, hi: int):
+    """Straight-line fit of f over [lo, hi): (slope, value at t[lo], rms)."""
+    if hi - lo < 3:
+        return None
+    tt = t[lo:hi] - t[lo]
+    coef = np.polyfit(tt, f[lo:hi], 1)
+    resid = f[lo:hi] - np.polyval(coef, tt)
+    return lambda x: np.polyval(coef, x - t[lo]), float(resid.std())
+
+
+def ramp_forces(time, spring_force, table: CycleTable, *, wall_position=None,
+                fraction: float = 0.5, tolerance: float = 3.0) -> CycleTable:
+    """Noise-robust yield and re-stick points from straight-line fits to the
+    stick ramps.
+
+    With noise, the detector's y is the highest sample near the top of the
+    ramp (biased upward, and often a few samples early) and its s the lowest
+    sample near the bottom.  Here a line is fitted to the last ``fraction``
+    of the stick before y and another to the first ``fraction`` of the stick
+    after s.  The refined y is the last sample between y and s still within
+    ``tolerance`` × (rms residual) of the first line, the refined s the first
+    sample within that band of the second line, and Fs, Fb are the lines'
+    values there (which also averages out ringing after the stick).  Where a
+    ramp has fewer than 3 samples the detector's point and value are kept.
+
+    Returns
+    -------
+    CycleTable
+        Rebuilt with :func:`cycle_table` at the refined points, with
+        ``static_force`` and ``backward_force`` (and x0, and Δx0 when derived
+        from the forces) from the fitted lines.
+    """
+    t = np.asarray(time, float)
+    f = np.asarray(spring_force, float)
+    yi = table.yield_index.copy()
+    si = table.stick_index.copy()
+    fs = np.array(table.static_force, float)
+    fb = np.array(table.backward_force, float)
+    m = len(table)
+    for i in range(m):
+        y, s = yi[i], si[i]
+        start = si[i - 1] if i else 0
+        pre = _line(t, f, y - int(fraction * (y - start)), y + 1)
+        stop = yi[i + 1] if i + 1 < m else f.size
+        post = _line(t, f, s, s + int(fraction * (stop - s)) + 1)
+        if pre is not None:
+            line, rms = pre
+            on = np.flatnonzero(f[y:s + 1] >= line(t[y:s + 1]) - tolerance * rms)
+            y = y + int(on[-1]) if on.size else y
+            fs[i] = line(t[y])
+        if post is not None:
+            line, rms = post
+            on = np.flatnonzero(f[y:s + 1] <= line(t[y:s + 1]) + tolerance * rms)
+            s = y + int(on[0]) if on.size else s
+            s = max(s, y)
+            fb[i] = line(t[s])
+        yi[i], si[i] = y, s
+    k = table.spring_constant
+    new = cycle_table(t, f, yi, si, spring_constant=k, wall_position=wall_position)
+    changes = dict(static_force=fs, backward_force=fb)
+    if k:
+        changes["spring_extension"] = fs / k
+        if wall_position is None:
+            changes["slip_distance"] = (fs - fb) / k
+    for a in changes.values():
+        a.setflags(write=False)
+    return replace(new, **changes)

@@ -1,0 +1,331 @@
+"""Structure of the confined film from a trajectory (MDAnalysis).
+
+* :class:`DensityProfile` — number density across the gap, layer count and
+  spacing (peaks of the profile);
+* :class:`HexaticOrder` — in-plane bond-orientational order ψ6 of each layer
+  per frame, to contrast stick (crystalline, |ψ6| high) with slip (shear
+  melted, |ψ6| low);
+* :class:`FilmThickness` — the gap between the walls' facing planes per
+  frame (dilation at slip).
+
+All follow MDAnalysis conventions: ``AnalysisBase`` subclasses, results in
+``.results``, ``run(start, stop, step, verbose=True)`` with a progress bar.
+Velocity profiles come from ``fix ave/chunk`` files (see
+:mod:`analysis.report`), not from trajectories (DCD holds positions only).
+Lengths are in the trajectory's units (σ for an LJ run).
+
+Atom types of a filmfriction run: 1 film, 2 bottom wall, 3 top wall.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from MDAnalysis.analysis.base import AnalysisBase
+from scipy.signal import find_peaks
+from scipy.spatial import cKDTree
+
+__all__ = ["DensityProfile", "HexaticOrder", "FilmThickness", "find_layers",
+           "frame_steps", "summarize_run"]
+
+
+def find_layers(centers, density, *, min_spacing: float = 0.5,
+                min_prominence: float = 0.1) -> dict:
+    """Layers as peaks of a density profile.
+
+    Parameters
+    ----------
+    centers, density : array_like
+        Bin centres along z and the density there.
+    min_spacing : float
+        Smallest distance between two layers (length units).
+    min_prominence : float
+        Smallest peak prominence, as a fraction of the highest density.
+
+    Returns
+    -------
+    dict
+        ``count``, ``positions`` (z of each layer), ``spacing`` (mean
+        distance between neighbouring layers, NaN for fewer than 2),
+        ``spacing_std`` and ``edges`` (boundaries between layers: midpoints,
+        with the outer ones half a spacing beyond the outer layers).
+    """
+    z = np.asarray(centers, float)
+    rho = np.asarray(density, float)
+    dz = float(z[1] - z[0]) if z.size > 1 else 1.0
+    # pad with zeros so a layer in the first/last bin is still a peak
+    padded = np.concatenate([[0.0], rho, [0.0]])
+    peaks, _ = find_peaks(padded, prominence=min_prominence * max(rho.max(), 1e-300),
+                          distance=max(1, int(round(min_spacing / dz))))
+    pos = z[peaks - 1]
+    gaps = np.diff(pos)
+    spacing = float(gaps.mean()) if gaps.size else math.nan
+    half = 0.5 * (spacing if gaps.size else min_spacing)
+    edges = np.concatenate([[pos[0] - half] if pos.size else [],
+                            0.5 * (pos[1:] + pos[:-1]),
+                            [pos[-1] + half] if pos.size else []])
+    return {"count": int(pos.size), "positions": pos, "spacing": spacing,
+            "spacing_std": float(gaps.std(ddof=1)) if gaps.size > 1 else math.nan,
+            "edges": edges}
+
+
+class DensityProfile(AnalysisBase):
+    """Number density of an atom group across the gap (along z).
+
+    Parameters
+    ----------
+    atomgroup : AtomGroup
+        The film atoms.
+    bin_width : float
+        Bin width along z.
+    zrange : (float, float), optional
+        Range of the profile; default: the group's z extent in the first
+        analysed frame, widened by 1.
+    min_spacing, min_prominence : float
+        Passed to :func:`find_layers`.
+
+    Attributes
+    ----------
+    results.bin_centers, results.density : ndarray
+        Profile, number per volume averaged over the frames.
+    results.layers : dict
+        From :func:`find_layers` (count, positions, spacing, edges).
+
+    Examples
+    --------
+    >>> u = mda.Universe("topology.data", "trajectory.dcd",
+    ...                  atom_style="id type x y z")          # doctest: +SKIP
+    >>> prof = DensityProfile(u.select_atoms("type 1")).run(step=10)  # doctest: +SKIP
+    >>> prof.results.layers["count"]                           # doctest: +SKIP
+    3
+    """
+
+    def __init__(self, atomgroup, bin_width: float = 0.05, zrange=None,
+                 min_spacing: float = 0.5, min_prominence: float = 0.1, **kwargs):
+        super().__init__(atomgroup.universe.trajectory, **kwargs)
+        self._ag = atomgroup
+        self._bin = bin_width
+        self._zrange = zrange
+        self._spacing = min_spacing
+        self._prominence = min_prominence
+
+    def _prepare(self):
+        self._area_sum = 0.0
+        if self._zrange is None:
+            self._ag.universe.trajectory[self.start or 0]
+            z = self._ag.positions[:, 2]
+            self._zrange = (float(z.min()) - 1.0, float(z.max()) + 1.0)
+        lo, hi = self._zrange
+        n = max(1, int(math.ceil((hi - lo) / self._bin)))
+        self._edges = np.linspace(lo, lo + n * self._bin, n + 1)
+        self._counts = np.zeros(n)
+
+    def _single_frame(self):
+        z = self._ag.positions[:, 2]
+        idx = np.floor((z - self._edges[0]) / self._bin).astype(np.int64)
+        idx = idx[(idx >= 0) & (idx < self._counts.size)]
+        self._counts += np.bincount(idx, minlength=self._counts.size)
+        self._area_sum += float(
+            self._ts.dimensions[0] * self._ts.dimensions[1])
+
+    def _conclude(self):
+        frames = max(self.n_frames, 1)
+        area = self._area_sum / frames
+        density = self._counts / frames / (area * self._bin)
+        centers = 0.5 * (self._edges[1:] + self._edges[:-1])
+        self.results.bin_edges = self._edges
+        self.results.bin_centers = centers
+        self.results.density = density
+        self.results.layers = find_layers(centers, density, min_spacing=self._spacing,
+                                          min_prominence=self._prominence)
+
+
+class HexaticOrder(AnalysisBase):
+    """In-plane hexatic order ψ6 of each film layer, per frame.
+
+    Atoms are assigned to layers by z (``layer_edges``, e.g. from
+    :class:`DensityProfile`).  In each layer, neighbours are the atoms closer
+    in-plane than ``cutoff`` (periodic in x and y; ``scipy.spatial.cKDTree``
+    with ``boxsize``), and ψ6_j = (1/n_j) Σ_k exp(6iθ_jk).  The default
+    cutoff, 1.37 a with a = (2/(√3 ρ₂))^½ the triangular-lattice spacing
+    of the layer's areal density ρ₂, lies between the first (a) and second
+    (√3 a) shells.  Per layer and frame: ``psi6`` = |⟨ψ6_j⟩| (orientational
+    order of the layer as a whole: ≈ 1 crystal, ≈ 0 liquid) and
+    ``psi6_local`` = ⟨|ψ6_j|⟩ over atoms with neighbours.
+
+    Parameters
+    ----------
+    atomgroup : AtomGroup
+        The film atoms.
+    layer_edges : array_like
+        Boundaries along z; layer i is between edges[i] and edges[i+1].
+    cutoff : float, optional
+        In-plane neighbour distance (default: from each layer's density).
+
+    Attributes
+    ----------
+    results.psi6, results.psi6_local : ndarray, shape (n_frames, n_layers)
+    results.frames : ndarray
+        Frame indices analysed.
+
+    Examples
+    --------
+    >>> layers = DensityProfile(film).run().results.layers   # doctest: +SKIP
+    >>> psi = HexaticOrder(film, layers["edges"]).run(verbose=True)  # doctest: +SKIP
+    >>> psi.results.psi6.mean(axis=0)                         # doctest: +SKIP
+    """
+
+    def __init__(self, atomgroup, layer_edges, cutoff: float | None = None, **kwargs):
+        super().__init__(atomgroup.universe.trajectory, **kwargs)
+        self._ag = atomgroup
+        self._edges = np.asarray(layer_edges, float)
+        self._cutoff = cutoff
+
+    def _prepare(self):
+        n_layers = self._edges.size - 1
+        self._psi = np.full((self.n_frames, n_layers), np.nan)
+        self._local = np.full((self.n_frames, n_layers), np.nan)
+
+    def _single_frame(self):
+        pos = self._ag.positions
+        box = self._ts.dimensions[:2].astype(float)
+        layer = np.searchsorted(self._edges, pos[:, 2]) - 1
+        xy = np.mod(pos[:, :2].astype(float), box)
+        xy[xy >= box] = 0.0           # guard the upper edge after rounding
+        for i in range(self._edges.size - 1):
+            sel = xy[layer == i]
+            n = sel.shape[0]
+            if n < 3:
+                continue
+            rc = self._cutoff or 1.37 * math.sqrt(2.0 * box[0] * box[1] / (math.sqrt(3.0) * n))
+            tree = cKDTree(sel, boxsize=box, balanced_tree=False, compact_nodes=False)
+            pairs = tree.query_pairs(rc, output_type="ndarray")
+            if pairs.size == 0:
+                continue
+            d = sel[pairs[:, 1]] - sel[pairs[:, 0]]
+            d -= box * np.round(d / box)                  # minimum image
+            z6 = ((d[:, 0] + 1j * d[:, 1]) / np.hypot(d[:, 0], d[:, 1])) ** 6
+            # exp(6i(θ+π)) = exp(6iθ): the same term for both atoms of a pair
+            ends = np.concatenate([pairs[:, 0], pairs[:, 1]])
+            zz = np.concatenate([z6, z6])
+            count = np.bincount(ends, minlength=n)
+            has = count > 0
+            psi_j = (np.bincount(ends, zz.real, n) + 1j * np.bincount(ends, zz.imag, n))[has] \
+                / count[has]
+            self._psi[self._frame_index, i] = abs(psi_j.mean())
+            self._local[self._frame_index, i] = np.abs(psi_j).mean()
+
+    def _conclude(self):
+        self.results.psi6 = self._psi
+        self.results.psi6_local = self._local
+        self.results.frames = np.asarray(self.frames)
+
+
+class FilmThickness(AnalysisBase):
+    """Gap between the facing planes of the two walls, per frame.
+
+    The facing plane of each wall is the set of its atoms within ``plane``
+    of its innermost atom in the first analysed frame (rigid walls: the set
+    does not change); the gap is the difference of the planes' mean z.
+
+    Parameters
+    ----------
+    bottom, top : AtomGroup
+        Bottom and top wall atoms.
+    plane : float
+        Thickness of the facing plane's slab.
+
+    Attributes
+    ----------
+    results.gap : ndarray, shape (n_frames,)
+    results.frames : ndarray
+
+    Examples
+    --------
+    >>> gap = FilmThickness(u.select_atoms("type 2"),
+    ...                     u.select_atoms("type 3")).run()  # doctest: +SKIP
+    >>> gap.results.gap.mean()                                # doctest: +SKIP
+    """
+
+    def __init__(self, bottom, top, plane: float = 0.3, **kwargs):
+        super().__init__(bottom.universe.trajectory, **kwargs)
+        self._bottom, self._top, self._plane = bottom, top, plane
+
+    def _prepare(self):
+        self._bottom.universe.trajectory[self.start or 0]
+        zb = self._bottom.positions[:, 2]
+        zt = self._top.positions[:, 2]
+        self._bsel = self._bottom[zb > zb.max() - self._plane]
+        self._tsel = self._top[zt < zt.min() + self._plane]
+        self._gap = np.full(self.n_frames, np.nan)
+
+    def _single_frame(self):
+        self._gap[self._frame_index] = (self._tsel.positions[:, 2].mean()
+                                        - self._bsel.positions[:, 2].mean())
+
+    def _conclude(self):
+        self.results.gap = self._gap
+        self.results.frames = np.asarray(self.frames)
+
+
+def frame_steps(universe) -> np.ndarray | None:
+    """MD step of each frame of a DCD trajectory (istart + i·nsavc), or None."""
+    header = getattr(getattr(universe.trajectory, "_file", None), "header", None)
+    if not header or not header.get("nsavc"):
+        return None
+    n = universe.trajectory.n_frames
+    return header["istart"] + header["nsavc"] * np.arange(n)
+
+
+def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
+                  film_type: int = 1, bottom_type: int = 2, top_type: int = 3,
+                  step: int = 1) -> dict:
+    """Structure section of ``analysis.json`` for one run.
+
+    Layers from the mean density profile; ψ6 per layer and the gap per
+    frame; with a trace that has a ``step`` column and a slip table, frames
+    are split into stick and slip (t(y) <= t <= t(s)) and the means of ψ6
+    and gap are reported for each.
+    """
+    import warnings
+
+    import MDAnalysis as mda
+
+    with warnings.catch_warnings():      # DCDReader's 3.0 deprecation notice
+        warnings.simplefilter("ignore", DeprecationWarning)
+        u = mda.Universe(str(topology), str(trajectory), format="DCD",
+                         topology_format="DATA", atom_style="id type x y z")
+    film = u.select_atoms(f"type {film_type}")
+    if film.n_atoms == 0:
+        raise ValueError(f"no film atoms (type {film_type}) in {topology}")
+    prof = DensityProfile(film).run(step=step)
+    layers = prof.results.layers
+    out = {"frames": int(prof.n_frames), "units": units,
+           "layers": {"count": layers["count"],
+                      "positions": layers["positions"].tolist(),
+                      "spacing": {"mean": layers["spacing"], "std": layers["spacing_std"]}}}
+    hex_ = HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
+    bottom = u.select_atoms(f"type {bottom_type}")
+    top = u.select_atoms(f"type {top_type}")
+    gap = FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
+    if hex_ is not None:
+        out["psi6"] = {"per_layer_mean": np.nanmean(hex_.results.psi6, axis=0).tolist()}
+    if gap is not None:
+        out["gap"] = {"mean": float(np.mean(gap.results.gap)),
+                      "std": float(np.std(gap.results.gap))}
+    steps = frame_steps(u)
+    if (trace is not None and table is not None and len(table) and steps is not None
+            and trace.has("step")):
+        frames = np.arange(u.trajectory.n_frames)[slice(None, None, step)]
+        t_frame = np.interp(steps[frames], trace.columns["step"], trace.time)
+        slipping = np.zeros(frames.size, bool)
+        for ty, ts in zip(table.yield_time, table.stick_time):
+            slipping |= (t_frame >= ty) & (t_frame <= ts)
+        for name, mask in (("stick", ~slipping), ("slip", slipping)):
+            sec = {"frames": int(mask.sum())}
+            if mask.any() and hex_ is not None:
+                sec["psi6_per_layer"] = np.nanmean(hex_.results.psi6[mask], axis=0).tolist()
+            if mask.any() and gap is not None:
+                sec["gap"] = float(np.mean(gap.results.gap[mask]))
+            out[name] = sec
+    return out

@@ -1,0 +1,238 @@
+"""Synthetic traces with known answers, for tests, benchmarks and examples.
+
+* :func:`sawtooth` — linear stick ramps and instantaneous drops, plus noise;
+* :func:`klein_trace` — a driven spring-block whose slips obey Klein's
+  equation M x'' + B x' = K(x_d − x), integrated numerically
+  (``solve_ivp``, independent of the closed form in :mod:`.viscosity`), and
+  which re-sticks when the force has fallen to Fb;
+* :func:`smooth_trace` — steady sliding: constant mean force plus
+  correlated (AR(1)) noise.
+
+All return a dict of columns named as in a trace CSV.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.signal import lfilter
+
+__all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
+
+
+def _ar1(n: int, sigma: float, rho: float, rng) -> np.ndarray:
+    e = rng.normal(0.0, sigma * np.sqrt(1 - rho ** 2), n)
+    return lfilter([1.0], [1.0, -rho], e) if rho else rng.normal(0.0, sigma, n)
+
+
+def sawtooth(*, static_force=3.0, backward_force=1.0, period=2.0, cycles=10,
+             dt=0.005, noise=0.0, rho=0.0, seed=0, spring_constant=2.0) -> dict:
+    """Force rising linearly from Fb to Fs over one period, then dropping.
+
+    The first drop is at t = period; the trace ends half a period after the
+    last drop.  ``wall_position`` jumps by (Fs − Fb)/K at each drop; the
+    spring end moves at V = (Fs − Fb)/(K · period).
+    """
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, (cycles + 0.5) * period, dt)
+    phase = (t % period) / period
+    f = backward_force + (static_force - backward_force) * phase
+    k = spring_constant
+    v = (static_force - backward_force) / (k * period)
+    drive = backward_force / k + v * t
+    wall = drive - f / k
+    f = f + _ar1(t.size, noise, rho, rng)
+    return {"time": t, "spring_force": f, "drive_position": drive,
+            "wall_position": wall}
+
+
+def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
+                drive_velocity=100e-9, static_force=9.7e-6, backward_force=3.0e-6,
+                cycles=4, dt=2e-4, noise=0.0, seed=0, ringing=0.0,
+                ringing_frequency=45.0, ringing_decay=0.02) -> dict:
+    """A driven spring-block with Klein-type slips, sampled every ``dt``.
+
+    Stick: wall at rest until K(x_d − x) reaches Fs.  Slip: M x'' + B x' =
+    K(x_d − x) from rest until the force falls to Fb; the wall then stops
+    (the film solidifies).  Defaults are Klein's SFB numbers (SI).  With
+    ``ringing`` > 0 a decaying oscillation of that force amplitude is added
+    after each re-stick (energy ringing²/(2K)).
+
+    Returns columns ``time, spring_force, drive_position, wall_position,
+    wall_velocity`` (noise only on the force).
+    """
+    k, m, b, v = spring_constant, mass, damping, drive_velocity
+    rng = np.random.default_rng(seed)
+    segments = []                # (t0, t1, kind, payload)
+    t, x = 0.0, 0.0
+    xd0 = backward_force / k     # start just re-stuck
+    for _ in range(cycles):
+        t_yield = (static_force / k - xd0 - v * t + x) / v + t
+        segments.append((t, t_yield, "stick", x))
+        t = t_yield
+
+        def rhs(tt, s):
+            return [s[1], (k * (xd0 + v * tt - s[0]) - b * s[1]) / m]
+
+        def stick(tt, s):
+            return k * (xd0 + v * tt - s[0]) - backward_force
+        stick.terminal, stick.direction = True, -1
+        horizon = 100.0 * (b / k + np.sqrt(m / k))
+        sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=stick,
+                        dense_output=True, rtol=1e-10, atol=1e-16,
+                        first_step=1e-6 * horizon, max_step=1e-3 * horizon)
+        t_s = float(sol.t_events[0][0])
+        segments.append((t, t_s, "slip", sol.sol))
+        t, x = t_s, float(sol.sol(t_s)[0])
+    t_end = t + 0.5 * (segments[-2][1] - segments[-2][0])
+    segments.append((t, t_end, "stick", x))
+    time = np.arange(0.0, t_end, dt)
+    wall = np.empty_like(time)
+    vel = np.zeros_like(time)
+    extra = np.zeros_like(time)
+    for t0, t1, kind, payload in segments:
+        sel = (time >= t0) & (time < t1)
+        if kind == "stick":
+            wall[sel] = payload
+            if ringing and t0 > 0:
+                tau = time[sel] - t0
+                extra[sel] = (ringing * np.exp(-tau / ringing_decay)
+                              * np.sin(2 * np.pi * ringing_frequency * tau))
+        else:
+            st = payload(time[sel])
+            wall[sel], vel[sel] = st[0], st[1]
+    drive = xd0 + v * time
+    force = k * (drive - wall) + extra + rng.normal(0.0, noise, time.size)
+    return {"time": time, "spring_force": force, "drive_position": drive,
+            "wall_position": wall, "wall_velocity": vel}
+
+
+def smooth_trace(*, mean_force=1.0, noise=0.05, rho=0.9, n=20000, dt=0.5,
+                 velocity=0.01, gap=4.0, seed=0) -> dict:
+    """Steady sliding: constant force plus AR(1) noise of correlation ``rho``."""
+    rng = np.random.default_rng(seed)
+    t = dt * np.arange(n)
+    f = mean_force + _ar1(n, noise, rho, rng)
+    return {"time": t, "spring_force": f, "drive_position": velocity * t,
+            "wall_velocity": velocity + _ar1(n, 0.1 * velocity, rho, rng),
+            "gap": gap + _ar1(n, 0.01 * gap, rho, rng)}
+
+
+def write_csv(path, columns: dict) -> None:
+    """Write columns as a trace CSV (header line, then rows)."""
+    names = list(columns)
+    data = np.column_stack([np.asarray(columns[n], float) for n in names])
+    np.savetxt(path, data, delimiter=",", header=",".join(names), comments="",
+               fmt="%.10g")
+
+
+def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2,
+                 frames=20, thermal=0.05, melt_frames=(), nsavc=100, seed=0):
+    """Write ``topology.data`` + ``trajectory.dcd`` of a film of ``layers``
+    close-packed (111) planes between two walls, for structure tests.
+
+    The in-plane lattice is triangular (``nx`` × 2``ny`` atoms per plane,
+    box ``nx·a`` × ``ny·√3·a``); planes are ``√(2/3)·a`` apart, stacked ABC.
+    Each frame adds Gaussian displacements of ``thermal``; frames listed in
+    ``melt_frames`` have the film's in-plane positions randomised (a
+    shear-melted film keeps its layers but loses in-plane order).  Types:
+    1 film, 2 bottom wall, 3 top wall.
+
+    Returns
+    -------
+    (Path, Path)
+        Topology and trajectory paths.
+    """
+    import MDAnalysis as mda
+    from pathlib import Path
+
+    directory = Path(directory)
+    rng = np.random.default_rng(seed)
+    a = spacing
+    h = np.sqrt(2.0 / 3.0) * a
+    lx, ly = nx * a, ny * np.sqrt(3.0) * a
+    i, j = np.meshgrid(np.arange(nx), np.arange(2 * ny), indexing="ij")
+    base = np.column_stack([(i + 0.5 * (j % 2)).ravel() * a,
+                            (j * np.sqrt(3.0) / 2).ravel() * a])
+    shifts = [np.array([0.0, 0.0]), np.array([0.5 * a, a / (2 * np.sqrt(3))]),
+              np.array([a, a / np.sqrt(3)])]
+    planes, types = [], []
+    n_planes = 2 * wall_planes + layers
+    for p in range(n_planes):
+        xy = np.mod(base + shifts[p % 3], [lx, ly])
+        z = np.full((xy.shape[0], 1), (p + 1) * h)
+        planes.append(np.hstack([xy, z]))
+        kind = 2 if p < wall_planes else 3 if p >= wall_planes + layers else 1
+        types.append(np.full(xy.shape[0], kind))
+    pos0 = np.vstack(planes)
+    types = np.concatenate(types)
+    n = pos0.shape[0]
+    lz = (n_planes + 2) * h
+    top = directory / "topology.data"
+    lines = ["LAMMPS data file (filmfriction synthetic)", "", f"{n} atoms",
+             "3 atom types", "", f"0 {lx} xlo xhi", f"0 {ly} ylo yhi",
+             f"0 {lz} zlo zhi", "", "Masses", "", "1 1.0", "2 1.0", "3 1.0", "",
+             "Atoms # atomic", ""]
+    lines += [f"{k + 1} {types[k]} {x:.6f} {y:.6f} {z:.6f}"
+              for k, (x, y, z) in enumerate(pos0)]
+    top.write_text("\n".join(lines) + "\n")
+    film = types == 1
+    coords = np.empty((frames, n, 3), np.float32)
+    for f in range(frames):
+        pos = pos0 + rng.normal(0.0, thermal, pos0.shape) * film[:, None]
+        if f in melt_frames:
+            pos[film, :2] = rng.uniform(0, 1, (film.sum(), 2)) * [lx, ly]
+        coords[f] = pos
+    u = mda.Universe.empty(n, trajectory=True)
+    u.dimensions = [lx, ly, lz, 90, 90, 90]
+    traj = directory / "trajectory.dcd"
+    with mda.Writer(str(traj), n, nsavc=nsavc, istart=0) as w:
+        for f in range(frames):
+            u.atoms.positions = coords[f]
+            u.dimensions = [lx, ly, lz, 90, 90, 90]
+            w.write(u.atoms)
+    return top, traj
+
+
+def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0):
+    """A run directory in the MD runner's format (LJ units), from a Klein-type
+    spring-block trace: ``trace.csv`` with every contract column (the energy
+    ledger closes exactly), ``run.json`` and, optionally, a trajectory whose
+    steps match the trace's ``step`` column.  Returns the directory."""
+    import json
+    from pathlib import Path
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    k, m, b, v = 8.0, 500.0, 40.0, 0.01
+    tr = klein_trace(spring_constant=k, mass=m, damping=b, drive_velocity=v,
+                     static_force=3.0, backward_force=1.0, cycles=4, dt=dt_trace,
+                     noise=0.01, seed=seed)
+    t = tr["time"]
+    n = t.size
+    f = tr["spring_force"]
+    vel = tr["wall_velocity"]
+    from scipy.integrate import cumulative_trapezoid
+    drive_work = cumulative_trapezoid(f * v, t, initial=0.0)
+    spring = f ** 2 / (2 * k)
+    kinetic = 0.5 * m * vel ** 2
+    heat = drive_work - (spring - spring[0]) - (kinetic - kinetic[0])
+    gap = 1.0 + layers * 0.9
+    step = np.round(t / 0.005).astype(int)
+    cols = {"time": t, "step": step, "drive_position": tr["drive_position"],
+            "spring_force": f, "wall_position": tr["wall_position"],
+            "wall_velocity": vel, "wall_z": np.full(n, 10.0), "gap": np.full(n, gap),
+            "film_temperature": np.full(n, 0.7), "drive_work": drive_work,
+            "load_work": np.zeros(n), "thermostat_heat": heat,
+            "potential_energy": np.full(n, -100.0), "kinetic_energy": kinetic,
+            "spring_energy": spring}
+    write_csv(directory / "trace.csv", cols)
+    area = 12 * 1.1 * 7 * np.sqrt(3) * 1.1
+    run = {"status": "done", "scene": {"film_layers": layers},
+           "trace_parameters": {"spring_constant": k, "mass": m, "area": area,
+                                "thickness": gap, "drive_velocity": v, "units": "lj"}}
+    (directory / "run.json").write_text(json.dumps(run, indent=2))
+    if trajectory:
+        frames = 60
+        nsavc = int(step[-1] // (frames - 1))
+        layered_film(directory, layers=layers, frames=frames, nsavc=nsavc, seed=seed)
+    return directory

@@ -1,0 +1,125 @@
+"""Reading traces, the analyze command and its analysis.json."""
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+from analysis.synthetic import klein_trace, run_directory, smooth_trace, write_csv
+from analysis.trace import MissingInput, TraceParameters, read_trace
+from workflows.cli import main
+
+warnings.filterwarnings("ignore", category=DeprecationWarning)
+
+SFB = ["--units", "si", "--spring-constant", "97", "--mass", "1.47e-3",
+       "--area", "4e-10", "--thickness", "3.5e-9", "--drive-velocity", "1e-7"]
+
+
+@pytest.fixture(scope="module")
+def sfb_csv(tmp_path_factory):
+    tr = klein_trace(cycles=5, noise=0.005 * 9.7e-6, seed=2)
+    path = tmp_path_factory.mktemp("sfb") / "sfb.csv"
+    write_csv(path, {k: tr[k] for k in ("time", "spring_force", "drive_position")})
+    return path
+
+
+def test_read_csv_and_missing_pieces(tmp_path):
+    p = tmp_path / "t.csv"
+    p.write_text("# comment\ntime, spring_force ,gap\n0,1,3\n1,2,3\n2,1.5,3\n")
+    tr = read_trace(p, thickness=2.0)
+    assert len(tr) == 3 and tr.has("gap") and tr.units == "lj"
+    with pytest.raises(MissingInput, match="column 'wall_velocity'"):
+        tr.column("wall_velocity")
+    with pytest.raises(MissingInput, match="--spring-constant"):
+        tr.parameters.require("spring_constant")
+    p.write_text("time,force\n0,1\n")
+    with pytest.raises(ValueError, match="'spring_force' missing"):
+        read_trace(p)
+
+
+def test_truncated_file(tmp_path):
+    p = tmp_path / "t.csv"
+    p.write_text("time,spring_force\n0,1\n1,2\n2,")          # cut mid-row
+    tr = read_trace(p)
+    assert len(tr) == 2 and "truncated" in tr.notes[0]
+    p.write_text("time,spring_force\n0,1\n1\n2,3\n")          # damaged inside
+    with pytest.raises(ValueError, match="cannot parse"):
+        read_trace(p)
+    p.write_text("time,spring_force\n")
+    with pytest.raises(ValueError, match="no data rows"):
+        read_trace(p)
+
+
+def test_bad_parameters():
+    with pytest.raises(ValueError, match="units"):
+        TraceParameters(units="cgs")
+    with pytest.raises(ValueError, match="positive"):
+        TraceParameters(mass=-1.0)
+
+
+def test_analyze_sfb_csv(sfb_csv, capsys):
+    assert main(["analyze", str(sfb_csv), "--json", *SFB]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    doc = json.loads((sfb_csv.parent / "analysis.json").read_text())
+    assert printed == doc
+    assert doc["regime"] == "stick-slip" and doc["units"] == "si"
+    assert doc["slips"]["count"] == 5
+    for key in ("static_force", "backward_force", "slip_distance", "slip_duration", "period"):
+        entry = doc["slips"][key]
+        assert {"mean", "stderr", "units"} <= set(entry) and entry["mean"] is not None
+    assert doc["slips"]["static_force"]["units"] == "N"
+    assert doc["slips"]["static_force"]["mean"] == pytest.approx(9.7e-6, rel=0.01)
+    e = doc["energy"]
+    assert e["spring_released"]["units"] == "J"
+    assert 0.9 < e["viscous_fraction"]["mean"] <= 1.0
+    assert e["at_stick_fraction"]["mean"] >= 0.0
+    eta = doc["viscosity"]["from_slip"]["eta_eff"]
+    assert eta["units"] == "Pa·s"
+    assert eta["mean"] == pytest.approx(3.09 * 3.5e-9 / 4e-10, rel=0.02)   # 27 Pa·s
+    assert "viscosity.steady" in doc["skipped"]
+    csv_rows = (sfb_csv.parent / doc["cycles_csv"]).read_text().splitlines()
+    assert len(csv_rows) == 1 + 5 and "eta_eff" in csv_rows[0]
+
+
+def test_analyze_without_parameters_skips_with_reasons(sfb_csv, tmp_path, capsys):
+    out = tmp_path / "a.json"
+    assert main(["analyze", str(sfb_csv), "--units", "si", "--output", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["slips"]["count"] == 5 and doc["slips"]["period"]["mean"] > 0
+    assert "--spring-constant" in doc["skipped"]["energy"]
+    assert "--spring-constant" in doc["skipped"]["viscosity.from_slip"]
+
+
+def test_analyze_smooth_sliding_steady_viscosity(tmp_path, capsys):
+    tr = smooth_trace(mean_force=2.0, noise=0.05, rho=0.9, n=20000, velocity=0.01, gap=4.0)
+    p = tmp_path / "smooth.csv"
+    write_csv(p, tr)
+    assert main(["analyze", str(p), "--json", "--area", "50",
+                 "--drive-velocity", "0.01"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["regime"] == "smooth" and doc["slips"]["count"] == 0
+    st = doc["viscosity"]["steady"]
+    assert st["eta_eff"]["units"] == "ετ/σ³"
+    assert st["eta_eff"]["mean"] == pytest.approx(2.0 / 50 / (0.01 / 4.0), rel=0.02)
+    assert st["thickness"]["source"] == "mean of gap column"
+
+
+def test_user_errors(tmp_path, capsys):
+    assert main(["analyze", str(tmp_path / "nope.csv")]) == 2
+    p = tmp_path / "nan.csv"
+    p.write_text("time,spring_force\n0,1\n1,nan\n2,1\n3,2\n")
+    assert main(["analyze", str(p)]) == 2
+    assert "non-finite" in capsys.readouterr().err
+
+
+def test_analyze_run_directory(tmp_path, capsys):
+    run = run_directory(tmp_path / "run", layers=3)
+    assert main(["analyze", str(run), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert (run / "analysis.json").exists()
+    assert doc["regime"] == "stick-slip" and doc["units"] == "lj"
+    assert doc["slips"]["count"] == 4
+    assert doc["energy"]["ledger"]["closure"]["mean"] < 0.02
+    assert doc["viscosity"]["from_slip"]["eta_eff"]["units"] == "ετ/σ³"
+    assert doc["structure"]["layers"]["count"] == 3
+    assert doc["structure"]["stick"]["frames"] + doc["structure"]["slip"]["frames"] == 60
