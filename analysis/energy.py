@@ -163,6 +163,12 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         if not mass:
             method += " (no mass: ΔKE neglected)"
         film = work - dke
+        mount_heat = (ledger_columns or {}).get("mount_heat")
+        if mount_heat is not None:
+            # the mount dashpot's heat over the same window is not the film's
+            mh = np.asarray(mount_heat, float)
+            film = film - (mh[hi] - mh[lo])
+            method += " (mount dashpot heat subtracted)"
     else:
         method = "klein-eq1"
         film = exact + drive
@@ -192,7 +198,8 @@ def ledger(columns: dict) -> dict:
     """Energy ledger of an MD run.
 
     drive_work + load_work = Δ(potential + kinetic + spring) + thermostat_heat
-    + residual.
+    + mount_heat + residual  (``mount_heat``, the mount dashpot's heat, when the
+    trace has it).
 
     Returns
     -------
@@ -204,9 +211,13 @@ def ledger(columns: dict) -> dict:
     c = {n: np.asarray(columns[n], float) for n in LEDGER_COLUMNS}
     work = c["drive_work"] + c["load_work"]
     stored = c["potential_energy"] + c["kinetic_energy"] + c["spring_energy"]
-    residual = (work - work[0]) - (stored - stored[0]) - (c["thermostat_heat"]
-                                                          - c["thermostat_heat"][0])
+    heat = c["thermostat_heat"] - c["thermostat_heat"][0]
+    mount = np.zeros_like(heat)
+    if "mount_heat" in columns:
+        mount = np.asarray(columns["mount_heat"], float)
+        mount = mount - mount[0]
+    residual = (work - work[0]) - (stored - stored[0]) - heat - mount
     total = float(work[-1] - work[0])
     closure = abs(float(residual[-1])) / abs(total) if total else math.nan
     return {"residual": residual, "input": total, "closure": closure,
-            "thermostat_heat": float(c["thermostat_heat"][-1] - c["thermostat_heat"][0])}
+            "thermostat_heat": float(heat[-1]), "mount_heat": float(mount[-1])}

@@ -138,7 +138,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     per_cycle = table.as_dict()
 
     # --- energy
-    ledger_cols = {c: trace.columns[c] for c in _energy.LEDGER_COLUMNS if trace.has(c)}
+    ledger_cols = {c: trace.columns[c] for c in _energy.LEDGER_COLUMNS + ("mount_heat",)
+                   if trace.has(c)}
     energy: dict = {}
     try:
         if n == 0:
@@ -166,6 +167,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                             "input_work": {"mean": _num(led["input"]), "units": lab("energy")},
                             "thermostat_heat": {"mean": _num(led["thermostat_heat"]),
                                                 "units": lab("energy")},
+                            "mount_heat": {"mean": _num(led["mount_heat"]),
+                                           "units": lab("energy")},
                             "residual": {"mean": _num(led["residual"][-1]),
                                          "units": lab("energy")}}
     else:
@@ -211,7 +214,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         if v_drive is None:
             v_drive, v_src = 0.0, "spring end taken fixed (no drive velocity given)"
         sl = viscosity.slip_viscosity(t, f, table[skip:], mass=mass, spring_constant=kk,
-                                      area=area, thickness=d, drive_velocity=v_drive)
+                                      area=area, thickness=d, drive_velocity=v_drive,
+                                      mount_damping=p.mount_damping or 0.0)
         b_ok = sl.damping[np.isfinite(sl.damping)]
         visc["from_slip"] = {
             "eta_eff": _value(sl.eta_eff, sl.eta_eff_stderr, lab("viscosity"),

@@ -27,7 +27,8 @@ __all__ = ["MissingInput", "TraceParameters", "Trace", "read_trace",
            "read_csv_trace", "UNITS", "unit"]
 
 REQUIRED_COLUMNS = ("time", "spring_force")
-PARAMETERS = ("spring_constant", "mass", "area", "thickness", "drive_velocity")
+PARAMETERS = ("spring_constant", "mass", "area", "thickness", "drive_velocity",
+              "mount_damping")
 
 #: Unit labels per quantity, per unit system (labels only: no conversion).
 UNITS = {
@@ -78,6 +79,9 @@ class TraceParameters:
     area: float | None = None
     thickness: float | None = None
     drive_velocity: float | None = None
+    # damping of the wall's mount (force per velocity) that is not the film's:
+    # an MD run's dashpot gamma*M; subtracted from the fitted slip damping
+    mount_damping: float | None = None
     units: str = "lj"
 
     def __post_init__(self):

@@ -276,8 +276,14 @@ class SlipViscosity:
 
 def slip_viscosity(time, spring_force, table: CycleTable, *, mass: float,
                    spring_constant: float, area: float, thickness: float,
-                   drive_velocity: float = 0.0) -> SlipViscosity:
-    """Fit every slip of ``table`` (see :func:`fit_slip`) and convert B to η."""
+                   drive_velocity: float = 0.0,
+                   mount_damping: float = 0.0) -> SlipViscosity:
+    """Fit every slip of ``table`` (see :func:`fit_slip`) and convert B to η.
+
+    ``mount_damping`` (force per velocity) is damping acting on the wall that
+    is not the film's (an MD run's mount dashpot); the film's share of the
+    fitted B is ``B - mount_damping``.
+    """
     bs, errs, failures = [], [], []
     for y, s in zip(table.yield_index, table.stick_index):
         prev = table.stick_index[table.stick_index < y]
@@ -293,7 +299,7 @@ def slip_viscosity(time, spring_force, table: CycleTable, *, mass: float,
             bs.append(math.nan)
             errs.append(math.nan)
     b, e = np.array(bs), np.array(errs)
-    eta = b * thickness / area
+    eta = (b - mount_damping) * thickness / area
     eta_err = e * thickness / area
     ok = np.isfinite(eta)
     n = int(ok.sum())

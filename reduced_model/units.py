@@ -1,0 +1,320 @@
+"""Lennard-Jones <-> SI conversions: the one place in filmfriction where they happen.
+
+MD runs in reduced Lennard-Jones units (σ, ε, m); experiments (the surface
+force balance, SFB) are quoted in SI.  Every conversion between the two goes
+through a :class:`LJUnits` instance, so that the choice of σ, ε and m is made
+once, documented once, and can be overridden once (every function that
+converts takes ``units=`` defaulting to :data:`OMCTS`).
+
+The OMCTS mapping
+-----------------
+OMCTS (octamethylcyclotetrasiloxane, D4) is the liquid of Klein's SFB
+experiment (PRL 98, 056101 (2007); seed 004).  One LJ sphere stands for one
+OMCTS molecule.
+
+σ = 0.82 nm
+    The period of the oscillatory solvation force of OMCTS between mica,
+    0.82 ± 0.02 nm (Attard & Parker 1992, as quoted in the project's
+    reference notes, /work/shared/reference/README.md).  That period *is* the layer spacing of the confined liquid in
+    the same mica–OMCTS–mica geometry, and the layer spacing of a confined
+    LJ film is ≈ 1 σ, so it is the length that maps the MD film's layering
+    onto the SFB film's.  Klein's own film, 3.5 ± 0.3 nm for 4 layers, gives
+    0.875 ± 0.075 nm per layer: consistent, but ~4× less precise, so it is
+    not preferred.  Use ``LJUnits.from_molecule(sigma_nm=0.875, ...)`` to
+    see the sensitivity.
+ε/k_B = T_triple / T*_triple = 290.25 K / 0.69 ≈ 421 K
+    OMCTS's triple point is 290.25 K (Colonna et al., Fluid Phase Equilib.
+    244, 193 (2006), as tabulated in CoolProp's D4 fluid file); the triple
+    point of the full LJ fluid is at k_B T/ε ≈ 0.69 (reference notes;
+    recalled literature values lie within ~0.68–0.70, not re-checked here).  A potential truncated at 2.5 σ melts lower, which would
+    push ε/k_B toward ~450 K: the range 420–450 K is the honest uncertainty
+    (≈ 7 %).  Room temperature (298 K) is then k_B T/ε ≈ 0.71.
+m = 296.62 g/mol
+    The molar mass of C8H24O4Si4 (296.616 g/mol, Colonna et al. 2006).
+
+Derived values for this default: τ = σ√(m/ε) ≈ 7.6 ps, σ/τ ≈ 109 m/s,
+ε/σ³ ≈ 10.5 MPa, ετ/σ³ ≈ 0.080 mPa·s, ε/σ ≈ 7.1 pN, ε/σ² ≈ 8.6 mN/m.  (With σ = 0.8 nm and
+ε/k_B = 450 K, the reference-note values — τ ≈ 7.1 ps, σ/τ ≈ 112 m/s,
+ε/σ³ ≈ 12 MPa, ετ/σ³ ≈ 0.086 mPa·s, ε/σ ≈ 7.8 pN — are recovered; the
+tests check both.)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import constants
+
+__all__ = ["LJUnits", "OMCTS", "QUANTITIES", "to_si", "from_si",
+           "OMCTS_SIGMA_NM", "OMCTS_EPSILON_OVER_KB", "OMCTS_MOLAR_MASS_G",
+           "OMCTS_T_TRIPLE", "LJ_T_TRIPLE_REDUCED"]
+
+#: Force-oscillation period of OMCTS between mica (Attard & Parker 1992), nm.
+OMCTS_SIGMA_NM = 0.82
+#: Triple point of OMCTS, K (Colonna et al. 2006 / CoolProp D4).
+OMCTS_T_TRIPLE = 290.25
+#: Triple-point temperature of the LJ fluid in units of ε/k_B (full potential).
+LJ_T_TRIPLE_REDUCED = 0.69
+#: ε/k_B for OMCTS from matching triple points, K.
+OMCTS_EPSILON_OVER_KB = OMCTS_T_TRIPLE / LJ_T_TRIPLE_REDUCED
+#: Molar mass of OMCTS (C8H24O4Si4), g/mol.
+OMCTS_MOLAR_MASS_G = 296.62
+
+# Each quantity's dimension as exponents of (σ, ε, m): LJ value × σ^a ε^b m^c
+# is the SI value.  τ = σ m^½ ε^-½ is built in, e.g. velocity σ/τ = σ^0 ε^½ m^-½.
+# Written as exponents rather than one property per name so that to_si and
+# from_si can never disagree with each other.
+_DIMENSIONS: dict[str, tuple[float, float, float]] = {
+    "dimensionless": (0.0, 0.0, 0.0),
+    "length": (1.0, 0.0, 0.0),
+    "area": (2.0, 0.0, 0.0),
+    "volume": (3.0, 0.0, 0.0),
+    "mass": (0.0, 0.0, 1.0),
+    "energy": (0.0, 1.0, 0.0),
+    "time": (1.0, -0.5, 0.5),                 # τ = σ √(m/ε)
+    "frequency": (-1.0, 0.5, -0.5),           # 1/τ
+    "shear_rate": (-1.0, 0.5, -0.5),          # 1/τ
+    "velocity": (0.0, 0.5, -0.5),             # σ/τ
+    "acceleration": (-1.0, 1.0, -1.0),        # σ/τ²
+    "force": (-1.0, 1.0, 0.0),                # ε/σ
+    "stress": (-3.0, 1.0, 0.0),               # ε/σ³
+    "pressure": (-3.0, 1.0, 0.0),             # ε/σ³
+    "viscosity": (-2.0, 0.5, 0.5),            # ετ/σ³
+    "spring_constant": (-2.0, 1.0, 0.0),      # ε/σ²
+    "damping": (-1.0, 0.5, 0.5),              # force/velocity = m/τ
+    "momentum": (0.0, 0.5, 0.5),              # m σ/τ
+    "power": (-1.0, 1.5, -0.5),               # ε/τ
+    "number_density": (-3.0, 0.0, 0.0),       # 1/σ³
+    "mass_density": (-3.0, 0.0, 1.0),         # m/σ³
+    "diffusion": (1.0, 0.5, -0.5),            # σ²/τ
+    "temperature": (0.0, 1.0, 0.0),           # handled apart: ε/k_B, not ε
+}
+
+#: The quantity names accepted by :meth:`LJUnits.to_si` / :meth:`LJUnits.from_si`.
+QUANTITIES: tuple[str, ...] = tuple(sorted(_DIMENSIONS))
+
+
+@dataclass(frozen=True)
+class LJUnits:
+    """A Lennard-Jones unit system expressed in SI.
+
+    Parameters
+    ----------
+    sigma : float
+        Length unit σ, m.
+    epsilon : float
+        Energy unit ε, J.
+    mass : float
+        Mass unit m (mass of one particle), kg.
+    name : str, optional
+        Label used in reports.
+    source : str, optional
+        Where the numbers come from (free text, carried into reports).
+
+    Notes
+    -----
+    The derived scales are attributes (``tau``, ``velocity``, ``force``, …),
+    each the SI value of one LJ unit of that quantity.  Convert arrays with
+    :meth:`to_si` and :meth:`from_si` and a quantity name from
+    :data:`QUANTITIES`.
+    """
+
+    sigma: float
+    epsilon: float
+    mass: float
+    name: str = "custom"
+    source: str = ""
+
+    def __post_init__(self):
+        for field in ("sigma", "epsilon", "mass"):
+            value = getattr(self, field)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"LJUnits.{field} must be a positive finite number, got {value!r}")
+
+    # -- construction ------------------------------------------------------------
+    @classmethod
+    def from_molecule(cls, sigma_nm: float = OMCTS_SIGMA_NM,
+                      epsilon_over_kB: float = OMCTS_EPSILON_OVER_KB,
+                      molar_mass_g: float = OMCTS_MOLAR_MASS_G,
+                      name: str = "custom", source: str = "") -> "LJUnits":
+        """Build units from chemist's numbers.
+
+        Parameters
+        ----------
+        sigma_nm : float
+            σ in nanometres.
+        epsilon_over_kB : float
+            ε/k_B in kelvin.
+        molar_mass_g : float
+            Molar mass of one LJ particle in g/mol.
+        name, source : str
+            Labels carried into reports.
+        """
+        return cls(sigma=sigma_nm * 1e-9,
+                   epsilon=epsilon_over_kB * constants.k,
+                   mass=molar_mass_g * 1e-3 / constants.N_A,
+                   name=name, source=source)
+
+    # -- derived scales (SI value of one LJ unit) -----------------------------------
+    @property
+    def length(self) -> float:
+        """σ, m."""
+        return self.sigma
+
+    @property
+    def tau(self) -> float:
+        """τ = σ √(m/ε), s."""
+        return self.sigma * math.sqrt(self.mass / self.epsilon)
+
+    @property
+    def time(self) -> float:
+        """Same as :attr:`tau`, s."""
+        return self.tau
+
+    @property
+    def velocity(self) -> float:
+        """σ/τ, m/s."""
+        return self.sigma / self.tau
+
+    @property
+    def force(self) -> float:
+        """ε/σ, N."""
+        return self.epsilon / self.sigma
+
+    @property
+    def energy(self) -> float:
+        """ε, J."""
+        return self.epsilon
+
+    @property
+    def stress(self) -> float:
+        """ε/σ³, Pa."""
+        return self.epsilon / self.sigma**3
+
+    @property
+    def pressure(self) -> float:
+        """ε/σ³, Pa (same as :attr:`stress`)."""
+        return self.stress
+
+    @property
+    def viscosity(self) -> float:
+        """ετ/σ³, Pa·s."""
+        return self.epsilon * self.tau / self.sigma**3
+
+    @property
+    def shear_rate(self) -> float:
+        """1/τ, s⁻¹."""
+        return 1.0 / self.tau
+
+    @property
+    def temperature(self) -> float:
+        """ε/k_B, K."""
+        return self.epsilon / constants.k
+
+    @property
+    def spring_constant(self) -> float:
+        """ε/σ², N/m."""
+        return self.epsilon / self.sigma**2
+
+    @property
+    def area(self) -> float:
+        """σ², m²."""
+        return self.sigma**2
+
+    @property
+    def damping(self) -> float:
+        """Force per velocity, m/τ, N·s/m."""
+        return self.mass / self.tau
+
+    @property
+    def molar_mass_g(self) -> float:
+        """Mass unit as g/mol."""
+        return self.mass * constants.N_A * 1e3
+
+    # -- conversion -------------------------------------------------------------------
+    def scale(self, quantity: str) -> float:
+        """SI value of one LJ unit of ``quantity``.
+
+        Raises
+        ------
+        ValueError
+            If ``quantity`` is not one of :data:`QUANTITIES`.
+        """
+        try:
+            a, b, c = _DIMENSIONS[quantity]
+        except (KeyError, TypeError):
+            raise ValueError(
+                f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}") from None
+        if quantity == "temperature":
+            return self.temperature
+        return self.sigma**a * self.epsilon**b * self.mass**c
+
+    def to_si(self, value, quantity: str):
+        """Convert ``value`` in LJ units of ``quantity`` to SI.
+
+        Parameters
+        ----------
+        value : float or array_like
+            Value(s) in LJ units.
+        quantity : str
+            One of :data:`QUANTITIES`.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            The SI value(s): m, s, m/s, N, J, Pa, Pa·s, s⁻¹, K, N/m, kg, m²,
+            N·s/m, … according to ``quantity``.
+        """
+        return _scaled(value, self.scale(quantity))
+
+    def from_si(self, value, quantity: str):
+        """Convert ``value`` in SI to LJ units of ``quantity`` (inverse of :meth:`to_si`)."""
+        return _scaled(value, 1.0 / self.scale(quantity))
+
+    def summary(self) -> dict:
+        """The unit system as a flat dict of SI scales (for reports and JSON)."""
+        return {
+            "name": self.name,
+            "sigma_m": self.sigma,
+            "epsilon_J": self.epsilon,
+            "epsilon_over_kB_K": self.temperature,
+            "mass_kg": self.mass,
+            "molar_mass_g_per_mol": self.molar_mass_g,
+            "tau_s": self.tau,
+            "velocity_m_per_s": self.velocity,
+            "force_N": self.force,
+            "stress_Pa": self.stress,
+            "viscosity_Pa_s": self.viscosity,
+            "spring_constant_N_per_m": self.spring_constant,
+            "source": self.source,
+        }
+
+
+def _scaled(value, factor: float):
+    # Keep Python floats as floats (JSON-friendly); arrays stay arrays.
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value) * factor
+    return np.asarray(value, dtype=float) * factor
+
+
+#: The project's default unit system: one LJ particle = one OMCTS molecule.
+OMCTS = LJUnits.from_molecule(
+    sigma_nm=OMCTS_SIGMA_NM,
+    epsilon_over_kB=OMCTS_EPSILON_OVER_KB,
+    molar_mass_g=OMCTS_MOLAR_MASS_G,
+    name="OMCTS",
+    source=("σ = 0.82 nm: OMCTS force-oscillation period between mica (Attard & Parker 1992); "
+            "ε/k_B = 290.25 K / 0.69: OMCTS triple point over the LJ triple point; "
+            "m = 296.62 g/mol"),
+)
+
+
+def to_si(value, quantity: str, units: LJUnits = OMCTS):
+    """Convert LJ ``value`` of ``quantity`` to SI with ``units`` (default :data:`OMCTS`)."""
+    return units.to_si(value, quantity)
+
+
+def from_si(value, quantity: str, units: LJUnits = OMCTS):
+    """Convert SI ``value`` of ``quantity`` to LJ with ``units`` (default :data:`OMCTS`)."""
+    return units.from_si(value, quantity)

@@ -1,0 +1,93 @@
+"""``filmfriction run`` and ``filmfriction scenes``."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+DEFAULT_SCENE = "stick-slip"
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "run", help="run a scene in LAMMPS (default: the stick-slip study end to end)",
+        description="Run a scene in LAMMPS on N MPI ranks, then analyse the run. "
+                    "Values are checked before LAMMPS starts; a run never overwrites "
+                    "an existing directory.")
+    p.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
+                   help=f"scene name or TOML file (default: {DEFAULT_SCENE}; see "
+                        "'filmfriction scenes')")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene parameter (LJ units), e.g. --set drive_velocity=0.05")
+    p.add_argument("--np", type=int, default=2, help="MPI ranks (default 2)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="run directory to create (default runs/<scene>-<time>)")
+    p.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                   help="continue an interrupted run from its newest restart file")
+    p.add_argument("--fidelity", choices=("preview", "standard", "reference"), default=None,
+                   help="accuracy/cost preset applied before --set values")
+    p.add_argument("--md-only", action="store_true",
+                   help="run the MD only: no analysis, calibration or report")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+    s = subparsers.add_parser("scenes", help="list the scenes with what they model and cost")
+    s.set_defaults(func=list_scenes)
+
+
+def _overrides(args) -> dict:
+    from .scene import parse_assignment
+
+    values = {}
+    if args.fidelity:
+        from .fidelity import preset
+
+        values.update(preset(args.fidelity))
+    for text in args.overrides:
+        key, value = parse_assignment(text)
+        values[key] = value
+    return values
+
+
+def run(args: argparse.Namespace) -> int:
+    from .cli import UserError
+    from .runner import RunFailed, execute, resume
+    from .scene import SceneError, load
+
+    if args.np < 1:
+        raise UserError(f"--np {args.np}: need at least 1 MPI rank")
+    try:
+        if args.resume:
+            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet)
+        else:
+            scene = load(args.scene, _overrides(args))
+            run_dir = execute(scene, out=args.out, nprocs=args.np, progress=not args.quiet)
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    except RunFailed as exc:
+        print(f"filmfriction run: {exc}", file=sys.stderr)
+        return 1
+    print(f"run directory: {run_dir}")
+    if args.md_only:
+        return 0
+    return post_process(run_dir)
+
+
+def post_process(run_dir: Path) -> int:
+    """Analysis, then (when available) calibration, SFB check and report."""
+    from .study import finish_study
+
+    return finish_study(run_dir)
+
+
+def list_scenes(args: argparse.Namespace) -> int:
+    from .scene import available, load
+
+    for name, path in available().items():
+        scene = load(str(path))
+        p = scene.parameters
+        print(f"{name:18s} {scene.description}")
+        print(f"{'':18s} V={p['drive_velocity']:g} K={p['spring_constant']:g} "
+              f"P={p['normal_pressure']:g} T={p['temperature']:g} n={p['film_layers']}; "
+              f"observables: {', '.join(scene.observables)}; cost: {scene.expected_cost}")
+    return 0

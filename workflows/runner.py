@@ -1,0 +1,464 @@
+"""Run a scene in LAMMPS: a run directory, the engine, progress, and a record.
+
+A run directory holds::
+
+    scene.toml      the resolved scene (every parameter, as run)
+    command.txt     the exact command line
+    run.json        the record: scene, versions, seeds, atoms, timing, status
+    trace.csv       the trace in LJ units (columns: TRACE_COLUMNS)
+    trace.dat       LAMMPS's own trace (fix print), kept for --resume
+    lammps.log      LAMMPS's log
+    restart.<step>  restart files (for --resume)
+    trajectory.dcd, topology.data, profiles/   when the scene asks for them
+
+A run never writes into an existing directory.  ``run.json`` says
+``running`` while LAMMPS runs and ``completed`` or ``failed`` (with the
+engine's own message) at the end; a failed run keeps its partial trace.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import re
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+
+import md_inputs
+from . import engine
+from .scene import Scene, SceneError
+
+SCRIPT = "film_slide.lmp"
+
+# trace.dat (fix print) columns, in order
+DAT_COLUMNS = ("step time drive_position spring_force wall_position wall_velocity wall_z gap "
+               "film_temperature drive_work load_work thermostat_heat potential_energy "
+               "kinetic_energy spring_energy mount_heat").split()
+# trace.csv columns, in order (LJ units)
+TRACE_COLUMNS = ("time", "step", "drive_position", "spring_force", "wall_position",
+                 "wall_velocity", "wall_z", "gap", "film_temperature", "drive_work",
+                 "load_work", "thermostat_heat", "potential_energy", "kinetic_energy",
+                 "spring_energy", "mount_heat")
+TRACE_UNITS = {
+    "time": "tau", "step": "-", "drive_position": "sigma", "spring_force": "epsilon/sigma",
+    "wall_position": "sigma", "wall_velocity": "sigma/tau", "wall_z": "sigma",
+    "gap": "sigma", "film_temperature": "epsilon/k_B", "drive_work": "epsilon",
+    "load_work": "epsilon", "thermostat_heat": "epsilon", "potential_energy": "epsilon",
+    "kinetic_energy": "epsilon", "spring_energy": "epsilon", "mount_heat": "epsilon",
+}
+
+
+class RunFailed(RuntimeError):
+    """LAMMPS stopped with an error, lost atoms, or produced NaN; see ``run.json``."""
+
+    def __init__(self, message: str, run_dir: Path):
+        super().__init__(message)
+        self.run_dir = run_dir
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` so that readers never see a half-written file."""
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def write_json(path: Path, data: dict) -> None:
+    write_atomic(path, json.dumps(data, indent=2, default=_json_default) + "\n")
+
+
+def _json_default(obj):
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.floating,)):
+        return float(obj)
+    if isinstance(obj, Path):
+        return str(obj)
+    raise TypeError(type(obj))
+
+
+def versions() -> dict:
+    from importlib import metadata
+
+    out = {"python": platform.python_version()}
+    for pkg in ("filmfriction", "lammps", "mpich", "numpy", "scipy", "MDAnalysis"):
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def new_run_dir(scene_name: str, out: Path | None) -> Path:
+    """Create a fresh run directory; never reuse an existing one."""
+    if out is None:
+        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+        base = Path("runs") / f"{scene_name}-{stamp}"
+        base.parent.mkdir(parents=True, exist_ok=True)
+        for i in range(1000):
+            candidate = base if i == 0 else base.with_name(f"{base.name}-{i}")
+            try:
+                candidate.mkdir()
+                return candidate
+            except FileExistsError:
+                continue
+        raise SceneError(f"could not create a new run directory under {base.parent}")
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir()
+    except FileExistsError:
+        raise SceneError(
+            f"run directory {out} already exists: a run never overwrites another; "
+            f"choose a new --out, or continue it with --resume {out}") from None
+    return out
+
+
+def scene_toml(scene: Scene) -> str:
+    lines = [f"# resolved scene, as run ({datetime.now(timezone.utc).isoformat()})",
+             f"name = {json.dumps(scene.name)}",
+             f"description = {json.dumps(scene.description)}",
+             f"models = {json.dumps(scene.models)}",
+             f"observables = {json.dumps(list(scene.observables))}",
+             f"expected_cost = {json.dumps(scene.expected_cost)}",
+             "", "[parameters]"]
+    from .scene import PARAMETERS
+
+    for name, value in scene.parameters.items():
+        lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------- the engine
+_THERMO_LINE = re.compile(r"^\s*(\d+)\s+[-+0-9.eE]+")
+_STAGE = re.compile(r"^FILMFRICTION stage (\w+) (\d+)")
+_ATOMS = re.compile(r"^FILMFRICTION atoms film=(\d+) top=(\d+) area=([0-9.eE+-]+)")
+_PERF = re.compile(r"Performance: .*?([0-9.]+) timesteps/s, ([0-9.]+) (\w?)atom-step/s")
+_ATOMS_TOTAL = re.compile(r"Loop time of [0-9.]+ on \d+ procs for \d+ steps with (\d+) atoms")
+
+
+@dataclass
+class EngineOutcome:
+    returncode: int
+    error: str | None
+    film_atoms: int | None = None
+    top_atoms: int | None = None
+    total_atoms: int | None = None
+    area: float | None = None
+    atom_steps_per_second: list | None = None
+    wall_time: float = 0.0
+
+
+def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
+               start_step: int = 0, label: str = "") -> EngineOutcome:
+    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors."""
+    from tqdm import tqdm
+
+    t0 = time.perf_counter()
+    stage_offset = 0
+    stage_name = "resume" if start_step else "setup"
+    errors: list[str] = []
+    outcome = EngineOutcome(returncode=0, error=None, atom_steps_per_second=[])
+    bar = tqdm(total=total_steps, initial=start_step, unit="step", disable=not progress,
+               desc=label or "lammps", dynamic_ncols=True, file=sys.stderr, smoothing=0.1)
+    with open(cwd / "lammps.screen", "a") as screen:
+        proc = subprocess.Popen(cmd, cwd=cwd, env=engine.engine_env(), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True, bufsize=1,
+                                start_new_session=True)
+        done = start_step
+        try:
+            for line in proc.stdout:
+                screen.write(line)
+                if "ERROR" in line or "Lost atoms" in line:
+                    errors.append(line.strip())
+                m = _STAGE.match(line)
+                if m:
+                    if m.group(1) == "slide" and stage_name == "equilibrate":
+                        stage_offset = done
+                    stage_name = m.group(1)
+                    bar.set_description(f"{label} {stage_name}".strip())
+                    continue
+                m = _ATOMS.match(line)
+                if m:
+                    outcome.film_atoms, outcome.top_atoms = int(m.group(1)), int(m.group(2))
+                    outcome.area = float(m.group(3))
+                    continue
+                m = _PERF.search(line)
+                if m:
+                    scale = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}.get(m.group(3), 1.0)
+                    outcome.atom_steps_per_second.append(float(m.group(2)) * scale)
+                    continue
+                m = _ATOMS_TOTAL.search(line)
+                if m:
+                    outcome.total_atoms = int(m.group(1))
+                    continue
+                m = _THERMO_LINE.match(line)
+                if m and stage_name in ("equilibrate", "slide", "resume"):
+                    step = int(m.group(1)) + (stage_offset if stage_name == "slide" else 0)
+                    if step > done:
+                        bar.update(min(step, total_steps) - done)
+                        done = min(step, total_steps)
+            proc.wait()
+        except KeyboardInterrupt:
+            os.killpg(proc.pid, signal.SIGTERM)
+            proc.wait()
+            bar.close()
+            raise
+        finally:
+            bar.close()
+    outcome.returncode = proc.returncode
+    outcome.wall_time = time.perf_counter() - t0
+    if errors:
+        outcome.error = errors[0]
+    elif proc.returncode != 0:
+        outcome.error = f"LAMMPS exited with code {proc.returncode} (see lammps.screen)"
+    return outcome
+
+
+# ---------------------------------------------------------------- the trace
+def read_trace_dat(path: Path) -> np.ndarray:
+    """Rows of ``trace.dat``; a final line cut off by a crash is dropped."""
+    rows = []
+    if not path.exists():
+        return np.empty((0, len(DAT_COLUMNS)))
+    for line in path.read_text().splitlines():
+        if not line.strip() or line.startswith("#"):
+            continue
+        parts = line.split()
+        if len(parts) != len(DAT_COLUMNS):
+            continue
+        try:
+            rows.append([float(x) for x in parts])
+        except ValueError:
+            continue
+    return np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
+
+
+def write_trace_csv(dat: np.ndarray, path: Path) -> None:
+    """trace.csv in TRACE_COLUMNS order, written atomically."""
+    index = [DAT_COLUMNS.index(c) for c in TRACE_COLUMNS]
+    table = dat[:, index] if len(dat) else np.empty((0, len(TRACE_COLUMNS)))
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    fmt = ["%.10g"] * len(TRACE_COLUMNS)
+    fmt[1] = "%d"
+    np.savetxt(tmp, table, delimiter=",", header=",".join(TRACE_COLUMNS), comments="", fmt=fmt)
+    os.replace(tmp, path)
+
+
+def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
+    """A blow-up the engine did not flag itself: NaN, runaway temperature or gap."""
+    if not len(dat):
+        return None
+    if not np.all(np.isfinite(dat)):
+        row = int(np.argmax(~np.all(np.isfinite(dat), axis=1)))
+        return f"NaN or infinite value in the trace at step {int(dat[row, 0])}"
+    T = dat[:, DAT_COLUMNS.index("film_temperature")]
+    limit = max(20.0 * scene.parameters["temperature"], 5.0)
+    if np.any(T > limit):
+        row = int(np.argmax(T > limit))
+        return (f"film temperature {T[row]:.3g} epsilon/k_B at step {int(dat[row, 0])} exceeds "
+                f"{limit:.3g}: the integration blew up (timestep too large for the forces?)")
+    return None
+
+
+# ---------------------------------------------------------------- the run
+def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
+    d = scene.derived()
+    p = scene.parameters
+    return {
+        "schema": "filmfriction.run/1",
+        "status": "running",
+        "error": None,
+        "scene": scene.as_dict(),
+        "derived": d,
+        "outputs": {
+            "trace": True,
+            "trajectory": scene.writes_trajectory,
+            "trajectory_reason": ("asked for by observables "
+                                  + ", ".join(o for o in scene.observables if o == "structure"))
+            if scene.writes_trajectory else "no structural observable asked: no dump",
+            "profiles": scene.writes_profiles,
+            "profiles_reason": "asked for by observable 'profiles'" if scene.writes_profiles
+            else "no profile observable asked: no fix ave/chunk",
+            "restarts": p["restart_every"] > 0,
+        },
+        "trace_parameters": {
+            "spring_constant": p["spring_constant"], "mass": p["wall_mass"],
+            "area": d["area"], "thickness": None, "drive_velocity": p["drive_velocity"],
+            "mount_damping": (p["mount_damping"] * p["wall_mass"]) or None,
+            "units": "lj",
+        },
+        "trace_units": TRACE_UNITS,
+        "command": cmd, "np": nprocs, "cwd": str(run_dir.resolve()),
+        "seeds": {"seed": p["seed"]},
+        "versions": versions(),
+        "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
+        "started": datetime.now(timezone.utc).isoformat(),
+        "segments": [],
+    }
+
+
+def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
+            progress: bool = True) -> Path:
+    """Run ``scene`` in a new directory and return it; raise RunFailed on failure."""
+    run_dir = new_run_dir(scene.name, out)
+    if scene.writes_profiles:
+        (run_dir / "profiles").mkdir()
+    variables = scene.lammps_variables()
+    total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
+    variables["thermo_every"] = str(max(100, min(2000, total // 200)))
+    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"))
+    write_atomic(run_dir / "scene.toml", scene_toml(scene))
+    write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
+    record = _record(scene, run_dir, cmd, nprocs)
+    write_json(run_dir / "run.json", record)
+    return _drive(scene, run_dir, record, cmd, total, 0, progress)
+
+
+def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+    try:
+        outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
+                             label=scene.name)
+    except KeyboardInterrupt:
+        _finish(run_dir, record, scene, None, "interrupted by the user (resume with "
+                f"filmfriction run --resume {run_dir})")
+        raise
+    except engine.EngineNotFound as exc:
+        _finish(run_dir, record, scene, None, str(exc))
+        raise RunFailed(str(exc), run_dir) from exc
+    return _finish(run_dir, record, scene, outcome, outcome.error)
+
+
+def _finish(run_dir, record, scene, outcome, error):
+    dat = read_trace_dat(run_dir / "trace.dat")
+    write_trace_csv(dat, run_dir / "trace.csv")
+    if error is None and outcome is not None:
+        error = trace_problem(dat, scene)
+        if error is None and len(dat) and dat[-1, 0] < scene.parameters["slide_steps"]:
+            error = (f"LAMMPS stopped at step {int(dat[-1, 0])} of "
+                     f"{scene.parameters['slide_steps']} without an error message")
+    seg = {"finished": datetime.now(timezone.utc).isoformat(), "rows": int(len(dat))}
+    if outcome is not None:
+        seg.update(wall_time=outcome.wall_time, returncode=outcome.returncode,
+                   atom_steps_per_second=outcome.atom_steps_per_second)
+        if outcome.film_atoms is not None:
+            record["atoms"] = {"film": outcome.film_atoms, "top_wall": outcome.top_atoms,
+                               "total": outcome.total_atoms}
+            record["trace_parameters"]["area"] = outcome.area
+    record["segments"].append(seg)
+    record["wall_time"] = sum(s.get("wall_time", 0.0) for s in record["segments"])
+    perf = [x for s in record["segments"] for x in s.get("atom_steps_per_second") or []]
+    if perf:
+        # the last figure is the slide, the one that matters for cost
+        record["atom_steps_per_second"] = perf[-1]
+    record["finished"] = seg["finished"]
+    record["status"] = "failed" if error else "completed"
+    record["error"] = error
+    write_json(run_dir / "run.json", record)
+    if error:
+        raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
+    _prune_restarts(run_dir)
+    return run_dir
+
+
+def _prune_restarts(run_dir: Path) -> None:
+    """Keep only the newest restart file: the one --resume would use."""
+    files = _restart_files(run_dir)
+    for _, path in files[:-1]:
+        path.unlink(missing_ok=True)
+
+
+def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
+    found = []
+    for p in run_dir.glob("restart.*"):
+        suffix = p.name.split(".", 1)[1]
+        if suffix.isdigit():
+            found.append((int(suffix), p))
+    return sorted(found)
+
+
+def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
+    """Continue an interrupted or failed run from its newest restart file."""
+    from . import scene as scene_mod
+
+    run_dir = Path(run_dir)
+    record_path = run_dir / "run.json"
+    if not record_path.exists():
+        raise SceneError(f"{run_dir} is not a run directory (no run.json)")
+    record = json.loads(record_path.read_text())
+    if record.get("status") == "completed":
+        raise SceneError(f"{run_dir} already completed; nothing to resume")
+    restarts = _restart_files(run_dir)
+    if not restarts:
+        raise SceneError(f"{run_dir} has no restart file to resume from (restart_every = "
+                         f"{record['scene']['parameters'].get('restart_every')}); start a new run")
+    step, restart = restarts[-1]
+    params = record["scene"]["parameters"]
+    scene = scene_mod.Scene(
+        name=record["scene"]["name"], description=record["scene"]["description"],
+        models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
+        expected_cost=record["scene"]["expected_cost"],
+        parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
+    dat = read_trace_dat(run_dir / "trace.dat")
+    keep = dat[dat[:, 0] < step] if len(dat) else dat
+    at = dat[dat[:, 0] == step] if len(dat) else dat
+    # offsets at the restart step: from the row printed there, else the last kept row
+    ref = at[0] if len(at) else (keep[-1] if len(keep) else None)
+    if ref is None:
+        raise SceneError(f"{run_dir}/trace.dat has no rows up to the restart step {step}")
+    _rewrite_trace_dat(run_dir / "trace.dat", keep)
+    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    first = read_trace_dat_first(run_dir / "trace.dat")
+    variables = scene.lammps_variables()
+    variables.update({"resume": "1", "restart_file": restart.name})
+    # trace positions are relative to the slide's start; LAMMPS saved that origin
+    variables["drive_origin"], variables["wall_z0"] = _slide_origin(run_dir, first)
+    variables["drive_work0"] = repr(float(ref[col["drive_work"]]))
+    variables["heat0"] = repr(float(ref[col["thermostat_heat"]]))
+    total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
+    variables["thermo_every"] = str(max(100, min(2000, total // 200)))
+    nprocs = nprocs or int(record.get("np", 2))
+    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
+                             log=Path(f"lammps.resume{step}.log"))
+    record["status"] = "running"
+    record["resumed_from"] = restart.name
+    record.setdefault("commands", [record["command"]]).append(cmd)
+    write_json(record_path, record)
+    return _drive(scene, run_dir, record, cmd, total,
+                  scene.parameters["equilibrate_steps"] + step, progress)
+
+
+def read_trace_dat_first(path: Path):
+    dat = read_trace_dat(path)
+    return dat[0] if len(dat) else None
+
+
+def _slide_origin(run_dir: Path, first) -> tuple[str, str]:
+    """Absolute wall x and z at the slide's start (slide_origin.txt, written by LAMMPS)."""
+    if first is None:
+        raise SceneError(f"{run_dir}/trace.dat has no rows: cannot resume")
+    origin_file = run_dir / "slide_origin.txt"
+    if not origin_file.exists():
+        raise SceneError(f"{origin_file} is missing: cannot resume")
+    x0, z0 = origin_file.read_text().split()
+    return repr(float(x0)), repr(float(z0))
+
+
+def _rewrite_trace_dat(path: Path, rows: np.ndarray) -> None:
+    header = "# " + " ".join(DAT_COLUMNS)
+    lines = [header] + [" ".join(f"{v:.10g}" for v in r) for r in rows]
+    write_atomic(path, "\n".join(lines) + "\n")
+
+
+def _shell_line(cmd: list[str]) -> str:
+    import shlex
+
+    return " ".join(shlex.quote(c) for c in cmd)

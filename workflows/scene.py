@@ -1,0 +1,327 @@
+"""Scenes: what a run models, its parameters, and their validation.
+
+A scene is a TOML file (see ``workflows/scenes/``)::
+
+    name = "stick-slip"
+    description = "one line"
+    models = "a paragraph: what physics this scene stands for"
+    observables = ["stick_slip", "energy", "viscosity_from_slip"]
+    expected_cost = "about 1 minute on 2 cores"
+
+    [parameters]          # LJ reduced units, names as in PARAMETERS below
+    drive_velocity = 0.02
+    ...
+
+Every value that reaches LAMMPS passes through :func:`resolve`: it must be a
+known name, of the declared type, finite and inside the declared range, and is
+formatted here as a plain number.  Nothing a user writes is ever pasted into
+an input script as text, so a scene cannot smuggle LAMMPS commands (``shell``)
+into a run.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+
+class SceneError(ValueError):
+    """A scene or a parameter value is not acceptable; the message says why."""
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One scene parameter: type, unit, default and allowed range (inclusive)."""
+
+    name: str
+    kind: type            # int or float
+    unit: str
+    default: float | int
+    low: float
+    high: float
+    help: str
+    low_open: bool = False  # True: the lower bound itself is excluded
+
+    def check(self, value: Any) -> float | int:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(
+                f"{self.name} = {value!r}: must be a number ({self.kind.__name__}, "
+                f"{self.unit}), not {type(value).__name__}")
+        if self.kind is int:
+            if isinstance(value, float):
+                if not value.is_integer():
+                    raise SceneError(f"{self.name} = {value!r}: must be a whole number")
+                value = int(value)
+        else:
+            value = float(value)
+            if not math.isfinite(value):
+                raise SceneError(f"{self.name} = {value!r}: must be finite")
+        below = value <= self.low if self.low_open else value < self.low
+        if below or value > self.high:
+            bracket = "(" if self.low_open else "["
+            raise SceneError(
+                f"{self.name} = {value} {self.unit}: outside the allowed range "
+                f"{bracket}{self.low}, {self.high}] ({self.help})")
+        return value
+
+
+P = Parameter
+# Physics' own names: these are the user-facing contract.
+PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
+    P("drive_velocity", float, "sigma/tau", 0.02, 0.0, 5.0,
+      "velocity of the spring's far end", low_open=True),
+    P("spring_constant", float, "epsilon/sigma^2", 100.0, 0.0, 1.0e5,
+      "stiffness of the drive spring", low_open=True),
+    P("normal_pressure", float, "epsilon/sigma^3", 1.0, 0.0, 100.0,
+      "normal load per area on the top wall"),
+    P("temperature", float, "epsilon/k_B", 0.7, 0.0, 5.0,
+      "film thermostat temperature"),
+    P("film_layers", int, "-", 3, 1, 8, "close-packed layers of film atoms"),
+    P("wall_mass", float, "m", 500.0, 0.0, 1.0e7,
+      "total mass of the rigid top wall", low_open=True),
+    P("wall_fluid_epsilon", float, "epsilon", 1.0, 0.0, 10.0,
+      "wall-film LJ interaction strength", low_open=True),
+    P("wall_spacing", float, "sigma", 1.1, 0.8, 1.6,
+      "nearest-neighbour distance in the walls' (111) planes"),
+    P("film_spacing", float, "sigma", 1.1, 0.8, 1.6,
+      "in-plane spacing the film is built with (sets its atom count)"),
+    P("wall_layers", int, "-", 0, 0, 20,
+      "(111) planes per wall; 0 = fewest that span the cutoff"),
+    P("cells_x", int, "-", 7, 1, 200, "wall rows along x (Lx = cells_x * wall_spacing)"),
+    P("cells_y", int, "-", 4, 1, 200,
+      "wall row pairs along y (Ly = cells_y * sqrt(3) * wall_spacing)"),
+    P("timestep", float, "tau", 0.005, 0.0, 0.05, "integration step", low_open=True),
+    P("cutoff", float, "sigma", 2.5, 2.0 ** (1.0 / 6.0), 6.0,
+      "LJ cutoff (2^(1/6) = purely repulsive WCA)"),
+    P("thermostat_damping", float, "tau", 1.0, 0.0, 1.0e6,
+      "Langevin damping time of the film thermostat", low_open=True),
+    P("mount_damping", float, "1/tau", 0.1, 0.0, 100.0,
+      "dashpot on the wall (x and z), force -gamma*M*v: the mount's ring-down"),
+    P("seed", int, "-", 4928459, 1, 2**31 - 1, "random seed (velocities, thermostat)"),
+    P("equilibrate_steps", int, "steps", 10000, 0, 10**9,
+      "loaded and thermostatted, spring off"),
+    P("slide_steps", int, "steps", 90000, 1, 10**10, "spring drive on"),
+    P("trace_every", int, "steps", 50, 1, 10**7, "interval of trace.csv rows"),
+    P("restart_every", int, "steps", 20000, 0, 10**9,
+      "restart-file interval for --resume (0 = none)"),
+    P("dump_every", int, "steps", 500, 1, 10**9,
+      "trajectory frame interval (used only when the scene asks for structure)"),
+    P("profile_every", int, "steps", 5000, 1, 10**9,
+      "density/velocity profile interval (used only when profiles are asked for)"),
+    P("profile_bin", float, "sigma", 0.05, 0.0, 1.0,
+      "profile bin width along z", low_open=True),
+]}
+del P
+
+# What each observable needs from the engine beyond the trace.
+OBSERVABLES = {
+    "stick_slip": "stick-slip events from the spring force (trace)",
+    "energy": "energy partition and ledger (trace)",
+    "viscosity_from_slip": "effective viscosity from the slip dynamics (trace)",
+    "viscosity_steady": "effective viscosity from steady sliding (trace)",
+    "structure": "layering and in-plane order of the film (DCD trajectory)",
+    "profiles": "density and velocity profiles across the gap (fix ave/chunk)",
+}
+NEEDS_TRAJECTORY = {"structure"}
+NEEDS_PROFILES = {"profiles"}
+
+# LJ time step limits.  0.01 tau is where velocity Verlet stops conserving
+# energy for LJ atoms of unit mass at liquid density; a stiffer wall-film
+# interaction shortens the fastest vibration as 1/sqrt(eps_wf).
+LJ_TIMESTEP_LIMIT = 0.01
+# Resolve the wall-on-spring oscillation with at least this many steps.
+STEPS_PER_SPRING_PERIOD = 50
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A resolved scene: every parameter present, typed and range-checked."""
+
+    name: str
+    description: str
+    models: str
+    observables: tuple[str, ...]
+    expected_cost: str
+    parameters: dict[str, float | int] = field(hash=False)
+    source: str = ""
+
+    @property
+    def writes_trajectory(self) -> bool:
+        return bool(NEEDS_TRAJECTORY & set(self.observables))
+
+    @property
+    def writes_profiles(self) -> bool:
+        return bool(NEEDS_PROFILES & set(self.observables))
+
+    def derived(self) -> dict[str, float]:
+        return derived_quantities(self.parameters)
+
+    def lammps_variables(self) -> dict[str, str]:
+        """``-var`` values for ``film_slide.lmp``: numbers formatted here, nothing else."""
+        p = dict(self.parameters)
+        if not self.writes_trajectory:
+            p["dump_every"] = 0
+        if not self.writes_profiles:
+            p["profile_every"] = 0
+        out = {}
+        for name, value in p.items():
+            kind = PARAMETERS[name].kind
+            out[name] = str(int(value)) if kind is int else repr(float(value))
+        return out
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "description": self.description, "models": self.models,
+                "observables": list(self.observables), "expected_cost": self.expected_cost,
+                "parameters": dict(self.parameters), "source": self.source}
+
+
+def derived_quantities(p: dict) -> dict[str, float]:
+    """Box, atom counts and time scales implied by the parameters (before LAMMPS runs)."""
+    d = p["wall_spacing"]
+    lx = p["cells_x"] * d
+    ly = p["cells_y"] * math.sqrt(3.0) * d
+    fs = p["film_spacing"]
+    fx = max(1, round(lx / fs))
+    fy = max(1, round(ly / (math.sqrt(3.0) * fs)))
+    per_layer = 2 * fx * fy
+    hw = math.sqrt(2.0 / 3.0) * d
+    wall_layers = p["wall_layers"] or math.ceil(p["cutoff"] / hw) + 1
+    omega = math.sqrt(p["spring_constant"] / p["wall_mass"])
+    return {
+        "box_x": lx, "box_y": ly, "area": lx * ly,
+        "film_atoms_per_layer": per_layer,
+        "film_atoms": per_layer * p["film_layers"],
+        "film_strain_x": lx / fx / fs - 1.0,
+        "film_strain_y": ly / fy / (math.sqrt(3.0) * fs) - 1.0,
+        "wall_layers": wall_layers,
+        "wall_atoms_per_layer": 2 * p["cells_x"] * p["cells_y"],
+        "spring_period": 2.0 * math.pi / omega,
+        "timestep_limit": min(LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"])),
+                              2.0 * math.pi / omega / STEPS_PER_SPRING_PERIOD),
+        "slide_time": p["slide_steps"] * p["timestep"],
+        "drive_distance": p["slide_steps"] * p["timestep"] * p["drive_velocity"],
+    }
+
+
+def check_consistency(p: dict) -> None:
+    """Checks between parameters, each naming the values and the reason."""
+    q = derived_quantities(p)
+    dt = p["timestep"]
+    lj_limit = LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"]))
+    if dt > lj_limit:
+        raise SceneError(
+            f"timestep {dt:g} tau is above the stability limit {lj_limit:.3g} tau of the LJ "
+            f"interactions (0.01 tau / sqrt(max(1, wall_fluid_epsilon = "
+            f"{p['wall_fluid_epsilon']:g})))")
+    spring_limit = q["spring_period"] / STEPS_PER_SPRING_PERIOD
+    if dt > spring_limit:
+        raise SceneError(
+            f"timestep {dt:g} tau is above the stability limit {spring_limit:.3g} tau for "
+            f"spring_constant K={p['spring_constant']:g} epsilon/sigma^2 and wall_mass "
+            f"M={p['wall_mass']:g} m (the wall's period 2*pi*sqrt(M/K) = "
+            f"{q['spring_period']:.3g} tau needs >= {STEPS_PER_SPRING_PERIOD} steps)")
+    for axis in ("x", "y"):
+        length = q[f"box_{axis}"]
+        if length < 2.0 * p["cutoff"]:
+            cells = f"cells_{axis}"
+            raise SceneError(
+                f"lateral box L{axis} = {length:.3g} sigma (cells_{axis}={p[cells]}) is "
+                f"shorter than 2 cutoffs = {2 * p['cutoff']:.3g} sigma: an atom would feel "
+                f"its own periodic image; raise {cells}")
+    for axis in ("x", "y"):
+        strain = q[f"film_strain_{axis}"]
+        if abs(strain) > 0.1:
+            raise SceneError(
+                f"film_spacing {p['film_spacing']:g} sigma does not fit the box along {axis} "
+                f"(the film would be strained by {100 * strain:+.0f} %, limit 10 %): change "
+                f"cells_{axis} or film_spacing")
+    if p["thermostat_damping"] < 10.0 * dt:
+        raise SceneError(
+            f"thermostat_damping {p['thermostat_damping']:g} tau is shorter than 10 time steps "
+            f"({10 * dt:g} tau): the Langevin thermostat would be unstable")
+    if p["profile_bin"] > 0.5 * q["wall_layers"] * math.sqrt(2 / 3) * p["wall_spacing"]:
+        raise SceneError(f"profile_bin {p['profile_bin']:g} sigma is too coarse to resolve layers")
+
+
+def resolve(raw: dict[str, Any], overrides: dict[str, Any] | None = None) -> dict:
+    """Defaults + scene values + overrides, each checked; returns typed parameters."""
+    values: dict[str, Any] = {}
+    for source in (raw, overrides or {}):
+        for key, value in source.items():
+            if key not in PARAMETERS:
+                raise SceneError(
+                    f"unknown parameter {key!r}; known: {', '.join(sorted(PARAMETERS))}")
+            values[key] = PARAMETERS[key].check(value)
+    resolved = {name: values.get(name, spec.default) for name, spec in PARAMETERS.items()}
+    for name, spec in PARAMETERS.items():
+        resolved[name] = spec.check(resolved[name])
+    check_consistency(resolved)
+    return resolved
+
+
+def parse_assignment(text: str) -> tuple[str, float | int]:
+    """``KEY=VALUE`` from the command line; VALUE must be a number."""
+    if "=" not in text:
+        raise SceneError(f"--set {text!r}: expected KEY=VALUE")
+    key, _, value = text.partition("=")
+    key = key.strip()
+    if key not in PARAMETERS:
+        raise SceneError(f"--set {key!r}: unknown parameter; known: "
+                         f"{', '.join(sorted(PARAMETERS))}")
+    kind = PARAMETERS[key].kind
+    try:
+        number = int(value) if kind is int else float(value)
+    except ValueError:
+        raise SceneError(
+            f"--set {key}={value!r}: not a {kind.__name__} ({PARAMETERS[key].unit})") from None
+    return key, number
+
+
+def scenes_directory() -> Path:
+    return Path(str(resources.files("workflows") / "scenes"))
+
+
+def available() -> dict[str, Path]:
+    return {p.stem: p for p in sorted(scenes_directory().glob("*.toml"))}
+
+
+def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
+    """Load a scene by name (``stick-slip``) or from a TOML file path."""
+    scenes = available()
+    if name_or_path in scenes:
+        path = scenes[name_or_path]
+    else:
+        path = Path(name_or_path)
+        if not path.is_file():
+            raise SceneError(f"no scene {name_or_path!r}; known scenes: "
+                             f"{', '.join(scenes)} (or give a path to a .toml file)")
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    allowed = {"name", "description", "models", "observables", "expected_cost", "parameters"}
+    unknown = set(data) - allowed
+    if unknown:
+        raise SceneError(f"{path}: unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}")
+    observables = data.get("observables", ["stick_slip", "energy"])
+    if not isinstance(observables, list) or not all(isinstance(o, str) for o in observables):
+        raise SceneError(f"{path}: observables must be a list of names")
+    bad = [o for o in observables if o not in OBSERVABLES]
+    if bad:
+        raise SceneError(f"{path}: unknown observables {bad}; known: {sorted(OBSERVABLES)}")
+    params = data.get("parameters", {})
+    if not isinstance(params, dict):
+        raise SceneError(f"{path}: [parameters] must be a table")
+    try:
+        resolved = resolve(params, overrides)
+    except SceneError as exc:
+        raise SceneError(f"scene {data.get('name', path.stem)!r}: {exc}") from None
+    return Scene(name=str(data.get("name", path.stem)),
+                 description=str(data.get("description", "")),
+                 models=str(data.get("models", "")),
+                 observables=tuple(observables),
+                 expected_cost=str(data.get("expected_cost", "")),
+                 parameters=resolved, source=str(path))
