@@ -24,8 +24,6 @@ def register(subparsers) -> None:
                    help="run directory to create (default runs/<scene>-<time>)")
     p.add_argument("--resume", type=Path, default=None, metavar="DIR",
                    help="continue an interrupted run from its newest restart file")
-    p.add_argument("--fidelity", choices=("preview", "standard", "reference"), default=None,
-                   help="accuracy/cost preset applied before --set values")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -39,10 +37,6 @@ def _overrides(args) -> dict:
     from .scene import parse_assignment
 
     values = {}
-    if args.fidelity:
-        from .fidelity import preset
-
-        values.update(preset(args.fidelity))
     for text in args.overrides:
         key, value = parse_assignment(text)
         values[key] = value
