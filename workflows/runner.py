@@ -423,6 +423,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
     variables["drive_origin"], variables["wall_z0"] = _slide_origin(run_dir, first)
     variables["drive_work0"] = repr(float(ref[col["drive_work"]]))
     variables["heat0"] = repr(float(ref[col["thermostat_heat"]]))
+    variables["mount_heat0"] = repr(float(ref[col["mount_heat"]]))
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     nprocs = nprocs or int(record.get("np", 2))
