@@ -187,7 +187,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         if v_drive is None:
             raise MissingInput("--drive-velocity", "γ̇ = V/D")
         d, d_src = _thickness(trace, half)
-        sv = viscosity.steady_viscosity(f[half], area, v_drive, d)
+        sv = viscosity.steady_viscosity(f[half], area, v_drive, d,
+                                        mount_damping=p.mount_damping or 0.0)
         visc["steady"] = {
             "eta_eff": _value(sv.eta_eff, sv.eta_eff_stderr, lab("viscosity")),
             "shear_rate": _value(sv.shear_rate, None, lab("shear_rate")),

@@ -52,8 +52,13 @@ def _block_stderr(x: np.ndarray, blocks: int = 10) -> float:
 
 
 def steady_viscosity(spring_force, area: float, velocity: float,
-                     thickness) -> SteadyViscosity:
+                     thickness, mount_damping: float = 0.0) -> SteadyViscosity:
     """Effective viscosity of steady sliding.
+
+    In steady sliding the spring force balances the film's friction plus any
+    damping of the wall that is not the film's (``mount_damping``, force per
+    velocity, e.g. an MD run's mount dashpot): the film's share is
+    ``F - mount_damping * V``.
 
     Parameters
     ----------
@@ -65,6 +70,8 @@ def steady_viscosity(spring_force, area: float, velocity: float,
         Sliding velocity V.
     thickness : float or array_like
         Film thickness D (the mean of an array, e.g. the gap column, is used).
+    mount_damping : float
+        Damping of the wall outside the film (force per velocity).
 
     Examples
     --------
@@ -75,7 +82,7 @@ def steady_viscosity(spring_force, area: float, velocity: float,
     f = np.asarray(spring_force, float)
     d = float(np.mean(thickness))
     rate = velocity / d
-    fbar = float(f.mean())
+    fbar = float(f.mean()) - mount_damping * velocity
     err = _block_stderr(f)
     eta = fbar / area / rate
     return SteadyViscosity(eta, err / area / rate, fbar / area, rate, fbar, d)
