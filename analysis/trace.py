@@ -80,7 +80,9 @@ class TraceParameters:
     thickness: float | None = None
     drive_velocity: float | None = None
     # damping of the wall's mount (force per velocity) that is not the film's:
-    # an MD run's dashpot gamma*M; subtracted from the fitted slip damping
+    # an MD run's dashpot gamma*M, in parallel with the spring (it acts on the
+    # wall's velocity relative to the drive); subtracted from the fitted slip
+    # damping
     mount_damping: float | None = None
     units: str = "lj"
 

@@ -99,7 +99,7 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("thermostat_damping", float, "tau", 1.0, 0.0, 1.0e6,
       "Langevin damping time of the film thermostat", low_open=True),
     P("mount_damping", float, "1/tau", 0.3, 0.0, 100.0,
-      "dashpot on the wall (x and z), force -gamma*M*v: the mount's ring-down"),
+      "mount dashpot: -gamma*M*(vx - V) in parallel with the spring, -gamma*M*vz along z"),
     P("seed", int, "-", 4928459, 1, 2**31 - 1, "random seed (velocities, thermostat)"),
     P("equilibrate_steps", int, "steps", 10000, 0, 10**9,
       "loaded and thermostatted, spring off"),
