@@ -314,7 +314,8 @@ def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,
 
 def detect_slips(time, spring_force, *, threshold: float | None = None,
                  noise: float | None = None, k: float | None = None,
-                 min_drop: float = 0.0, relative_drop: float = 0.1) -> SlipEvents:
+                 min_drop: float = 0.0, relative_drop: float = 0.1,
+                 ringing_window: float = 3.0) -> SlipEvents:
     """Find yield (y) and re-stick (s) points in a noisy spring-force trace.
 
     Criterion: a slip is a fall of the force by more than ``h`` from a
@@ -343,6 +344,11 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         Additionally require Fs − Fb >= relative_drop × the largest drop
         found (default 0.1): ringing after a re-stick, or small stress
         relaxations during a stick, are not slips.
+    ringing_window : float
+        A candidate that follows the previous re-stick after less than
+        ``ringing_window`` × that slip's duration, and whose drop is less than
+        half of that slip's drop, is the wall ringing after the re-stick, not
+        a new slip (default 3; 0 turns the rule off).
 
     Returns
     -------
@@ -404,7 +410,22 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         drop = f[yi] - f[si]
         keep = drop >= relative_drop * drop.max()
         yi, si = yi[keep], si[keep]
+    if yi.size > 1 and ringing_window > 0:
+        yi, si = _drop_ringing(t, f, yi, si, ringing_window)
     return SlipEvents(yi, si, h, float(noise), unfinished)
+
+
+def _drop_ringing(t, f, yi, si, window):
+    """Remove candidates that are the ringing of the wall after a re-stick."""
+    kept = [0]
+    for i in range(1, yi.size):
+        j = kept[-1]
+        stick = t[yi[i]] - t[si[j]]
+        slip = t[si[j]] - t[yi[j]]
+        if stick < window * slip and (f[yi[i]] - f[si[i]]) < 0.5 * (f[yi[j]] - f[si[j]]):
+            continue
+        kept.append(i)
+    return yi[kept], si[kept]
 
 
 def classify_regime(table: CycleTable, max_cv: float = REGIME_CV_MAX) -> str:
