@@ -73,4 +73,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # run through the package module, so that sub-commands and this entry
+    # point share one UserError class (not a second copy in __main__)
+    from workflows.cli import main as _main
+
+    sys.exit(_main())
