@@ -171,3 +171,18 @@ def test_interrupted_run_resumes(tmp_path):
     heat = d["thermostat_heat"] + d["mount_heat"]
     residual = (work - work[0]) - (stored - stored[0]) - (heat - heat[0])
     assert abs(residual[-1]) < 0.02 * max(abs(work[-1]), abs(heat[-1]))
+
+
+def test_analysis_of_a_real_run(tmp_path):
+    """The analysis on a real small run: slips found, ledger closed, n layers in the DCD."""
+    from analysis.report import analyze
+    from analysis.trace import read_trace
+
+    scene = small("film-structure", drive_velocity=0.05, slide_steps=12000, dump_every=500)
+    run_dir = runner.execute(scene, out=tmp_path / "run", nprocs=2, progress=False)
+    doc, per_cycle = analyze(read_trace(run_dir))
+    assert doc["slips"]["count"] >= 2
+    assert doc["energy"]["ledger"]["closure"]["mean"] < 0.02
+    assert doc["structure"]["layers"]["count"] == scene.parameters["film_layers"]
+    fs = np.asarray(per_cycle["static_force"], float)
+    assert np.all(fs > 0)
