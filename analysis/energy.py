@@ -63,19 +63,28 @@ class EnergyTable:
     thermostat_heat_cycle: np.ndarray
     ledger_residual_cycle: np.ndarray
     film_dissipation_method: str
+    # heat of an MD run's mount dashpot over the same slip window (NaN when
+    # the trace has no mount_heat): the share of the released energy that is
+    # neither the film's nor the ringing's
+    mount_dissipation_slip: np.ndarray | None = None
 
     _NAMES = ("spring_released", "spring_released_exact", "drive_work_slip",
               "film_dissipation", "wall_ke_change", "ringing_energy",
               "viscous_fraction", "at_stick_fraction", "thermostat_heat_cycle",
-              "ledger_residual_cycle")
+              "ledger_residual_cycle", "mount_dissipation_slip")
+
+    def _column(self, name):
+        value = getattr(self, name)
+        if value is None:
+            return np.full(len(self.spring_released), math.nan)
+        return np.asarray(value, float)
 
     def summary(self, skip: int = 0) -> dict:
         """``{name: {"mean", "std", "stderr", "n"}}``, NaN ignored."""
-        return {n: _stats(np.asarray(getattr(self, n), float)[skip:])
-                for n in self._NAMES}
+        return {n: _stats(self._column(n)[skip:]) for n in self._NAMES}
 
     def as_dict(self) -> dict:
-        out = {n: np.asarray(getattr(self, n), float).tolist() for n in self._NAMES}
+        out = {n: self._column(n).tolist() for n in self._NAMES}
         out["film_dissipation_method"] = self.film_dissipation_method
         return out
 
@@ -150,7 +159,7 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         v = np.asarray(wall_velocity, float)
     elif wall_position is not None:
         v = np.gradient(np.asarray(wall_position, float), t)
-    film, dke = nan(), nan()
+    film, dke, mount = nan(), nan(), nan()
     if v is not None:
         method = "equation-of-motion"
         starts = np.concatenate([[0], si[:-1]])
@@ -167,7 +176,8 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         if mount_heat is not None:
             # the mount dashpot's heat over the same window is not the film's
             mh = np.asarray(mount_heat, float)
-            film = film - (mh[hi] - mh[lo])
+            mount = mh[hi] - mh[lo]
+            film = film - mount
             method += " (mount dashpot heat subtracted)"
     else:
         method = "klein-eq1"
@@ -191,7 +201,7 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         r = ledger(cols)["residual"]
         resid[:-1] = np.diff(r[yi])
     return EnergyTable(released, exact, drive, film, dke, ring, visc_frac,
-                       stick_frac, heat, resid, method)
+                       stick_frac, heat, resid, method, mount)
 
 
 def ledger(columns: dict) -> dict:

@@ -30,7 +30,8 @@ _ENERGY_UNITS = {"spring_released": "energy", "spring_released_exact": "energy",
                  "drive_work_slip": "energy", "film_dissipation": "energy",
                  "wall_ke_change": "energy", "ringing_energy": "energy",
                  "viscous_fraction": "1", "at_stick_fraction": "1",
-                 "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy"}
+                 "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy",
+                 "mount_dissipation_slip": "energy"}
 
 
 def _num(x):
