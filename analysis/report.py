@@ -63,6 +63,37 @@ def _drive_velocity(trace: Trace) -> tuple[float | None, str]:
     return None, ""
 
 
+def _not_sliding(trace: Trace, half: slice) -> str | None:
+    """Why the last half of a slip-free trace is not steady sliding, or None.
+
+    No slips is not enough: a wall stuck for the whole run (V -> 0, a soft
+    spring) has no slip either, and its ramping force over V/D would be a
+    meaningless viscosity.  Steady sliding means the wall moves at the drive's
+    velocity (within 20 %); without wall columns, the force has no trend
+    (its change over the half is below 10 % of its mean).
+    """
+    t = np.asarray(trace.columns["time"], float)[half]
+    v_drive, _ = _drive_velocity(trace)
+    wall = None
+    if trace.has("wall_velocity"):
+        wall = float(np.mean(np.asarray(trace.columns["wall_velocity"], float)[half]))
+    elif trace.has("wall_position") and t.size > 2:
+        x = np.asarray(trace.columns["wall_position"], float)[half]
+        wall = float(np.polyfit(t, x, 1)[0])
+    if wall is not None and v_drive:
+        if abs(wall - v_drive) > 0.2 * abs(v_drive):
+            return (f"the wall moves at {wall:.3g} on average, not at the drive's "
+                    f"{v_drive:.3g}: it is not sliding steadily")
+        return None
+    f = np.asarray(trace.columns["spring_force"], float)[half]
+    if t.size > 2:
+        trend = float(np.polyfit(t, f, 1)[0]) * float(t[-1] - t[0])
+        if abs(trend) > 0.1 * abs(float(np.mean(f))):
+            return (f"the force changes by {trend:.3g} over the last half (mean "
+                    f"{float(np.mean(f)):.3g}): not steady")
+    return None
+
+
 def _thickness(trace: Trace, sel=slice(None)) -> tuple[float, str]:
     if trace.has("gap"):
         return float(np.mean(trace.columns["gap"][sel])), "mean of gap column"
@@ -183,6 +214,9 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     try:
         if regime != "smooth":
             raise MissingInput("steady sliding", f"steady viscosity (regime is {regime})")
+        why_not = _not_sliding(trace, half)
+        if why_not:
+            raise MissingInput("steady sliding", f"steady viscosity ({why_not})")
         area = p.require("area", "η_eff = (F/A)/γ̇")
         v_drive, v_src = _drive_velocity(trace)
         if v_drive is None:

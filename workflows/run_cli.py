@@ -24,6 +24,11 @@ def register(subparsers) -> None:
                    help="run directory to create (default runs/<scene>-<time>)")
     p.add_argument("--resume", type=Path, default=None, metavar="DIR",
                    help="continue an interrupted run from its newest restart file")
+    from .fidelity import names as _fidelities
+
+    p.add_argument("--fidelity", choices=_fidelities(), default=None,
+                   help="numerical preset (preview, standard = the defaults, reference); "
+                        "measured costs and errors in the README")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -54,7 +59,19 @@ def run(args: argparse.Namespace) -> int:
         if args.resume:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet)
         else:
-            scene = load(args.scene, _overrides(args))
+            user = _overrides(args)
+            if args.fidelity:
+                from .fidelity import preset
+
+                extra = preset(args.fidelity, load(args.scene, user).parameters)
+                clash = sorted(set(extra) & set(user))
+                if clash:
+                    # the preset rescales step counts with its timestep: a --set of
+                    # the same keys would silently break that
+                    raise UserError(f"--set {', '.join(clash)} conflicts with "
+                                    f"--fidelity {args.fidelity}")
+                user = {**extra, **user}
+            scene = load(args.scene, user)
             run_dir = execute(scene, out=args.out, nprocs=args.np, progress=not args.quiet)
     except SceneError as exc:
         raise UserError(str(exc)) from None

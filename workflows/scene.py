@@ -132,6 +132,8 @@ NEEDS_PROFILES = {"profiles"}
 # energy for LJ atoms of unit mass at liquid density; a stiffer wall-film
 # interaction shortens the fastest vibration as 1/sqrt(eps_wf).
 LJ_TIMESTEP_LIMIT = 0.01
+# A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
+WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
 # Resolve the wall-on-spring oscillation with at least this many steps.
 STEPS_PER_SPRING_PERIOD = 50
 
@@ -238,6 +240,11 @@ def check_consistency(p: dict) -> None:
                 f"film_spacing {p['film_spacing']:g} sigma does not fit the box along {axis} "
                 f"(the film would be strained by {100 * strain:+.0f} %, limit 10 %): change "
                 f"cells_{axis} or film_spacing")
+    if p["normal_pressure"] == 0.0 and p["cutoff"] <= WCA_CUTOFF * (1.0 + 1e-9):
+        raise SceneError(
+            f"normal_pressure 0 with cutoff {p['cutoff']:.6g} sigma (purely repulsive WCA): "
+            f"nothing holds the top wall on the film, it drifts off and LAMMPS loses atoms; "
+            f"give normal_pressure > 0 or a cutoff > 2^(1/6) sigma (wall-film adhesion)")
     if p["thermostat_damping"] < 10.0 * dt:
         raise SceneError(
             f"thermostat_damping {p['thermostat_damping']:g} tau is shorter than 10 time steps "

@@ -1,0 +1,140 @@
+"""The trade study's pieces, the fidelity presets, and one tiny end-to-end study."""
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from workflows import cli, fidelity, tradeoff
+from workflows.scene import SceneError, load
+
+
+def test_pareto_front_keeps_only_undominated_points():
+    cost = [1.0, 2.0, 3.0, 4.0, 0.5, math.nan]
+    error = [5.0, -1.0, 2.0, 0.5, 9.0, 0.0]      # |error| counts; NaN cost is left out
+    front = tradeoff.pareto_front(cost, error)
+    assert [int(i) for i in front] == [4, 0, 1, 3]
+
+
+def test_drift_recovers_a_slope_and_its_noise():
+    t = np.linspace(0.0, 100.0, 5001)
+    rng = np.random.default_rng(3)
+    r = 0.02 * t + np.cumsum(rng.normal(0.0, 0.05, t.size))
+    slope, se = tradeoff.drift(t, r)
+    assert slope == pytest.approx((r[-1] - r[0]) / 100.0)
+    assert 0 < se < 0.05
+    assert abs(slope - 0.02) < 4 * se + 0.01
+
+
+def test_compare_combines_standard_errors_and_zeroes_the_reference():
+    names = list(tradeoff.OBSERVABLES)
+    a = tradeoff.Measurement({n: (10.0, 3.0) for n in names}, 5, "stick-slip", 1.0)
+    b = tradeoff.Measurement({n: (7.0, 4.0) for n in names}, 5, "stick-slip", 1.0)
+    row = tradeoff.compare(a, b, is_reference=False)
+    assert row["error_static_force"] == 3.0
+    assert row["error_static_force_uncertainty"] == 5.0
+    ref = tradeoff.compare(b, b, is_reference=True)
+    assert ref["error_period"] == 0.0 and ref["error_period_uncertainty"] == 0.0
+
+
+def test_knob_overrides_keep_simulated_time_and_drive_per_area():
+    base = {"slide_steps": 60000, "trace_every": 50}
+    o = tradeoff.timestep_overrides(base, 0.0025)
+    assert o["slide_steps"] * 0.0025 == pytest.approx(base["slide_steps"] * 0.005)
+    assert o["trace_every"] * 0.0025 == pytest.approx(base["trace_every"] * 0.005)
+    b = tradeoff.box_overrides({}, (10, 6))
+    assert b["spring_constant"] / 100.0 == pytest.approx(60 / 28)
+    assert b["wall_mass"] / 500.0 == pytest.approx(60 / 28)
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_every_planned_setting_is_a_valid_scene_with_one_reference_per_knob(quick):
+    p = tradeoff.plan(quick)
+    for s in p.settings:
+        load(tradeoff.SCENE, {**p.base, **s.overrides})
+    knobs = {s.knob for s in p.settings}
+    for knob in knobs:
+        assert sum(s.reference for s in p.settings if s.knob == knob) == 1, knob
+    assert {"timestep", "cutoff", "thermostat_damping", "trace_every", "run_length"} <= knobs
+
+
+def test_reduced_integrators_agree_with_the_closed_form():
+    rows = {r["value"]: r for r in tradeoff.reduced_rows(repeat=1)}
+    assert rows["closed_form"]["reference"]
+    assert rows["closed_form"]["cycles"] >= 20
+    for label, r in rows.items():
+        for name in ("static_force", "slip_distance", "period"):
+            assert abs(r[f"error_{name}"]) < 1e-2 * abs(r[f"value_{name}"]), (label, name)
+    # the event-driven ODE path is exact to round-off whatever its rtol; a hand-written
+    # RK45 loop is not: its error follows its tolerance
+    assert abs(rows["solve_ivp_rk45_rtol_1e-3"]["error_period"]) > \
+        abs(rows["solve_ivp_rk45_rtol_1e-9"]["error_period"])
+
+
+@pytest.mark.parametrize("name", fidelity.names())
+def test_presets_are_valid_for_every_scene(name):
+    for scene in ("stick-slip", "smooth-sliding", "film-structure"):
+        base = load(scene).parameters
+        resolved = load(scene, fidelity.preset(name, base)).parameters
+        # a preset never changes the physics, only numerics
+        for key in ("drive_velocity", "normal_pressure", "temperature", "film_layers",
+                    "cutoff", "mount_damping"):
+            assert resolved[key] == base[key]
+        # and keeps simulated times (up to its own factor)
+        f = fidelity.PRESETS[name]
+        assert resolved["slide_steps"] * resolved["timestep"] == pytest.approx(
+            f.slide_factor * base["slide_steps"] * base["timestep"], rel=1e-4)
+
+
+def test_standard_preset_is_the_default_scene():
+    assert fidelity.preset("standard") == {}
+    assert fidelity.preset("standard", load("stick-slip").parameters) == {}
+
+
+def test_unknown_preset_is_a_clear_error():
+    with pytest.raises(SceneError, match="unknown fidelity 'fast'.*preview"):
+        fidelity.preset("fast")
+
+
+def test_cli_refuses_bad_input(tmp_path, capsys):
+    taken = tmp_path / "taken"
+    taken.mkdir()
+    assert cli.main(["tradeoff", "--quick", "--out", str(taken)]) == 2
+    assert "already exists" in capsys.readouterr().err
+    assert cli.main(["tradeoff", "--np", "0", "--out", str(tmp_path / "x")]) == 2
+    assert "--np 0" in capsys.readouterr().err
+
+
+@pytest.mark.md
+def test_tiny_study_writes_table_json_and_figures(tmp_path, monkeypatch, capsys):
+    # two short MD settings and a run-length prefix: the whole pipeline in seconds
+    base = {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 500, "slide_steps": 4000,
+            "trace_every": 20, "restart_every": 0}
+    settings = (tradeoff.Setting("trace_every", "20", {}, reference=True),
+                tradeoff.Setting("trace_every", "40", {"trace_every": 40}),
+                tradeoff.Setting("run_length", "0.5", {}, prefix=0.5),
+                tradeoff.Setting("run_length", "1", {}, reference=True))
+    monkeypatch.setattr(tradeoff, "plan", lambda quick: tradeoff.Plan(base, settings, "tiny"))
+    monkeypatch.setattr(tradeoff, "reduced_rows", lambda repeat=2: [])
+    out = tmp_path / "study"
+    assert cli.main(["tradeoff", "--quick", "--json", "--np", "1", "--out", str(out)]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [(r["knob"], r["value"]) for r in rows] == [(s.knob, s.value) for s in settings]
+    for r in rows:
+        assert r["cost_seconds"] > 0 and r["cost_seconds_per_tau"] > 0
+        assert r["atom_steps_per_second"] > 0 and r["memory_peak_rss_mb"] > 1
+        for name in tradeoff.OBSERVABLES:
+            assert f"error_{name}" in r and f"error_{name}_uncertainty" in r
+    assert rows[0]["error_static_force"] == 0.0
+    # the same trajectory traced every 40 steps instead of 20: identical dynamics
+    assert rows[1]["value_ledger_closure"] is not None
+    # half the run costs less than the whole
+    assert rows[2]["cost_seconds"] < rows[3]["cost_seconds"]
+    with open(out / "tradeoff.csv") as fh:
+        table = list(csv.DictReader(fh))
+    assert len(table) == len(rows) and "error_period_uncertainty" in table[0]
+    for name in tradeoff.OBSERVABLES:
+        assert (out / f"pareto_{name}.png").stat().st_size > 1000

@@ -1,0 +1,730 @@
+"""The speed–accuracy trade: what each numerical knob costs and what it changes.
+
+``filmfriction tradeoff [--quick] [--json] [--out DIR]`` runs the stick-slip
+scene once per knob setting, one knob at a time around a *base* setting, and
+compares the observables with a *reference* value of the same knob (the most
+accurate one tried: the smallest timestep, the longest cutoff, the largest
+box, the finest trace, the longest run).  Each error carries the statistical
+uncertainty of the two runs combined, ``sqrt(se_setting**2 + se_reference**2)``,
+so a difference smaller than about twice that is noise, not bias.
+
+Knobs
+-----
+MD: ``timestep`` (step counts rescaled so the simulated time stays the same),
+``cutoff`` (WCA 2^(1/6), 2.5, 3.5 sigma), ``box`` (``cells_x x cells_y``, with
+the spring constant and wall mass scaled with the area so that the drive per
+area, hence the slip distance and the period, stay the same),
+``thermostat_damping``, ``trace_every`` and ``run_length`` (prefixes of the
+base run: the first 1/4, 1/2 of the slide; a shorter run with the same seed
+is exactly such a prefix).  Reduced model: ``reduced_integrator`` (closed
+form, the ODE path at several tolerances, a plain ``solve_ivp`` RK45).
+
+Observables (``error_<name>`` in the rows): ``static_force`` (mean Fs;
+extensive, so scaled to the base box's area), ``slip_distance``, ``period``,
+``eta_eff`` (from the slip fits), ``ledger_closure`` (|residual|/input work)
+and ``energy_drift`` (slope of the energy-ledger residual, the integrator's
+non-conservation, ε/τ scaled to the base area).
+
+Cost: wall seconds of the run (``cost_seconds``), per τ simulated and per slip
+cycle, atom-steps/s from ``run.json``, the peak resident memory of the LAMMPS
+processes (``getrusage(RUSAGE_CHILDREN)`` of a forked child that runs only
+that setting) and LAMMPS's own per-rank allocation estimate.
+
+Not done (they need a change of ``md_inputs/film_slide.lmp``): thermostat
+*placement* (the script thermostats the film along y only) and flexible
+thermostatted walls (the top wall is one rigid body).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import multiprocessing
+import re
+import resource
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field, replace
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+
+WCA = 2.0 ** (1.0 / 6.0)
+SCENE = "stick-slip"
+
+# name -> unit; the order is the order of the table's columns
+OBSERVABLES = {
+    "static_force": "epsilon/sigma",
+    "slip_distance": "sigma",
+    "period": "tau",
+    "eta_eff": "epsilon tau/sigma^3",
+    "ledger_closure": "1",
+    "energy_drift": "epsilon/tau",
+}
+# observables whose value grows with the contact area: scaled to the base area
+EXTENSIVE = {"static_force", "energy_drift"}
+COST_FIELDS = ("cost_seconds", "cost_seconds_per_tau", "cost_seconds_per_cycle",
+               "atom_steps_per_second", "memory_peak_rss_mb", "memory_lammps_mb_per_rank",
+               "atoms", "steps", "simulated_tau", "cycles")
+
+
+# ----------------------------------------------------------------- the plan
+@dataclass(frozen=True)
+class Setting:
+    """One row of the study: a knob at one value.
+
+    Attributes
+    ----------
+    knob, value : str
+        What is varied and its value as printed (``"0.005"``, ``"7x4"``).
+    overrides : dict
+        Scene parameters that differ from the base (applied on top of it).
+    reference : bool
+        This is the knob's reference value: its errors are zero by definition.
+    prefix : float
+        For ``run_length``: the fraction of the base run's slide analysed.
+    """
+
+    knob: str
+    value: str
+    overrides: dict = field(default_factory=dict, hash=False)
+    reference: bool = False
+    prefix: float = 1.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The base setting and the rows of a study."""
+
+    base: dict = field(hash=False)
+    settings: tuple
+    description: str
+
+
+# Quick study: the default scene (616 atoms; 8 slips in 500 tau) cut to 300 tau
+# of slide (5 slips, the first left out) and a shorter equilibration.  A smaller
+# box is not a quicker answer: at 5 x 3 cells the slips turn irregular after
+# ~100 tau, with K and M scaled by the area or not, and the analysis then finds
+# no periodic slips to average (measured).
+QUICK_BASE = {"equilibrate_steps": 5000, "slide_steps": 60000, "restart_every": 0}
+# Full study: the default scene as shipped, 400 tau of slide (7 slips).
+FULL_BASE = {"slide_steps": 80000, "restart_every": 0}
+
+
+def timestep_overrides(base: dict, dt: float) -> dict:
+    """Overrides for a timestep: step counts rescaled to keep the simulated times."""
+    from .scene import PARAMETERS
+
+    dt0 = base.get("timestep", PARAMETERS["timestep"].default)
+    ratio = dt0 / dt
+    out = {"timestep": dt}
+    for key in ("equilibrate_steps", "slide_steps", "trace_every"):
+        steps = base.get(key, PARAMETERS[key].default)
+        out[key] = max(1, int(round(steps * ratio)))
+    return out
+
+
+def box_overrides(base: dict, cells: tuple[int, int]) -> dict:
+    """Overrides for a lateral box: K and M scale with the area (same drive per area)."""
+    from .scene import PARAMETERS
+
+    def get(key):
+        return base.get(key, PARAMETERS[key].default)
+
+    ratio = cells[0] * cells[1] / (get("cells_x") * get("cells_y"))
+    return {"cells_x": cells[0], "cells_y": cells[1],
+            "spring_constant": get("spring_constant") * ratio,
+            "wall_mass": get("wall_mass") * ratio}
+
+
+def plan(quick: bool) -> Plan:
+    """The settings of the quick or the full study."""
+    base = dict(QUICK_BASE if quick else FULL_BASE)
+    rows: list[Setting] = []
+
+    def add(knob, value, overrides, reference=False, prefix=1.0):
+        rows.append(Setting(knob, value, overrides, reference, prefix))
+
+    # timestep: the reference is the smallest step tried
+    dts = (0.004, 0.005, 0.008) if quick else (0.0025, 0.004, 0.005, 0.0075, 0.01)
+    for dt in dts:
+        add("timestep", f"{dt:g}", timestep_overrides(base, dt), reference=dt == min(dts))
+    # cutoff: a 3.5 sigma cutoff needs a box of at least 7 sigma (the default's)
+    cuts = (WCA, 2.5) if quick else (WCA, 2.5, 3.5)
+    for rc in cuts:
+        add("cutoff", "wca" if rc == WCA else f"{rc:g}", {"cutoff": rc},
+            reference=rc == max(cuts))
+    if not quick:
+        for cells in ((5, 3), (7, 4), (10, 6)):
+            add("box", f"{cells[0]}x{cells[1]}", box_overrides(base, cells),
+                reference=cells == (10, 6))
+    # thermostat damping: no 'exact' value exists; the default is the reference
+    # and the rows measure the sensitivity of the answer to it
+    for tdamp in ((1.0, 0.25) if quick else (0.25, 1.0, 4.0)):
+        add("thermostat_damping", f"{tdamp:g}", {"thermostat_damping": tdamp},
+            reference=tdamp == 1.0)
+    traces = (50, 250) if quick else (10, 50, 250)
+    for every in traces:
+        add("trace_every", str(every), {"trace_every": every}, reference=every == min(traces))
+    for frac in (0.25, 0.5, 1.0):
+        add("run_length", f"{frac:g}", {}, reference=frac == 1.0, prefix=frac)
+    text = ("quick: the default stick-slip scene, 300 tau of slide" if quick else
+            "full: the default stick-slip scene, 400 tau of slide")
+    return Plan(base=base, settings=tuple(rows), description=text)
+
+
+def _key(overrides: dict) -> str:
+    """Identity of a setting: its resolved parameters (a default given explicitly is no change)."""
+    from .scene import load
+
+    return json.dumps(sorted(load(SCENE, overrides).parameters.items()))
+
+
+# ----------------------------------------------------------------- running
+@dataclass(frozen=True)
+class RunCost:
+    """What one MD run cost."""
+
+    run_dir: Path
+    wall_seconds: float
+    atom_steps_per_second: float
+    atoms: int
+    steps: int
+    simulated_tau: float
+    slide_tau: float
+    equilibrate_seconds_fraction: float
+    peak_rss_mb: float
+    lammps_mb_per_rank: float
+
+
+_MEMORY = re.compile(r"Per MPI rank memory allocation \(min/avg/max\) = "
+                     r"[0-9.eE+-]+ \| [0-9.eE+-]+ \| ([0-9.eE+-]+) Mbytes")
+
+
+def _child_run(scene_name, overrides, out, nprocs, queue):
+    """Body of the forked child: one run, then the children's peak RSS."""
+    try:
+        from .runner import execute
+        from .scene import load
+
+        scene = load(scene_name, overrides)
+        run_dir = execute(scene, out=out, nprocs=nprocs, progress=False)
+        # ru_maxrss of RUSAGE_CHILDREN: the largest reaped descendant (an lmp
+        # rank); the counter starts at zero in a freshly forked process
+        rss_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+        queue.put(("ok", str(run_dir), rss_kb))
+    except BaseException as exc:  # noqa: BLE001 -- reported to the parent
+        queue.put(("error", f"{type(exc).__name__}: {exc}", traceback.format_exc()))
+
+
+def run_setting(overrides: dict, out: Path, nprocs: int = 2,
+                scene_name: str = SCENE) -> RunCost:
+    """Run one setting in a forked child and measure its cost.
+
+    Raises
+    ------
+    RuntimeError
+        The run failed; the message is the runner's.
+    """
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_child_run, args=(scene_name, overrides, out, nprocs, queue))
+    proc.start()
+    result = queue.get()
+    proc.join()
+    if result[0] != "ok":
+        raise RuntimeError(f"setting {overrides}: {result[1]}")
+    run_dir = Path(result[1])
+    record = json.loads((run_dir / "run.json").read_text())
+    p = record["scene"]["parameters"]
+    steps = p["equilibrate_steps"] + p["slide_steps"]
+    memory = [float(m.group(1)) for m in _MEMORY.finditer(
+        (run_dir / "lammps.log").read_text(errors="replace"))]
+    wall = float(record["wall_time"])
+    rate = float(record.get("atom_steps_per_second") or math.nan)
+    atoms = int(record["atoms"]["total"])
+    return RunCost(run_dir=run_dir, wall_seconds=wall, atom_steps_per_second=rate, atoms=atoms,
+                   steps=steps, simulated_tau=steps * p["timestep"],
+                   slide_tau=p["slide_steps"] * p["timestep"],
+                   equilibrate_seconds_fraction=p["equilibrate_steps"] / steps,
+                   peak_rss_mb=result[2] / 1024.0,
+                   lammps_mb_per_rank=max(memory) if memory else math.nan)
+
+
+# ----------------------------------------------------------------- measuring
+@dataclass(frozen=True)
+class Measurement:
+    """Observables of one setting: name -> (mean, standard error)."""
+
+    values: dict
+    cycles: int
+    regime: str
+    area: float
+
+
+def _pair(entry) -> tuple[float, float]:
+    if not entry:
+        return math.nan, math.nan
+    mean, se = entry.get("mean"), entry.get("stderr")
+    return (math.nan if mean is None else float(mean)), (math.nan if se is None else float(se))
+
+
+def drift(time_, residual, blocks: int = 5) -> tuple[float, float]:
+    """Slope of the ledger residual with its standard error from block slopes.
+
+    Parameters
+    ----------
+    time_, residual : array
+        Time and the cumulative ledger residual (zero at the start).
+    blocks : int
+        Equal-time blocks; the spread of their mean slopes gives the error.
+
+    Returns
+    -------
+    (slope, stderr) : tuple of float
+    """
+    t = np.asarray(time_, float)
+    r = np.asarray(residual, float)
+    if t.size < 2 or t[-1] <= t[0]:
+        return math.nan, math.nan
+    slope = (r[-1] - r[0]) / (t[-1] - t[0])
+    edges = np.linspace(t[0], t[-1], blocks + 1)
+    idx = np.searchsorted(t, edges)
+    idx[-1] = t.size - 1
+    slopes = [(r[b] - r[a]) / (t[b] - t[a]) for a, b in zip(idx[:-1], idx[1:]) if t[b] > t[a]]
+    se = float(np.std(slopes, ddof=1) / math.sqrt(len(slopes))) if len(slopes) > 1 else math.nan
+    return float(slope), se
+
+
+def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0,
+            trace_stride: int = 1) -> Measurement:
+    """Analyse a run (or the first ``prefix`` of it) into the study's observables.
+
+    Parameters
+    ----------
+    run_dir : Path
+    area_ref : float, optional
+        Area the extensive observables are scaled to (default: the run's own).
+    prefix : float
+        Fraction of the slide to analyse (a shorter run with the same seed).
+    trace_stride : int
+        Keep every n-th trace row (a coarser ``trace_every``).
+    """
+    from analysis import energy
+    from analysis.report import analyze
+    from analysis.trace import read_trace
+
+    trace = read_trace(run_dir)
+    if prefix < 1.0 or trace_stride > 1:
+        t = trace.time
+        keep = np.flatnonzero(t <= t[0] + prefix * (t[-1] - t[0]))[::trace_stride]
+        trace = replace(trace, columns={k: v[keep] for k, v in trace.columns.items()})
+    doc, _ = analyze(trace, structure=False)
+    area = float(trace.parameters.area)
+    scale = (area_ref / area) if area_ref else 1.0
+    slips = doc["slips"]
+    values = {
+        "static_force": _pair(slips["static_force"]),
+        "slip_distance": _pair(slips["slip_distance"]),
+        "period": _pair(slips["period"]),
+        "eta_eff": _pair(doc["viscosity"].get("from_slip", {}).get("eta_eff")),
+    }
+    led = energy.ledger({c: trace.columns[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)
+                         if trace.has(c)})
+    slope, slope_se = drift(trace.time, led["residual"])
+    duration = float(trace.time[-1] - trace.time[0])
+    values["ledger_closure"] = (led["closure"],
+                                abs(slope_se * duration / led["input"]) if led["input"]
+                                else math.nan)
+    values["energy_drift"] = (slope, slope_se)
+    values = {k: ((m * scale, s * scale) if k in EXTENSIVE else (m, s))
+              for k, (m, s) in values.items()}
+    return Measurement(values=values, cycles=int(slips["count"]), regime=doc["regime"],
+                       area=area)
+
+
+def compare(setting: Measurement, reference: Measurement, is_reference: bool) -> dict:
+    """``error_<obs>`` = setting − reference with ``error_<obs>_uncertainty``.
+
+    The uncertainty combines both standard errors in quadrature; for a run
+    compared with itself both are zero.  A missing standard error (fewer
+    than two cycles) gives a NaN uncertainty: the error is then not tested.
+    """
+    row = {}
+    for name in OBSERVABLES:
+        m, s = setting.values[name]
+        mr, sr = reference.values[name]
+        row[f"value_{name}"] = m
+        if is_reference:
+            row[f"error_{name}"], row[f"error_{name}_uncertainty"] = 0.0, 0.0
+        else:
+            row[f"error_{name}"] = m - mr
+            row[f"error_{name}_uncertainty"] = math.hypot(s, sr)
+    return row
+
+
+# ----------------------------------------------------------------- the reduced model
+# The reduced model stands in for the default MD run: M, K and V of the default
+# scene, Coulomb friction with the measured Fs and a kinetic force (Fs + Fb)/2,
+# so that an undamped slip re-sticks at the measured Fb = 2 Fk - Fs; a light
+# viscous term (damping ratio 0.045) keeps the slip dynamics non-trivial.  The
+# MD mount dashpot acts on v - V and has no counterpart in SpringBlock's
+# ground damper, so it is left out.  1100 tau hold 24 cycles.
+REDUCED = {"mass": 500.0, "stiffness": 100.0, "drive_velocity": 0.02, "damping": 0.0,
+           "static": 98.7, "kinetic": 61.2, "viscous": 20.0, "duration": 1100.0}
+
+
+def _reduced_block():
+    from reduced_model import SpringBlock, laws
+
+    r = REDUCED
+    return SpringBlock(mass=r["mass"], stiffness=r["stiffness"],
+                       drive_velocity=r["drive_velocity"], damping=r["damping"],
+                       law=laws.Coulomb(static=r["static"], kinetic=r["kinetic"],
+                                        viscous=r["viscous"]))
+
+
+def _rk45_cycles(rtol: float, duration: float):
+    """The same block integrated by hand with ``solve_ivp`` RK45: what a user writes.
+
+    Slips are integrated to the event v = 0; sticks are linear ramps solved in
+    closed form (exactly as a careful user would).  Returns (t, F, yields,
+    sticks, wall position, work, dissipated) sampled at the event times.
+    """
+    from scipy.integrate import solve_ivp
+
+    r = REDUCED
+    M, K, V, d = r["mass"], r["stiffness"], r["drive_velocity"], r["damping"]
+    fs, fk, b = r["static"], r["kinetic"], r["viscous"]
+    t, x, v = 0.0, 0.0, 0.0
+    ts, fs_, xs, kinds = [0.0], [0.0], [0.0], ["start"]
+    while t < duration:
+        # stick: the force K (V t - x) rises linearly to Fs (SpringBlock's damper acts
+        # on the block's own velocity, zero while stuck)
+        t = max(t, (fs / K + x) / V)
+        if t >= duration:
+            break
+        ts.append(t), fs_.append(K * (V * t - x)), xs.append(x), kinds.append("slip")
+        t0, x0 = t, x
+
+        def rhs(tau, y, t0=t0):
+            f = K * (V * (t0 + tau) - y[0]) - d * y[1] - fk - b * y[1]
+            return [y[1], f / M]
+
+        def stop(tau, y):
+            return y[1]
+        stop.terminal, stop.direction = True, -1
+        sol = solve_ivp(rhs, (0.0, duration - t0), [x0, 1e-12], method="RK45", rtol=rtol,
+                        atol=1e-9, events=stop)
+        x, t = float(sol.y[0, -1]), t0 + float(sol.t[-1])
+        ts.append(t), fs_.append(K * (V * t - x)), xs.append(x), kinds.append("stick")
+        if sol.status != 1:
+            break
+    return np.array(ts), np.array(fs_), np.array(xs), kinds
+
+
+def _reduced_measure(t, f, x, yields, sticks) -> dict:
+    from analysis.stickslip import cycle_table
+
+    table = cycle_table(t, f, yields, sticks, spring_constant=REDUCED["stiffness"],
+                        wall_position=x)
+    summ = table.summary(skip=1)
+    out = {}
+    for name in ("static_force", "slip_distance", "period"):
+        s = summ[name]
+        out[name] = (float(s["mean"]), 0.0)  # deterministic: no sampling error
+    return out
+
+
+def reduced_rows(repeat: int = 3) -> list[dict]:
+    """Cost and error of the reduced model's integrators against the closed form."""
+    block = _reduced_block()
+    T = REDUCED["duration"]
+    variants = [("closed_form", {"method": "closed_form"}),
+                ("ode_rtol_1e-4", {"method": "ode", "rtol": 1e-4}),
+                ("ode_rtol_1e-7", {"method": "ode", "rtol": 1e-7}),
+                ("ode_rtol_1e-10", {"method": "ode", "rtol": 1e-10}),
+                ("solve_ivp_rk45_rtol_1e-3", {"rk45": 1e-3}),
+                ("solve_ivp_rk45_rtol_1e-6", {"rk45": 1e-6}),
+                ("solve_ivp_rk45_rtol_1e-9", {"rk45": 1e-9})]
+    results = {}
+    for label, kw in variants:
+        best = math.inf
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            if "rk45" in kw:
+                t, f, x, kinds = _rk45_cycles(kw["rk45"], T)
+                yi = np.array([i for i, k in enumerate(kinds) if k == "slip"])
+                si = np.array([i for i, k in enumerate(kinds) if k == "stick"])
+                n = min(len(yi), len(si))
+                values = _reduced_measure(t, f, x, yi[:n], si[:n])
+                values["ledger_closure"] = (math.nan, math.nan)
+            else:
+                res = block.simulate(T, **kw)
+                yi, si = res.slip_pairs()
+                values = _reduced_measure(res.t, res.spring_force, res.x, yi, si)
+                values["ledger_closure"] = (float(res.energy.closure), 0.0)
+            best = min(best, time.perf_counter() - t0)
+        values["eta_eff"] = (math.nan, math.nan)
+        values["energy_drift"] = (math.nan, math.nan)
+        results[label] = (Measurement(values, len(yi), "stick-slip", 1.0), best)
+    ref = results["closed_form"][0]
+    rows = []
+    for label, (meas, seconds) in results.items():
+        row = {"knob": "reduced_integrator", "value": label, "reference": label == "closed_form",
+               "cost_seconds": seconds, "cost_seconds_per_tau": seconds / T,
+               "cost_seconds_per_cycle": seconds / T * meas.values["period"][0],
+               "atom_steps_per_second": math.nan, "memory_peak_rss_mb": math.nan,
+               "memory_lammps_mb_per_rank": math.nan, "atoms": 1, "steps": math.nan,
+               "simulated_tau": T, "cycles": meas.cycles, "regime": meas.regime}
+        row.update(compare(meas, ref, label == "closed_form"))
+        # ledger closure is the model's own check, not a difference: report it as is
+        row["error_ledger_closure"] = meas.values["ledger_closure"][0]
+        row["error_ledger_closure_uncertainty"] = 0.0
+        rows.append(row)
+    return rows
+
+
+# ----------------------------------------------------------------- the study
+def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
+    """Run every MD setting of ``study`` (each distinct scene once) and tabulate."""
+    runs: dict[str, RunCost] = {}
+    failed: dict[str, str] = {}
+    todo = []
+    for s in study.settings:
+        key = _key({**study.base, **s.overrides})
+        if key not in runs and key not in [k for k, _ in todo]:
+            todo.append((key, s))
+    for i, (key, s) in enumerate(todo, 1):
+        label = f"{s.knob}={s.value}" if s.overrides else "base"
+        log(f"[{i}/{len(todo)}] {label}")
+        t0 = time.perf_counter()
+        try:
+            runs[key] = run_setting({**study.base, **s.overrides},
+                                    out / "runs" / f"{i:02d}-{label.replace('=', '-')}", nprocs)
+        except RuntimeError as exc:
+            # one failed setting is a result (the knob is past its limit), not the end
+            failed[key] = str(exc).splitlines()[0]
+            log(f"    FAILED: {failed[key]}")
+            continue
+        log(f"    {time.perf_counter() - t0:.0f} s, "
+            f"{runs[key].atom_steps_per_second:.3g} atom-steps/s")
+    base_key = _key(study.base)
+    if base_key not in runs:
+        raise RuntimeError(f"the base run failed: {failed[base_key]}")
+    area_ref = measure(runs[base_key].run_dir).area
+    measured = {}
+    for s in study.settings:
+        key = _key({**study.base, **s.overrides})
+        if key in runs:
+            measured[(s.knob, s.value)] = measure(runs[key].run_dir, area_ref=area_ref,
+                                                  prefix=s.prefix)
+    rows = []
+    for s in study.settings:
+        ref = next(r for r in study.settings if r.knob == s.knob and r.reference)
+        key = _key({**study.base, **s.overrides})
+        if key not in runs or (ref.knob, ref.value) not in measured:
+            why = failed.get(key) or f"its reference {ref.value} failed"
+            rows.append({"knob": s.knob, "value": s.value, "reference": s.reference,
+                         "regime": f"failed: {why}"})
+            continue
+        meas = measured[(s.knob, s.value)]
+        cost = runs[key]
+        seconds, tau = cost.wall_seconds, cost.simulated_tau
+        if s.prefix < 1.0:
+            # a shorter run costs its share of the slide plus the whole equilibration
+            f_eq = cost.equilibrate_seconds_fraction
+            seconds *= f_eq + (1.0 - f_eq) * s.prefix
+            tau = cost.simulated_tau - cost.slide_tau * (1.0 - s.prefix)
+        period = meas.values["period"][0]
+        row = {"knob": s.knob, "value": s.value, "reference": s.reference,
+               "cost_seconds": seconds, "cost_seconds_per_tau": seconds / tau,
+               "cost_seconds_per_cycle": seconds / tau * period if math.isfinite(period)
+               else math.nan,
+               "atom_steps_per_second": cost.atom_steps_per_second,
+               "memory_peak_rss_mb": cost.peak_rss_mb,
+               "memory_lammps_mb_per_rank": cost.lammps_mb_per_rank,
+               "atoms": cost.atoms, "steps": cost.steps, "simulated_tau": tau,
+               "cycles": meas.cycles, "regime": meas.regime}
+        row.update(compare(meas, measured[(ref.knob, ref.value)], s.reference))
+        row["run_dir"] = str(cost.run_dir)
+        rows.append(row)
+    return rows
+
+
+def columns() -> list[str]:
+    cols = ["knob", "value", "reference", *COST_FIELDS, "regime"]
+    for name in OBSERVABLES:
+        cols += [f"value_{name}", f"error_{name}", f"error_{name}_uncertainty"]
+    return cols + ["run_dir"]
+
+
+def write_csv(rows: list[dict], path: Path) -> Path:
+    cols = columns()
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=cols, extrasaction="ignore")
+        w.writeheader()
+        for row in rows:
+            w.writerow({c: _fmt(row.get(c)) for c in cols})
+    return path
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        return "" if not math.isfinite(v) else f"{v:.6g}"
+    return "" if v is None else v
+
+
+def _clean(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, (np.floating,)):
+        return _clean(float(v))
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    return v
+
+
+def pareto_front(cost, error) -> np.ndarray:
+    """Indices of the points no other point beats in both cost and |error|, by cost."""
+    cost, error = np.asarray(cost, float), np.abs(np.asarray(error, float))
+    ok = np.flatnonzero(np.isfinite(cost) & np.isfinite(error))
+    order = ok[np.lexsort((error[ok], cost[ok]))]
+    front, best = [], math.inf
+    for i in order:
+        if error[i] < best:
+            front.append(i)
+            best = error[i]
+    return np.array(front, dtype=int)
+
+
+def _float(v):
+    return math.nan if v is None else v
+
+
+def plot(rows: list[dict], out: Path) -> list[Path]:
+    """One cost–error PNG per observable, MD and reduced-model rows side by side."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    paths = []
+    knobs = sorted({r["knob"] for r in rows})
+    colors = dict(zip(knobs, plt.cm.tab10.colors))
+    for name, unit in OBSERVABLES.items():
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        # references are the zero of their knob's errors: shown, not part of the front
+        pts = [r for r in rows if not r["reference"]
+               and r.get(f"error_{name}") is not None and math.isfinite(r[f"error_{name}"])]
+        for knob in knobs:
+            sel = [r for r in pts if r["knob"] == knob]
+            if not sel:
+                continue
+            x = [r["cost_seconds"] for r in sel]
+            y = [abs(r[f"error_{name}"]) for r in sel]
+            e = [r[f"error_{name}_uncertainty"] for r in sel]
+            e = [v if v is not None and math.isfinite(v) else 0.0 for v in e]
+            ax.errorbar(x, y, yerr=e, fmt="o", color=colors[knob], label=knob, capsize=3)
+            for xi, yi, r in zip(x, y, sel):
+                ax.annotate(r["value"], (xi, yi), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+        # the front is over the MD settings: the reduced model answers another question
+        # (the spring-block ODE) and would dominate any MD setting trivially
+        md = [r for r in pts if r["knob"] != "reduced_integrator"]
+        if md:
+            idx = pareto_front([r["cost_seconds"] for r in md],
+                               [r[f"error_{name}"] for r in md])
+            if idx.size:
+                ax.step([md[i]["cost_seconds"] for i in idx],
+                        [abs(md[i][f"error_{name}"]) for i in idx], where="post",
+                        color="k", lw=1, alpha=0.6, label="Pareto front (MD)")
+        ax.set_xscale("log")
+        ax.set_ylim(bottom=0.0)
+        ax.set_xlabel("cost: wall seconds of the run (MD: --np ranks; reduced model: 1 core)")
+        ax.set_ylabel(f"|error of {name}| [{unit}]")
+        ax.set_title(f"{name}: error against each knob's reference (bars: 1 s.e.)")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        path = out / f"pareto_{name}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def study(quick: bool, out: Path, nprocs: int = 2, log=print) -> list[dict]:
+    """Run the study; write ``tradeoff.csv``, ``tradeoff.json`` and the PNGs under ``out``."""
+    out.mkdir(parents=True, exist_ok=False)
+    p = plan(quick)
+    log(f"tradeoff ({p.description}); output in {out}")
+    rows = md_rows(p, out, nprocs, log) + reduced_rows()
+    rows = [{k: _clean(v) for k, v in r.items()} for r in rows]
+    write_csv(rows, out / "tradeoff.csv")
+    (out / "tradeoff.json").write_text(json.dumps(rows, indent=1, allow_nan=False) + "\n")
+    plot([{k: (math.nan if v is None else v) for k, v in r.items()} for r in rows], out)
+    return rows
+
+
+# ----------------------------------------------------------------- CLI
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "tradeoff", help="cost and error of each numerical knob (timestep, cutoff, box, ...)",
+        description="Run the stick-slip scene once per knob setting and tabulate the cost "
+                    "and the error of the observables against each knob's reference, "
+                    "with the statistical uncertainty of each error.")
+    p.add_argument("--quick", action="store_true",
+                   help="300 tau runs, few values (a few minutes on 2 cores)")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
+    p.add_argument("--out", type=Path, default=None,
+                   help="directory to create (default runs/tradeoff-<time>)")
+    p.add_argument("--np", type=int, default=2, help="MPI ranks per run (default 2)")
+    p.set_defaults(func=main)
+
+
+def main(args: argparse.Namespace) -> int:
+    from .cli import UserError
+
+    if args.np < 1:
+        raise UserError(f"--np {args.np}: need at least 1 MPI rank")
+    out = args.out or Path("runs") / f"tradeoff-{datetime.now():%Y%m%d-%H%M%S}"
+    if out.exists():
+        raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
+    log = (lambda msg: print(msg, file=sys.stderr)) if args.json else print
+    try:
+        rows = study(args.quick, out, args.np, log)
+    except RuntimeError as exc:
+        print(f"filmfriction tradeoff: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(rows, indent=1, allow_nan=False))
+    else:
+        print(summary(rows))
+        print(f"table: {out / 'tradeoff.csv'}; figures: {out}/pareto_*.png")
+    return 0
+
+
+def summary(rows: list[dict]) -> str:
+    """A text table: cost and the relative error ± uncertainty of Fs, slip, period, eta."""
+    head = f"{'knob':20s} {'value':26s} {'s':>7s} {'s/tau':>7s} {'MB':>6s}"
+    names = ("static_force", "slip_distance", "period", "eta_eff", "energy_drift")
+    head += "".join(f" {n[:12]:>19s}" for n in names)
+    lines = [head]
+    for r in rows:
+        line = (f"{r['knob']:20s} {r['value'] + (' (ref)' if r['reference'] else ''):26s} "
+                f"{_g(r.get('cost_seconds'), 7)} {_g(r.get('cost_seconds_per_tau'), 7)} "
+                f"{_g(r.get('memory_peak_rss_mb'), 6)}")
+        for n in names:
+            e, u = r.get(f"error_{n}"), r.get(f"error_{n}_uncertainty")
+            line += f" {_g(e, 9)}±{_g(u, 9, left=True)}"
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def _g(v, width, left=False):
+    text = "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.3g}"
+    return f"{text:<{width}s}" if left else f"{text:>{width}s}"
