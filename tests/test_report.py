@@ -113,3 +113,34 @@ def test_report_renders_in_headless_chromium(study):
     n_img = proc.stdout.count("<img")
     assert int(total.group(1)) == n_img >= 2
     assert int(loaded.group(1)) == int(total.group(1)), "some figures did not load"
+
+
+@pytest.mark.md
+def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path):
+    """A finished sweep directory given to the report adds its section and its runs."""
+    import json
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sweep = tmp_path / "sweep"
+    sweep.mkdir()
+    fig, ax = plt.subplots()
+    ax.plot([1, 2], [1, 2])
+    fig.savefig(sweep / "velocity_map.png")
+    plt.close(fig)
+    (sweep / "aggregate.json").write_text(json.dumps({
+        "scene": "stick-slip", "grid": [{"key": "drive_velocity", "spec": "drive_velocity=0.1,0.5",
+                                          "values": [0.1, 0.5]}],
+        "points": [{}, {}], "run_dirs": [str(study)], "calibration_runs": [str(study)],
+        "critical_velocity": [{"group": {}, "status": "bracketed", "value": 0.22, "factor": 2.2,
+                               "note": "stick-slip up to V = 0.1, smooth from 0.5"}],
+        "power_law": {"exponent": -0.7, "exponent_stderr": 0.1, "n": 3, "points": "steady"}}))
+    from workflows import cli
+
+    assert cli.main(["report", str(sweep)]) == 0
+    text = (sweep / "report.md").read_text()
+    assert "## Sweeps" in text and "0.22" in text and "−2/3" in text
+    assert (sweep / "report-sweep-velocity_map.png").exists()
+    assert str(study) in text  # the sweep's run is the report's main run

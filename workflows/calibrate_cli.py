@@ -21,7 +21,8 @@ def register(subparsers) -> None:
                     "MD mount dashpot) on one or several run directories, replay the MD trace with "
                     "it, and write calibration.json into the first run directory.")
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
-                   help="run directories (trace.csv + run.json); several give the shear-rate law")
+                   help="run directories (trace.csv + run.json) or finished sweeps "
+                        "(aggregate.json); several runs give the shear-rate law")
     p.add_argument("--json", action="store_true", help="print calibration.json")
     p.set_defaults(func=run)
 
@@ -71,13 +72,18 @@ def run(args) -> int:
     from workflows.calibrate import calibrate, write_calibration
     from workflows.cli import UserError
 
+    from workflows.report import _split_sweeps
+
     for d in args.run_dirs:
         if not d.is_dir():
             raise UserError(f"{d}: not a directory")
-        if not (d / "trace.csv").exists():
-            raise UserError(f"{d}: no trace.csv (not a run directory)")
+        if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
+            raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
+                            "(aggregate.json)")
+    # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
+    run_dirs, _ = _split_sweeps(list(args.run_dirs))
     try:
-        cal = calibrate(args.run_dirs)
+        cal = calibrate(run_dirs)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     path = write_calibration(cal)

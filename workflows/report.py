@@ -688,13 +688,64 @@ def _write_atomic(path: Path, data) -> None:
 # ---------------------------------------------------------------------------
 # entry point
 # ---------------------------------------------------------------------------
+def _split_sweeps(paths: list) -> tuple[list, list]:
+    """Run directories, and sweeps (directories with ``aggregate.json``).
+
+    A sweep contributes its stick-slip runs (its ``calibration_runs``, else all
+    its runs) to the calibration, after the run directories given directly.
+    """
+    from workflows.sweep import load_aggregate
+
+    runs, sweeps = [], []
+    for p in paths:
+        if (p / "aggregate.json").exists():
+            agg = load_aggregate(p)
+            sweeps.append(agg)
+            runs += [d for d in (agg.calibration_runs or agg.run_dirs) if d not in runs]
+        elif p not in runs:
+            runs.append(p)
+    return runs, sweeps
+
+
+def _sweep_section(sweeps) -> Section:
+    sec = Section("Sweeps")
+    for agg in sweeps:
+        doc = agg.doc
+        grid = ", ".join(f"`{g.get('spec', g.get('key'))}`" for g in doc.get("grid") or [])
+        sec.p(f"Sweep `{agg.sweep_dir}` of scene `{doc.get('scene')}` over {grid}: "
+              f"{len(doc.get('points', []))} points.")
+        rows = []
+        for cv in doc.get("critical_velocity") or []:
+            group = ", ".join(f"{k}={v}" for k, v in (cv.get("group") or {}).items()) or "all"
+            rows.append((group, cv.get("status", ""), _fmt(cv.get("value")),
+                         f"×/÷ {_fmt(cv.get('factor'), 3)}", cv.get("note", "")))
+        if rows:
+            sec.add(Table(("points", "status", "critical velocity V_c [σ/τ]", "uncertainty",
+                           "bracket"), tuple(rows)))
+        law = doc.get("power_law") or {}
+        if law.get("exponent") is not None:
+            sec.p(f"η_eff ∝ γ̇^α with α = {_fmt(law['exponent'], 3)} ± "
+                  f"{_fmt(law.get('exponent_stderr'), 2)} over {law.get('n')} runs "
+                  f"({law.get('points', '')}); Thompson, Grest & Robbins report about −2/3 for "
+                  "glassy films.")
+        for name, path in agg.figures.items():
+            sec.add(Figure(f"sweep-{name}", Path(path).read_bytes(),
+                           "Friction and regime against the drive velocity, with the critical "
+                           "velocity bracket; η_eff against shear rate with the power law."
+                           if name == "velocity_map" else
+                           "Regime over (V, K), with the calibrated reduced model's boundary "
+                           "when a calibration was given."))
+    return sec
+
+
 def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=None) -> Path:
     """Write ``report.html`` and ``report.md`` for one or several runs.
 
     Parameters
     ----------
     run_dirs : path-like or list of path-like
-        Run directories; the first is the main run.
+        Run directories; the first is the main run.  A sweep directory (with
+        ``aggregate.json``) adds a sweep section and its stick-slip runs.
     out : path-like, optional
         HTML file to write (default ``<first run>/report.html``); the Markdown
         twin and its PNG figures go next to it (same stem).
@@ -714,9 +765,12 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
 
     if isinstance(run_dirs, (str, os.PathLike)):
         run_dirs = [run_dirs]
-    run_dirs = [Path(d) for d in run_dirs]
+    given = [Path(d) for d in run_dirs]
+    run_dirs, sweeps = _split_sweeps(given)
+    if out is None and sweeps and given[0] == sweeps[0].sweep_dir:
+        out = sweeps[0].sweep_dir / "report.html"   # a sweep's report lives with the sweep
     if not run_dirs:
-        raise ValueError("no run directory given")
+        raise ValueError("no run directory given (a sweep without completed runs?)")
     failures = dict(failures or {})
     run = load_run(run_dirs[0])          # a report needs at least the main run's trace
     if calibration is None and "calibration" not in failures:
@@ -737,6 +791,8 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
                 _viscosity_section(calibration, failures), _film_section(run, failures),
                 _calibration_section(calibration, failures), _sfb_section(sfb, failures),
                 _cost_section(run)]
+    if sweeps:
+        sections.insert(4, _sweep_section(sweeps))
     if failures:
         sec = Section("Steps that failed")
         sec.add(Table(("step", "reason"), tuple((k, v) for k, v in failures.items())))

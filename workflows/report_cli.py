@@ -19,7 +19,8 @@ def register(subparsers) -> None:
         description="Scene, stick-slip trace, energy partition, viscosity, film structure, calibrated "
                     "model, SFB comparison, cost and provenance of one or several runs.")
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
-                   help="run directories (the first is the main run; several give the rate law)")
+                   help="run directories (the first is the main run; several give the rate law) "
+                        "or finished sweep directories (a sweep section and their runs)")
     p.add_argument("--out", type=Path, default=None, metavar="FILE",
                    help="HTML file to write (default RUN_DIR/report.html; the .md goes next to it)")
     p.set_defaults(func=run)
@@ -31,8 +32,9 @@ def run(args) -> int:
     from workflows.report import build_report
 
     for d in args.run_dirs:
-        if not (d / "trace.csv").exists():
-            raise UserError(f"{d}: not a run directory (no trace.csv)")
+        if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
+            raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
+                            "(aggregate.json)")
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     try:
