@@ -256,11 +256,16 @@ def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
         u.trajectory[-1]
         ax2 = axes[0, 1]
         colors = {1: "tab:orange", 2: "0.45", 3: "0.65"}
+        lx = float(u.dimensions[0])
         for typ, c in colors.items():
             g = u.select_atoms(f"type {typ}")
             if g.n_atoms:
-                ax2.scatter(g.positions[:, 0], g.positions[:, 2], s=9, color=c,
+                # the trajectory is unwrapped (for the analyses); the picture
+                # shows the periodic box
+                x = np.mod(g.positions[:, 0], lx) if lx > 0 else g.positions[:, 0]
+                ax2.scatter(x, g.positions[:, 2], s=9, color=c,
                             label={1: "film", 2: "bottom wall", 3: "top wall"}[typ])
+        ax.set_ylim(ax2.get_ylim())
         ax2.set_aspect("equal")
         ax2.set_xlabel("x [σ] (sliding direction)")
         ax2.set_ylabel("z [σ]")
