@@ -19,6 +19,13 @@ friction:
 damping): solve_ivp only detects a sign change between steps, so a step
 spanning a whole oscillation could miss two crossings.
 
+Stateless laws with static friction (Coulomb via ``method="ode"``, the
+Stribeck curves, exponential weakening, films with a yield force unless
+heavily damped) take a fast path, :func:`_slip_dop853`: Hairer's Fortran
+DOP853 with a right-hand side on plain Python floats, the displacement counted
+from the slip's start, and the re-stick located by Newton's method on the RK
+step map (see its docstring).
+
 Smooth laws (rate-and-state, films without a yield force) are one ODE; their
 ``slip``/``stick`` events mark the maxima/minima of the spring force.  A
 massless block (M = 0) is integrated quasi-statically: the slip velocity
@@ -140,6 +147,27 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             rec.event("slip", t, K * (xa - x))
             continue
 
+        if has_stick and method == "DOP853":
+            # stateless law: the slip runs on plain floats with the displacement counted
+            # from the slip's start (rtol then applies to the slip, not to the whole run)
+            ts, ys, ended, nfev = _slip_dop853(law, N, M, K, d, u, va, K * (xa - x), v, sigma,
+                                               remaining, rtol, atol, max_step)
+            ys[0] += x
+            rec.nfev += nfev
+            rec.append(t + ts, ys[0], ys[1], xa + va * ts, ys[5:], ys[2], ys[3], ys[4])
+            x, v, xa, state = ys[0, -1], ys[1, -1], xa + va * ts[-1], ys[5:, -1].copy()
+            if not ended:
+                break
+            t += ts[-1]
+            held = K * (xa - x) - d * u
+            if abs(held) <= law.static_force(state, N):
+                mode = "stick"
+                rec.event("stick", t, K * (xa - x))
+            else:
+                sigma = math.copysign(1.0, held)
+                rec.event("reversal", t, K * (xa - x))
+            continue
+
         xa_seg, sig = xa, sigma
         if has_stick:
             def friction(s, st):
@@ -163,24 +191,6 @@ def run_ode(p: Problem, rtol: float = 1e-10):
                 s = v_ - u
                 fr = float(friction(s, ()))
                 return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s, d * v_ * v_))
-
-        if has_stick and method == "DOP853":
-            ts, ys, ended, nfev = _slip_dop853(rhs, np.concatenate(([x, v, 0.0, 0.0, 0.0], state)),
-                                               remaining, sig, u, rtol, atol, max_step)
-            rec.nfev += nfev
-            rec.append(t + ts, ys[0], ys[1], xa + va * ts, ys[5:], ys[2], ys[3], ys[4])
-            x, v, xa, state = ys[0, -1], ys[1, -1], xa + va * ts[-1], ys[5:, -1].copy()
-            if not ended:
-                break
-            t += ts[-1]
-            held = K * (xa - x) - d * u
-            if abs(held) <= law.static_force(state, N):
-                mode = "stick"
-                rec.event("stick", t, K * (xa - x))
-            else:
-                sigma = math.copysign(1.0, held)
-                rec.event("reversal", t, K * (xa - x))
-            continue
 
         events = []
         if has_stick:
@@ -218,14 +228,22 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     return rec.finish()
 
 
-def _slip_dop853(rhs, y0, t_end, sigma, u, rtol, atol, max_step):
-    """One slip with Hairer's Fortran DOP853 (scipy.integrate.ode), ended at s = 0.
+def _slip_dop853(law, N, M, K, d, u, va, f0, v0, sigma, t_end, rtol, atol, max_step):
+    """One slip of a stateless law with static friction, ended at s = 0.
 
-    Same method as solve_ivp's DOP853 but the step loop runs in Fortran, with a
-    Python callback only per accepted step to watch the sign of the slip
-    velocity; the crossing is then bracketed between two accepted steps and
-    located by brentq, re-integrating the last step to each trial time (so the
-    event state is an RK solution, not an interpolant).
+    Hairer's Fortran DOP853 (scipy.integrate.ode): the step loop runs in
+    Fortran; the right-hand side is a closure on plain floats (no NumPy in the
+    per-evaluation path) and a Python callback per accepted step watches the
+    sign of the slip velocity.  The state is (displacement since the slip began,
+    velocity, drive work, friction and damper dissipation), all starting at 0
+    but the velocity; ``f0`` is the spring force at the start.
+
+    The re-stick is the root of the slip velocity of the RK solution itself
+    (not of an interpolant): bracketed between two accepted steps, first guessed
+    by a cubic Hermite fit, then refined by Newton's method on the map "one
+    DOP853 step from the last accepted point to t" (its derivative is the
+    acceleration, known from the right-hand side), falling back to brentq on the
+    same map should Newton leave the bracket.
     Returns (times, states, ended_at_restick, n_evaluations).
     """
     from scipy.integrate import ode
@@ -233,47 +251,115 @@ def _slip_dop853(rhs, y0, t_end, sigma, u, rtol, atol, max_step):
     # scipy's dop853 wrapper takes a scalar atol: integrate z = y / scale with the
     # per-component tolerances folded into the scale
     scale = np.asarray(atol, dtype=float) / 1e-12
+    s0, s1, s2, s3, s4 = (float(c) for c in scale)
+    i0, i1, i2, i3, i4 = 1.0 / s0, 1.0 / s1, 1.0 / s2, 1.0 / s3, 1.0 / s4
+    # plain Python floats throughout: NumPy scalars would cost ~10x per operation
+    N, M, K, d, u, va, f0, sig = (float(c) for c in (N, M, K, d, u, va, f0, sigma))
+    sliding, Kva = law.scalar_sliding(N), K * va
+    ks0, a1, v0_scale, u_i2, dv_i4 = K * s0, i1 / M, s1 * i0, u * i2, d * i4
     count = [0]
 
     def f(tau, z):
         count[0] += 1
-        return rhs(tau, z * scale) / scale
+        z0, z1, _, _, _ = z.tolist()
+        vb = z1 * s1
+        f_spring = f0 + Kva * tau - ks0 * z0
+        s = vb - u
+        ss = sig * s
+        fr = sig * sliding(ss if ss > 0.0 else 0.0)
+        return [z1 * v0_scale, (f_spring - d * vb - fr) * a1, f_spring * va * i2 - fr * u_i2,
+                fr * s * i3, dv_i4 * vb * vb]
 
-    ts, zs = [0.0], [np.array(y0, dtype=float) / scale]
+    def slip_of(z):
+        return sig * (float(z[1]) * s1 - u)
+
+    ts, zs = [0.0], [np.array([0.0, v0 * i1, 0.0, 0.0, 0.0])]
 
     def watch(tau, z):
         if tau > ts[-1]:
             ts.append(tau)
             zs.append(np.array(z))
-            if sigma * (z[1] * scale[1] - u) < 0.0:
+            if slip_of(z) < 0.0:
                 return -1                       # crossed s = 0: stop and bracket
         return 0
 
-    def solver():
-        return ode(f).set_integrator("dop853", rtol=rtol, atol=1e-12, nsteps=10 ** 8, max_step=max_step)
+    def solver(first_step=0.0):
+        return ode(f).set_integrator("dop853", rtol=rtol, atol=1e-12, nsteps=10 ** 8,
+                                     max_step=max_step, first_step=first_step)
 
     main = solver()
     main.set_solout(watch)
     main.set_initial_value(zs[0], 0.0)
     main.integrate(t_end)
-    if not (sigma * (zs[-1][1] * scale[1] - u) < 0.0):
+    if not slip_of(zs[-1]) < 0.0:
         return np.array(ts), (np.array(zs) * scale).T, False, count[0]
-    t_a, z_a = ts[-2], zs[-2]
-    sub = solver()
+    t_a, z_a, t_b = ts[-2], zs[-2], ts[-1]
+
+    last = {t_a: z_a}
 
     def state_at(tau):
-        sub.set_initial_value(z_a, t_a)
-        return sub.integrate(tau) * scale
+        if tau not in last:
+            sub = solver(first_step=tau - t_a)  # one step (if its error test passes)
+            sub.set_initial_value(z_a, t_a)
+            last.clear()
+            last[t_a], last[tau] = z_a, sub.integrate(tau)
+        return last[tau]
 
-    def slip(tau):
-        return sigma * (state_at(tau)[1] - u)
+    def slip_rate(tau, z):
+        return sig * f(tau, z)[1] * s1
 
-    t_root = brentq(slip, t_a, ts[-1], xtol=max(1e-15 * ts[-1], 1e-300), rtol=8.9e-16)
-    y_root = state_at(t_root)
+    t_root = _restick_root(state_at, slip_of, slip_rate, t_a, z_a, t_b, zs[-1])
+    y_root = state_at(t_root) * scale
     y_root[1] = u                               # the root: slip velocity exactly zero
     ys = np.array(zs) * scale
     ts[-1], ys[-1] = t_root, y_root
     return np.array(ts), ys.T, True, count[0]
+
+
+def _restick_root(state_at, slip_of, slip_rate, t_a, z_a, t_b, z_b):
+    """Root of ``slip_of(state_at(t))`` in [t_a, t_b] (slip >= 0 at t_a, < 0 at t_b)."""
+    g_a, g_b = slip_of(z_a), slip_of(z_b)
+    if g_a <= 0.0:
+        return t_a
+    h = t_b - t_a
+    xtol = max(1e-15 * abs(t_b), 1e-300)
+    # cubic Hermite guess from values and slopes at both ends, solved by Newton from
+    # the secant guess (the cubic is monotone enough on a bracket this short)
+    d_a, d_b = slip_rate(t_a, z_a) * h, slip_rate(t_b, z_b) * h
+    c2, c3 = 3.0 * (g_b - g_a) - 2.0 * d_a - d_b, 2.0 * (g_a - g_b) + d_a + d_b
+    theta = g_a / (g_a - g_b)
+    for _ in range(6):
+        slope = d_a + theta * (2.0 * c2 + 3.0 * c3 * theta)
+        if not slope < 0.0:
+            theta = g_a / (g_a - g_b)
+            break
+        theta -= (g_a + theta * (d_a + theta * (c2 + theta * c3))) / slope
+        if not 0.0 < theta < 1.0:
+            theta = g_a / (g_a - g_b)
+            break
+    lo, hi = t_a, t_b
+    t = t_a + theta * h
+    for _ in range(8):
+        t = min(max(t, lo), hi)
+        z = state_at(t)
+        g = slip_of(z)
+        if g == 0.0:
+            return t
+        if g > 0.0:
+            lo = t
+        else:
+            hi = t
+        rate = slip_rate(t, z)
+        step = -g / rate if rate != 0.0 else math.inf
+        if abs(step) <= xtol:
+            return t
+        t_new = t + step
+        if not lo < t_new < hi:
+            break                               # Newton left the bracket: bisect the rest
+        t = t_new
+    if hi == t_b and not slip_of(state_at(t_b)) < 0.0:
+        return t_b      # re-integrating the last step lands on s = 0 within round-off
+    return brentq(lambda tt: slip_of(state_at(tt)), lo, hi, xtol=xtol, rtol=8.9e-16)
 
 
 def _force_extrema(ts, ys, dense, rate, force, rel_tol=1e-6):

@@ -98,6 +98,16 @@ class FrictionLaw:
         return 0.0
 
     # -- fast paths --------------------------------------------------------
+    def scalar_sliding(self, normal_load):
+        """``speed -> sliding_force(speed, (), normal_load)`` for a stateless law on
+        Python floats (the ODE hot loop calls it at every evaluation); laws may
+        return a specialised closure, which must agree with ``sliding_force``."""
+        sliding = self.sliding_force
+
+        def force(speed):
+            return sliding(speed, (), normal_load)
+        return force
+
     def closed_form(self, normal_load):
         """``(static or None, kinetic, viscous)`` forces if the law is Coulomb + viscous."""
         return None
@@ -191,6 +201,18 @@ class StribeckExponential(FrictionLaw):
         else:
             drop = (self.static - self.kinetic) * np.exp(-(np.asarray(speed) / self.stribeck_velocity) ** self.shape)
         return normal_load * (self.kinetic + drop) + self.viscous * speed
+
+    def scalar_sliding(self, normal_load):
+        n_k, n_drop = normal_load * self.kinetic, normal_load * (self.static - self.kinetic)
+        inv_vs, shape, viscous, exp = 1.0 / self.stribeck_velocity, self.shape, self.viscous, math.exp
+        if shape == 2.0:
+            def force(speed):
+                w = speed * inv_vs
+                return n_k + n_drop * exp(-w * w) + viscous * speed
+        else:
+            def force(speed):
+                return n_k + n_drop * exp(-(speed * inv_vs) ** shape) + viscous * speed
+        return force
 
     def static_force(self, state, normal_load):
         return self.static * normal_load

@@ -173,3 +173,71 @@ def test_massless_limits():
     with pytest.raises(ValueError, match="initial_state"):
         SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
                     law=STICK_LAWS["contact_age"]).simulate(1.0, initial_state=[1.0, 2.0])
+
+
+@pytest.mark.parametrize("law", [
+    laws.Coulomb(static=1.0, kinetic=0.5, viscous=0.3),
+    laws.StribeckExponential(static=1.0, kinetic=0.5, stribeck_velocity=0.05),
+    laws.StribeckExponential(static=1.0, kinetic=0.5, stribeck_velocity=0.05, shape=1.3, viscous=0.2),
+    laws.StribeckSchnelle(),
+    laws.ExponentialWeakening(static=1.0, kinetic=0.5, velocity_scale=0.1),
+], ids=lambda law: type(law).__name__)
+def test_scalar_sliding_agrees_with_sliding_force(law):
+    """The hot-loop closure of a stateless law is the same curve as sliding_force."""
+    fast = law.scalar_sliding(1.7)
+    for speed in (0.0, 1e-4, 0.01, 0.05, 0.3, 2.0, 40.0):
+        assert fast(speed) == pytest.approx(float(law.sliding_force(speed, (), 1.7)), rel=1e-14, abs=1e-300)
+
+
+def test_restick_root_newton_and_brentq_fallback():
+    from reduced_model.hybrid import _restick_root
+
+    def state_at(t):
+        return np.array([0.0, math.cos(t) - 0.5])
+
+    def slip_of(z):
+        return float(z[1])
+
+    root = math.pi / 3
+    exact_rate = (lambda t, z: -math.sin(t))
+    assert _restick_root(state_at, slip_of, exact_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
+        pytest.approx(root, rel=0, abs=4e-16)
+    # a rate that sends Newton out of the bracket: brentq on the same map finishes the job
+    wrong_rate = (lambda t, z: 1.0)
+    assert _restick_root(state_at, slip_of, wrong_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
+        pytest.approx(root, rel=0, abs=4e-16)
+    # zero slip at the start of the bracket: the slip ends at once
+    assert _restick_root(state_at, slip_of, exact_rate, root, np.array([0.0, 0.0]), 1.2, state_at(1.2)) == root
+
+
+def test_stribeck_ode_events_converge_over_many_cycles():
+    """The benchmark problem: 41 events over 300 time units; per-slip errors accumulate
+    (each cycle starts from the previous one), so this checks the slip integration
+    and the re-stick root together."""
+    law = laws.StribeckExponential(static=1.0, kinetic=0.5, stribeck_velocity=0.05)
+    b = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1, damping=0.02, law=law)
+
+    def events(rtol):
+        r = b.simulate(300.0, rtol=rtol, samples_per_segment=16)
+        assert r.energy.closure <= 1e-8, r.energy
+        return np.array([e.time for e in r.events])
+
+    tight = events(1e-12)
+    assert tight.size == 41
+    np.testing.assert_allclose(events(1e-10), tight, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(events(1e-7), tight, rtol=0, atol=1e-6)
+
+
+def test_stateless_ode_slip_is_mirror_symmetric():
+    """Launched backwards, a free Stribeck oscillator is the mirror image of the forward one
+    (slip direction -1 through the whole fast path: reversals, re-stick, ledger)."""
+    law = laws.StribeckExponential(static=0.3, kinetic=0.2, stribeck_velocity=0.05)
+    free = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.0, drive="fixed", damping=0.01, law=law)
+    fwd = free.simulate(40.0, initial_velocity=2.0)
+    bwd = free.simulate(40.0, initial_velocity=-2.0)
+    assert [e.kind for e in fwd.events] == [e.kind for e in bwd.events]
+    assert "reversal" in [e.kind for e in fwd.events] and fwd.events[-1].kind == "stick"
+    np.testing.assert_allclose([e.time for e in bwd.events], [e.time for e in fwd.events], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(bwd.x, -fwd.x, rtol=0, atol=1e-12)
+    assert fwd.v[-1] == 0.0 and bwd.v[-1] == 0.0
+    assert fwd.energy.closure <= 1e-8 and bwd.energy.closure <= 1e-8
