@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -329,16 +327,7 @@ def to_json(doc: dict) -> str:
     return json.dumps(_clean(doc), indent=2, ensure_ascii=False, allow_nan=False)
 
 
-def _atomic_write(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+from .atomic import write_atomic as _atomic_write  # noqa: E402  (kept name for callers)
 
 
 def per_cycle_csv(per_cycle: dict) -> str:

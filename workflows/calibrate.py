@@ -74,7 +74,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -834,14 +833,6 @@ def write_calibration(cal: Calibration, path=None) -> Path:
     from analysis.report import to_json
 
     path = Path(path) if path is not None else cal.main.run.run_dir / "calibration.json"
-    text = to_json(cal.as_dict()) + "\n"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    from analysis.atomic import write_atomic
+
+    return write_atomic(path, to_json(cal.as_dict()) + "\n")

@@ -6,7 +6,6 @@ the MD calibration handed to the SFB check; ``--json`` prints the document.
 """
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 

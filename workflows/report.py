@@ -19,7 +19,6 @@ import io
 import json
 import math
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -677,17 +676,7 @@ def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str,
     return "\n".join(lines) + "\n", files
 
 
-def _write_atomic(path: Path, data) -> None:
-    mode = "wb" if isinstance(data, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, mode) as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+from analysis.atomic import write_atomic as _write_atomic  # noqa: E402
 
 
 # ---------------------------------------------------------------------------

@@ -18,7 +18,6 @@ engine's own message) at the end; a failed run keeps its partial trace.
 from __future__ import annotations
 
 import json
-import math
 import os
 import platform
 import re
@@ -64,11 +63,7 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
-def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so that readers never see a half-written file."""
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+from analysis.atomic import write_atomic  # noqa: E402  (re-exported for callers)
 
 
 def write_json(path: Path, data: dict) -> None:

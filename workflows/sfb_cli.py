@@ -12,7 +12,6 @@ it to SI.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 from reduced_model.units import OMCTS, LJUnits

@@ -51,6 +51,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from analysis.atomic import write_atomic
+
 import numpy as np
 
 __all__ = ["GridAxis", "SweepPoint", "SweepPlan", "CriticalVelocity", "Aggregate",
@@ -333,9 +335,7 @@ def _write_if_changed(path: Path, text: str) -> bool:
     keeps Snakemake from re-running a point whose parameters did not change."""
     if path.exists() and path.read_text() == text:
         return False
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    write_atomic(path, text)
     return True
 
 
@@ -953,9 +953,7 @@ def _csv(rows: list[dict]) -> str:
 
 
 def _write_bytes(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
+    write_atomic(path, data)
 
 
 # ---------------------------------------------------------------------------
