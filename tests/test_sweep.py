@@ -297,6 +297,10 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path):
             assert time.time() < deadline, "no point completed in 120 s"
             time.sleep(0.1)
         assert any("lmp" in cmd for cmd in processes_in(out)), "an engine is running"
+        before = set(completed(out))
+        # the point whose run is in progress: points/.<point>.tmp-<pid>/
+        running = {p.parent.name[1:].rsplit(".tmp-", 1)[0]
+                   for p in out.glob("points/.*.tmp-*/trace.dat")}
         proc.send_signal(signal.SIGTERM)
         rc = proc.wait(timeout=60)
     finally:
@@ -305,7 +309,12 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path):
     log = proc.stdout.read()
     assert rc == 130, log[-3000:]
     done = completed(out)
-    assert 1 <= len(done) < 3, "the kill must land mid-sweep"
+    assert before <= set(done), "a point finished before the kill was lost"
+    interrupted = running - {p.parent.name for p in before}
+    assert interrupted, "no run was in progress when the sweep was killed"
+    for name in interrupted:
+        assert not (out / "points" / name / "run.json").exists(), \
+            f"the interrupted point {name} was put in place as if it had completed"
     kept = {p: (p.stat().st_ino, p.stat().st_mtime_ns) for p in done}
     for p in done:
         assert json.loads(p.read_text())["status"] == "completed"
