@@ -23,6 +23,19 @@ from .trajectory import Problem
 __all__ = ["run_closed_form", "stick_break_time"]
 
 
+def settle(held_force: float, static: float) -> tuple[str, float]:
+    """What a block at rest on its surface does: ``("stick", ...)`` when the
+    contact can hold ``held_force`` (|F| <= static), else ``("slip", ...)``;
+    the second value is the direction of the force, the way a slip goes.
+
+    Example
+    -------
+    >>> settle(-2.0, 1.0)
+    ('slip', -1.0)
+    """
+    return ("stick" if abs(held_force) <= static else "slip"), math.copysign(1.0, held_force)
+
+
 def stick_break_time(held_force: float, rate: float, static: float) -> float:
     """Time until ``|held_force + rate t|`` reaches ``static`` (inf if never).
 
@@ -55,11 +68,7 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float):
     sigma = 1.0
     mode = "slip"
     if not smooth and v == u:
-        held = K * (xa - x) - d * u
-        if abs(held) <= static:
-            mode = "stick"
-        else:
-            sigma = math.copysign(1.0, held)
+        mode, sigma = settle(K * (xa - x) - d * u, static)
     elif v != u:
         sigma = math.copysign(1.0, v - u)
 
@@ -116,11 +125,6 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float):
         if tau is None:
             break
         t += end
-        held = K * (xa - x) - d * u
-        if abs(held) <= static:
-            mode = "stick"
-            rec.event("stick", t, K * (xa - x))
-        else:
-            sigma = math.copysign(1.0, held)
-            rec.event("reversal", t, K * (xa - x))
+        mode, sigma = settle(K * (xa - x) - d * u, static)
+        rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
     return rec.finish()

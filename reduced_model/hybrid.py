@@ -40,7 +40,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from ._checks import SimulationLimitError
-from .coulomb import stick_break_time
+from .coulomb import settle, stick_break_time
 from .trajectory import Problem
 
 __all__ = ["run_ode"]
@@ -116,11 +116,7 @@ def run_ode(p: Problem, rtol: float = 1e-10):
 
     sigma, mode = 1.0, "slip"
     if has_stick and v == u:
-        held = K * (xa - x) - d * u
-        if abs(held) <= law.static_force(state, N):
-            mode = "stick"
-        else:
-            sigma = math.copysign(1.0, held)
+        mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
     elif v != u:
         sigma = math.copysign(1.0, v - u)
 
@@ -159,13 +155,8 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             if not ended:
                 break
             t += ts[-1]
-            held = K * (xa - x) - d * u
-            if abs(held) <= law.static_force(state, N):
-                mode = "stick"
-                rec.event("stick", t, K * (xa - x))
-            else:
-                sigma = math.copysign(1.0, held)
-                rec.event("reversal", t, K * (xa - x))
+            mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
+            rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
             continue
 
         xa_seg, sig = xa, sigma
@@ -218,13 +209,8 @@ def run_ode(p: Problem, rtol: float = 1e-10):
         if not ended:
             break
         t += ts[-1]
-        held = K * (xa - x) - d * u
-        if abs(held) <= law.static_force(state, N):
-            mode = "stick"
-            rec.event("stick", t, K * (xa - x))
-        else:
-            sigma = math.copysign(1.0, held)
-            rec.event("reversal", t, K * (xa - x))
+        mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
+        rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
     return rec.finish()
 
 

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from ._checks import finite, non_negative, positive
+from ._checks import non_negative, positive
 from .laws import ContactAge, Coulomb, RateState
 from .oscillator import DampedOscillator
 from .springblock import SpringBlock
