@@ -269,15 +269,22 @@ def resolve(raw: dict[str, Any], overrides: dict[str, Any] | None = None) -> dic
     return resolved
 
 
-def parse_assignment(text: str) -> tuple[str, float | int]:
-    """``KEY=VALUE`` from the command line; VALUE must be a number."""
+def split_parameter(text: str, flag: str, form: str) -> tuple[str, str]:
+    """``KEY`` and the text after ``=`` of a command-line ``KEY=...`` (``--set``,
+    ``--grid``); KEY must name a scene parameter."""
     if "=" not in text:
-        raise SceneError(f"--set {text!r}: expected KEY=VALUE")
-    key, _, value = text.partition("=")
+        raise SceneError(f"{flag} {text!r}: expected {form}")
+    key, _, rest = text.partition("=")
     key = key.strip()
     if key not in PARAMETERS:
-        raise SceneError(f"--set {key!r}: unknown parameter; known: "
+        raise SceneError(f"{flag} {text!r}: unknown parameter {key!r}; known: "
                          f"{', '.join(sorted(PARAMETERS))}")
+    return key, rest
+
+
+def parse_assignment(text: str) -> tuple[str, float | int]:
+    """``KEY=VALUE`` from the command line; VALUE must be a number."""
+    key, value = split_parameter(text, "--set", "KEY=VALUE")
     kind = PARAMETERS[key].kind
     try:
         number = int(value) if kind is int else float(value)

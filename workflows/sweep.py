@@ -141,15 +141,9 @@ def parse_grid(text: str) -> GridAxis:
     >>> parse_grid("seed=1,2").values
     (1, 2)
     """
-    from .scene import PARAMETERS, SceneError
+    from .scene import PARAMETERS, SceneError, split_parameter
 
-    if "=" not in text:
-        raise SceneError(f"--grid {text!r}: expected KEY=START:STOP:N[:log] or KEY=V1,V2,...")
-    key, _, body = text.partition("=")
-    key = key.strip()
-    if key not in PARAMETERS:
-        raise SceneError(f"--grid {text!r}: unknown parameter {key!r}; known: "
-                         f"{', '.join(sorted(PARAMETERS))}")
+    key, body = split_parameter(text, "--grid", "KEY=START:STOP:N[:log] or KEY=V1,V2,...")
     kind = PARAMETERS[key].kind
 
     def number(s: str, what: str) -> float:
