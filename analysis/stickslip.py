@@ -22,11 +22,14 @@ reduced-model traces: nothing here depends on the unit system.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+
+from .atomic import write_atomic
 
 __all__ = ["CycleTable", "SlipEvents", "cycle_table", "detect_slips",
            "noise_level", "classify_regime", "ramp_forces", "REGIME_CV_MAX"]
@@ -137,13 +140,14 @@ class CycleTable:
         path = Path(path)
         names = ("yield_index", "stick_index") + _COLUMNS
         cols = [np.asarray(getattr(self, n)) for n in names]
-        with path.open("w", newline="") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(names)
-            for row in zip(*cols):
-                writer.writerow(["" if (isinstance(v, float) and math.isnan(v))
-                                 else repr(v.item()) if hasattr(v, "item") else v
-                                 for v in row])
+        buf = io.StringIO(newline="")
+        writer = csv.writer(buf)
+        writer.writerow(names)
+        for row in zip(*cols):
+            writer.writerow(["" if (isinstance(v, float) and math.isnan(v))
+                             else repr(v.item()) if hasattr(v, "item") else v
+                             for v in row])
+        write_atomic(path, buf.getvalue())
         return path
 
 

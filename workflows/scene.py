@@ -68,6 +68,9 @@ class Parameter:
         return value
 
 
+# A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
+WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
+
 P = Parameter
 # Physics' own names: these are the user-facing contract.
 PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
@@ -94,7 +97,7 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("cells_y", int, "-", 4, 1, 200,
       "wall row pairs along y (Ly = cells_y * sqrt(3) * wall_spacing)"),
     P("timestep", float, "tau", 0.005, 0.0, 0.05, "integration step", low_open=True),
-    P("cutoff", float, "sigma", 2.5, 2.0 ** (1.0 / 6.0), 6.0,
+    P("cutoff", float, "sigma", 2.5, WCA_CUTOFF, 6.0,
       "LJ cutoff (2^(1/6) = purely repulsive WCA)"),
     P("thermostat_damping", float, "tau", 1.0, 0.0, 1.0e6,
       "Langevin damping time of the film thermostat", low_open=True),
@@ -132,8 +135,6 @@ NEEDS_PROFILES = {"profiles"}
 # energy for LJ atoms of unit mass at liquid density; a stiffer wall-film
 # interaction shortens the fastest vibration as 1/sqrt(eps_wf).
 LJ_TIMESTEP_LIMIT = 0.01
-# A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
-WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
 # Resolve the wall-on-spring oscillation with at least this many steps.
 STEPS_PER_SPRING_PERIOD = 50
 

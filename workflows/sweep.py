@@ -913,14 +913,14 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
     doc["run_dirs"] = [r["run_dir"] for r in rows]
     outputs = ["aggregate.json", "aggregate.csv"]
     if figures:
-        _write_bytes(sweep_dir / "velocity_map.png", fig_velocity_map(doc))
+        write_atomic(sweep_dir / "velocity_map.png", fig_velocity_map(doc))
         outputs.append("velocity_map.png")
         if vk:
-            _write_bytes(sweep_dir / "vk_map.png", fig_vk_map(doc))
+            write_atomic(sweep_dir / "vk_map.png", fig_vk_map(doc))
             outputs.append("vk_map.png")
     doc["outputs"] = outputs
-    _write_bytes(sweep_dir / "aggregate.csv", _csv(rows).encode())
-    _write_bytes(sweep_dir / "aggregate.json", _dumps(_clean(doc)).encode())
+    write_atomic(sweep_dir / "aggregate.csv", _csv(rows).encode())
+    write_atomic(sweep_dir / "aggregate.json", _dumps(_clean(doc)).encode())
     return doc
 
 
@@ -946,8 +946,6 @@ def _csv(rows: list[dict]) -> str:
     return buf.getvalue()
 
 
-def _write_bytes(path: Path, data: bytes) -> None:
-    write_atomic(path, data)
 
 
 # ---------------------------------------------------------------------------

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
 import math
 import multiprocessing
@@ -52,7 +53,9 @@ from pathlib import Path
 
 import numpy as np
 
-WCA = 2.0 ** (1.0 / 6.0)
+from analysis.atomic import write_atomic
+
+from .scene import WCA_CUTOFF as WCA
 SCENE = "stick-slip"
 
 # name -> unit; the order is the order of the table's columns
@@ -399,7 +402,7 @@ def _rk45_cycles(rtol: float, duration: float):
     r = REDUCED
     M, K, V, d = r["mass"], r["stiffness"], r["drive_velocity"], r["damping"]
     fs, fk, b = r["static"], r["kinetic"], r["viscous"]
-    t, x, v = 0.0, 0.0, 0.0
+    t, x = 0.0, 0.0
     ts, fs_, xs, kinds = [0.0], [0.0], [0.0], ["start"]
     while t < duration:
         # stick: the force K (V t - x) rises linearly to Fs (SpringBlock's damper acts
@@ -564,12 +567,12 @@ def columns() -> list[str]:
 
 def write_csv(rows: list[dict], path: Path) -> Path:
     cols = columns()
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=cols, extrasaction="ignore")
-        w.writeheader()
-        for row in rows:
-            w.writerow({c: _fmt(row.get(c)) for c in cols})
-    return path
+    buf = io.StringIO(newline="")
+    w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore")
+    w.writeheader()
+    for row in rows:
+        w.writerow({c: _fmt(row.get(c)) for c in cols})
+    return write_atomic(path, buf.getvalue())
 
 
 def _fmt(v):
@@ -665,7 +668,7 @@ def study(quick: bool, out: Path, nprocs: int = 2, log=print) -> list[dict]:
     rows = md_rows(p, out, nprocs, log) + reduced_rows()
     rows = [{k: _clean(v) for k, v in r.items()} for r in rows]
     write_csv(rows, out / "tradeoff.csv")
-    (out / "tradeoff.json").write_text(json.dumps(rows, indent=1, allow_nan=False) + "\n")
+    write_atomic(out / "tradeoff.json", json.dumps(rows, indent=1, allow_nan=False) + "\n")
     plot([{k: (math.nan if v is None else v) for k, v in r.items()} for r in rows], out)
     return rows
 
