@@ -10,17 +10,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import subprocess
 import tempfile
 from pathlib import Path
 
 import md_inputs
 from . import engine
+from .runner import atom_steps_per_second, loop_atoms
 from .scene import load, parse_assignment
 
-_PERF = re.compile(r"Performance: .*?([0-9.]+) timesteps/s, ([0-9.]+) (\w?)atom-step/s")
-_ATOMS = re.compile(r"Loop time of [0-9.]+ on \d+ procs for (\d+) steps with (\d+) atoms")
 
 
 def register(subparsers) -> None:
@@ -40,10 +38,10 @@ def _run(cmd, cwd) -> tuple[float, int]:
     if out.returncode != 0 or "ERROR" in out.stdout:
         err = [l for l in out.stdout.splitlines() if "ERROR" in l] or [out.stderr.strip()]
         raise RuntimeError(f"LAMMPS failed: {err[0]}")
-    perf = _PERF.findall(out.stdout)
-    atoms = _ATOMS.findall(out.stdout)
-    value, scale = float(perf[-1][1]), {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}[perf[-1][2]]
-    return value * scale, int(atoms[-1][1])
+    lines = out.stdout.splitlines()
+    rates = [r for r in map(atom_steps_per_second, lines) if r is not None]
+    atoms = [n for n in map(loop_atoms, lines) if n is not None]
+    return rates[-1], atoms[-1]
 
 
 def bulk_cells(n_atoms: int) -> tuple[int, int, int]:

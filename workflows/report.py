@@ -766,15 +766,15 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     if not run_dirs:
         raise ValueError("no run directory given (a sweep without completed runs?)")
     failures = dict(failures or {})
-    run = load_run(run_dirs[0])          # a report needs at least the main run's trace
     if calibration is None and "calibration" not in failures:
         calibration = _attempt(failures, "calibration", calibrate, run_dirs)
     if sfb is None and "sfb" not in failures:
         from workflows.sfb import sfb_check
         md = calibration.md_calibration if calibration is not None else None
         sfb = _attempt(failures, "sfb", sfb_check, md)
-    if calibration is not None:
-        run = calibration.main.run
+    # the calibration has read the main run already; without one, the report
+    # still needs at least the main run's trace
+    run = calibration.main.run if calibration is not None else load_run(run_dirs[0])
     out = Path(out) if out is not None else run.run_dir / "report.html"
     scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
     title = f"filmfriction report — {scene} ({run.run_dir.name})"

@@ -138,6 +138,19 @@ _STAGE = re.compile(r"^FILMFRICTION stage (\w+) (\d+)")
 _ATOMS = re.compile(r"^FILMFRICTION atoms film=(\d+) top=(\d+) area=([0-9.eE+-]+)")
 _PERF = re.compile(r"Performance: .*?([0-9.]+) timesteps/s, ([0-9.]+) (\w?)atom-step/s")
 _ATOMS_TOTAL = re.compile(r"Loop time of [0-9.]+ on \d+ procs for \d+ steps with (\d+) atoms")
+_SI_PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
+
+
+def atom_steps_per_second(line: str) -> float | None:
+    """Throughput from a LAMMPS "Performance:" line (None for any other line)."""
+    m = _PERF.search(line)
+    return float(m.group(2)) * _SI_PREFIX.get(m.group(3), 1.0) if m else None
+
+
+def loop_atoms(line: str) -> int | None:
+    """Atom count from a LAMMPS "Loop time of ..." line (None for any other line)."""
+    m = _ATOMS_TOTAL.search(line)
+    return int(m.group(1)) if m else None
 
 
 @dataclass
@@ -186,14 +199,13 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
                     outcome.film_atoms, outcome.top_atoms = int(m.group(1)), int(m.group(2))
                     outcome.area = float(m.group(3))
                     continue
-                m = _PERF.search(line)
-                if m:
-                    scale = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}.get(m.group(3), 1.0)
-                    outcome.atom_steps_per_second.append(float(m.group(2)) * scale)
+                rate = atom_steps_per_second(line)
+                if rate is not None:
+                    outcome.atom_steps_per_second.append(rate)
                     continue
-                m = _ATOMS_TOTAL.search(line)
-                if m:
-                    outcome.total_atoms = int(m.group(1))
+                atoms = loop_atoms(line)
+                if atoms is not None:
+                    outcome.total_atoms = atoms
                     continue
                 m = _THERMO_LINE.match(line)
                 if m and stage_name in ("equilibrate", "slide", "resume"):
@@ -456,13 +468,14 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
     ref = at[0] if len(at) else (keep[-1] if len(keep) else None)
     if ref is None:
         raise SceneError(f"{run_dir}/trace.dat has no rows up to the restart step {step}")
+    # trace positions are relative to the slide's start; LAMMPS saved that origin
+    # (read before trace.dat is trimmed, so a refusal loses nothing)
+    origin = _slide_origin(run_dir)
     _rewrite_trace_dat(run_dir / "trace.dat", keep)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
-    first = read_trace_dat_first(run_dir / "trace.dat")
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
-    # trace positions are relative to the slide's start; LAMMPS saved that origin
-    variables["drive_origin"], variables["wall_z0"] = _slide_origin(run_dir, first)
+    variables["drive_origin"], variables["wall_z0"] = origin
     variables["drive_work0"] = repr(float(ref[col["drive_work"]]))
     variables["heat0"] = repr(float(ref[col["thermostat_heat"]]))
     variables["mount_heat0"] = repr(float(ref[col["mount_heat"]]))
@@ -479,15 +492,8 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
                   scene.parameters["equilibrate_steps"] + step, progress)
 
 
-def read_trace_dat_first(path: Path):
-    dat = read_trace_dat(path)
-    return dat[0] if len(dat) else None
-
-
-def _slide_origin(run_dir: Path, first) -> tuple[str, str]:
+def _slide_origin(run_dir: Path) -> tuple[str, str]:
     """Absolute wall x and z at the slide's start (slide_origin.txt, written by LAMMPS)."""
-    if first is None:
-        raise SceneError(f"{run_dir}/trace.dat has no rows: cannot resume")
     origin_file = run_dir / "slide_origin.txt"
     if not origin_file.exists():
         raise SceneError(f"{origin_file} is missing: cannot resume")

@@ -68,6 +68,10 @@ class Parameter:
         return value
 
 
+# Steps between samples of the drive's and the mount's power (at most): they
+# change over hundreds of steps, and sampling every step cost a fifth of a run.
+WORK_EVERY = 10
+
 # A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
 
@@ -173,6 +177,9 @@ class Scene:
         for name, value in p.items():
             kind = PARAMETERS[name].kind
             out[name] = str(int(value)) if kind is int else repr(float(value))
+        # the drive and mount powers are integrated from samples every work_every
+        # steps; the trace and the restarts must fall on samples
+        out["work_every"] = str(math.gcd(WORK_EVERY, p["trace_every"], p["restart_every"]))
         return out
 
     def as_dict(self) -> dict:
