@@ -330,9 +330,8 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
         "outputs": {
             "trace": True,
             "trajectory": scene.writes_trajectory,
-            "trajectory_reason": ("asked for by observables "
-                                  + ", ".join(o for o in scene.observables if o == "structure"))
-            if scene.writes_trajectory else "no structural observable asked: no dump",
+            "trajectory_reason": "asked for by observable 'structure'" if scene.writes_trajectory
+            else "no structural observable asked: no dump",
             "profiles": scene.writes_profiles,
             "profiles_reason": "asked for by observable 'profiles'" if scene.writes_profiles
             else "no profile observable asked: no fix ave/chunk",
