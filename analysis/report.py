@@ -61,8 +61,42 @@ def _drive_velocity(trace: Trace) -> tuple[float | None, str]:
     return None, ""
 
 
-def _not_sliding(trace: Trace, half: slice) -> str | None:
-    """Why the last half of a slip-free trace is not steady sliding, or None.
+def _sliding(trace: Trace, half: slice) -> dict:
+    """The last half of the trace as a sliding state: time-averaged spring force
+    (block-average error), the wall's mean velocity (slope of wall_position,
+    else mean of wall_velocity) and its ratio to the drive's, the force's trend."""
+    t = np.asarray(trace.columns["time"], float)[half]
+    f = np.asarray(trace.columns["spring_force"], float)[half]
+    v_drive, _ = _drive_velocity(trace)
+    wall = None
+    if trace.has("wall_position") and t.size > 2:
+        wall = float(np.polyfit(t, np.asarray(trace.columns["wall_position"], float)[half], 1)[0])
+    elif trace.has("wall_velocity") and t.size:
+        wall = float(np.mean(np.asarray(trace.columns["wall_velocity"], float)[half]))
+    mean, err = viscosity.block_mean(f)
+    trend = float(np.polyfit(t, f, 1)[0]) * float(t[-1] - t[0]) if t.size > 2 else math.nan
+    ratio = wall / v_drive if (wall is not None and v_drive) else None
+    return {"mean_force": mean, "mean_force_stderr": err, "wall_velocity": wall,
+            "wall_velocity_ratio": ratio, "force_trend": trend}
+
+
+def _sliding_doc(s: dict, lab) -> dict:
+    return {"samples": "last half of the trace",
+            "mean_force": _value(s["mean_force"], s["mean_force_stderr"], lab("force")),
+            "wall_velocity": _value(s["wall_velocity"], None, lab("velocity")),
+            "wall_velocity_ratio": _num(s["wall_velocity_ratio"])}
+
+
+def sliding_section(trace: Trace) -> dict:
+    """``analysis.json``'s ``sliding`` section for ``trace``: the time-averaged
+    spring force over the last half (block-average error) and the wall's mean
+    velocity there, also as a ratio to the drive's."""
+    return _sliding_doc(_sliding(trace, slice(len(trace) // 2, None)),
+                        lambda q: unit(trace.parameters.units, q))
+
+
+def _not_sliding(s: dict) -> str | None:
+    """Why the last half of a slip-free trace (``_sliding``) is not steady sliding.
 
     No slips is not enough: a wall stuck for the whole run (V -> 0, a soft
     spring) has no slip either, and its ramping force over V/D would be a
@@ -70,25 +104,14 @@ def _not_sliding(trace: Trace, half: slice) -> str | None:
     velocity (within 20 %); without wall columns, the force has no trend
     (its change over the half is below 10 % of its mean).
     """
-    t = np.asarray(trace.columns["time"], float)[half]
-    v_drive, _ = _drive_velocity(trace)
-    wall = None
-    if trace.has("wall_velocity"):
-        wall = float(np.mean(np.asarray(trace.columns["wall_velocity"], float)[half]))
-    elif trace.has("wall_position") and t.size > 2:
-        x = np.asarray(trace.columns["wall_position"], float)[half]
-        wall = float(np.polyfit(t, x, 1)[0])
-    if wall is not None and v_drive:
-        if abs(wall - v_drive) > 0.2 * abs(v_drive):
-            return (f"the wall moves at {wall:.3g} on average, not at the drive's "
-                    f"{v_drive:.3g}: it is not sliding steadily")
+    if s["wall_velocity_ratio"] is not None:
+        if abs(s["wall_velocity_ratio"] - 1.0) > 0.2:
+            return (f"the wall moves at {s['wall_velocity_ratio']:.3g} × the drive's "
+                    "velocity on average: it is not sliding steadily")
         return None
-    f = np.asarray(trace.columns["spring_force"], float)[half]
-    if t.size > 2:
-        trend = float(np.polyfit(t, f, 1)[0]) * float(t[-1] - t[0])
-        if abs(trend) > 0.1 * abs(float(np.mean(f))):
-            return (f"the force changes by {trend:.3g} over the last half (mean "
-                    f"{float(np.mean(f)):.3g}): not steady")
+    if abs(s["force_trend"]) > 0.1 * abs(s["mean_force"]):
+        return (f"the force changes by {s['force_trend']:.3g} over the last half (mean "
+                f"{s['mean_force']:.3g}): not steady")
     return None
 
 
@@ -206,13 +229,17 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         skipped["energy.ledger"] = f"missing column(s) {', '.join(missing)}"
     doc["energy"] = energy
 
+    # --- the last half as a sliding state (time-averaged friction, wall speed)
+    half = slice(len(trace) // 2, None)
+    sl = _sliding(trace, half)
+    doc["sliding"] = _sliding_doc(sl, lab)
+
     # --- viscosity
     visc: dict = {}
-    half = slice(len(trace) // 2, None)
     try:
         if regime != "smooth":
             raise MissingInput("steady sliding", f"steady viscosity (regime is {regime})")
-        why_not = _not_sliding(trace, half)
+        why_not = _not_sliding(sl)
         if why_not:
             raise MissingInput("steady sliding", f"steady viscosity ({why_not})")
         area = p.require("area", "η_eff = (F/A)/γ̇")

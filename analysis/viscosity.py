@@ -43,12 +43,25 @@ class SteadyViscosity:
     thickness: float
 
 
-def _block_stderr(x: np.ndarray, blocks: int = 10) -> float:
+def block_mean(x, blocks: int = 10) -> tuple[float, float]:
+    """Mean of correlated samples and its standard error from block averages.
+
+    NaN samples are ignored; the error is NaN when there are fewer samples
+    than blocks.
+    """
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return math.nan, math.nan
     n = x.size // blocks
     if n < 1 or blocks < 2:
-        return math.nan
+        return float(x.mean()), math.nan
     means = x[: n * blocks].reshape(blocks, n).mean(axis=1)
-    return float(means.std(ddof=1) / math.sqrt(blocks))
+    return float(x.mean()), float(means.std(ddof=1) / math.sqrt(blocks))
+
+
+def _block_stderr(x: np.ndarray, blocks: int = 10) -> float:
+    return block_mean(x, blocks)[1]
 
 
 def steady_viscosity(spring_force, area: float, velocity: float,

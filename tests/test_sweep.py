@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from analysis.report import sliding_section
+from analysis.trace import read_trace
 from workflows import sweep
 from workflows.scene import SceneError
 
@@ -148,10 +150,12 @@ def fake_point(sweep_dir, plan, name, regime, slips, eta, rate):
     np.savetxt(run_dir / "trace.csv", np.column_stack([t, force, v * t]), delimiter=",",
                header="time,spring_force,wall_position", comments="")
     e = lambda m, s=None: {"mean": m, "stderr": s}  # noqa: E731
+    sliding = sliding_section(read_trace(run_dir / "trace.csv", drive_velocity=v))
     doc = {"regime": regime, "slips": {"count": slips, "static_force": e(60.0, 1.0),
                                        "backward_force": e(20.0, 1.0), "period": e(10.0, 0.5),
                                        "slip_distance": e(1.0), "slip_duration": e(2.0)},
-           "viscosity": {"steady": {"eta_eff": e(eta, 0.1 * eta), "shear_rate": e(rate)}}}
+           "viscosity": {"steady": {"eta_eff": e(eta, 0.1 * eta), "shear_rate": e(rate)}},
+           "sliding": sliding}
     (run_dir / "analysis.json").write_text(json.dumps(doc))
 
 
@@ -198,6 +202,11 @@ def test_a_run_too_short_to_slip_is_unresolved_not_smooth(tmp_path):
     data = np.genfromtxt(slow, delimiter=",", names=True)
     np.savetxt(slow, np.column_stack([data["time"], data["spring_force"], 0 * data["time"]]),
                delimiter=",", header="time,spring_force,wall_position", comments="")
+    analysed = slow.parent / "analysis.json"
+    doc = json.loads(analysed.read_text())
+    v_slow = plan.parameters[plan.points[0].name]["drive_velocity"]
+    doc["sliding"] = sliding_section(read_trace(slow, drive_velocity=v_slow))
+    analysed.write_text(json.dumps(doc))
     doc = sweep.aggregate(tmp_path, figures=False)
     assert [r["sweep_regime"] for r in doc["points"]] == ["unresolved", "smooth"]
     assert doc["critical_velocity"][0]["status"] == "below_range"

@@ -677,19 +677,6 @@ def critical_velocity(velocities, regimes) -> CriticalVelocity:
     return CriticalVelocity("bracketed", value, low, high, half, monotonic, per_v, note)
 
 
-def _block_mean(x: np.ndarray, blocks: int = 10) -> tuple[float, float]:
-    """Mean and its standard error from block averages (correlated samples)."""
-    x = np.asarray(x, float)
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        return math.nan, math.nan
-    n = x.size // blocks
-    if n < 1:
-        return float(x.mean()), math.nan
-    means = x[: n * blocks].reshape(blocks, n).mean(axis=1)
-    return float(x.mean()), float(means.std(ddof=1) / math.sqrt(blocks))
-
-
 def _get(doc: dict, *path):
     for key in path:
         if not isinstance(doc, dict):
@@ -723,19 +710,15 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
         row[q] = _finite(_get(doc, "slips", q, "mean"))
         row[f"{q}_stderr"] = _finite(_get(doc, "slips", q, "stderr"))
     # the time-averaged friction: the spring force over the last half of the drive
-    # (the start-up ramp from a relaxed spring is in the first half)
-    data = np.genfromtxt(run_dir / "trace.csv", delimiter=",", names=True)
-    f = np.atleast_1d(data["spring_force"])
-    half = slice(f.size // 2, None)
-    mean, err = _block_mean(f[half])
-    row["mean_force"], row["mean_force_stderr"] = _finite(mean), _finite(err)
+    # (the start-up ramp from a relaxed spring is in the first half), as analysed
+    row["mean_force"] = _finite(_get(doc, "sliding", "mean_force", "mean"))
+    row["mean_force_stderr"] = _finite(_get(doc, "sliding", "mean_force", "stderr"))
     # "smooth" means fewer than 2 slips; a run too short for a second yield has as few,
     # but its wall stood still most of the time.  Sliding moves the wall at V on average.
-    t, x = np.atleast_1d(data["time"])[half], np.atleast_1d(data["wall_position"])[half]
-    ratio = (float(np.polyfit(t, x, 1)[0]) / p["drive_velocity"]) if t.size > 2 else math.nan
-    row["wall_velocity_ratio"] = _finite(ratio)
+    ratio = _finite(_get(doc, "sliding", "wall_velocity_ratio"))
+    row["wall_velocity_ratio"] = ratio
     row["sweep_regime"] = row["regime"]
-    if row["regime"] == SMOOTH and not ratio > STUCK_RATIO:
+    if row["regime"] == SMOOTH and not (ratio is not None and ratio > STUCK_RATIO):
         row["sweep_regime"] = STUCK
     # η_eff at its shear rate: steady sliding (V/D), else the slip fits (slip velocity / D)
     eta = rate = eta_err = None
