@@ -217,12 +217,10 @@ def test_launcher_replaces_mpiexec_by_srun():
     from workflows import engine
 
     plain = engine.lmp_command(4, Path("in.lmp"))
-    with sweep._launcher(["srun", "--mpi=pmi2"]):
-        wrapped = engine.lmp_command(4, Path("in.lmp"))
+    wrapped = engine.lmp_command(4, Path("in.lmp"), launcher=["srun", "--mpi=pmi2"])
     assert wrapped == ["srun", "--mpi=pmi2", *plain[1:]] and wrapped[2:4] == ["-n", "4"]
-    assert engine.lmp_command(4, Path("in.lmp")) == plain      # restored
-    with sweep._launcher(["mpiexec"]):
-        assert engine.lmp_command(4, Path("in.lmp")) == plain
+    assert engine.lmp_command(4, Path("in.lmp")) == plain      # no state left behind
+    assert plain[0].endswith("mpiexec")
 
 
 def test_a_second_sweep_in_the_same_directory_is_refused(tmp_path):

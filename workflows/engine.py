@@ -77,12 +77,16 @@ def engine_env(base: dict | None = None) -> dict:
 
 
 def lmp_command(nprocs: int, script: Path, variables: dict[str, str] | None = None,
-                log: Path | None = None) -> list[str]:
-    """Command line that runs ``script`` on ``nprocs`` MPI ranks."""
+                log: Path | None = None, launcher: list[str] | None = None) -> list[str]:
+    """Command line that runs ``script`` on ``nprocs`` MPI ranks.
+
+    ``launcher`` replaces the venv's ``mpiexec`` (e.g. ``["srun"]`` inside a
+    Slurm allocation); it takes the same ``-n N``.
+    """
     if not isinstance(nprocs, int) or nprocs < 1:
         raise ValueError(f"np = {nprocs!r}: need an integer >= 1 MPI ranks")
-    cmd = [str(mpiexec()), "-n", str(nprocs), str(lmp_binary()), "-in", str(script),
-           "-nocite"]
+    start = list(launcher) if launcher else [str(mpiexec())]
+    cmd = [*start, "-n", str(nprocs), str(lmp_binary()), "-in", str(script), "-nocite"]
     cmd += ["-log", str(log) if log else "none"]
     for key, value in (variables or {}).items():
         cmd += ["-var", key, value]

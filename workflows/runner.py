@@ -354,15 +354,20 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
 
 
 def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
-            progress: bool = True) -> Path:
-    """Run ``scene`` in a new directory and return it; raise RunFailed on failure."""
+            progress: bool = True, launcher: list[str] | None = None) -> Path:
+    """Run ``scene`` in a new directory and return it; raise RunFailed on failure.
+
+    ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
+    ``["srun"]`` for a sweep point inside a Slurm allocation).
+    """
     run_dir = new_run_dir(scene.name, out)
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"))
+    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"),
+                             launcher=launcher)
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
     record = _record(scene, run_dir, cmd, nprocs)

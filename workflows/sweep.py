@@ -474,32 +474,6 @@ def run_sweep(plan: SweepPlan, out: Path, cores: int = 2, *, dry_run: bool = Fal
 # ---------------------------------------------------------------------------
 # the jobs (called from the Snakefile)
 # ---------------------------------------------------------------------------
-@contextlib.contextmanager
-def _launcher(words: list[str]):
-    """Start LAMMPS with ``words`` (e.g. ``srun``) instead of the venv's mpiexec.
-
-    The runner has no launcher option yet, so the engine's command builder is
-    wrapped for the duration of one point (this process runs one point only).
-    ``srun`` takes the same ``-n N`` as ``mpiexec``.
-    """
-    from . import engine
-
-    if not words or words == ["mpiexec"]:
-        yield
-        return
-    original = engine.lmp_command
-
-    def lmp_command(nprocs, script, variables=None, log=None):
-        cmd = original(nprocs, script, variables, log)
-        return [*words, *cmd[1:]]
-
-    engine.lmp_command = lmp_command
-    try:
-        yield
-    finally:
-        engine.lmp_command = original
-
-
 def _pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -550,8 +524,9 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
     tmp = run_dir.with_name(f".{run_dir.name}.tmp-{os.getpid()}")
     stamp = time.strftime("%Y%m%d-%H%M%S")
     try:
-        with _launcher(shlex.split(launcher)):
-            execute(scene, out=tmp, nprocs=np_, progress=False)
+        words = shlex.split(launcher)
+        execute(scene, out=tmp, nprocs=np_, progress=False,
+                launcher=None if words in ([], ["mpiexec"]) else words)
     except RunFailed:
         if _INTERRUPTED:
             # the runner turns an interrupt into a failed run; for a sweep it is neither
