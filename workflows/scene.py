@@ -34,18 +34,28 @@ class SceneError(ValueError):
 
 @dataclass(frozen=True)
 class Parameter:
-    """One scene parameter: type, unit, default and allowed range (inclusive)."""
+    """One scene parameter: type, unit, default and allowed range (inclusive).
+
+    A parameter with ``choices`` is a name from that list (``kind`` str); LAMMPS
+    receives its position in the list, never the text.
+    """
 
     name: str
-    kind: type            # int or float
+    kind: type            # int, float or str (with choices)
     unit: str
-    default: float | int
+    default: float | int | str
     low: float
     high: float
     help: str
     low_open: bool = False  # True: the lower bound itself is excluded
+    choices: tuple[str, ...] = ()
 
-    def check(self, value: Any) -> float | int:
+    def check(self, value: Any) -> float | int | str:
+        if self.choices:
+            if not isinstance(value, str) or value not in self.choices:
+                raise SceneError(f"{self.name} = {value!r}: must be one of "
+                                 f"{', '.join(self.choices)} ({self.help})")
+            return value
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise SceneError(
                 f"{self.name} = {value!r}: must be a number ({self.kind.__name__}, "
@@ -71,6 +81,13 @@ class Parameter:
 # Steps between samples of the drive's and the mount's power (at most): they
 # change over hundreds of steps, and sampling every step cost a fifth of a run.
 WORK_EVERY = 10
+
+# Flexible walls: an LJ crystal of atoms twice as strongly bound and twice as
+# heavy as the film's, so its fastest vibration is the film's own (the time
+# step limit is unchanged) while it stays crystalline at kT = 1 (kT/eps_ww = 0.5,
+# below the LJ triple point 0.69).
+FLEXIBLE_WALL_EPSILON = 2.0
+FLEXIBLE_WALL_ATOM_MASS = 2.0
 
 # A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
@@ -105,6 +122,14 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
       "LJ cutoff (2^(1/6) = purely repulsive WCA)"),
     P("thermostat_damping", float, "tau", 1.0, 0.0, 1.0e6,
       "Langevin damping time of the film thermostat", low_open=True),
+    P("wall_model", str, "-", "rigid", 0, 0,
+      "rigid: each wall one rigid body; flexible: the planes facing the film are an LJ "
+      "crystal on a rigid outer plane, so heat and strain can enter the walls",
+      choices=("rigid", "flexible")),
+    P("thermostat_placement", str, "-", "film", 0, 0,
+      "film: Langevin on the film along y only; walls: on the flexible walls' atoms "
+      "(the film unthermostatted, as in an experiment); both",
+      choices=("film", "walls", "both")),
     P("mount_damping", float, "1/tau", 0.3, 0.0, 100.0,
       "mount dashpot: -gamma*M*(vx - V) in parallel with the spring, -gamma*M*vz along z"),
     P("seed", int, "-", 4928459, 1, 2**31 - 1, "random seed (velocities, thermostat)"),
@@ -175,8 +200,13 @@ class Scene:
             p["profile_every"] = 0
         out = {}
         for name, value in p.items():
-            kind = PARAMETERS[name].kind
-            out[name] = str(int(value)) if kind is int else repr(float(value))
+            spec = PARAMETERS[name]
+            if spec.choices:
+                out[name] = str(spec.choices.index(value))
+            else:
+                out[name] = str(int(value)) if spec.kind is int else repr(float(value))
+        out["wall_epsilon"] = repr(FLEXIBLE_WALL_EPSILON)
+        out["wall_atom_mass"] = repr(FLEXIBLE_WALL_ATOM_MASS)
         # the drive and mount powers are integrated from samples every work_every
         # steps; the trace and the restarts must fall on samples
         out["work_every"] = str(math.gcd(WORK_EVERY, p["trace_every"], p["restart_every"]))
@@ -200,6 +230,8 @@ def derived_quantities(p: dict) -> dict[str, float]:
     hw = math.sqrt(2.0 / 3.0) * d
     wall_layers = p["wall_layers"] or math.ceil(p["cutoff"] / hw) + 1
     omega = math.sqrt(p["spring_constant"] / p["wall_mass"])
+    flexible = p["wall_model"] == "flexible"
+    wall_per_layer = 2 * p["cells_x"] * p["cells_y"]
     return {
         "box_x": lx, "box_y": ly, "area": lx * ly,
         "film_atoms_per_layer": per_layer,
@@ -207,7 +239,10 @@ def derived_quantities(p: dict) -> dict[str, float]:
         "film_strain_x": lx / fx / fs - 1.0,
         "film_strain_y": ly / fy / (math.sqrt(3.0) * fs) - 1.0,
         "wall_layers": wall_layers,
-        "wall_atoms_per_layer": 2 * p["cells_x"] * p["cells_y"],
+        "wall_atoms_per_layer": wall_per_layer,
+        # the top wall's planes facing the film, mobile when the walls are flexible
+        "top_flexible_mass": (wall_layers - 1) * wall_per_layer * FLEXIBLE_WALL_ATOM_MASS
+        if flexible else 0.0,
         "spring_period": 2.0 * math.pi / omega,
         "timestep_limit": min(LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"])),
                               2.0 * math.pi / omega / STEPS_PER_SPRING_PERIOD),
@@ -257,6 +292,17 @@ def check_consistency(p: dict) -> None:
         raise SceneError(
             f"thermostat_damping {p['thermostat_damping']:g} tau is shorter than 10 time steps "
             f"({10 * dt:g} tau): the Langevin thermostat would be unstable")
+    flexible_mass = q["top_flexible_mass"]
+    if p["wall_mass"] <= flexible_mass:
+        raise SceneError(
+            f"wall_mass {p['wall_mass']:g} m is not above the mass of the top wall's flexible "
+            f"planes ({flexible_mass:g} m: {q['wall_layers'] - 1} planes of "
+            f"{q['wall_atoms_per_layer']} atoms of {FLEXIBLE_WALL_ATOM_MASS:g} m); with "
+            f"wall_model = 'flexible' the rigid backing carries the rest of M: raise wall_mass")
+    if p["thermostat_placement"] != "film" and p["wall_model"] != "flexible":
+        raise SceneError(
+            f"thermostat_placement = {p['thermostat_placement']!r} needs wall_model = "
+            f"'flexible': rigid walls have no thermal motion to thermostat")
     if p["profile_bin"] > 0.5 * q["wall_layers"] * math.sqrt(2 / 3) * p["wall_spacing"]:
         raise SceneError(f"profile_bin {p['profile_bin']:g} sigma is too coarse to resolve layers")
 
@@ -291,8 +337,11 @@ def split_parameter(text: str, flag: str, form: str) -> tuple[str, str]:
 
 
 def parse_assignment(text: str) -> tuple[str, float | int]:
-    """``KEY=VALUE`` from the command line; VALUE must be a number."""
+    """``KEY=VALUE`` from the command line; VALUE must be a number or, for a
+    parameter with choices, one of them."""
     key, value = split_parameter(text, "--set", "KEY=VALUE")
+    if PARAMETERS[key].choices:
+        return key, PARAMETERS[key].check(value.strip())
     kind = PARAMETERS[key].kind
     try:
         number = int(value) if kind is int else float(value)

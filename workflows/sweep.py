@@ -110,6 +110,8 @@ def _round(value: float) -> float:
 
 def format_value(value) -> str:
     """A grid value as it appears in a point name (ints plain, floats ``%.6g``)."""
+    if isinstance(value, str):
+        return value
     return str(value) if isinstance(value, int) else f"{value:.{SIGNIFICANT}g}"
 
 
@@ -145,6 +147,12 @@ def parse_grid(text: str) -> GridAxis:
 
     key, body = split_parameter(text, "--grid", "KEY=START:STOP:N[:log] or KEY=V1,V2,...")
     kind = PARAMETERS[key].kind
+    if PARAMETERS[key].choices:
+        names = tuple(PARAMETERS[key].check(v.strip()) for v in body.split(",") if v.strip())
+        if not names or len(set(names)) != len(names):
+            raise SceneError(f"--grid {text!r}: give distinct values from "
+                             f"{', '.join(PARAMETERS[key].choices)}, comma-separated")
+        return GridAxis(key=key, values=names, spec=text)
 
     def number(s: str, what: str) -> float:
         try:
