@@ -58,7 +58,10 @@ def test_every_planned_setting_is_a_valid_scene_with_one_reference_per_knob(quic
     knobs = {s.knob for s in p.settings}
     for knob in knobs:
         assert sum(s.reference for s in p.settings if s.knob == knob) == 1, knob
-    assert {"timestep", "cutoff", "thermostat_damping", "trace_every", "run_length"} <= knobs
+    assert {"timestep", "cutoff", "thermostat_damping", "trace_every", "run_length",
+            "wall_model"} <= knobs
+    if not quick:
+        assert {"box", "thermostat_placement"} <= knobs
 
 
 def test_reduced_integrators_agree_with_the_closed_form():

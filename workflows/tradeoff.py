@@ -14,9 +14,13 @@ MD: ``timestep`` (step counts rescaled so the simulated time stays the same),
 ``cutoff`` (WCA 2^(1/6), 2.5, 3.5 sigma), ``box`` (``cells_x x cells_y``, with
 the spring constant and wall mass scaled with the area so that the drive per
 area, hence the slip distance and the period, stay the same),
-``thermostat_damping``, ``trace_every`` and ``run_length`` (prefixes of the
-base run: the first 1/4, 1/2 of the slide; a shorter run with the same seed
-is exactly such a prefix).  Reduced model: ``reduced_integrator`` (closed
+``thermostat_damping``, ``trace_every`` (the output interval), ``run_length``
+(prefixes of the base run: the first 1/4, 1/2 of the slide; a shorter run with
+the same seed is exactly such a prefix), ``wall_model`` (rigid walls against
+flexible walls whose film-facing planes are an LJ crystal; reference:
+flexible) and, full study only, ``thermostat_placement`` on flexible walls
+(the film along y, the walls, both; reference: the walls, where an
+experiment's heat goes).  Reduced model: ``reduced_integrator`` (closed
 form, the ODE path at several tolerances, a plain ``solve_ivp`` RK45).
 
 Observables (``error_<name>`` in the rows): ``static_force`` (mean Fs;
@@ -30,9 +34,8 @@ cycle, atom-steps/s from ``run.json``, the peak resident memory of the LAMMPS
 processes (``getrusage(RUSAGE_CHILDREN)`` of a forked child that runs only
 that setting) and LAMMPS's own per-rank allocation estimate.
 
-Not done (they need a change of ``md_inputs/film_slide.lmp``): thermostat
-*placement* (the script thermostats the film along y only) and flexible
-thermostatted walls (the top wall is one rigid body).
+The wall-model and placement rows measure a change of the model, not only of
+its numerics: their "errors" are what the cheaper model changes in the answer.
 """
 from __future__ import annotations
 
@@ -172,6 +175,13 @@ def plan(quick: bool) -> Plan:
     traces = (50, 250) if quick else (10, 50, 250)
     for every in traces:
         add("trace_every", str(every), {"trace_every": every}, reference=every == min(traces))
+    for model in ("rigid", "flexible"):
+        add("wall_model", model, {"wall_model": model}, reference=model == "flexible")
+    if not quick:
+        for where in ("film", "walls", "both"):
+            add("thermostat_placement", where,
+                {"wall_model": "flexible", "thermostat_placement": where},
+                reference=where == "walls")
     for frac in (0.25, 0.5, 1.0):
         add("run_length", f"{frac:g}", {}, reference=frac == 1.0, prefix=frac)
     text = ("quick: the default stick-slip scene, 300 tau of slide" if quick else
