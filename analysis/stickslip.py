@@ -260,6 +260,11 @@ def _mad_std(x: np.ndarray) -> float:
     return 1.4826 * float(np.median(np.abs(x - np.median(x))))
 
 
+# s(2L)/s(L) beyond what any stationary noise gives (at most 4, for a smooth
+# process): the windows at 2L straddle slips
+STRADDLE_RATIO = 4.5
+
+
 def noise_level(spring_force, *, max_lag: int | None = None,
                 plateau: float = 1.15) -> tuple[float, int]:
     """Robust standard deviation of the fluctuations of a trace.
@@ -270,6 +275,12 @@ def noise_level(spring_force, *, max_lag: int | None = None,
     slip).  For white noise s(L) = σ at every L; for correlated (thermal)
     noise s(L) grows with L until L exceeds the correlation time.  The
     estimate is s(2L) at the first lag with s(2L)/s(L) < ``plateau``.
+
+    A ratio s(2L)/s(L) above 4.5 stops the search at s(L): no stationary
+    process grows that fast (a smooth one at most as L², a factor 4), so at 2L
+    most windows straddle a slip or its ringing.  Without this a coarse trace
+    (≈ 1 τ per sample, a few samples per ringing period) reached lags of a
+    quarter period before any plateau and took the slips for noise.
 
     Returns
     -------
@@ -292,6 +303,8 @@ def noise_level(spring_force, *, max_lag: int | None = None,
         cur = s(2 * lag)
         if prev == 0.0 or cur < plateau * prev:
             return (cur if prev else 0.0), lag
+        if cur > STRADDLE_RATIO * prev:
+            return prev, lag
         lag, prev = 2 * lag, cur
     return prev, lag
 

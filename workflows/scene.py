@@ -88,6 +88,9 @@ WORK_EVERY = 10
 # below the LJ triple point 0.69).
 FLEXIBLE_WALL_EPSILON = 2.0
 FLEXIBLE_WALL_ATOM_MASS = 2.0
+# Hottest the flexible walls may be run at: half their bond energy, well below
+# their melting near kT = 0.7 eps_ww (tests/test_md_walls.py runs it).
+FLEXIBLE_WALL_MAX_TEMPERATURE = 0.5 * FLEXIBLE_WALL_EPSILON
 
 # A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
@@ -299,6 +302,12 @@ def check_consistency(p: dict) -> None:
             f"planes ({flexible_mass:g} m: {q['wall_layers'] - 1} planes of "
             f"{q['wall_atoms_per_layer']} atoms of {FLEXIBLE_WALL_ATOM_MASS:g} m); with "
             f"wall_model = 'flexible' the rigid backing carries the rest of M: raise wall_mass")
+    if p["wall_model"] == "flexible" and p["temperature"] > FLEXIBLE_WALL_MAX_TEMPERATURE:
+        raise SceneError(
+            f"temperature {p['temperature']:g} epsilon/k_B is above "
+            f"{FLEXIBLE_WALL_MAX_TEMPERATURE:g}, the limit for flexible walls (LJ crystals "
+            f"of eps_ww = {FLEXIBLE_WALL_EPSILON:g} epsilon melt near kT = 0.7 eps_ww): "
+            f"use wall_model = 'rigid' for a hotter film")
     if p["thermostat_placement"] != "film" and p["wall_model"] != "flexible":
         raise SceneError(
             f"thermostat_placement = {p['thermostat_placement']!r} needs wall_model = "

@@ -502,6 +502,16 @@ def reduced_rows(repeat: int = 3) -> list[dict]:
 
 
 # ----------------------------------------------------------------- the study
+def _atom_steps(overrides: dict) -> float:
+    """Atoms times steps of a setting, from the scene alone (for the ETA)."""
+    from .scene import load
+
+    scene = load(SCENE, overrides)
+    p, q = scene.parameters, scene.derived()
+    atoms = q["film_atoms"] + 2 * q["wall_layers"] * q["wall_atoms_per_layer"]
+    return float(atoms * (p["equilibrate_steps"] + p["slide_steps"]))
+
+
 def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
     """Run every MD setting of ``study`` (each distinct scene once) and tabulate."""
     runs: dict[str, RunCost] = {}
@@ -511,10 +521,17 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
         key = _key({**study.base, **s.overrides})
         if key not in runs and key not in [k for k, _ in todo]:
             todo.append((key, s))
+    work = [_atom_steps({**study.base, **s.overrides}) for _, s in todo]
+    started, done = time.perf_counter(), 0.0
     for i, (key, s) in enumerate(todo, 1):
         label = f"{s.knob}={s.value}" if s.overrides else "base"
-        log(f"[{i}/{len(todo)}] {label}")
+        elapsed = time.perf_counter() - started
+        # ETA from the atom-steps done so far: settings differ in atoms and steps
+        eta = (f", about {elapsed / done * sum(work[i - 1:]) / 60:.0f} min left" if done
+               else "")
+        log(f"[{i}/{len(todo)}] {label} ({elapsed / 60:.1f} min elapsed{eta})")
         t0 = time.perf_counter()
+        done += work[i - 1]
         try:
             runs[key] = run_setting({**study.base, **s.overrides},
                                     out / "runs" / f"{i:02d}-{label.replace('=', '-')}", nprocs)
@@ -707,7 +724,11 @@ def main(args: argparse.Namespace) -> int:
     out = args.out or Path("runs") / f"tradeoff-{datetime.now():%Y%m%d-%H%M%S}"
     if out.exists():
         raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
-    log = (lambda msg: print(msg, file=sys.stderr)) if args.json else print
+    stream = sys.stderr if args.json else sys.stdout
+    # flushed: the progress lines must show while the study runs, even in a log file
+
+    def log(msg):
+        print(msg, file=stream, flush=True)
     try:
         rows = study(args.quick, out, args.np, log)
     except RuntimeError as exc:
