@@ -59,7 +59,21 @@ def test_grid_linear_log_and_list():
     assert sweep.parse_grid("temperature=0.5:0.5:1").values == (0.5,)
 
 
+def test_a_choice_axis_lists_names_and_plans_points():
+    assert sweep.parse_grid("wall_model=rigid,flexible").values == ("rigid", "flexible")
+    plan = sweep.plan_sweep("stick-slip", ["drive_velocity=0.02,0.5",
+                                           "wall_model=rigid,flexible"])
+    assert plan.points[1].name == "drive_velocity=0.02__wall_model=flexible"
+    assert plan.parameters["drive_velocity=0.5__wall_model=flexible"]["wall_model"] == "flexible"
+    # the velocity is the map's x axis; a choice can only group the points
+    doc = {"grid": [{"key": "wall_model", "values": ["rigid", "flexible"]},
+                    {"key": "drive_velocity", "values": [0.02, 0.5]}]}
+    assert sweep._numeric_axes(doc) == ["drive_velocity"]
+
+
 @pytest.mark.parametrize("text, words", [
+    ("wall_model=rigid,soft", "must be one of rigid, flexible"),
+    ("wall_model=rigid,rigid", "distinct values"),
     ("velocity=0.1:1:3", "unknown parameter 'velocity'"),
     ("drive_velocity=0:1:3:log", "START > 0"),
     ("drive_velocity=0.1:1:0", "at least 1"),

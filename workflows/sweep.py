@@ -878,7 +878,10 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
     doc["calibration_runs"] = [r["run_dir"] for r in rows if r["regime"] == STICK_SLIP]
     doc["run_dirs"] = [r["run_dir"] for r in rows]
     outputs = ["aggregate.json", "aggregate.csv"]
-    if figures:
+    if figures and not _numeric_axes(doc):
+        doc["notes"].append("no velocity_map.png: every grid axis is a choice (e.g. "
+                            "wall_model); the table compares the points")
+    elif figures:
         write_atomic(sweep_dir / "velocity_map.png", fig_velocity_map(doc))
         outputs.append("velocity_map.png")
         if vk:
@@ -942,6 +945,12 @@ def _err(x):
     return 0.0 if x is None else x
 
 
+def _numeric_axes(doc: dict) -> list[str]:
+    """Grid keys with numbers for values (a choice such as wall_model cannot be an x axis)."""
+    return [a["key"] for a in doc["grid"]
+            if all(isinstance(v, (int, float)) for v in a["values"])]
+
+
 def _plain_log_axis(axis) -> None:
     """Log axis labelled 0.01, 0.1, 1 rather than 10^-2 (and no crowded minor labels)."""
     from matplotlib.ticker import FuncFormatter, NullFormatter
@@ -960,7 +969,7 @@ def fig_velocity_map(doc: dict) -> bytes:
     plt = _plt()
     rows = doc["points"]
     keys = [a["key"] for a in doc["grid"]]
-    xkey = "drive_velocity" if "drive_velocity" in keys else keys[0]
+    xkey = "drive_velocity" if "drive_velocity" in keys else _numeric_axes(doc)[0]
     group_keys = [k for k in keys if k not in (xkey, "seed")]
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     groups: dict = {}
