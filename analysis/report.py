@@ -172,7 +172,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     doc["regime_criterion"] = (
         f"smooth: < 2 slips; stick-slip: >= 2 slips with CV(Fs) and CV(period) "
         f"<= {stickslip.REGIME_CV_MAX} (first slip excluded when >= 3); "
-        "irregular: otherwise")
+        "irregular: otherwise; unresolved: < 2 slips and the last half not steady sliding "
+        "(stuck, or too short to tell)")
     doc["detection"] = {
         "noise": {"mean": _num(events.noise), "units": lab("force")},
         "threshold": {"mean": _num(events.threshold), "units": lab("force")},
@@ -233,15 +234,19 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     half = slice(len(trace) // 2, None)
     sl = _sliding(trace, half)
     doc["sliding"] = _sliding_doc(sl, lab)
+    # fewer than 2 slips is smooth sliding only if the wall slides: a wall stuck
+    # (V -> 0, a soft spring) or a run too short for a second yield has as few
+    not_sliding = _not_sliding(sl) if regime == "smooth" else None
+    if not_sliding:
+        regime = doc["regime"] = "unresolved"
+        doc["regime_note"] = f"fewer than 2 slips, but {not_sliding}"
 
     # --- viscosity
     visc: dict = {}
     try:
         if regime != "smooth":
-            raise MissingInput("steady sliding", f"steady viscosity (regime is {regime})")
-        why_not = _not_sliding(sl)
-        if why_not:
-            raise MissingInput("steady sliding", f"steady viscosity ({why_not})")
+            why = doc.get("regime_note", f"regime is {regime}")
+            raise MissingInput("steady sliding", f"steady viscosity ({why})")
         area = p.require("area", "η_eff = (F/A)/γ̇")
         v_drive, v_src = _drive_velocity(trace)
         if v_drive is None:
