@@ -657,14 +657,24 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
             x = [r["cost_seconds"] for r in sel]
             y = [abs(r[f"error_{name}"]) for r in sel]
             e = [r[f"error_{name}_uncertainty"] for r in sel]
-            e = [v if v is not None and math.isfinite(v) else 0.0 for v in e]
+            known = [v is not None and math.isfinite(v) for v in e]
+            e = [v if k else 0.0 for v, k in zip(e, known)]
             ax.errorbar(x, y, yerr=e, fmt="o", color=colors[knob], label=knob, capsize=3)
+            # hollow: no uncertainty (a single cycle), so no measured error
+            ax.scatter([xi for xi, k in zip(x, known) if not k],
+                       [yi for yi, k in zip(y, known) if not k], s=60, color="white",
+                       edgecolors=colors[knob], zorder=3)
+            if knob == "reduced_integrator":
+                continue  # seven labels on one spot; the table names them
             for xi, yi, r in zip(x, y, sel):
                 ax.annotate(r["value"], (xi, yi), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
-        # the front is over the MD settings: the reduced model answers another question
-        # (the spring-block ODE) and would dominate any MD setting trivially
-        md = [r for r in pts if r["knob"] != "reduced_integrator"]
+        # the front is over the MD settings with a measured error: the reduced model
+        # answers another question (the spring-block ODE) and would dominate any MD
+        # setting trivially
+        md = [r for r in pts if r["knob"] != "reduced_integrator"
+              and r.get(f"error_{name}_uncertainty") is not None
+              and math.isfinite(r[f"error_{name}_uncertainty"])]
         if md:
             idx = pareto_front([r["cost_seconds"] for r in md],
                                [r[f"error_{name}"] for r in md])
