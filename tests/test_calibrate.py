@@ -133,3 +133,21 @@ def test_cli(stick_slip, capsys, tmp_path):
     doc = json.loads(capsys.readouterr().out)
     assert doc["runs"][0]["replay"]["errors"]["period"]["rel_error"] is not None
     assert cli.main(["calibrate", str(tmp_path / "missing")]) == 2
+
+
+def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
+    from types import SimpleNamespace
+
+    from analysis.trace import TraceParameters
+    from workflows.calibrate import _no_restick
+
+    def run(mass, mount=None):
+        p = TraceParameters(spring_constant=100.0, mass=mass, drive_velocity=0.02,
+                            mount_damping=mount)
+        return SimpleNamespace(trace=SimpleNamespace(parameters=p))
+
+    # the energy-partition scene: B = 97 against 2 sqrt(K M) = 89.4
+    why = _no_restick(run(20.0), 0.0, 97.0)
+    assert "overdamped (B + d = 97 >= 2 sqrt(K M) = 89.4" in why
+    # the default scene: M = 500 and the mount's 150 m/tau, underdamped: it re-sticks
+    assert _no_restick(run(500.0, 150.0), 60.0, 11.0) is None

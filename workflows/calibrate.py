@@ -458,6 +458,27 @@ class Replay:
                 "errors": {k: {kk: _num(vv) for kk, vv in v.items()} for k, v in self.errors.items()}}
 
 
+def _no_restick(run: RunData, kinetic_force: float, film_damping: float) -> str | None:
+    """Why the calibrated block cannot come back to rest, if it cannot.
+
+    With the mount's d, the slip is overdamped when B + d >= 2 sqrt(K M): the
+    velocity then relaxes towards V without ever reaching zero, and with no
+    kinetic force left to hold it the block slides on for good.  The MD film
+    re-solidifies while the wall still moves; the model has no rule for that.
+    """
+    p = run.trace.parameters
+    k, m = p.require("spring_constant"), p.require("mass")
+    damping = film_damping + (p.mount_damping or 0.0)
+    critical = 2.0 * math.sqrt(k * m)
+    if damping < critical:
+        return None
+    return (f"the calibrated slip is overdamped (B + d = {damping:.3g} >= 2 sqrt(K M) = "
+            f"{critical:.3g}, F_k = {kinetic_force:.3g}): the model's block never comes back to "
+            "rest, so its replay has no cycles; the MD film re-solidifies while the wall still "
+            "moves, and the Coulomb + viscous law has no re-stick rule for that (a freeze "
+            "velocity would be the next model)")
+
+
 def replay(run: RunData, static_force: float, kinetic_force: float, film_damping: float) -> Replay:
     """Run the calibrated :class:`reduced_model.SpringBlock` over the MD trace and compare cycles."""
     from reduced_model import SpringBlock, laws
@@ -649,6 +670,9 @@ def calibrate_run(run: RunData) -> RunCalibration:
         try:
             kw["replay"] = replay(run, kw["static_force"].value, fit.kinetic_force.value,
                                   fit.film_damping.value)
+            why = _no_restick(run, fit.kinetic_force.value, fit.film_damping.value)
+            if why and not kw["replay"].errors["period"]["model_cycles"]:
+                failures["replay"] = why
         except (ValueError, LookupError, RuntimeError) as exc:
             failures["replay"] = str(exc)
     else:
