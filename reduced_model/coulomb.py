@@ -51,8 +51,36 @@ def stick_break_time(held_force: float, rate: float, static: float) -> float:
     return math.inf
 
 
-def run_closed_form(p: Problem, static, kinetic: float, viscous: float):
-    """Integrate a Coulomb + viscous block exactly; returns a SimulationResult."""
+def _freeze_time(osc: DampedOscillator, e0: float, ed0: float, level: float, sigma: float,
+                 freeze: float, t_end: float) -> float | None:
+    """First time the slip speed sigma*(v - u) falls through ``freeze`` (None: never).
+
+    A slip from stick starts at speed 0 and first rises through ``freeze``;
+    that crossing is skipped, and so is any other rising one.
+    """
+    target = level + sigma * freeze            # e' at which the slip speed equals freeze
+    t0, e, ed = 0.0, e0, ed0
+    while True:
+        tau = osc.first_crossing(e, ed, target, t_end - t0, skip_start=(ed == target))
+        if tau is None:
+            return None
+        a0 = -2.0 * osc.gamma * ed - osc.w0sq * e
+        e_next = float(osc.value(tau, e, ed))
+        ed_next = float(osc.value(tau, ed, a0))
+        acc = float(osc.value(tau, a0, -2.0 * osc.gamma * a0 - osc.w0sq * ed))
+        if sigma * acc < 0.0:                  # the slip speed is falling: the film freezes
+            return t0 + tau
+        t0, e, ed = t0 + tau, e_next, target
+
+
+def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
+                    freeze_velocity: float = 0.0):
+    """Integrate a Coulomb + viscous block exactly; returns a SimulationResult.
+
+    With ``freeze_velocity`` > 0 a slip ends when the slip speed, falling,
+    reaches it (the film freezes); the block then takes the surface's velocity
+    and the kinetic energy it loses is counted as friction work.
+    """
     M, K, d, u, va = p.mass, p.stiffness, p.damping, p.u, p.va
     D = d + viscous
     osc = DampedOscillator(M, D, K)
@@ -98,7 +126,12 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float):
         alpha = xa + (viscous * u - f_kin - D * va) / K
         e0, ed0 = x - alpha, v - va
         level = u - va                               # e' = level  <=>  slip velocity zero
-        tau = None if smooth else osc.first_crossing(e0, ed0, level, remaining, skip_start=(v == u))
+        if smooth:
+            tau = None
+        elif freeze_velocity > 0.0:
+            tau = _freeze_time(osc, e0, ed0, level, sigma, freeze_velocity, remaining)
+        else:
+            tau = osc.first_crossing(e0, ed0, level, remaining, skip_start=(v == u))
         end = remaining if tau is None else tau
         ts = np.linspace(0.0, end, n_slip)
         a0 = -2.0 * osc.gamma * ed0 - osc.w0sq * e0
@@ -119,7 +152,10 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float):
         xs = alpha + va * ts + e
         vs = va + ed
         if tau is not None:
-            vs[-1] = u                                # the root: slip velocity is exactly zero
+            # the root: slip velocity zero, or the film freezes at sigma*freeze_velocity and
+            # the block's kinetic energy relative to the surface goes into the film
+            friction[-1] += 0.5 * M * (vs[-1] ** 2 - u ** 2)
+            vs[-1] = u
         rec.append(t + ts, xs, vs, xa + va * ts, state, drive, friction, damper)
         x, v, xa = xs[-1], vs[-1], xa + va * end
         if tau is None:

@@ -133,6 +133,14 @@ class Coulomb(FrictionLaw):
     viscous : float, optional
         Extra viscous friction while slipping, force per unit slip velocity
         (Coulomb + viscous; still solved in closed form).
+    freeze_velocity : float, optional
+        The contact re-solidifies when the slip velocity falls to this value
+        (0: only when the block comes to rest on the surface).  An overdamped
+        slip (viscous + damping >= 2 sqrt(K M)) never comes to rest: a film
+        that freezes while still moving (a confined film re-crystallising)
+        needs this rule to stick again.  The kinetic energy the block still
+        has relative to the surface is dissipated by the freezing film.
+        Closed form only.
 
     Example
     -------
@@ -143,10 +151,13 @@ class Coulomb(FrictionLaw):
     static: float
     kinetic: float
     viscous: float = 0.0
+    freeze_velocity: float = 0.0
 
     def __post_init__(self):
         non_negative("Coulomb.kinetic", self.kinetic, "a friction coefficient")
         non_negative("Coulomb.viscous", self.viscous, "negative viscous friction would feed energy")
+        non_negative("Coulomb.freeze_velocity", self.freeze_velocity,
+                     "a slip speed at which the film re-solidifies")
         s = non_negative("Coulomb.static", self.static, "a friction coefficient")
         if s < self.kinetic:
             raise ValueError(f"Coulomb.static = {self.static!r}: allowed range is "

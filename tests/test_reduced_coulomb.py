@@ -187,3 +187,46 @@ def test_bad_law_and_run_parameters():
         block().simulate(0.0)
     with pytest.raises(ValueError, match="samples_per_segment"):
         block().simulate(1.0, samples_per_segment=1)
+
+
+# ---------------------------------------------------------------- freeze velocity
+# the energy-partition scene's calibrated film: overdamped (B = 97 > 2 sqrt(K M) = 89)
+OVERDAMPED = dict(mass=20.0, stiffness=100.0, drive_velocity=0.02, damping=0.0)
+
+
+def test_an_overdamped_slip_never_rests_without_a_freeze_velocity():
+    r = SpringBlock(**OVERDAMPED, law=laws.Coulomb(97.3, 0.0, viscous=97.0)).simulate(500.0)
+    assert len(r.cycles()) == 0
+    # it relaxes to steady sliding at V: the spring force tends to B V
+    assert r.spring_force[-1] == pytest.approx(97.0 * 0.02, rel=1e-3)
+
+
+def test_freeze_velocity_re_sticks_at_that_speed_and_the_ledger_closes():
+    vf = 0.2
+    r = SpringBlock(**OVERDAMPED, law=laws.Coulomb(97.3, 0.0, viscous=97.0,
+                                                 freeze_velocity=vf)).simulate(500.0)
+    table = r.cycles()
+    assert len(table) >= 9
+    assert r.energy.closure < 1e-12
+    # every slip ends on the freeze: just before each stick the block moves at vf
+    for e in (e for e in r.events if e.kind == "stick"):
+        i = np.searchsorted(r.t, e.time)
+        assert r.v[i - 1] == pytest.approx(vf, rel=0.05)
+    # the re-stick force is below B vf: the block still decelerates when it freezes
+    assert 0.0 < table.backward_force[-1] < 97.0 * vf
+    with pytest.raises(ValueError, match="closed form only"):
+        SpringBlock(**OVERDAMPED, law=laws.Coulomb(97.3, 0.0, 97.0, freeze_velocity=vf)
+                    ).simulate(100.0, method="ode")
+    with pytest.raises(ValueError, match="freeze_velocity"):
+        laws.Coulomb(1.0, 0.5, freeze_velocity=-1.0)
+
+
+def test_calibration_recovers_the_freeze_velocity_from_the_restick_force():
+    from workflows.calibrate import freeze_velocity_for
+
+    law = laws.Coulomb(97.3, 0.0, viscous=97.0, freeze_velocity=0.2)
+    fb = SpringBlock(**OVERDAMPED, law=law).simulate(500.0).cycles().backward_force[-1]
+    block = SpringBlock(**OVERDAMPED, law=laws.Coulomb(97.3, 0.0, viscous=97.0))
+    assert freeze_velocity_for(block, 97.3, fb) == pytest.approx(0.2, rel=1e-6)
+    with pytest.raises(ValueError, match="outside what a freeze velocity"):
+        freeze_velocity_for(block, 97.3, 200.0)

@@ -479,8 +479,53 @@ def _no_restick(run: RunData, kinetic_force: float, film_damping: float) -> str 
             "velocity would be the next model)")
 
 
-def replay(run: RunData, static_force: float, kinetic_force: float, film_damping: float) -> Replay:
-    """Run the calibrated :class:`reduced_model.SpringBlock` over the MD trace and compare cycles."""
+def freeze_velocity_for(block, static_force: float, restick_force: float) -> float:
+    """Slip speed at which the film must freeze for ``block`` to re-stick at ``restick_force``.
+
+    For an overdamped slip (see :func:`_no_restick`): the re-stick force of the
+    model's steady cycle rises monotonically with the freeze velocity, from
+    near the steady-sliding force to ``static_force``; brentq finds it.
+
+    Raises
+    ------
+    ValueError
+        ``restick_force`` is not reachable (not between those ends).
+    """
+    from dataclasses import replace as _replace
+
+    from scipy.optimize import brentq
+
+    k, v = block.stiffness, abs(block.drive_velocity)
+    law = block.law
+    # one cycle's stick and a slip: (Fs - Fb)/(K V) plus margin; two cycles give a steady one
+    horizon = 3.0 * static_force / (k * max(v, 1e-300))
+
+    def restick(vf):
+        r = _replace(block, law=_replace(law, freeze_velocity=vf)).simulate(horizon)
+        fb = np.asarray(r.cycles().backward_force, float)
+        return float(fb[-1]) if fb.size else -math.inf
+
+    # the film can only freeze between the steady sliding speed V, which the
+    # overdamped slip approaches from above, and the slip's peak speed
+    peak = float(np.max(np.abs(block.simulate(horizon).v)))
+    lo, hi = v * (1.0 + 1e-3), 0.999 * peak
+    f_lo, f_hi = restick(lo) - restick_force, restick(hi) - restick_force
+    if not (f_lo < 0.0 < f_hi):
+        raise ValueError(f"re-stick force {restick_force:.4g} is outside what a freeze velocity "
+                         f"in [{lo:.3g}, {hi:.3g}] gives ({f_lo + restick_force:.4g} .. "
+                         f"{f_hi + restick_force:.4g})")
+    return float(brentq(lambda vf: restick(vf) - restick_force, lo, hi, xtol=1e-9 * peak))
+
+
+def replay(run: RunData, static_force: float, kinetic_force: float, film_damping: float,
+           restick_force: float | None = None) -> Replay:
+    """Run the calibrated :class:`reduced_model.SpringBlock` over the MD trace and compare cycles.
+
+    An overdamped calibrated slip never comes to rest (:func:`_no_restick`); with
+    the MD's ``restick_force`` the law then gets the freeze velocity that
+    re-sticks it there (:func:`freeze_velocity_for`), a fitted, not a predicted,
+    re-stick level.
+    """
     from reduced_model import SpringBlock, laws
 
     tr = run.trace
@@ -497,6 +542,12 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
     duration = float(t[-1] - t0)
     law = laws.Coulomb(static=static_force, kinetic=kinetic_force, viscous=film_damping)
     block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, damping=d, law=law)
+    freeze = 0.0
+    if restick_force is not None and _no_restick(run, kinetic_force, film_damping):
+        freeze = freeze_velocity_for(block, static_force, restick_force)
+        block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, damping=d,
+                            law=laws.Coulomb(static=static_force, kinetic=kinetic_force,
+                                             viscous=film_damping, freeze_velocity=freeze))
     ext = min(float(f[i0]) / k, 0.999 * static_force / k)
     r = block.simulate(duration, initial_extension=ext)
     model_t = r.t + t0
@@ -519,8 +570,9 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
         rel = (model_mean - md_mean) / abs(md_mean) if md_mean and math.isfinite(model_mean) else math.nan
         errors[name] = {"md": md_mean, "md_stderr": md_err, "model": model_mean, "rel_error": rel,
                         "model_cycles": float(len(table))}
+    frz = f", freeze_velocity={freeze:.4g} (fitted to F_b)" if freeze else ""
     desc = (f"SpringBlock(M={m:g}, K={k:g}, V={v:g}, d={d:g}) with Coulomb(F_s={static_force:.4g}, "
-            f"F_k={kinetic_force:.4g}, B={film_damping:.4g}), from t = {t0:g}")
+            f"F_k={kinetic_force:.4g}, B={film_damping:.4g}{frz}), from t = {t0:g}")
     return Replay(model_t, r.spring_force, t0, errors, desc)
 
 
@@ -668,8 +720,9 @@ def calibrate_run(run: RunData) -> RunCalibration:
             failures["eta_eff"] = "neither a slip fit nor steady sliding in this run"
     if fit is not None:
         try:
+            restick = kw["restick_force"].value if kw.get("restick_force") else None
             kw["replay"] = replay(run, kw["static_force"].value, fit.kinetic_force.value,
-                                  fit.film_damping.value)
+                                  fit.film_damping.value, restick_force=restick)
             why = _no_restick(run, fit.kinetic_force.value, fit.film_damping.value)
             if why and not kw["replay"].errors["period"]["model_cycles"]:
                 failures["replay"] = why
