@@ -74,12 +74,20 @@ def _freeze_time(osc: DampedOscillator, e0: float, ed0: float, level: float, sig
 
 
 def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
-                    freeze_velocity: float = 0.0):
+                    freeze_velocity: float = 0.0, shear_stiffness: float = math.inf):
     """Integrate a Coulomb + viscous block exactly; returns a SimulationResult.
 
     With ``freeze_velocity`` > 0 a slip ends when the slip speed, falling,
     reaches it (the film freezes); the block then takes the surface's velocity
     and the kinetic energy it loses is counted as friction work.
+
+    With a finite ``shear_stiffness`` k_f the stuck film is an elastic spring
+    between the surface and the block: while stuck, the block creeps at the
+    constant velocity (k_f u + K V)/(k_f + K) (quasi-static: no net force), the
+    held force rises at K k_f/(K + k_f) (V - u), and the work done on the film
+    (its elastic energy, released as heat when it melts at breakaway) is
+    friction work.  A step of the block's velocity to that creep speed at
+    re-stick is counted there too, so the ledger stays exact.
     """
     M, K, d, u, va = p.mass, p.stiffness, p.damping, p.u, p.va
     D = d + viscous
@@ -93,26 +101,37 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
     t, x, v, xa = 0.0, p.x0, p.v0, p.xa0
     state = p.state0
 
+    # the creep velocity of a stuck block on an elastic film (u when rigid)
+    kf = shear_stiffness
+    creep = u if math.isinf(kf) else (kf * u + K * va) / (kf + K)
+    jump = 0.0      # kinetic energy lost when a re-stuck block takes the creep velocity
     sigma = 1.0
     mode = "slip"
     if not smooth and v == u:
-        mode, sigma = settle(K * (xa - x) - d * u, static)
+        mode, sigma = settle(K * (xa - x) - d * creep, static)
+        # an elastic film: the block takes the creep velocity as the stick begins
+        jump = 0.5 * M * (v * v - creep * creep) if mode == "stick" else 0.0
     elif v != u:
         sigma = math.copysign(1.0, v - u)
 
     while t < T:
         remaining = T - t
         if mode == "stick":
-            held = K * (xa - x) - d * u        # force the contact must hold
-            rate = K * (va - u)
+            vc = creep
+            held = K * (xa - x) - d * vc       # force the contact must hold
+            rate = K * (va - vc)
             tau = stick_break_time(held, rate, static)
             end = min(tau, remaining)
             ts = np.linspace(0.0, end, n_stick)
-            f_spring = K * (xa - x) * ts + 0.5 * K * (va - u) * ts ** 2   # integral of spring force
-            drive = va * f_spring + u * (d * u * ts - f_spring)             # spring end + belt work
-            rec.append(t + ts, x + u * ts, np.full_like(ts, u), xa + va * ts, state,
-                       drive, np.zeros_like(ts), d * u * u * ts)
-            x, xa, v = x + u * end, xa + va * end, u
+            f_spring = K * (xa - x) * ts + 0.5 * K * (va - vc) * ts ** 2  # integral of spring force
+            drive = va * f_spring + u * (d * vc * ts - f_spring)            # spring end + belt work
+            film = (vc - u) * (held * ts + 0.5 * rate * ts ** 2)           # work on the elastic film
+            if jump:
+                film = film + jump
+                jump = 0.0
+            rec.append(t + ts, x + vc * ts, np.full_like(ts, vc), xa + va * ts, state,
+                       drive, film, d * vc * vc * ts)
+            x, xa, v = x + vc * end, xa + va * end, vc
             if tau >= remaining:
                 break
             t += end
@@ -161,6 +180,7 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
         if tau is None:
             break
         t += end
-        mode, sigma = settle(K * (xa - x) - d * u, static)
+        mode, sigma = settle(K * (xa - x) - d * creep, static)
+        jump = 0.5 * M * (u * u - creep * creep) if mode == "stick" else 0.0
         rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
     return rec.finish()

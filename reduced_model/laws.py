@@ -141,6 +141,12 @@ class Coulomb(FrictionLaw):
         needs this rule to stick again.  The kinetic energy the block still
         has relative to the surface is dissipated by the freezing film.
         Closed form only.
+    shear_stiffness : float, optional
+        Elastic shear stiffness of the stuck contact, force per displacement
+        (inf: rigid).  A solid-like film strains before it yields: the block
+        creeps while stuck and the force rises at K k_f/(K + k_f) times the
+        drive, not K.  The elastic energy is released as heat when the film
+        melts at breakaway.  Closed form only.
 
     Example
     -------
@@ -152,12 +158,16 @@ class Coulomb(FrictionLaw):
     kinetic: float
     viscous: float = 0.0
     freeze_velocity: float = 0.0
+    shear_stiffness: float = math.inf
 
     def __post_init__(self):
         non_negative("Coulomb.kinetic", self.kinetic, "a friction coefficient")
         non_negative("Coulomb.viscous", self.viscous, "negative viscous friction would feed energy")
         non_negative("Coulomb.freeze_velocity", self.freeze_velocity,
                      "a slip speed at which the film re-solidifies")
+        if not self.shear_stiffness > 0.0:
+            raise ValueError(f"Coulomb.shear_stiffness = {self.shear_stiffness!r}: allowed range "
+                             "is (0, inf] (a stiffness; inf = a rigid contact)")
         s = non_negative("Coulomb.static", self.static, "a friction coefficient")
         if s < self.kinetic:
             raise ValueError(f"Coulomb.static = {self.static!r}: allowed range is "

@@ -199,12 +199,15 @@ class SpringBlock:
             raise ValueError(f"method = 'closed_form': {type(law).__name__} has no closed form "
                              "(only Coulomb(+viscous) and Newtonian films, with mass > 0)")
         freeze = getattr(law, "freeze_velocity", 0.0)
-        if freeze > 0.0 and (closed is None or method == "ode"):
-            raise ValueError(f"{type(law).__name__}.freeze_velocity = {freeze!r}: the re-stick at "
-                             "a finite slip velocity is solved in closed form only (mass > 0, "
-                             "method 'auto' or 'closed_form')")
+        shear = getattr(law, "shear_stiffness", math.inf)
+        for name, value, on in (("freeze_velocity", freeze, freeze > 0.0),
+                                ("shear_stiffness", shear, not math.isinf(shear))):
+            if on and (closed is None or method == "ode"):
+                raise ValueError(f"{type(law).__name__}.{name} = {value!r}: solved in closed "
+                                 "form only (mass > 0, method 'auto' or 'closed_form')")
         if closed is not None and method != "ode":
             from .coulomb import run_closed_form
-            return run_closed_form(problem, *closed, freeze_velocity=freeze)
+            return run_closed_form(problem, *closed, freeze_velocity=freeze,
+                                   shear_stiffness=shear)
         from .hybrid import run_ode
         return run_ode(problem, rtol=rtol)

@@ -151,3 +151,17 @@ def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     assert "overdamped (B + d = 97 >= 2 sqrt(K M) = 89.4" in why
     # the default scene: M = 500 and the mount's 150 m/tau, underdamped: it re-sticks
     assert _no_restick(run(500.0, 150.0), 60.0, 11.0) is None
+
+
+def test_the_film_shear_stiffness_comes_from_the_stick_ramps(tmp_path):
+    # a trace made with an elastic stuck film: the ramps rise at K k_f/(K + k_f) V
+    run_dir, truth = model_run(tmp_path / "run", laws.Coulomb(static=FS, kinetic=FK, viscous=B,
+                                                              shear_stiffness=2.0 * K))
+    r = cal_mod.calibrate([run_dir]).main
+    assert r.shear_stiffness.value == pytest.approx(2.0 * K, rel=0.1), r.shear_stiffness
+    # with it, the replay's period is the generating run's
+    errs = r.replay.errors
+    assert abs(errs["period"]["rel_error"]) < 0.08, errs["period"]
+    # a rigid film shows no compliance: no estimate (see the module's other runs)
+    rigid_dir, _ = model_run(tmp_path / "rigid", laws.Coulomb(static=FS, kinetic=FK, viscous=B))
+    assert cal_mod.calibrate([rigid_dir]).main.shear_stiffness is None

@@ -230,3 +230,30 @@ def test_calibration_recovers_the_freeze_velocity_from_the_restick_force():
     assert freeze_velocity_for(block, 97.3, fb) == pytest.approx(0.2, rel=1e-6)
     with pytest.raises(ValueError, match="outside what a freeze velocity"):
         freeze_velocity_for(block, 97.3, 200.0)
+
+
+def test_an_elastic_film_creeps_while_stuck_and_the_ledger_closes():
+    k, kf, v = 100.0, 233.0, 0.02
+    law = laws.Coulomb(98.0, 60.0, viscous=11.0, shear_stiffness=kf)
+    r = SpringBlock(mass=500.0, stiffness=k, drive_velocity=v, damping=150.0,
+                    law=law).simulate(600.0)
+    assert r.energy.closure < 1e-12
+    table = r.cycles()
+    # the held force rises at K k_f/(K + k_f) V, and the block creeps at K V/(K + k_f)
+    k_eff = k * kf / (k + kf)
+    sticks = [e.time for e in r.events if e.kind == "stick"]
+    slips = [e.time for e in r.events if e.kind == "slip"]
+    for t0, t1 in zip(sticks, [t for t in slips if t > sticks[0]]):
+        inside = (r.t > t0) & (r.t < t1)
+        assert inside.any() and np.allclose(r.v[inside], k * v / (k + kf), rtol=1e-9)
+    # stick i runs from re-stick i to yield i+1
+    rise = np.asarray(table.static_force[1:]) - np.asarray(table.backward_force[:-1])
+    stick = np.asarray(table.stick_duration[:-1])
+    assert np.allclose(stick, rise / (k_eff * v), rtol=1e-6)
+    rigid = SpringBlock(mass=500.0, stiffness=k, drive_velocity=v, damping=150.0,
+                        law=laws.Coulomb(98.0, 60.0, viscous=11.0)).simulate(600.0).cycles()
+    assert np.mean(table.period[1:-1]) > 1.3 * np.mean(rigid.period[1:-1])
+    with pytest.raises(ValueError, match="shear_stiffness"):
+        laws.Coulomb(1.0, 0.5, shear_stiffness=0.0)
+    with pytest.raises(ValueError, match="closed form only|solved in closed"):
+        SpringBlock(1.0, 1.0, 0.1, law=law).simulate(10.0, method="ode")

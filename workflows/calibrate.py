@@ -58,22 +58,33 @@ F/A, η_eff and the rate law; the thinning law is Carreau with its onset at
 the lowest MD rate, matched to the fit there (the pure power law from that
 rate is the SFB check's upper bracket).
 
+``shear_stiffness``
+    The stuck film's elastic shear stiffness k_f, from the slopes of the stick
+    ramps (K_eff = slope / V, 1/k_f = 1/K_eff − 1/K); none when the ramps rise
+    at K within their errors.
+
 Replay
 ------
-The calibrated model is run with the MD's K, M, V and d from the MD's first
-re-stick point (the start-up yield, whose larger threshold reflects the
+The calibrated law carries k_f (the block creeps on the elastic film while
+stuck) and a freeze velocity fitted to the MD's mean re-stick force F_b (the
+MD film re-solidifies while the wall still moves; an overdamped slip would
+otherwise never stop, and an underdamped one would overshoot below F_b).
+F_s and F_b are therefore inputs of the replay; slip distance and period are
+its predictions.  The calibrated model is run with the MD's K, M, V and d from
+the MD's first re-stick point (the start-up yield, whose larger threshold reflects the
 contact's age after equilibration, is not part of the steady cycle), and its
 cycles are measured with the same ruler as the MD's
 (:func:`analysis.stickslip.cycle_table` via ``SimulationResult.cycles``).
 Errors are (model − MD)/MD of the mean peak force, slip distance and period.
-The peak force is an input of the model (its error is a check of the
-replay, not a prediction); slip distance and period are predictions.
+The peak and re-stick forces are inputs of the model (their errors check the
+replay, they predict nothing); slip distance and period are predictions.
 """
 from __future__ import annotations
 
 import json
 import math
 import os
+import dataclasses
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -482,9 +493,10 @@ def _no_restick(run: RunData, kinetic_force: float, film_damping: float) -> str 
 def freeze_velocity_for(block, static_force: float, restick_force: float) -> float:
     """Slip speed at which the film must freeze for ``block`` to re-stick at ``restick_force``.
 
-    For an overdamped slip (see :func:`_no_restick`): the re-stick force of the
-    model's steady cycle rises monotonically with the freeze velocity, from
-    near the steady-sliding force to ``static_force``; brentq finds it.
+    The re-stick force of the model's steady cycle rises monotonically with the
+    freeze velocity, up to ``static_force``; brentq finds it.  An overdamped
+    slip (see :func:`_no_restick`) needs one above V to re-stick at all; an
+    underdamped one that already re-sticks at or above ``restick_force`` gets 0.
 
     Raises
     ------
@@ -505,11 +517,14 @@ def freeze_velocity_for(block, static_force: float, restick_force: float) -> flo
         fb = np.asarray(r.cycles().backward_force, float)
         return float(fb[-1]) if fb.size else -math.inf
 
-    # the film can only freeze between the steady sliding speed V, which the
-    # overdamped slip approaches from above, and the slip's peak speed
-    peak = float(np.max(np.abs(block.simulate(horizon).v)))
-    lo, hi = v * (1.0 + 1e-3), 0.999 * peak
+    # the film can only freeze below the slip's peak speed, and an overdamped
+    # slip only above the steady sliding speed V, which it approaches from above
+    free = block.simulate(horizon)
+    peak = float(np.max(np.abs(free.v)))
+    lo, hi = (v * (1.0 + 1e-3) if len(free.cycles()) == 0 else 0.0), 0.999 * peak
     f_lo, f_hi = restick(lo) - restick_force, restick(hi) - restick_force
+    if f_lo >= 0.0 and lo == 0.0:
+        return 0.0      # it already re-sticks at or above F_b: freezing could only raise it
     if not (f_lo < 0.0 < f_hi):
         raise ValueError(f"re-stick force {restick_force:.4g} is outside what a freeze velocity "
                          f"in [{lo:.3g}, {hi:.3g}] gives ({f_lo + restick_force:.4g} .. "
@@ -518,13 +533,13 @@ def freeze_velocity_for(block, static_force: float, restick_force: float) -> flo
 
 
 def replay(run: RunData, static_force: float, kinetic_force: float, film_damping: float,
-           restick_force: float | None = None) -> Replay:
+           restick_force: float | None = None, shear_stiffness: float = math.inf) -> Replay:
     """Run the calibrated :class:`reduced_model.SpringBlock` over the MD trace and compare cycles.
 
-    An overdamped calibrated slip never comes to rest (:func:`_no_restick`); with
-    the MD's ``restick_force`` the law then gets the freeze velocity that
-    re-sticks it there (:func:`freeze_velocity_for`), a fitted, not a predicted,
-    re-stick level.
+    With the MD's ``restick_force`` the law gets the freeze velocity that
+    re-sticks it there (:func:`freeze_velocity_for`): a fitted, not a predicted,
+    re-stick level, which an overdamped slip (:func:`_no_restick`) needs to stop
+    at all.  ``shear_stiffness`` is the stuck film's k_f (inf: rigid).
     """
     from reduced_model import SpringBlock, laws
 
@@ -540,14 +555,14 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
         i0 = 0
     t0 = float(t[i0])
     duration = float(t[-1] - t0)
-    law = laws.Coulomb(static=static_force, kinetic=kinetic_force, viscous=film_damping)
+    law = laws.Coulomb(static=static_force, kinetic=kinetic_force, viscous=film_damping,
+                       shear_stiffness=shear_stiffness)
     block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, damping=d, law=law)
     freeze = 0.0
-    if restick_force is not None and _no_restick(run, kinetic_force, film_damping):
+    if restick_force is not None:
         freeze = freeze_velocity_for(block, static_force, restick_force)
         block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, damping=d,
-                            law=laws.Coulomb(static=static_force, kinetic=kinetic_force,
-                                             viscous=film_damping, freeze_velocity=freeze))
+                            law=dataclasses.replace(law, freeze_velocity=freeze))
     ext = min(float(f[i0]) / k, 0.999 * static_force / k)
     r = block.simulate(duration, initial_extension=ext)
     model_t = r.t + t0
@@ -571,6 +586,8 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
         errors[name] = {"md": md_mean, "md_stderr": md_err, "model": model_mean, "rel_error": rel,
                         "model_cycles": float(len(table))}
     frz = f", freeze_velocity={freeze:.4g} (fitted to F_b)" if freeze else ""
+    if math.isfinite(shear_stiffness):
+        frz += f", shear_stiffness={shear_stiffness:.4g}"
     desc = (f"SpringBlock(M={m:g}, K={k:g}, V={v:g}, d={d:g}) with Coulomb(F_s={static_force:.4g}, "
             f"F_k={kinetic_force:.4g}, B={film_damping:.4g}{frz}), from t = {t0:g}")
     return Replay(model_t, r.spring_force, t0, errors, desc)
@@ -612,6 +629,7 @@ class RunCalibration:
     eta_eff: Estimate | None = None
     shear_rate: Estimate | None = None
     ageing: Estimate | None = None
+    shear_stiffness: Estimate | None = None
     slip_fit: SlipLawFit | None = None
     replay: Replay | None = None
     failures: dict = field(default_factory=dict)
@@ -621,7 +639,7 @@ class RunCalibration:
                "area": _num(self.area), "thickness": _num(self.thickness),
                "slips": self.run.n_slips, "skipped_first": self.run.skip}
         for name in ("static_force", "restick_force", "first_yield_force", "kinetic_force",
-                     "film_damping", "eta_eff", "shear_rate", "ageing"):
+                     "film_damping", "eta_eff", "shear_rate", "ageing", "shear_stiffness"):
             e = getattr(self, name)
             out[name] = None if e is None else e.as_dict()
         if self.slip_fit is not None:
@@ -660,6 +678,42 @@ def _ageing(run: RunData) -> Estimate | None:
                     f"linear fit of F_s vs ln(preceding stick time), {int(ok.sum())} slips")
 
 
+def _shear_stiffness(run: RunData) -> Estimate | None:
+    """The stuck film's elastic shear stiffness k_f from the slopes of the stick ramps.
+
+    A stuck film strains like a spring in series with the drive spring: the
+    force rises at K_eff V with 1/K_eff = 1/K + 1/k_f.  Each ramp (re-stick to
+    the next yield, its first quarter and last tenth left out: ringing and
+    creep before the yield) gives a slope; k_f = K K_eff/(K − K_eff) from
+    their mean, its error propagated from theirs.  None with fewer than 2
+    ramps or when K_eff is not below K (no measurable compliance).
+    """
+    tr = run.trace
+    k = tr.parameters.spring_constant
+    v = tr.parameters.drive_velocity
+    if not (k and v):
+        return None
+    t, f = tr.time, tr.spring_force
+    sticks = np.asarray(run.cycles.get("stick_index", []), int)
+    yields = np.asarray(run.cycles.get("yield_index", []), int)
+    slopes = []
+    for i0, i1 in zip(sticks[:-1], yields[1:]):
+        lo, hi = i0 + (i1 - i0) // 4, i1 - (i1 - i0) // 10
+        if hi - lo >= 5:
+            slopes.append(np.polyfit(t[lo:hi], f[lo:hi], 1)[0] / v)
+    if len(slopes) < 2:
+        return None
+    k_eff = float(np.mean(slopes))
+    se = float(np.std(slopes, ddof=1) / math.sqrt(len(slopes)))
+    if not 0.0 < k_eff < k - 2.0 * se:
+        return None
+    k_f = k * k_eff / (k - k_eff)
+    dk = se * (k / (k - k_eff)) ** 2          # d k_f / d K_eff
+    return Estimate(k_f, dk, _labels(tr.units)["stiffness"],
+                    f"stick ramps' slope K_eff = {k_eff:.4g} (K = {k:g}) from {len(slopes)} "
+                    "ramps: 1/k_f = 1/K_eff - 1/K")
+
+
 def calibrate_run(run: RunData) -> RunCalibration:
     """Calibrate the model on one run (see the module docstring for each parameter)."""
     tr = run.trace
@@ -681,6 +735,7 @@ def calibrate_run(run: RunData) -> RunCalibration:
         kw["first_yield_force"] = Estimate(float(run.cycles["static_force"][0]), math.nan, u["force"],
                                            "start-up yield from a relaxed spring (one value)")
     kw["ageing"] = _ageing(run)
+    kw["shear_stiffness"] = _shear_stiffness(run)
     if kw["static_force"] is None:
         failures["slip_fit"] = f"no slips to fit (regime {regime})"
     else:
@@ -721,8 +776,10 @@ def calibrate_run(run: RunData) -> RunCalibration:
     if fit is not None:
         try:
             restick = kw["restick_force"].value if kw.get("restick_force") else None
+            shear = kw["shear_stiffness"].value if kw.get("shear_stiffness") else math.inf
             kw["replay"] = replay(run, kw["static_force"].value, fit.kinetic_force.value,
-                                  fit.film_damping.value, restick_force=restick)
+                                  fit.film_damping.value, restick_force=restick,
+                                  shear_stiffness=shear)
             why = _no_restick(run, fit.kinetic_force.value, fit.film_damping.value)
             if why and not kw["replay"].errors["period"]["model_cycles"]:
                 failures["replay"] = why
