@@ -490,8 +490,8 @@ def ramp_forces(time, spring_force, table: CycleTable, *, wall_position=None,
     of the stick before y and another to the first ``fraction`` of the stick
     after s.  The refined y is the last sample between y and s still within
     ``tolerance`` × (rms residual) of the first line, the refined s the first
-    sample within that band of the second line, and Fs, Fb are the lines'
-    values there (which also averages out ringing after the stick).  Where a
+    sample at or below the second line (within its band only if the force never
+    reaches it), and Fs, Fb are the lines' values there (which also averages out ringing after the stick).  Where a
     ramp has fewer than 3 samples the detector's point and value are kept.
 
     Returns
@@ -521,7 +521,12 @@ def ramp_forces(time, spring_force, table: CycleTable, *, wall_position=None,
             fs[i] = line(t[y])
         if post is not None:
             line, rms = post
-            on = np.flatnonzero(f[y:s + 1] <= line(t[y:s + 1]) + tolerance * rms)
+            # the force must come down to the next ramp's line itself: a band of
+            # tolerance x rms (large when the wall rings) is met halfway down the fall
+            below = f[y:s + 1] <= line(t[y:s + 1])
+            on = np.flatnonzero(below)
+            if not on.size:
+                on = np.flatnonzero(f[y:s + 1] <= line(t[y:s + 1]) + tolerance * rms)
             s = y + int(on[0]) if on.size else s
             s = max(s, y)
             fb[i] = line(t[s])

@@ -57,3 +57,28 @@ def test_ringing_and_correlated_noise_do_not_hide_the_slips(dt):
     assert noise < 10.0
     events = stickslip.detect_slips(t, f)
     assert len(events.yield_index) in (6, 7)
+
+
+def test_the_restick_point_is_where_the_fall_ends_not_halfway_down():
+    # each slip: the force falls linearly from 100 to 20 over 3 tau, then the wall
+    # rings about the next ramp (amplitude 15, period 14 tau).  The ringing makes
+    # the ramp's line fit rough; a band of 3 rms above the line was met halfway
+    # down the fall, which cut the measured slip distance short (MD: 0.66 sigma
+    # for a 0.84 sigma slip).
+    k, period, fall = 100.0, 54.0, 3.0
+    t = np.arange(0.0, 6 * period, 0.05)
+    u = t % period
+    f = np.where(u < period - fall, 20.0 + 80.0 * u / (period - fall),
+                 100.0 - 80.0 * (u - period + fall) / fall)
+    since = u                              # time since the fall ended (at u = 0)
+    f = f + 15.0 * np.exp(-since / 10.0) * np.sin(2 * np.pi * since / 14.0) * (t > period)
+    drive = 0.02 * t
+    wall = drive - f / k
+    events = stickslip.detect_slips(t, f)
+    table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
+                                  spring_constant=k, wall_position=wall)
+    table = stickslip.ramp_forces(t, f, table, wall_position=wall)
+    ends = t[table.stick_index] % period
+    assert np.all(np.abs(ends - period) % period < 0.3), ends
+    # the slip covers the whole drop: (Fs - Fb)/K plus the drive's advance
+    assert np.allclose(table.slip_distance[1:], 0.8 + 0.02 * fall, atol=0.05)
