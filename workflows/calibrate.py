@@ -422,11 +422,19 @@ def fit_slip_law(run: RunData) -> SlipLawFit:
         how = f"fit covariance ({n} slip{'s' if n != 1 else ''}; jackknife needs 3)"
     u = _labels(tr.units)
     fs_err = float(yield_forces.std(ddof=1) / math.sqrt(n)) if n > 1 else math.nan
+    # a parameter pinned at a bound has no sampling spread to report: the
+    # jackknife's zero would read as an exact value
+    fk_how = b_how = how
+    if fk <= 1e-9 * max(fs_min, 1.0):
+        fk_err, fk_how = math.nan, how + "; at the fit's lower bound 0: no rate-independent part"
+    if logb <= math.log(1e-6 * b_crit) + 1e-6:
+        b_err, b_how = math.nan, (how + "; at the fit's lower bound: no film drag beyond the "
+                                  "mount's dashpot is resolved")
     return SlipLawFit(
         kinetic_force=Estimate(float(fk), fk_err, u["force"],
-                               f"joint fit of the Coulomb+viscous slip to {n} slips; {how}"),
+                               f"joint fit of the Coulomb+viscous slip to {n} slips; {fk_how}"),
         film_damping=Estimate(float(math.exp(logb)), b_err, u["damping"],
-                              f"same fit, mount dashpot d = {d:g} fixed; {how}"),
+                              f"same fit, mount dashpot d = {d:g} fixed; {b_how}"),
         static_force=Estimate(float(yield_forces.mean()), fs_err, u["force"],
                               f"spring force at the fitted yield instants of {n} slips, mean ± stderr"),
         mount_damping=d, rms_residual=rms, n_slips=n, jackknife=jack, windows=wins,
@@ -756,6 +764,14 @@ def calibrate_run(run: RunData) -> RunCalibration:
         rate = dx / ts / thickness if dx and ts else math.nan
         kw["eta_eff"] = Estimate(eta, b.stderr * thickness / area, u["viscosity"],
                                  "B D / A from the slip fit (D = mean gap)")
+        klein = (doc.get("viscosity", {}).get("from_slip") or {}).get("eta_eff") or {}
+        if "lower bound" in b.method and klein.get("mean"):
+            # F_k carries all of the sliding friction and B is unresolved: the film's
+            # viscosity is then Klein's own reading of the slips (all friction viscous)
+            kw["eta_eff"] = Estimate(float(klein["mean"]), float(klein.get("stderr") or math.nan),
+                                     u["viscosity"],
+                                     "Klein's purely viscous fit of the slips (analysis, mount "
+                                     "removed): the calibration's B is at its lower bound")
         kw["shear_rate"] = Estimate(rate, math.nan, u["shear_rate"],
                                     "mean slip velocity (dx0 / tau_s) over the gap")
     else:
