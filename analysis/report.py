@@ -237,6 +237,10 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     # fewer than 2 slips is smooth sliding only if the wall slides: a wall stuck
     # (V -> 0, a soft spring) or a run too short for a second yield has as few
     not_sliding = _not_sliding(sl) if regime == "smooth" else None
+    if regime == "smooth" and not not_sliding and len(events.yield_index):
+        if t[events.yield_index[-1]] > t[half.start]:
+            # a start-up yield is followed by sliding; one late in the trace is not
+            not_sliding = "its slip comes in the last half: too short to tell"
     if not_sliding:
         regime = doc["regime"] = "unresolved"
         doc["regime_note"] = f"fewer than 2 slips, but {not_sliding}"
