@@ -237,9 +237,13 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     # fewer than 2 slips is smooth sliding only if the wall slides: a wall stuck
     # (V -> 0, a soft spring) or a run too short for a second yield has as few
     not_sliding = _not_sliding(sl) if regime == "smooth" else None
-    if regime == "smooth" and not not_sliding and len(events.yield_index):
-        if t[events.yield_index[-1]] > t[half.start]:
-            # a start-up yield is followed by sliding; one late in the trace is not
+    if regime == "smooth" and not not_sliding:
+        # a start-up yield is followed by sliding; one late in the trace (or one
+        # still under way at its end) is not
+        late = list(events.yield_index)
+        if events.unfinished_yield is not None:
+            late.append(events.unfinished_yield)
+        if late and t[max(late)] > t[half.start]:
             not_sliding = "its slip comes in the last half: too short to tell"
     if not_sliding:
         regime = doc["regime"] = "unresolved"

@@ -123,3 +123,30 @@ def test_analyze_run_directory(tmp_path, capsys):
     assert doc["viscosity"]["from_slip"]["eta_eff"]["units"] == "ετ/σ³"
     assert doc["structure"]["layers"]["count"] == 3
     assert doc["structure"]["stick"]["frames"] + doc["structure"]["slip"]["frames"] == 60
+
+
+@pytest.mark.parametrize("case", ["stuck", "late-slip", "startup-then-sliding"])
+def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, capsys, case):
+    # K = 100, V = 0.02: a ramp of 2 eps/sigma per tau
+    k, v = 100.0, 0.02
+    t = np.arange(0.0, 100.0, 0.25)
+    rng = np.random.default_rng(0)
+    if case == "stuck":            # the force ramps up and never yields
+        f = k * v * t
+    elif case == "late-slip":      # one yield at 55 tau (of 100), then a new ramp: over
+        # the last half the wall moves at V on average, so only the slip's timing tells
+        f = np.where(t < 55.0, k * v * t, k * v * (t - 55.0) + 10.0)
+    else:                          # a start-up yield at 20 tau, then steady sliding at 30
+        f = np.where(t < 20.0, k * v * t, 30.0)
+    f = f + 0.3 * rng.standard_normal(t.size)
+    wall = v * t - f / k
+    p = tmp_path / "trace.csv"
+    write_csv(p, {"time": t, "spring_force": f, "wall_position": wall,
+                  "drive_position": v * t})
+    assert main(["analyze", str(p), "--json", "--spring-constant", str(k),
+                 "--drive-velocity", str(v)]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    want = "smooth" if case == "startup-then-sliding" else "unresolved"
+    assert doc["regime"] == want, (doc["regime"], doc.get("regime_note"))
+    if want == "unresolved":
+        assert doc["regime_note"].startswith("fewer than 2 slips, but")
