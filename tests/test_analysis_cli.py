@@ -133,9 +133,9 @@ def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, caps
     rng = np.random.default_rng(0)
     if case == "stuck":            # the force ramps up and never yields
         f = k * v * t
-    elif case == "late-slip":      # one yield at 55 tau (of 100), then a new ramp: over
-        # the last half the wall moves at V on average, so only the slip's timing tells
-        f = np.where(t < 55.0, k * v * t, k * v * (t - 55.0) + 10.0)
+    elif case == "late-slip":      # sliding at 30, then at 80 tau a drop to 10 and a new
+        # ramp: the wall still moves at V on average, only the slip's timing tells
+        f = np.where(t < 80.0, 30.0, np.minimum(10.0 + k * v * (t - 80.0), 30.0))
     else:                          # a start-up yield at 20 tau, then steady sliding at 30
         f = np.where(t < 20.0, k * v * t, 30.0)
     f = f + 0.3 * rng.standard_normal(t.size)
