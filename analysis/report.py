@@ -173,7 +173,7 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         f"smooth: < 2 slips; stick-slip: >= 2 slips with CV(Fs) and CV(period) "
         f"<= {stickslip.REGIME_CV_MAX} (first slip excluded when >= 3); "
         "irregular: otherwise; unresolved: < 2 slips and the last half not steady sliding "
-        "(stuck, or too short to tell)")
+        "(stuck, or a slip in the last half: too short to tell)")
     doc["detection"] = {
         "noise": {"mean": _num(events.noise), "units": lab("force")},
         "threshold": {"mean": _num(events.threshold), "units": lab("force")},
