@@ -87,6 +87,8 @@ def test_flexible_walls_stay_crystalline_and_follow_the_backing(walls_run):
     assert _wall_spread(run_dir) < 0.3
     record = json.loads((run_dir / "run.json").read_text())
     assert record["status"] == "completed"
+    # the whole top wall: its rigid plane and its flexible planes (5 x 3 cells, 30 per plane)
+    assert record["atoms"]["top_wall"] == record["derived"]["wall_layers"] * 30
 
 
 @pytest.mark.md
