@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["finite", "positive", "non_negative", "in_range", "SimulationLimitError"]
+__all__ = ["finite", "positive", "non_negative", "at_least", "in_range", "SimulationLimitError"]
 
 
 class SimulationLimitError(RuntimeError):
@@ -42,6 +42,15 @@ def non_negative(name: str, value, why: str = "") -> float:
     out = finite(name, value, why)
     if out < 0.0:
         raise ValueError(f"{name} = {value!r}: allowed range is [0, inf){_why(why)}")
+    return out
+
+
+def at_least(name: str, value, floor_name: str, floor: float, why: str = "") -> float:
+    """Return ``float(value)`` or raise unless ``value >= floor`` (another parameter)."""
+    out = finite(name, value, why)
+    if out < floor:
+        raise ValueError(f"{name} = {value!r}: allowed range is [{floor_name} = {floor}, inf)"
+                         f"{_why(why)}")
     return out
 
 

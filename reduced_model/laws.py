@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._checks import finite, in_range, non_negative, positive
+from ._checks import at_least, finite, in_range, non_negative, positive
 
 __all__ = [
     "FrictionLaw", "Coulomb", "StribeckExponential", "StribeckSchnelle",
@@ -168,11 +168,10 @@ class Coulomb(FrictionLaw):
         if not self.shear_stiffness > 0.0:
             raise ValueError(f"Coulomb.shear_stiffness = {self.shear_stiffness!r}: allowed range "
                              "is (0, inf] (a stiffness; inf = a rigid contact)")
-        s = non_negative("Coulomb.static", self.static, "a friction coefficient")
-        if s < self.kinetic:
-            raise ValueError(f"Coulomb.static = {self.static!r}: allowed range is "
-                             f"[kinetic = {self.kinetic}, inf) (static friction below kinetic "
-                             "would make the block stick while the kinetic force exceeds the load)")
+        non_negative("Coulomb.static", self.static, "a friction coefficient")
+        at_least("Coulomb.static", self.static, "kinetic", self.kinetic,
+                 "static friction below kinetic would make the block stick while the kinetic "
+                 "force exceeds the load")
 
     def sliding_force(self, speed, state, normal_load):
         return self.kinetic * normal_load + self.viscous * speed
@@ -206,10 +205,8 @@ class StribeckExponential(FrictionLaw):
 
     def __post_init__(self):
         non_negative("StribeckExponential.kinetic", self.kinetic, "a friction coefficient")
-        if finite("StribeckExponential.static", self.static) < self.kinetic:
-            raise ValueError(f"StribeckExponential.static = {self.static!r}: allowed range is "
-                             f"[kinetic = {self.kinetic}, inf) (static friction is the v -> 0 limit "
-                             "of a weakening curve)")
+        at_least("StribeckExponential.static", self.static, "kinetic", self.kinetic,
+                 "static friction is the v -> 0 limit of a weakening curve")
         positive("StribeckExponential.stribeck_velocity", self.stribeck_velocity,
                  "the velocity scale of the weakening")
         in_range("StribeckExponential.shape", self.shape, 0.0, 10.0, "exponent of the Stribeck decay",
@@ -298,9 +295,8 @@ class ExponentialWeakening(FrictionLaw):
 
     def __post_init__(self):
         non_negative("ExponentialWeakening.kinetic", self.kinetic, "a friction coefficient")
-        if finite("ExponentialWeakening.static", self.static) < self.kinetic:
-            raise ValueError(f"ExponentialWeakening.static = {self.static!r}: allowed range is "
-                             f"[kinetic = {self.kinetic}, inf) (the curve weakens from static to kinetic)")
+        at_least("ExponentialWeakening.static", self.static, "kinetic", self.kinetic,
+                 "the curve weakens from static to kinetic")
         positive("ExponentialWeakening.velocity_scale", self.velocity_scale, "the weakening velocity")
 
     def sliding_force(self, speed, state, normal_load):
@@ -447,9 +443,8 @@ class ContactAge(FrictionLaw):
 
     def __post_init__(self):
         non_negative("ContactAge.backward", self.backward, "friction coefficient of a fresh contact")
-        if finite("ContactAge.static", self.static) < self.backward:
-            raise ValueError(f"ContactAge.static = {self.static!r}: allowed range is "
-                             f"[backward = {self.backward}, inf) (contacts strengthen with age)")
+        at_least("ContactAge.static", self.static, "backward", self.backward,
+                 "contacts strengthen with age")
         positive("ContactAge.age_time", self.age_time, "ageing time tau of the static friction")
         positive("ContactAge.memory_length", self.memory_length, "slip distance a_phi that renews contacts")
 
