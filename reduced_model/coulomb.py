@@ -64,10 +64,10 @@ def _freeze_time(osc: DampedOscillator, e0: float, ed0: float, level: float, sig
         tau = osc.first_crossing(e, ed, target, t_end - t0, skip_start=(ed == target))
         if tau is None:
             return None
-        a0 = -2.0 * osc.gamma * ed - osc.w0sq * e
+        # e'' is a solution of the same equation: its value at tau is the acceleration
+        a0 = osc.second_derivative_at_zero(e, ed)
         e_next = float(osc.value(tau, e, ed))
-        ed_next = float(osc.value(tau, ed, a0))
-        acc = float(osc.value(tau, a0, -2.0 * osc.gamma * a0 - osc.w0sq * ed))
+        acc = float(osc.value(tau, a0, osc.second_derivative_at_zero(ed, a0)))
         if sigma * acc < 0.0:                  # the slip speed is falling: the film freezes
             return t0 + tau
         t0, e, ed = t0 + tau, e_next, target
@@ -117,21 +117,21 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
     while t < T:
         remaining = T - t
         if mode == "stick":
-            vc = creep
-            held = K * (xa - x) - d * vc       # force the contact must hold
-            rate = K * (va - vc)
+            held = K * (xa - x) - d * creep    # force the contact must hold
+            rate = K * (va - creep)
             tau = stick_break_time(held, rate, static)
             end = min(tau, remaining)
             ts = np.linspace(0.0, end, n_stick)
-            f_spring = K * (xa - x) * ts + 0.5 * K * (va - vc) * ts ** 2  # integral of spring force
-            drive = va * f_spring + u * (d * vc * ts - f_spring)            # spring end + belt work
-            film = (vc - u) * (held * ts + 0.5 * rate * ts ** 2)           # work on the elastic film
+            # integral of the spring force, then spring end + belt work, and work on the film
+            f_spring = K * (xa - x) * ts + 0.5 * K * (va - creep) * ts ** 2
+            drive = va * f_spring + u * (d * creep * ts - f_spring)
+            film = (creep - u) * (held * ts + 0.5 * rate * ts ** 2)
             if jump:
                 film = film + jump
                 jump = 0.0
-            rec.append(t + ts, x + vc * ts, np.full_like(ts, vc), xa + va * ts, state,
-                       drive, film, d * vc * vc * ts)
-            x, xa, v = x + vc * end, xa + va * end, vc
+            rec.append(t + ts, x + creep * ts, np.full_like(ts, creep), xa + va * ts, state,
+                       drive, film, d * creep * creep * ts)
+            x, xa, v = x + creep * end, xa + va * end, creep
             if tau >= remaining:
                 break
             t += end

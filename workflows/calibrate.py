@@ -300,6 +300,8 @@ class SlipLawFit:
         Sample index windows fitted.
     yield_shifts : tuple of float
         Fitted yield instant minus the detected one, per slip (time units).
+    damping_at_bound : bool
+        B ended at the fit's lower bound: no film drag beyond the mount's is resolved.
     """
 
     kinetic_force: Estimate
@@ -311,6 +313,7 @@ class SlipLawFit:
     jackknife: list = field(default_factory=list)
     windows: list = field(default_factory=list)
     yield_shifts: tuple = ()
+    damping_at_bound: bool = False
 
 
 def _windows(t, yi, si) -> list[tuple[int, int]]:
@@ -427,7 +430,8 @@ def fit_slip_law(run: RunData) -> SlipLawFit:
     fk_how = b_how = how
     if fk <= 1e-9 * max(fs_min, 1.0):
         fk_err, fk_how = math.nan, how + "; at the fit's lower bound 0: no rate-independent part"
-    if logb <= math.log(1e-6 * b_crit) + 1e-6:
+    damping_at_bound = bool(logb <= math.log(1e-6 * b_crit) + 1e-6)
+    if damping_at_bound:
         b_err, b_how = math.nan, (how + "; at the fit's lower bound: no film drag beyond the "
                                   "mount's dashpot is resolved")
     return SlipLawFit(
@@ -438,7 +442,7 @@ def fit_slip_law(run: RunData) -> SlipLawFit:
         static_force=Estimate(float(yield_forces.mean()), fs_err, u["force"],
                               f"spring force at the fitted yield instants of {n} slips, mean ± stderr"),
         mount_damping=d, rms_residual=rms, n_slips=n, jackknife=jack, windows=wins,
-        yield_shifts=tuple(float(x) for x in deltas))
+        yield_shifts=tuple(float(x) for x in deltas), damping_at_bound=damping_at_bound)
 
 
 def _labels(units: str) -> dict:
@@ -511,8 +515,6 @@ def freeze_velocity_for(block, static_force: float, restick_force: float) -> flo
     ValueError
         ``restick_force`` is not reachable (not between those ends).
     """
-    from dataclasses import replace as _replace
-
     from scipy.optimize import brentq
 
     k, v = block.stiffness, abs(block.drive_velocity)
@@ -520,17 +522,25 @@ def freeze_velocity_for(block, static_force: float, restick_force: float) -> flo
     # one cycle's stick and a slip: (Fs - Fb)/(K V) plus margin; two cycles give a steady one
     horizon = 3.0 * static_force / (k * max(v, 1e-300))
 
-    def restick(vf):
-        r = _replace(block, law=_replace(law, freeze_velocity=vf)).simulate(horizon)
-        fb = np.asarray(r.cycles().backward_force, float)
+    def last_restick(result):
+        fb = np.asarray(result.cycles().backward_force, float)
         return float(fb[-1]) if fb.size else -math.inf
+
+    def run(vf):
+        return dataclasses.replace(block, law=dataclasses.replace(law, freeze_velocity=vf)
+                                   ).simulate(horizon)
+
+    def restick(vf):
+        return last_restick(run(vf))
 
     # the film can only freeze below the slip's peak speed, and an overdamped
     # slip only above the steady sliding speed V, which it approaches from above
-    free = block.simulate(horizon)
+    free = run(0.0)
     peak = float(np.max(np.abs(free.v)))
     lo, hi = (v * (1.0 + 1e-3) if len(free.cycles()) == 0 else 0.0), 0.999 * peak
-    f_lo, f_hi = restick(lo) - restick_force, restick(hi) - restick_force
+    # at lo = 0 the film never freezes early: that is the free run itself
+    f_lo = (last_restick(free) if lo == 0.0 else restick(lo)) - restick_force
+    f_hi = restick(hi) - restick_force
     if f_lo >= 0.0 and lo == 0.0:
         return 0.0      # it already re-sticks at or above F_b: freezing could only raise it
     if not (f_lo < 0.0 < f_hi):
@@ -569,8 +579,7 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
     freeze = 0.0
     if restick_force is not None:
         freeze = freeze_velocity_for(block, static_force, restick_force)
-        block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, damping=d,
-                            law=dataclasses.replace(law, freeze_velocity=freeze))
+        block = dataclasses.replace(block, law=dataclasses.replace(law, freeze_velocity=freeze))
     ext = min(float(f[i0]) / k, 0.999 * static_force / k)
     r = block.simulate(duration, initial_extension=ext)
     model_t = r.t + t0
@@ -765,7 +774,7 @@ def calibrate_run(run: RunData) -> RunCalibration:
         kw["eta_eff"] = Estimate(eta, b.stderr * thickness / area, u["viscosity"],
                                  "B D / A from the slip fit (D = mean gap)")
         klein = (doc.get("viscosity", {}).get("from_slip") or {}).get("eta_eff") or {}
-        if "lower bound" in b.method and klein.get("mean"):
+        if fit.damping_at_bound and klein.get("mean"):
             # F_k carries all of the sliding friction and B is unresolved: the film's
             # viscosity is then Klein's own reading of the slips (all friction viscous)
             kw["eta_eff"] = Estimate(float(klein["mean"]), float(klein.get("stderr") or math.nan),

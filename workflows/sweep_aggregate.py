@@ -21,9 +21,10 @@ from .sweep_plan import _dumps, format_value
 AGGREGATE_SCHEMA = "filmfriction.sweep-aggregate/1"
 # regimes from analysis.stickslip.classify_regime
 STICK_SLIP, SMOOTH, IRREGULAR = "stick-slip", "smooth", "irregular"
-# "smooth" means fewer than 2 slips.  A run whose wall moved slower than this fraction of V
-# over its last half was stuck for most of it: too short to tell its regime.  Such a point
-# is "unresolved" and left out of V_c and of η_eff.
+# The analysis itself now calls a run with fewer than 2 slips and no steady sliding
+# "unresolved".  An analysis.json written before it did says "smooth"; the sweep marks such
+# a point unresolved when its wall moved slower than this fraction of V over its last half.
+# Unresolved points are left out of V_c and of η_eff.
 STUCK, STUCK_RATIO = "unresolved", 0.5
 
 
@@ -156,8 +157,7 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
     # (the start-up ramp from a relaxed spring is in the first half), as analysed
     row["mean_force"] = _finite(_get(doc, "sliding", "mean_force", "mean"))
     row["mean_force_stderr"] = _finite(_get(doc, "sliding", "mean_force", "stderr"))
-    # "smooth" means fewer than 2 slips; a run too short for a second yield has as few,
-    # but its wall stood still most of the time.  Sliding moves the wall at V on average.
+    # an older analysis' "smooth" for a wall that mostly stood still (see STUCK_RATIO)
     ratio = _finite(_get(doc, "sliding", "wall_velocity_ratio"))
     row["wall_velocity_ratio"] = ratio
     row["sweep_regime"] = row["regime"]
