@@ -523,10 +523,10 @@ def ramp_forces(time, spring_force, table: CycleTable, *, wall_position=None,
             line, rms = post
             # the force must come down to the next ramp's line itself: a band of
             # tolerance x rms (large when the wall rings) is met halfway down the fall
-            below = f[y:s + 1] <= line(t[y:s + 1])
-            on = np.flatnonzero(below)
+            level = line(t[y:s + 1])
+            on = np.flatnonzero(f[y:s + 1] <= level)
             if not on.size:
-                on = np.flatnonzero(f[y:s + 1] <= line(t[y:s + 1]) + tolerance * rms)
+                on = np.flatnonzero(f[y:s + 1] <= level + tolerance * rms)
             s = y + int(on[0]) if on.size else s
             s = max(s, y)
             fb[i] = line(t[s])
