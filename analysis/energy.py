@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import trapezoid
 
-from .stickslip import CycleTable, _stats
+from filmfriction.reduced_model.cycles import CycleTable, stats as _stats
 
 __all__ = ["EnergyTable", "energy_table", "ledger"]
 

@@ -1,7 +1,7 @@
 """The ``analysis.json`` document: every analysis that the inputs allow.
 
 :func:`analyze` runs detection → cycle table → energy → viscosity (→ film
-structure when a trajectory exists) on a :class:`~analysis.trace.Trace` and
+structure when a trajectory exists) on a :class:`~filmfriction.analysis.trace.Trace` and
 returns a JSON-ready dict; an output whose input is missing is listed under
 ``skipped`` with the reason instead.  :func:`write_outputs` writes the
 document and the per-cycle CSV atomically.  The schema is documented in the
@@ -17,6 +17,7 @@ import numpy as np
 
 from . import energy as _energy
 from . import stickslip, viscosity
+from .stickslip import Regime
 from .trace import MissingInput, Trace, unit
 
 SCHEMA = "filmfriction.analysis/1"
@@ -236,8 +237,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     doc["sliding"] = _sliding_doc(sl, lab)
     # fewer than 2 slips is smooth sliding only if the wall slides: a wall stuck
     # (V -> 0, a soft spring) or a run too short for a second yield has as few
-    not_sliding = _not_sliding(sl) if regime == "smooth" else None
-    if regime == "smooth" and not not_sliding:
+    not_sliding = _not_sliding(sl) if regime == Regime.SMOOTH else None
+    if regime == Regime.SMOOTH and not not_sliding:
         # a start-up yield is followed by sliding; one late in the trace (or one
         # still under way at its end) is not
         late = list(events.yield_index)
@@ -246,13 +247,13 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         if late and t[max(late)] > t[half.start]:
             not_sliding = "its slip comes in the last half: too short to tell"
     if not_sliding:
-        regime = doc["regime"] = "unresolved"
+        regime = doc["regime"] = Regime.UNRESOLVED
         doc["regime_note"] = f"fewer than 2 slips, but {not_sliding}"
 
     # --- viscosity
     visc: dict = {}
     try:
-        if regime != "smooth":
+        if regime != Regime.SMOOTH:
             why = doc.get("regime_note", f"regime is {regime}")
             raise MissingInput("steady sliding", f"steady viscosity ({why})")
         area = p.require("area", "η_eff = (F/A)/γ̇")
@@ -368,16 +369,7 @@ def to_json(doc: dict) -> str:
 
 
 from .atomic import write_atomic as _atomic_write  # noqa: E402  (kept name for callers)
-
-
-def per_cycle_csv(per_cycle: dict) -> str:
-    names = list(per_cycle)
-    rows = [",".join(names)]
-    cols = [per_cycle[nm] for nm in names]
-    for row in zip(*cols):
-        rows.append(",".join("" if v is None or (isinstance(v, float) and not math.isfinite(v))
-                             else repr(v) for v in row))
-    return "\n".join(rows) + "\n"
+from .cycles_csv import write_cycles_csv  # noqa: E402
 
 
 def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Path]:
@@ -386,6 +378,6 @@ def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Pa
     csv_path = json_path.with_name(json_path.stem + "_cycles.csv")
     doc = dict(doc)
     doc["cycles_csv"] = csv_path.name
-    _atomic_write(csv_path, per_cycle_csv(per_cycle))
+    write_cycles_csv(per_cycle, csv_path)
     _atomic_write(json_path, to_json(doc) + "\n")
     return json_path, csv_path

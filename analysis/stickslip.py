@@ -21,205 +21,34 @@ reduced-model traces: nothing here depends on the unit system.
 """
 from __future__ import annotations
 
-import csv
-import io
+import enum
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
-from .atomic import write_atomic
+from filmfriction.reduced_model.cycles import CYCLE_COLUMNS, CycleTable, cycle_table, stats
 
-__all__ = ["CycleTable", "SlipEvents", "cycle_table", "detect_slips",
+__all__ = ["Regime", "CycleTable", "SlipEvents", "cycle_table", "detect_slips",
            "noise_level", "classify_regime", "ramp_forces", "REGIME_CV_MAX"]
+
+class Regime(enum.StrEnum):
+    """The sliding regime of a run (the one rule: :func:`classify_regime`, then the
+    analysis' check for a wall that does not slide, :func:`filmfriction.analysis.report.analyze`).
+
+    A member is its string (``Regime.STICK_SLIP == "stick-slip"``), as written in
+    ``analysis.json``.
+    """
+
+    STICK_SLIP = "stick-slip"  #: >= 2 slips, regular (CV of Fs and period <= REGIME_CV_MAX)
+    IRREGULAR = "irregular"    #: >= 2 slips that fail the regularity test
+    SMOOTH = "smooth"          #: < 2 slips and the wall slides steadily
+    UNRESOLVED = "unresolved"  #: < 2 slips without steady sliding: stuck, or too short to tell
+
 
 #: Largest coefficient of variation of Fs and of the period still called
 #: periodic ``stick-slip`` (see :func:`classify_regime`).
 REGIME_CV_MAX = 0.2
-
-_COLUMNS = ("yield_time", "stick_time", "static_force", "backward_force",
-            "spring_extension", "slip_distance", "slip_duration",
-            "stick_duration", "period")
-
-
-def _stats(values: np.ndarray) -> dict:
-    finite = values[np.isfinite(values)]
-    n = int(finite.size)
-    mean = float(finite.mean()) if n else math.nan
-    std = float(finite.std(ddof=1)) if n > 1 else math.nan
-    stderr = std / math.sqrt(n) if n > 1 else math.nan
-    return {"mean": mean, "std": std, "stderr": stderr, "n": n}
-
-
-@dataclass(frozen=True, eq=False)
-class CycleTable:
-    """Per-slip values of a stick-slip trace (one row per slip y → s).
-
-    Attributes
-    ----------
-    yield_index, stick_index : ndarray of int
-        Indices of the yield point y and re-stick point s in the trace.
-    yield_time, stick_time : ndarray
-        Times of y and s.
-    static_force : ndarray
-        Fs, spring force at y.
-    backward_force : ndarray
-        Fb, spring force at s.
-    spring_extension : ndarray
-        x0 = Fs / K (NaN without a spring constant).
-    slip_distance : ndarray
-        Δx0: wall displacement y → s when the wall position is known,
-        else (Fs − Fb)/K (exact when the spring end does not move during the
-        slip), else NaN.
-    slip_duration : ndarray
-        τ_s = t(s) − t(y).
-    stick_duration : ndarray
-        t(next y) − t(s); NaN for the last slip.
-    period : ndarray
-        τ_ss = t(next y) − t(y); NaN for the last slip.
-    """
-
-    yield_index: np.ndarray
-    stick_index: np.ndarray
-    yield_time: np.ndarray
-    stick_time: np.ndarray
-    static_force: np.ndarray
-    backward_force: np.ndarray
-    spring_extension: np.ndarray
-    slip_distance: np.ndarray
-    slip_duration: np.ndarray
-    stick_duration: np.ndarray
-    period: np.ndarray
-    spring_constant: float | None = field(default=None)
-
-    def __len__(self) -> int:
-        return int(self.yield_index.size)
-
-    def __getitem__(self, rows) -> "CycleTable":
-        """The table restricted to ``rows`` (a slice or index array); the
-        per-slip values (period, stick duration) are kept as computed."""
-        if isinstance(rows, (int, np.integer)):
-            rows = slice(rows, rows + 1 if rows != -1 else None)
-        names = ("yield_index", "stick_index") + _COLUMNS
-        return replace(self, **{n: np.asarray(getattr(self, n))[rows] for n in names})
-
-    @property
-    def count(self) -> int:
-        """Number of slips."""
-        return len(self)
-
-    def summary(self, skip: int = 0) -> dict:
-        """Mean, sample standard deviation, standard error and count of each
-        per-cycle quantity, ignoring NaN.
-
-        Parameters
-        ----------
-        skip : int
-            Leave out the first ``skip`` slips (e.g. 1 to drop the start-up
-            yield from a relaxed spring, which is larger than the rest).
-
-        Returns
-        -------
-        dict
-            ``{name: {"mean", "std", "stderr", "n"}}``.
-        """
-        return {name: _stats(np.asarray(getattr(self, name), float)[skip:])
-                for name in _COLUMNS[2:]}
-
-    def as_dict(self) -> dict:
-        """Per-cycle columns as lists (JSON-ready; NaN stays NaN)."""
-        out = {"yield_index": self.yield_index.tolist(),
-               "stick_index": self.stick_index.tolist()}
-        out.update({name: np.asarray(getattr(self, name), float).tolist()
-                    for name in _COLUMNS})
-        return out
-
-    def to_csv(self, path) -> Path:
-        """Write one row per slip to ``path`` (empty cells for NaN)."""
-        path = Path(path)
-        names = ("yield_index", "stick_index") + _COLUMNS
-        cols = [np.asarray(getattr(self, n)) for n in names]
-        buf = io.StringIO(newline="")
-        writer = csv.writer(buf)
-        writer.writerow(names)
-        for row in zip(*cols):
-            writer.writerow(["" if (isinstance(v, float) and math.isnan(v))
-                             else repr(v.item()) if hasattr(v, "item") else v
-                             for v in row])
-        write_atomic(path, buf.getvalue())
-        return path
-
-
-def cycle_table(time, spring_force, yield_index, stick_index, *,
-                spring_constant=None, wall_position=None) -> CycleTable:
-    """Tabulate stick-slip cycles from known yield and re-stick indices.
-
-    Parameters
-    ----------
-    time, spring_force : array_like, shape (n,)
-        The trace.
-    yield_index, stick_index : array_like of int, shape (m,)
-        Slip ``i`` runs from ``yield_index[i]`` (y) to ``stick_index[i]`` (s);
-        both increasing, with ``yield_index[i] <= stick_index[i] <=
-        yield_index[i+1]``.
-    spring_constant : float, optional
-        K; gives x0 = Fs/K and, without ``wall_position``, Δx0 = (Fs − Fb)/K.
-    wall_position : array_like, shape (n,), optional
-        Wall (slider) position; gives Δx0 = x(s) − x(y).
-
-    Returns
-    -------
-    CycleTable
-
-    Examples
-    --------
-    >>> t = np.arange(6.0); f = np.array([0, 1, 2, 0.5, 1.5, 2.5])
-    >>> cycle_table(t, f, [2], [3], spring_constant=2.0).slip_distance
-    array([0.75])
-    """
-    t = np.asarray(time, float)
-    f = np.asarray(spring_force, float)
-    if t.shape != f.shape or t.ndim != 1:
-        raise ValueError(f"time and spring_force must be 1-D of equal length, "
-                         f"got {t.shape} and {f.shape}")
-    yi = np.asarray(yield_index, dtype=np.int64).ravel()
-    si = np.asarray(stick_index, dtype=np.int64).ravel()
-    if yi.shape != si.shape:
-        raise ValueError(f"{yi.size} yield points but {si.size} re-stick points")
-    if yi.size:
-        if yi.min() < 0 or si.max() >= t.size:
-            raise ValueError("yield/stick index outside the trace")
-        if np.any(si < yi) or np.any(yi[1:] < si[:-1]):
-            raise ValueError("yield and re-stick indices must alternate: "
-                             "y[i] <= s[i] <= y[i+1]")
-    fs, fb = f[yi], f[si]
-    ty, ts = t[yi], t[si]
-    nan = np.full(yi.size, math.nan)
-    k = None if spring_constant is None else float(spring_constant)
-    x0 = fs / k if k else nan.copy()
-    if wall_position is not None:
-        x = np.asarray(wall_position, float)
-        if x.shape != t.shape:
-            raise ValueError("wall_position must have the length of time")
-        dx0 = x[si] - x[yi]
-    elif k:
-        dx0 = (fs - fb) / k
-    else:
-        dx0 = nan.copy()
-    period = nan.copy()
-    stick = nan.copy()
-    if yi.size > 1:
-        period[:-1] = np.diff(ty)
-        stick[:-1] = ty[1:] - ts[:-1]
-    arrays = dict(yield_index=yi, stick_index=si, yield_time=ty, stick_time=ts,
-                  static_force=fs, backward_force=fb, spring_extension=x0,
-                  slip_distance=dx0, slip_duration=ts - ty,
-                  stick_duration=stick, period=period)
-    for a in arrays.values():
-        a.setflags(write=False)
-    return CycleTable(**arrays, spring_constant=k)
-
 
 # --------------------------------------------------------------------------
 # event detection
@@ -445,7 +274,7 @@ def _drop_ringing(t, f, yi, si, window):
     return yi[kept], si[kept]
 
 
-def classify_regime(table: CycleTable, max_cv: float = REGIME_CV_MAX) -> str:
+def classify_regime(table: CycleTable, max_cv: float = REGIME_CV_MAX) -> Regime:
     """Sliding regime from the detected slips.
 
     * ``smooth`` — fewer than 2 slips (none, or a single start-up yield
@@ -459,14 +288,14 @@ def classify_regime(table: CycleTable, max_cv: float = REGIME_CV_MAX) -> str:
     """
     n = len(table)
     if n < 2:
-        return "smooth"
+        return Regime.SMOOTH
     skip = 1 if n >= 3 else 0
     for name in ("static_force", "period"):
-        st = _stats(np.asarray(getattr(table, name), float)[skip:])
+        st = stats(np.asarray(getattr(table, name), float)[skip:])
         if st["n"] >= 2 and st["mean"] != 0:
             if st["std"] / abs(st["mean"]) > max_cv:
-                return "irregular"
-    return "stick-slip"
+                return Regime.IRREGULAR
+    return Regime.STICK_SLIP
 
 
 def _line(t: np.ndarray, f: np.ndarray, lo: int, hi: int):

@@ -42,10 +42,10 @@ def _cpu() -> str:
 
 
 def bench_trace(n=1_000_000):
-    from analysis import energy, stickslip, viscosity
-    from analysis.report import analyze
-    from analysis.synthetic import klein_trace, write_csv
-    from analysis.trace import read_trace
+    from filmfriction.analysis import energy, stickslip, viscosity
+    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.synthetic import klein_trace, write_csv
+    from filmfriction.analysis.trace import read_trace
 
     k, m, fs = 97.0, 1.47e-3, 9.7e-6
     tr = klein_trace(cycles=60, noise=0.005 * fs, dt=1e-5)      # ~0.7 s per cycle
@@ -80,8 +80,8 @@ def bench_trace(n=1_000_000):
 def bench_trajectory(frames=400):
     import MDAnalysis as mda
 
-    from analysis.structure import DensityProfile, FilmThickness, HexaticOrder
-    from analysis.synthetic import layered_film
+    from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder
+    from filmfriction.analysis.synthetic import layered_film
 
     with tempfile.TemporaryDirectory() as d:
         top, traj = layered_film(d, layers=4, nx=22, ny=13, frames=frames,

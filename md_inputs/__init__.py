@@ -2,8 +2,11 @@
 
 The scripts are plain LAMMPS inputs runnable by hand::
 
-    mpiexec -n 2 lmp -in $(python -c 'import md_inputs; print(md_inputs.script("film_slide.lmp"))')
+    mpiexec -n 2 lmp -in $(python -c 'from filmfriction import md_inputs; print(md_inputs.script("film_slide.lmp"))')
 """
+
+if __name__ != "filmfriction.md_inputs":  # one name only: two would give two copies of every class
+    raise ImportError(f"import filmfriction.md_inputs, not {__name__}")
 from pathlib import Path
 
 DIRECTORY = Path(__file__).resolve().parent

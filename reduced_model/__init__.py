@@ -6,13 +6,16 @@ energy ledger on every run, the Prandtl-Tomlinson model and stability maps.
 
 Example
 -------
->>> from reduced_model import SpringBlock, laws
+>>> from filmfriction.reduced_model import SpringBlock, laws
 >>> block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1, damping=0.0,
 ...                     law=laws.Coulomb(static=1.0, kinetic=0.5))
 >>> result = block.simulate(duration=200.0)
 >>> result.energy.closure < 1e-8
 True
 """
+
+if __name__ != "filmfriction.reduced_model":  # one name only: two would give two copies of every class
+    raise ImportError(f"import filmfriction.reduced_model, not {__name__}")
 from . import laws
 from ._checks import SimulationLimitError
 from .result import EnergyLedger, Event, SimulationResult

@@ -3,7 +3,7 @@
 Stick: the block moves with the surface, the spring force is linear in time,
 and breakaway is the time it reaches the static threshold -- solved, not
 searched.  Slip: a damped oscillator about the steady-sliding equilibrium
-(:mod:`reduced_model.oscillator`), with the re-stick time found as the exact
+(:mod:`filmfriction.reduced_model.oscillator`), with the re-stick time found as the exact
 root of the slip velocity.  Energies over each segment come from the same
 closed forms (the oscillator's own energy identity gives the integral of
 v**2), so the ledger closes to round-off.

@@ -23,7 +23,7 @@ and implement ``sliding_force`` (plus the state methods if it has a state).
 
 Example
 -------
->>> from reduced_model import laws
+>>> from filmfriction.reduced_model import laws
 >>> law = laws.Coulomb(static=1.0, kinetic=0.5)
 >>> law.static_force(law.steady_state(0.0), 1.0), law.sliding_force(2.0, (), 1.0)
 (1.0, 0.5)
@@ -480,7 +480,7 @@ class ContactAge(FrictionLaw):
         """Persson's estimate ``v_c ~ (1/K) dF_s/dt|_0 = N (f_s - f_b) / (K tau)``.
 
         Stick-slip below, smooth sliding above (order of magnitude: the map in
-        :mod:`reduced_model.maps` gives the boundary the model really has).
+        :mod:`filmfriction.reduced_model.maps` gives the boundary the model really has).
         """
         k = positive("stiffness", stiffness, "spring constant")
         return normal_load * (self.static - self.backward) / (k * self.age_time)

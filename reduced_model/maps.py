@@ -26,7 +26,7 @@ otherwise, with Persson's estimate ``v_c ~ N (f_s - f_b)/(K tau)``
 
 Example
 -------
->>> from reduced_model.maps import critical_lambda
+>>> from filmfriction.reduced_model.maps import critical_lambda
 >>> lam = critical_lambda(1e-4)
 >>> round(lam ** 2 / (4 * 3.141592653589793e-4), 2)
 1.0

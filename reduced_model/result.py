@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .cycles import cycle_table
+
 __all__ = ["Event", "EnergyLedger", "SimulationResult"]
 
 
@@ -152,19 +154,17 @@ class SimulationResult:
     def cycles(self):
         """Per-cycle table (static force, backward force, slip distance, durations, period).
 
-        Uses ``analysis.stickslip.cycle_table`` -- the same ruler as for MD
+        Uses :func:`~filmfriction.reduced_model.cycles.cycle_table` -- the same ruler as for MD
         traces -- on the exact event samples of this run; the block position is
         the "wall" whose displacement is the slip distance.
 
         Example
         -------
-        >>> from reduced_model import SpringBlock, laws
+        >>> from filmfriction.reduced_model import SpringBlock, laws
         >>> r = SpringBlock(1.0, 1.0, 0.1, law=laws.Coulomb(1.0, 0.5)).simulate(100.0)
         >>> round(float(r.cycles().backward_force[0]), 12)    # 2 Fk - Fs
         0.0
         """
-        from analysis.stickslip import cycle_table  # lazy: analysis is optional for the model
-
         yields, sticks = self.slip_pairs()
         return cycle_table(self.t, self.spring_force, yields, sticks,
                            spring_constant=self.stiffness, wall_position=self.x)

@@ -18,7 +18,7 @@ Units are any consistent set: SI (kg, N/m, m/s, N s/m, N) or LJ.
 
 Example
 -------
->>> from reduced_model import SpringBlock, laws
+>>> from filmfriction.reduced_model import SpringBlock, laws
 >>> block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
 ...                     law=laws.Coulomb(static=1.0, kinetic=0.5))
 >>> r = block.simulate(duration=200.0)
@@ -58,7 +58,7 @@ class SpringBlock:
     damping : float
         Viscous damper d between block and ground [N s/m], >= 0.
     law : FrictionLaw
-        One of :mod:`reduced_model.laws`; default Coulomb(static=1, kinetic=0.5).
+        One of :mod:`filmfriction.reduced_model.laws`; default Coulomb(static=1, kinetic=0.5).
     normal_load : float
         Normal load N [N]; dry-friction coefficients of the law are multiplied by it.
     drive : {"spring", "fixed", "belt"}
@@ -79,7 +79,7 @@ class SpringBlock:
         non_negative("damping", self.damping, "a negative damper would feed energy in")
         non_negative("normal_load", self.normal_load, "the load presses the surfaces together")
         if not isinstance(self.law, FrictionLaw):
-            raise ValueError(f"law = {self.law!r}: must be a friction law from reduced_model.laws")
+            raise ValueError(f"law = {self.law!r}: must be a friction law from filmfriction.reduced_model.laws")
         if self.drive not in DRIVES:
             raise ValueError(f"drive = {self.drive!r}: allowed values are {DRIVES}")
         if self.drive == "fixed" and self.drive_velocity != 0.0:

@@ -5,9 +5,9 @@ import warnings
 import numpy as np
 import pytest
 
-from analysis.synthetic import klein_trace, run_directory, smooth_trace, write_csv
-from analysis.trace import MissingInput, TraceParameters, read_trace
-from workflows.cli import main
+from filmfriction.analysis.synthetic import klein_trace, run_directory, smooth_trace, write_csv
+from filmfriction.analysis.trace import MissingInput, TraceParameters, read_trace
+from filmfriction.workflows.cli import main
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 

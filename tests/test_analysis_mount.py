@@ -1,7 +1,7 @@
 """Damping outside the film (an MD run's mount dashpot) is not the film's."""
 import numpy as np
 
-from analysis import energy, viscosity
+from filmfriction.analysis import energy, viscosity
 
 
 def test_steady_viscosity_removes_mount_dashpot():

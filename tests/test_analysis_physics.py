@@ -3,10 +3,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from analysis.energy import energy_table, ledger, LEDGER_COLUMNS
-from analysis.stickslip import cycle_table, detect_slips, ramp_forces
-from analysis.synthetic import klein_trace
-from analysis.viscosity import (power_law_fit, profile_shear, slip_force,
+from filmfriction.analysis.energy import energy_table, ledger, LEDGER_COLUMNS
+from filmfriction.analysis.stickslip import cycle_table, detect_slips, ramp_forces
+from filmfriction.analysis.synthetic import klein_trace
+from filmfriction.analysis.viscosity import (power_law_fit, profile_shear, slip_force,
                                 slip_viscosity, steady_viscosity)
 
 KLEIN = dict(spring_constant=97.0, mass=1.47e-3, damping=3.09,

@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from analysis import stickslip, synthetic
+from filmfriction.analysis import stickslip, synthetic
 
-from analysis.stickslip import detect_slips
+from filmfriction.analysis.stickslip import detect_slips
 
 
 def ringing_sawtooth(n_slips=6, period=50.0, fs=100.0, fb=10.0, slip=3.0, ring=35.0,

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from analysis.stickslip import (classify_regime, cycle_table, detect_slips,
+from filmfriction.analysis.stickslip import (classify_regime, cycle_table, detect_slips,
                                 noise_level, ramp_forces)
-from analysis.synthetic import sawtooth, smooth_trace
+from filmfriction.analysis.synthetic import sawtooth, smooth_trace
 
 FS, FB, PERIOD, K = 3.0, 1.0, 2.0, 2.0
 
@@ -56,12 +56,16 @@ def test_cycle_table_rejects_bad_pairs():
 
 def test_cycle_table_csv_and_dict(tmp_path):
     tab, _ = _table(sawtooth(cycles=4))
-    path = tab.to_csv(tmp_path / "c.csv")
+    from filmfriction.analysis.cycles_csv import read_cycles_csv, write_cycles_csv
+    path = write_cycles_csv(tab.as_dict(), tmp_path / "c.csv")
     rows = path.read_text().splitlines()
     assert len(rows) == 1 + len(tab)
     assert rows[0].startswith("yield_index,stick_index")
     assert rows[-1].endswith(",")        # NaN period of the last slip → empty
     d = tab.as_dict()
+    back = read_cycles_csv(path)
+    np.testing.assert_array_equal(back["static_force"], tab.static_force)
+    assert list(back["yield_index"].astype(int)) == list(tab.yield_index)
     assert len(d["static_force"]) == len(tab)
 
 
@@ -152,3 +156,14 @@ def test_irregular_regime():
                      refine=False)
     assert ev.count >= 8
     assert classify_regime(tab) == "irregular"
+
+
+def test_cycle_table_iterates_row_by_row_and_ends():
+    # a CycleTable is a sequence of slips: iteration ends, an index out of range raises
+    tab, _ = _table(sawtooth(cycles=4))
+    rows = list(tab)
+    assert len(rows) == len(tab) >= 3
+    assert [float(r.static_force[0]) for r in rows] == list(tab.static_force)
+    assert float(tab[-1].static_force[0]) == float(tab.static_force[-1])
+    with pytest.raises(IndexError):
+        tab[len(tab)]

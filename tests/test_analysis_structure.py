@@ -5,8 +5,8 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from analysis.structure import DensityProfile, FilmThickness, HexaticOrder, frame_steps
-from analysis.synthetic import layered_film
+from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder, frame_steps
+from filmfriction.analysis.synthetic import layered_film
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 

@@ -10,9 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from reduced_model import SpringBlock, laws
-from workflows import calibrate as cal_mod
-from workflows import cli
+from filmfriction.reduced_model import SpringBlock, laws
+from filmfriction.workflows import calibrate as cal_mod
+from filmfriction.workflows import cli
 
 # a heavy wall on a stiff spring, like the MD scene (LJ units)
 M, K, V, D_MOUNT = 500.0, 100.0, 0.02, 50.0
@@ -104,7 +104,7 @@ def test_md_calibration_and_json(calibration):
     doc = json.loads(path.read_text())
     assert doc["schema"] == cal_mod.SCHEMA
     assert doc["runs"][0]["static_force"]["value"] == pytest.approx(FS, rel=0.03)
-    from workflows.sfb import MDCalibration
+    from filmfriction.workflows.sfb import MDCalibration
     MDCalibration.from_dict(doc["md_calibration"])      # round-trips into the SFB check
 
 
@@ -138,8 +138,8 @@ def test_cli(stick_slip, capsys, tmp_path):
 def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     from types import SimpleNamespace
 
-    from analysis.trace import TraceParameters
-    from workflows.calibrate import _no_restick
+    from filmfriction.analysis.trace import TraceParameters
+    from filmfriction.workflows.calibrate import _no_restick
 
     def run(mass, mount=None):
         p = TraceParameters(spring_constant=100.0, mass=mass, drive_velocity=0.02,

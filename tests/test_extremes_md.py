@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis import energy
-from analysis.stickslip import detect_slips
-from workflows import runner
-from workflows.scene import SceneError, load, resolve
+from filmfriction.analysis import energy
+from filmfriction.analysis.stickslip import detect_slips
+from filmfriction.workflows import runner
+from filmfriction.workflows.scene import SceneError, load, resolve
 
 pytestmark = pytest.mark.md
 

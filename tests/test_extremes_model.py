@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.report import analyze, to_json
-from analysis.trace import Trace, TraceParameters
-from reduced_model import SimulationLimitError, SpringBlock, laws
+from filmfriction.analysis.report import analyze, to_json
+from filmfriction.analysis.trace import Trace, TraceParameters
+from filmfriction.reduced_model import SimulationLimitError, SpringBlock, laws
 
 FS, FK, K, M, V = 1.0, 0.5, 1.0, 1.0, 0.1
 

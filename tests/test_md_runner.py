@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks
 
-from workflows import runner
-from workflows.scene import SceneError, load
+from filmfriction.workflows import runner
+from filmfriction.workflows.scene import SceneError, load
 
 pytestmark = pytest.mark.md
 
@@ -84,7 +84,7 @@ def test_energy_ledger_closes(short_run):
 
 def test_film_has_n_layers(short_run):
     scene, run_dir = short_run
-    from analysis.structure import DensityProfile  # noqa: F401  (trajectory analysis exists)
+    from filmfriction.analysis.structure import DensityProfile  # noqa: F401  (trajectory analysis exists)
     n, _ = _profile_layers(run_dir / "profiles" / "density.profile")
     assert n == scene.parameters["film_layers"]
 
@@ -145,7 +145,7 @@ def test_engine_failure_is_a_clear_error(tmp_path):
 
 def test_interrupted_run_resumes(tmp_path):
     out = tmp_path / "interrupted"
-    cmd = [sys.executable, "-m", "workflows.cli", "run", "stick-slip", "--md-only", "--quiet",
+    cmd = [sys.executable, "-m", "filmfriction.workflows.cli", "run", "stick-slip", "--md-only", "--quiet",
            "--out", str(out)] + [f"--set={k}={v}" for k, v in
                                  {**SMALL, "slide_steps": 20000, "restart_every": 2000}.items()]
     proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
@@ -175,8 +175,8 @@ def test_interrupted_run_resumes(tmp_path):
 
 def test_analysis_of_a_real_run(tmp_path):
     """The analysis on a real small run: slips found, ledger closed, n layers in the DCD."""
-    from analysis.report import analyze
-    from analysis.trace import read_trace
+    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.trace import read_trace
 
     scene = small("film-structure", drive_velocity=0.05, slide_steps=12000, dump_every=500)
     run_dir = runner.execute(scene, out=tmp_path / "run", nprocs=2, progress=False)

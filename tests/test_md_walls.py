@@ -5,8 +5,8 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from workflows import runner
-from workflows.scene import SceneError, load, parse_assignment
+from filmfriction.workflows import runner
+from filmfriction.workflows.scene import SceneError, load, parse_assignment
 
 SMALL = {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 2000, "slide_steps": 6000,
          "trace_every": 20, "wall_mass": 300.0}
@@ -109,8 +109,8 @@ def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path):
     # stick (Klein: >= 90 % viscous).  A check of the partition's bookkeeping on
     # a real run; that the light slider keeps the slips regular needs long runs
     # (README, "energy-partition").
-    from analysis.report import analyze
-    from analysis.trace import read_trace
+    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.trace import read_trace
 
     area = 15 / 28  # the 5 x 3 box against the scene's 7 x 4: same drive per area
     scene = load("energy-partition", {"cells_x": 5, "cells_y": 3,

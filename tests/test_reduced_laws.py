@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from reduced_model import SpringBlock, laws
+from filmfriction.reduced_model import SpringBlock, laws
 
 STICK_LAWS = {
     "coulomb": laws.Coulomb(static=1.0, kinetic=0.5),
@@ -190,7 +190,7 @@ def test_scalar_sliding_agrees_with_sliding_force(law):
 
 
 def test_restick_root_newton_and_brentq_fallback():
-    from reduced_model.hybrid import _restick_root
+    from filmfriction.reduced_model.hybrid import _restick_root
 
     def state_at(t):
         return np.array([0.0, math.cos(t) - 0.5])

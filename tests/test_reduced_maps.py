@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from reduced_model import PrandtlTomlinson, maps
+from filmfriction.reduced_model import PrandtlTomlinson, maps
 
 
 def test_critical_lambda_types_and_limits():
@@ -82,7 +82,7 @@ def test_velocity_stiffness_map_runs():
 
 
 def test_map_cli_writes_files(tmp_path, capsys):
-    from workflows.cli import main
+    from filmfriction.workflows.cli import main
     assert main(["map", "lambda-zeta", "--out", str(tmp_path), "--resolution", "6"]) == 0
     out = capsys.readouterr().out.split()
     assert (tmp_path / "lambda_zeta.csv").exists() and (tmp_path / "lambda_zeta.png").exists()

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from workflows import cli
+from filmfriction.workflows import cli
 
 SECTIONS = ("Scene and parameters", "Stick-slip trace", "Energy partition",
             "Effective viscosity", "The film: density profile and picture",
@@ -27,7 +27,7 @@ CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     """A small real run, then the post-MD study on it."""
-    from workflows import runner, scene, study as study_mod
+    from filmfriction.workflows import runner, scene, study as study_mod
 
     out = tmp_path_factory.mktemp("report") / "run"
     # drive_velocity 0.1 (5x the default) so that the short run reaches its first yield
@@ -78,8 +78,8 @@ def test_report_cli_with_out(study, tmp_path):
 
 def test_film_figure_from_a_trajectory(tmp_path):
     """The film picture and density profile from a (synthetic) trajectory."""
-    from analysis.synthetic import run_directory
-    from workflows.report import fig_film
+    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.workflows.report import fig_film
 
     d = run_directory(tmp_path / "synth", trajectory=True)
     png, note = fig_film(d)
@@ -137,7 +137,7 @@ def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path):
         "critical_velocity": [{"group": {}, "status": "bracketed", "value": 0.22, "factor": 2.2,
                                "note": "stick-slip up to V = 0.1, smooth from 0.5"}],
         "power_law": {"exponent": -0.7, "exponent_stderr": 0.1, "n": 3, "points": "steady"}}))
-    from workflows import cli
+    from filmfriction.workflows import cli
 
     assert cli.main(["report", str(sweep)]) == 0
     text = (sweep / "report.md").read_text()

@@ -3,8 +3,8 @@ import math
 
 import pytest
 
-from workflows import cli, scene
-from workflows.scene import PARAMETERS, SceneError, load, parse_assignment, resolve
+from filmfriction.workflows import cli, scene
+from filmfriction.workflows.scene import PARAMETERS, SceneError, load, parse_assignment, resolve
 
 
 def test_every_shipped_scene_loads_and_is_valid():

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from reduced_model.units import OMCTS, LJUnits
-from workflows import cli
-from workflows import sfb
-from workflows.sfb import KLEIN, MDCalibration, ROW_KEYS, SOURCES
+from filmfriction.reduced_model.units import OMCTS, LJUnits
+from filmfriction.workflows import cli
+from filmfriction.workflows import sfb
+from filmfriction.workflows.sfb import KLEIN, MDCalibration, ROW_KEYS, SOURCES
 
 K, M, A, D = KLEIN.spring_constant, KLEIN.mass, KLEIN.contact_area, KLEIN.film_thickness
 

@@ -13,15 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.report import sliding_section
-from analysis.trace import read_trace
-from workflows import sweep
-from workflows.scene import SceneError
+from filmfriction.analysis.report import sliding_section
+from filmfriction.analysis.trace import read_trace
+from filmfriction.workflows import sweep
+from filmfriction.workflows.scene import SceneError
 
 # about 330 atoms, 4000 steps: a few seconds per point on one rank
 SMALL = ["--set", "cells_x=5", "--set", "cells_y=3", "--set", "equilibrate_steps=1000",
          "--set", "slide_steps=3000", "--set", "trace_every=20"]
-# the installed command (``python -m workflows.cli`` would define a second UserError)
+# the installed command (``python -m filmfriction.workflows.cli`` would define a second UserError)
 FILMFRICTION = str(Path(sys.executable).with_name("filmfriction"))
 
 
@@ -136,7 +136,7 @@ def test_critical_velocity_brackets_the_transition():
 
 
 def test_reduced_model_boundary_follows_the_coulomb_threshold():
-    from reduced_model.maps import critical_lambda
+    from filmfriction.reduced_model.maps import critical_lambda
 
     cal = {"runs": [{"static_force": {"value": 60.0}, "kinetic_force": {"value": 20.0},
                      "film_damping": {"value": 10.0}}]}
@@ -228,7 +228,7 @@ def test_a_run_too_short_to_slip_is_unresolved_not_smooth(tmp_path):
 
 
 def test_launcher_replaces_mpiexec_by_srun():
-    from workflows import engine
+    from filmfriction.workflows import engine
 
     plain = engine.lmp_command(4, Path("in.lmp"))
     wrapped = engine.lmp_command(4, Path("in.lmp"), launcher=["srun", "--mpi=pmi2"])

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from workflows import cli, fidelity, tradeoff
-from workflows.scene import SceneError, load
+from filmfriction.workflows import cli, fidelity, tradeoff
+from filmfriction.workflows.scene import SceneError, load
 
 
 def test_pareto_front_keeps_only_undominated_points():

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from scipy import constants
 
-from reduced_model import units as U
-from reduced_model.units import OMCTS, QUANTITIES, LJUnits
+from filmfriction.reduced_model import units as U
+from filmfriction.reduced_model.units import OMCTS, QUANTITIES, LJUnits
 
 # The reference notes' example: σ = 0.8 nm, ε/k_B = 450 K, m = 296.62 g/mol.
 NOTES = LJUnits.from_molecule(sigma_nm=0.8, epsilon_over_kB=450.0, molar_mass_g=296.62)

@@ -14,7 +14,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-import md_inputs
+from filmfriction import md_inputs
 from . import engine
 from .runner import atom_steps_per_second, loop_atoms
 from .scene import load, parse_assignment

@@ -5,8 +5,8 @@ The model
 The MD top wall (mass M) is pulled through a spring K whose end moves at V,
 and its mount has a dashpot d = γ·M to ground (``trace_parameters``).  The
 reduced model is the same block, spring, drive and dashpot
-(:class:`reduced_model.SpringBlock` with ``damping = d``) on a film described by
-:class:`reduced_model.laws.Coulomb` with a viscous term::
+(:class:`filmfriction.reduced_model.SpringBlock` with ``damping = d``) on a film described by
+:class:`filmfriction.reduced_model.laws.Coulomb` with a viscous term::
 
     stick:  wall at rest until the spring force reaches F_s
     slip:   M x'' = K (x_d - x) - d x' - F_k - B x'   until x' = 0 (re-stick)
@@ -47,13 +47,13 @@ Fits (all in the run's LJ units)
     With a smooth-sliding run the steady η_eff = (F̄/A)/(V/D) is used instead.
 ``rate_law``
     With ≥ 3 runs at different shear rates, η_eff = c·γ̇^α fitted with
-    :func:`analysis.viscosity.power_law_fit` (α ± its standard error).
+    :func:`filmfriction.analysis.viscosity.power_law_fit` (α ± its standard error).
 ``ageing``
     With ≥ 4 slips, the slope of F_s against ln(preceding stick time), ± its
     standard error (contact ageing: positive and significant if the film
     strengthens while stuck).
 
-The :class:`workflows.sfb.MDCalibration` for the SFB check takes the stresses
+The :class:`filmfriction.workflows.sfb.MDCalibration` for the SFB check takes the stresses
 F/A, η_eff and the rate law; the thinning law is Carreau with its onset at
 the lowest MD rate, matched to the fit there (the pure power law from that
 rate is the SFB check's upper bracket).
@@ -74,7 +74,7 @@ its predictions.  The calibrated model is run with the MD's K, M, V and d from
 the MD's first re-stick point (the start-up yield, whose larger threshold reflects the
 contact's age after equilibration, is not part of the steady cycle), and its
 cycles are measured with the same ruler as the MD's
-(:func:`analysis.stickslip.cycle_table` via ``SimulationResult.cycles``).
+(:func:`filmfriction.analysis.stickslip.cycle_table` via ``SimulationResult.cycles``).
 Errors are (model − MD)/MD of the mean peak force, slip distance and period.
 The peak and re-stick forces are inputs of the model (their errors check the
 replay, they predict nothing); slip distance and period are predictions.
@@ -178,8 +178,9 @@ def load_run(run_dir) -> RunData:
     ValueError
         No run directory, no trace, or an unreadable analysis.
     """
-    from analysis.report import analyze, write_outputs
-    from analysis.trace import read_trace
+    from filmfriction.analysis.cycles_csv import read_cycles_csv
+    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.trace import read_trace
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
@@ -192,7 +193,7 @@ def load_run(run_dir) -> RunData:
             doc = json.loads(apath.read_text())
         except json.JSONDecodeError as exc:
             raise ValueError(f"{apath}: not valid JSON: {exc}") from None
-        cycles = _read_cycles(cpath)
+        cycles = read_cycles_csv(cpath)
     else:
         doc, per_cycle = analyze(trace)
         try:
@@ -207,21 +208,6 @@ def load_run(run_dir) -> RunData:
     return RunData(run_dir, trace, doc, cycles, skip)
 
 
-def _read_cycles(path: Path) -> dict:
-    lines = [ln for ln in path.read_text().splitlines() if ln.strip()]
-    if not lines:
-        return {}
-    names = lines[0].split(",")
-    cols = {n: [] for n in names}
-    for ln in lines[1:]:
-        for n, cell in zip(names, ln.split(",")):
-            try:
-                cols[n].append(float(cell) if cell else math.nan)
-            except ValueError:
-                cols[n].append(math.nan)
-    return {n: np.asarray(v, dtype=float) for n, v in cols.items()}
-
-
 # ---------------------------------------------------------------------------
 # the slip of a Coulomb + viscous block (closed form)
 # ---------------------------------------------------------------------------
@@ -230,7 +216,7 @@ def coulomb_slip_force(t, static_force: float, kinetic_force: float, damping: fl
     """Spring force of one Coulomb + viscous slip from rest at the yield point.
 
     Solves ``M x'' + b x' = K(x0 + V t − x) − F_k`` from x = x' = 0 with
-    K x0 = F_s (:func:`analysis.viscosity.slip_force` with F_s − F_k) until
+    K x0 = F_s (:func:`filmfriction.analysis.viscosity.slip_force` with F_s − F_k) until
     the wall velocity returns to zero, after which the wall sticks and the
     force ramps at K V.  A second yield inside ``t`` is not modelled.
 
@@ -251,7 +237,7 @@ def coulomb_slip_force(t, static_force: float, kinetic_force: float, damping: fl
     numpy.ndarray
         Spring force at ``t``.
     """
-    from analysis.viscosity import slip_force
+    from filmfriction.analysis.viscosity import slip_force
 
     t = np.asarray(t, dtype=float)
     k, v = stiffness, drive_velocity
@@ -446,7 +432,7 @@ def fit_slip_law(run: RunData) -> SlipLawFit:
 
 
 def _labels(units: str) -> dict:
-    from analysis.trace import UNITS
+    from filmfriction.analysis.trace import UNITS
     return UNITS[units]
 
 
@@ -552,14 +538,14 @@ def freeze_velocity_for(block, static_force: float, restick_force: float) -> flo
 
 def replay(run: RunData, static_force: float, kinetic_force: float, film_damping: float,
            restick_force: float | None = None, shear_stiffness: float = math.inf) -> Replay:
-    """Run the calibrated :class:`reduced_model.SpringBlock` over the MD trace and compare cycles.
+    """Run the calibrated :class:`filmfriction.reduced_model.SpringBlock` over the MD trace and compare cycles.
 
     With the MD's ``restick_force`` the law gets the freeze velocity that
     re-sticks it there (:func:`freeze_velocity_for`): a fitted, not a predicted,
     re-stick level, which an overdamped slip (:func:`_no_restick`) needs to stop
     at all.  ``shear_stiffness`` is the stuck film's k_f (inf: rigid).
     """
-    from reduced_model import SpringBlock, laws
+    from filmfriction.reduced_model import SpringBlock, laws
 
     tr = run.trace
     p = tr.parameters
@@ -887,7 +873,7 @@ def _stress(e: Estimate | None, area: float) -> Estimate | None:
 
 def _md_calibration(runs: list[RunCalibration], law, points, notes: list):
     """Build the MDCalibration (LJ stresses) or explain why not."""
-    from workflows.sfb import MDCalibration
+    from filmfriction.workflows.sfb import MDCalibration
 
     ss = [r for r in runs if r.static_force is not None and r.kinetic_force is not None
           and r.eta_eff is not None]
@@ -951,7 +937,7 @@ def calibrate(run_dirs) -> Calibration:
     ValueError
         A directory cannot be read.
     """
-    from analysis.viscosity import power_law_fit
+    from filmfriction.analysis.viscosity import power_law_fit
 
     if isinstance(run_dirs, (str, os.PathLike)):
         run_dirs = [run_dirs]
@@ -989,9 +975,9 @@ def calibrate(run_dirs) -> Calibration:
 
 def write_calibration(cal: Calibration, path=None) -> Path:
     """Write ``calibration.json`` atomically (default: in the first run directory)."""
-    from analysis.report import to_json
+    from filmfriction.analysis.report import to_json
 
     path = Path(path) if path is not None else cal.main.run.run_dir / "calibration.json"
-    from analysis.atomic import write_atomic
+    from filmfriction.analysis.atomic import write_atomic
 
     return write_atomic(path, to_json(cal.as_dict()) + "\n")

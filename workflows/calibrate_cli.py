@@ -34,7 +34,7 @@ def _fmt(e) -> str:
 
 
 def format_calibration(cal) -> str:
-    """Human-readable summary of a :class:`workflows.calibrate.Calibration`."""
+    """Human-readable summary of a :class:`filmfriction.workflows.calibrate.Calibration`."""
     out = []
     for r in cal.runs:
         out.append(f"{r.run.run_dir}: {r.regime}, {r.run.n_slips} slips")
@@ -67,11 +67,11 @@ def format_calibration(cal) -> str:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from analysis.report import to_json
-    from workflows.calibrate import calibrate, write_calibration
-    from workflows.cli import UserError
+    from filmfriction.analysis.report import to_json
+    from filmfriction.workflows.calibrate import calibrate, write_calibration
+    from filmfriction.workflows.cli import UserError
 
-    from workflows.report import _split_sweeps
+    from filmfriction.workflows.report import _split_sweeps
 
     for d in args.run_dirs:
         if not d.is_dir():
@@ -96,5 +96,5 @@ def run(args) -> int:
 
 if __name__ == "__main__":  # pragma: no cover
     import sys
-    from workflows.cli import main
+    from filmfriction.workflows.cli import main
     sys.exit(main(["calibrate"] + sys.argv[1:]))

@@ -14,16 +14,16 @@ import sys
 
 # name -> module providing register(subparsers)
 COMMANDS = {
-    "run": "workflows.run_cli",
-    "scenes": "workflows.run_cli",
-    "bench": "workflows.bench",
-    "analyze": "analysis.cli",
-    "map": "reduced_model.cli",
-    "calibrate": "workflows.calibrate_cli",
-    "sfb": "workflows.sfb_cli",
-    "report": "workflows.report_cli",
-    "tradeoff": "workflows.tradeoff",
-    "sweep": "workflows.sweep",
+    "run": "filmfriction.workflows.run_cli",
+    "scenes": "filmfriction.workflows.run_cli",
+    "bench": "filmfriction.workflows.bench",
+    "analyze": "filmfriction.workflows.analyze_cli",
+    "map": "filmfriction.workflows.map_cli",
+    "calibrate": "filmfriction.workflows.calibrate_cli",
+    "sfb": "filmfriction.workflows.sfb_cli",
+    "report": "filmfriction.workflows.report_cli",
+    "tradeoff": "filmfriction.workflows.tradeoff",
+    "sweep": "filmfriction.workflows.sweep",
 }
 
 
@@ -75,6 +75,6 @@ def main(argv: list[str] | None = None) -> int:
 if __name__ == "__main__":
     # run through the package module, so that sub-commands and this entry
     # point share one UserError class (not a second copy in __main__)
-    from workflows.cli import main as _main
+    from filmfriction.workflows.cli import main as _main
 
     sys.exit(_main())

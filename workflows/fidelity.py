@@ -14,7 +14,7 @@ presets"), from ``filmfriction tradeoff`` (see ``workflows/tradeoff.py``).
 
 Example
 -------
->>> from workflows.fidelity import preset
+>>> from filmfriction.workflows.fidelity import preset
 >>> preset("standard")
 {}
 >>> preset("preview")

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from reduced_model.units import OMCTS
+from filmfriction.reduced_model.units import OMCTS
 
 __all__ = ["build_report", "Section", "Figure", "Table", "PARAMETER_QUANTITIES"]
 
@@ -365,7 +365,7 @@ def _scene_section(run) -> Section:
             rows.append((f"{k} (trace)", _fmt(tp[k]), lab, f"{si:.3g} " + {"area": "m²", "mass": "kg",
                                                                             "damping": "N·s/m"}[q]))
     sec.add(Table(("parameter", "value", "LJ unit", f"SI ({OMCTS.name})"), tuple(rows)))
-    sec.p(f"SI equivalents use the {OMCTS.name} mapping of `reduced_model.units`: σ = "
+    sec.p(f"SI equivalents use the {OMCTS.name} mapping of `filmfriction.reduced_model.units`: σ = "
           f"{OMCTS.sigma * 1e9:.3g} nm, ε/k_B = {OMCTS.temperature:.0f} K, m = {OMCTS.molar_mass_g:.2f} g/mol, "
           f"τ = {OMCTS.tau * 1e12:.2f} ps ({OMCTS.source}).")
     return sec
@@ -464,7 +464,7 @@ def _calibration_section(cal, failures) -> Section:
         return sec
     rc = cal.main
     sec.p("Model: the MD wall's mass M, spring K, drive V and mount dashpot d in "
-          "`reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
+          "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
           "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
           "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
           "jackknife over slips (see `workflows/calibrate.py`).")
@@ -514,7 +514,7 @@ def _calibration_section(cal, failures) -> Section:
 
 
 def _sfb_section(check, failures) -> Section:
-    from workflows.sfb import BRAUN_TOSATTI_NOTE
+    from filmfriction.workflows.sfb import BRAUN_TOSATTI_NOTE
 
     sec = Section("Comparison with the SFB experiment (Klein, OMCTS)")
     if check is None:
@@ -676,7 +676,7 @@ def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str,
     return "\n".join(lines) + "\n", files
 
 
-from analysis.atomic import write_atomic as _write_atomic  # noqa: E402
+from filmfriction.analysis.atomic import write_atomic as _write_atomic  # noqa: E402
 
 
 # ---------------------------------------------------------------------------
@@ -688,7 +688,7 @@ def _split_sweeps(paths: list) -> tuple[list, list]:
     A sweep contributes its stick-slip runs (its ``calibration_runs``, else all
     its runs) to the calibration, after the run directories given directly.
     """
-    from workflows.sweep import load_aggregate
+    from filmfriction.workflows.sweep_aggregate import load_aggregate
 
     runs, sweeps = [], []
     for p in paths:
@@ -755,7 +755,7 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     Path
         The HTML file.
     """
-    from workflows.calibrate import calibrate, load_run
+    from filmfriction.workflows.calibrate import calibrate, load_run
 
     if isinstance(run_dirs, (str, os.PathLike)):
         run_dirs = [run_dirs]
@@ -769,7 +769,7 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     if calibration is None and "calibration" not in failures:
         calibration = _attempt(failures, "calibration", calibrate, run_dirs)
     if sfb is None and "sfb" not in failures:
-        from workflows.sfb import sfb_check
+        from filmfriction.workflows.sfb import sfb_check
         md = calibration.md_calibration if calibration is not None else None
         sfb = _attempt(failures, "sfb", sfb_check, md)
     # the calibration has read the main run already; without one, the report
@@ -779,7 +779,7 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
     title = f"filmfriction report — {scene} ({run.run_dir.name})"
     intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. MD quantities are in LJ units "
-             "(σ, ε, m, τ) unless marked SI; SI values go through `reduced_model.units` "
+             "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
              f"({OMCTS.name})."]
     sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
                 _viscosity_section(calibration, failures), _film_section(run, failures),

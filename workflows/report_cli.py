@@ -28,8 +28,8 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from workflows.cli import UserError
-    from workflows.report import build_report
+    from filmfriction.workflows.cli import UserError
+    from filmfriction.workflows.report import build_report
 
     for d in args.run_dirs:
         if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-import md_inputs
+from filmfriction import md_inputs
 from . import engine
 from .scene import Scene, SceneError
 
@@ -63,7 +63,7 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
-from analysis.atomic import write_atomic  # noqa: E402  (re-exported for callers)
+from filmfriction.analysis.atomic import write_atomic  # noqa: E402  (re-exported for callers)
 
 
 def write_json(path: Path, data: dict) -> None:

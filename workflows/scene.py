@@ -361,7 +361,7 @@ def parse_assignment(text: str) -> tuple[str, float | int]:
 
 
 def scenes_directory() -> Path:
-    return Path(str(resources.files("workflows") / "scenes"))
+    return Path(str(resources.files("filmfriction.workflows") / "scenes"))
 
 
 def available() -> dict[str, Path]:

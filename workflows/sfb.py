@@ -15,7 +15,7 @@ This module does two things, each as rows of one table
 
 ``source = "sfb-parameters"``
     Klein's own parameters (K, M, A, D, η_eff) in the reduced model
-    (:class:`reduced_model.SpringBlock` with :class:`reduced_model.laws.NewtonianFilm`,
+    (:class:`filmfriction.reduced_model.SpringBlock` with :class:`filmfriction.reduced_model.laws.NewtonianFilm`,
     spring end fixed, released from the extension x0): the slip time τ_s,
     the spring energy released, the viscous energy from the model's energy
     ledger, the viscous fraction, the residual kinetic energy at s, the ringing
@@ -24,7 +24,7 @@ This module does two things, each as rows of one table
     cross-checked against Klein's closed form (his Eq. 2).
 ``source = "md-calibrated"`` (only with an :class:`MDCalibration`)
     The MD film's yield, re-stick and sliding stresses (LJ) converted to SI
-    through :mod:`reduced_model.units` and scaled to Klein's contact area; its
+    through :mod:`filmfriction.reduced_model.units` and scaled to Klein's contact area; its
     η_eff(γ̇) law carried to the SFB slip's shear rate; the SFB-scale slip
     of the reduced model with those parameters — beside Klein's numbers, with
     uncertainties propagated from the calibration's, however large the
@@ -74,7 +74,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from reduced_model.units import OMCTS, LJUnits
+from filmfriction.reduced_model.units import OMCTS, LJUnits
 
 __all__ = [
     "KleinExperiment", "KLEIN", "LiquidProperties", "OMCTS_LIQUID", "SlipGeometry",
@@ -400,7 +400,7 @@ def run_slip(mass: float, stiffness: float, x0: float, law, *, restick_force: fl
              relaxed_fraction: float = 0.99, model_mass: float | None = None) -> SlipRun:
     """Release the block from a spring extension ``x0`` (spring end fixed) and follow the slip.
 
-    The reduced model (:class:`reduced_model.SpringBlock`, ``drive="fixed"``)
+    The reduced model (:class:`filmfriction.reduced_model.SpringBlock`, ``drive="fixed"``)
     integrates the slip; this function only finds s and reads the trace and
     the energy ledger there.
 
@@ -437,7 +437,7 @@ def run_slip(mass: float, stiffness: float, x0: float, law, *, restick_force: fl
     -------
     SlipRun
     """
-    from reduced_model import SpringBlock
+    from filmfriction.reduced_model import SpringBlock
 
     if restick_force is not None and not restick_force < stiffness * x0:
         raise ValueError(f"restick_force = {restick_force!r} N: must be below the yield force "
@@ -525,7 +525,7 @@ class MDCalibration:
 
     Stresses are in ε/σ³, viscosities in ετ/σ³, shear rates in 1/τ; each
     ``*_err`` is a one-standard-error uncertainty in the same unit (0: not
-    known).  Converted to SI with the :class:`~reduced_model.units.LJUnits`
+    known).  Converted to SI with the :class:`~filmfriction.reduced_model.units.LJUnits`
     passed to :func:`sfb_check`.
 
     Attributes
@@ -538,7 +538,7 @@ class MDCalibration:
         n in η ∝ γ̇⁻ⁿ above the onset rate; 0 is Newtonian, 0 ≤ n < 1.
     onset_rate : float
         Shear rate where thinning starts, 1/τ.  The law is the reduced model's
-        :class:`~reduced_model.laws.ShearThinningFilm`:
+        :class:`~filmfriction.reduced_model.laws.ShearThinningFilm`:
         η(γ̇) = η0 (1 + (γ̇/γ̇_c)²)^(−n/2).
     restick_stress : float or None
         Shear stress at the re-stick point s (film re-solidifies), ε/σ³.
@@ -641,7 +641,7 @@ class MDCalibration:
 
 def _film_law(calibration: MDCalibration, units: LJUnits, area: float, thickness: float):
     """The MD film as a reduced-model friction law in SI at the SFB contact."""
-    from reduced_model import laws
+    from filmfriction.reduced_model import laws
 
     eta0 = units.to_si(calibration.eta_zero, "viscosity")
     kinetic = units.to_si(calibration.sliding_stress, "stress") * area
@@ -659,7 +659,7 @@ def _film_law(calibration: MDCalibration, units: LJUnits, area: float, thickness
 
 def _thinning_film_with_sliding_class():
     # Defined lazily so that importing this module does not import the model.
-    from reduced_model import laws
+    from filmfriction.reduced_model import laws
 
     @dataclass(frozen=True)
     class ThinningFilmWithSliding(laws.ShearThinningFilm):
@@ -774,7 +774,7 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
     -------
     SFBCheck
     """
-    from reduced_model import SpringBlock, laws
+    from filmfriction.reduced_model import SpringBlock, laws
 
     ex = experiment
     K, M, A, D = ex.spring_constant, ex.mass, ex.contact_area, ex.film_thickness
@@ -1036,7 +1036,7 @@ def sfb_table(calibration=None, units: LJUnits = OMCTS) -> list[dict]:
     calibration : MDCalibration, dict or compatible object, optional
         Adds the ``md-calibrated`` rows.
     units : LJUnits
-        LJ ↔ SI units for the calibration (default :data:`reduced_model.units.OMCTS`).
+        LJ ↔ SI units for the calibration (default :data:`filmfriction.reduced_model.units.OMCTS`).
 
     Returns
     -------

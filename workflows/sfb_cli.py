@@ -4,7 +4,7 @@
 
 Prints the comparison table (name, Klein, model, ratio, units, source) and
 the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
-``--calibration`` reads an :class:`workflows.sfb.MDCalibration` (LJ units) from
+``--calibration`` reads an :class:`filmfriction.workflows.sfb.MDCalibration` (LJ units) from
 a JSON object with its field names and adds the ``md-calibrated`` rows;
 ``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to carry
 it to SI.
@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from reduced_model.units import OMCTS, LJUnits
+from filmfriction.reduced_model.units import OMCTS, LJUnits
 
 __all__ = ["register", "run", "format_table"]
 
@@ -38,7 +38,7 @@ def register(subparsers) -> None:
 def _units(args) -> LJUnits:
     if args.sigma_nm is None and args.epsilon_K is None:
         return OMCTS
-    from workflows.cli import UserError
+    from filmfriction.workflows.cli import UserError
     try:
         return LJUnits.from_molecule(
             sigma_nm=OMCTS.sigma * 1e9 if args.sigma_nm is None else args.sigma_nm,
@@ -51,8 +51,8 @@ def _units(args) -> LJUnits:
 def _calibration(path: Path | None):
     if path is None:
         return None
-    from workflows.cli import UserError
-    from workflows.sfb import MDCalibration
+    from filmfriction.workflows.cli import UserError
+    from filmfriction.workflows.sfb import MDCalibration
     try:
         data = json.loads(Path(path).read_text())
     except FileNotFoundError:
@@ -93,8 +93,8 @@ def format_table(rows, notes=()) -> str:
 
 def run(args) -> int:
     """Entry point of ``filmfriction sfb``; returns the exit code."""
-    from workflows.cli import UserError
-    from workflows.sfb import sfb_check
+    from filmfriction.workflows.cli import UserError
+    from filmfriction.workflows.sfb import sfb_check
 
     units = _units(args)
     calibration = _calibration(args.calibration)

@@ -15,8 +15,8 @@ from pathlib import Path
 
 
 def analyse(run_dir: Path) -> dict:
-    from analysis.report import analyze, write_outputs
-    from analysis.trace import read_trace
+    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.trace import read_trace
 
     trace = read_trace(run_dir)
     doc, per_cycle = analyze(trace)
@@ -37,7 +37,7 @@ def _step(name: str, failures: dict, fn, *args):
 
 
 def _write_sfb(run_dir: Path, check) -> Path:
-    from analysis.atomic import write_atomic as _atomic_write
+    from filmfriction.analysis.atomic import write_atomic as _atomic_write
 
     path = run_dir / "sfb.json"
     _atomic_write(path, json.dumps(check.rows, indent=2, allow_nan=False) + "\n")
@@ -62,7 +62,7 @@ def finish_study(run_dir: Path) -> int:
               f"{fs['mean'] if fs['mean'] is not None else float('nan'):.4g} ± {fs['stderr'] or 0:.2g} "
               f"{fs['units']} -> {run_dir / 'analysis.json'}")
 
-    from workflows.calibrate import calibrate, write_calibration
+    from filmfriction.workflows.calibrate import calibrate, write_calibration
     cal = _step("calibration", failures, calibrate, [run_dir])
     if cal is not None:
         path = _step("calibration (write)", failures, write_calibration, cal)
@@ -73,7 +73,7 @@ def finish_study(run_dir: Path) -> int:
               f"{rc.film_damping.value if rc.film_damping else float('nan'):.4g}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
-    from workflows.sfb import sfb_check
+    from filmfriction.workflows.sfb import sfb_check
     md = cal.md_calibration if cal is not None else None
     check = _step("sfb", failures, sfb_check, md)
     if check is not None:
@@ -81,7 +81,7 @@ def finish_study(run_dir: Path) -> int:
         n_md = sum(r["source"] == "md-calibrated" for r in check.rows)
         print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated) -> {path}")
 
-    from workflows import report
+    from filmfriction.workflows import report
     kwargs = {"failures": failures}
     if cal is not None:
         kwargs["calibration"] = cal

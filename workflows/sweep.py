@@ -1,7 +1,7 @@
 """Parameter sweeps: one scene fanned out over a grid, scheduled by Snakemake.
 
 ``filmfriction sweep SCENE --grid KEY=START:STOP:N[:log] ...`` plans the grid
-here (every point is validated through :func:`workflows.scene.load` before
+here (every point is validated through :func:`filmfriction.workflows.scene.load` before
 anything starts), writes it into the sweep directory, and hands the
 scheduling to Snakemake (``workflows/sweep.smk``): locally on ``--cores``,
 or on a Slurm cluster with ``--profile slurm``.  Nothing here schedules jobs.
@@ -43,8 +43,8 @@ from pathlib import Path
 # The sweep is split by purpose; this module is the command line and the one
 # place the rest of the project imports from.
 from .sweep_aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, STUCK_RATIO, Aggregate,
-                              CriticalVelocity, aggregate, critical_velocity, load_aggregate,
-                              reduced_model_boundary)
+                              CriticalVelocity, build_aggregate, critical_velocity, load_aggregate,
+                              reduced_model_boundary, write_aggregate)
 from .sweep_figures import _numeric_axes, fig_velocity_map, fig_vk_map
 from .sweep_jobs import (PROFILES, SNAKEFILE, _interrupt, analyse_point, profile_path, run_point,
                          run_sweep, snakemake_command)
@@ -56,6 +56,30 @@ __all__ = ["GridAxis", "SweepPoint", "SweepPlan", "CriticalVelocity", "Aggregate
            "run_sweep", "run_point", "analyse_point", "critical_velocity",
            "reduced_model_boundary", "aggregate", "load_aggregate", "register", "SNAKEFILE",
            "PROFILES", "format_value", "fig_velocity_map", "fig_vk_map", "_numeric_axes"]
+
+
+def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
+    """Combine every point of a finished sweep; write the aggregate files.
+
+    Writes ``aggregate.json``, ``aggregate.csv``, ``velocity_map.png`` and,
+    when both V and K are swept, ``vk_map.png``, each atomically.  Returns the
+    ``aggregate.json`` document (see :func:`.sweep_aggregate.build_aggregate`).
+    """
+    from filmfriction.analysis.atomic import write_atomic
+
+    sweep_dir = Path(sweep_dir)
+    doc, rows = build_aggregate(sweep_dir)
+    if figures and not _numeric_axes(doc):
+        doc["notes"].append("no velocity_map.png: every grid axis is a choice (e.g. "
+                            "wall_model); the table compares the points")
+    elif figures:
+        write_atomic(sweep_dir / "velocity_map.png", fig_velocity_map(doc))
+        doc["outputs"].append("velocity_map.png")
+        keys = {a["key"] for a in doc["grid"]}
+        if {"drive_velocity", "spring_constant"} <= keys:
+            write_atomic(sweep_dir / "vk_map.png", fig_vk_map(doc))
+            doc["outputs"].append("vk_map.png")
+    return write_aggregate(sweep_dir, doc, rows)
 
 
 # ---------------------------------------------------------------------------
@@ -169,8 +193,8 @@ def summary(agg: Aggregate) -> str:
 
 
 def _job_main(argv: list[str]) -> int:
-    """The Snakefile's jobs: ``python -m workflows.sweep point|analyse|aggregate ...``."""
-    parser = argparse.ArgumentParser(prog="python -m workflows.sweep")
+    """The Snakefile's jobs: ``python -m filmfriction.workflows.sweep point|analyse|aggregate ...``."""
+    parser = argparse.ArgumentParser(prog="python -m filmfriction.workflows.sweep")
     sub = parser.add_subparsers(dest="job", required=True)
     p = sub.add_parser("point")
     p.add_argument("inputs", type=Path)

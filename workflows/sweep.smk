@@ -53,7 +53,7 @@ rule point:
         mem_mb=2000,
         runtime=60,  # minutes; raise it in the profile for production-length runs
     shell:
-        "{PYTHON:q} -m workflows.sweep point {input:q} points/{wildcards.point:q} "
+        "{PYTHON:q} -m filmfriction.workflows.sweep point {input:q} points/{wildcards.point:q} "
         "--np {resources.tasks} --launcher {resources.mpi:q} > {log:q} 2>&1"
 
 
@@ -69,7 +69,7 @@ rule analyse:
         mem_mb=2000,
         runtime=15,
     shell:
-        "{PYTHON:q} -m workflows.sweep analyse points/{wildcards.point:q} > {log:q} 2>&1"
+        "{PYTHON:q} -m filmfriction.workflows.sweep analyse points/{wildcards.point:q} > {log:q} 2>&1"
 
 
 rule aggregate:
@@ -82,4 +82,4 @@ rule aggregate:
     log:
         "logs/aggregate.log",
     shell:
-        "{PYTHON:q} -m workflows.sweep aggregate . > {log:q} 2>&1"
+        "{PYTHON:q} -m filmfriction.workflows.sweep aggregate . > {log:q} 2>&1"

@@ -1,7 +1,7 @@
 """Sweep aggregation: per-point summaries, the critical velocity, η_eff vs γ̇, the
 (V, K) map, and reading a finished sweep back (report, calibration).
 
-Part of :mod:`workflows.sweep`.
+Part of :mod:`filmfriction.workflows.sweep`.
 """
 from __future__ import annotations
 
@@ -14,18 +14,19 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.atomic import write_atomic
+from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.stickslip import Regime
 
 from .sweep_plan import _dumps, format_value
 
 AGGREGATE_SCHEMA = "filmfriction.sweep-aggregate/1"
-# regimes from analysis.stickslip.classify_regime
-STICK_SLIP, SMOOTH, IRREGULAR = "stick-slip", "smooth", "irregular"
+# regimes of the analysis (filmfriction.analysis.stickslip.Regime)
+STICK_SLIP, SMOOTH, IRREGULAR = Regime.STICK_SLIP, Regime.SMOOTH, Regime.IRREGULAR
 # The analysis itself now calls a run with fewer than 2 slips and no steady sliding
 # "unresolved".  An analysis.json written before it did says "smooth"; the sweep marks such
 # a point unresolved when its wall moved slower than this fraction of V over its last half.
 # Unresolved points are left out of V_c and of η_eff.
-STUCK, STUCK_RATIO = "unresolved", 0.5
+STUCK, STUCK_RATIO = Regime.UNRESOLVED, 0.5
 
 
 # ---------------------------------------------------------------------------
@@ -199,13 +200,13 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     The calibrated film is Coulomb (static F_s, kinetic F_k) plus a viscous
     B, on the MD's wall mass M and mount dashpot d = γ·M.  For such a block
     stick-slip happens iff λ = (F_s − F_k)/(V√(KM)) exceeds
-    λ_c(ζ), ζ = (d + B)/(2√(KM)) (:func:`reduced_model.maps.critical_lambda`),
+    λ_c(ζ), ζ = (d + B)/(2√(KM)) (:func:`filmfriction.reduced_model.maps.critical_lambda`),
     so V_c(K) = (F_s − F_k)/(λ_c √(KM)); V_c = 0 for ζ ≥ 1.
 
     Parameters
     ----------
     calibration : dict
-        A ``calibration.json`` document (``workflows.calibrate``); the runs
+        A ``calibration.json`` document (``filmfriction.workflows.calibrate``); the runs
         with F_s, F_k and B are averaged.
     stiffnesses : array_like
         K values (ε/σ²).
@@ -217,7 +218,7 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     dict
         ``stiffness``, ``velocity`` lists and the parameters used.
     """
-    from reduced_model.maps import critical_lambda, damping_ratio
+    from filmfriction.reduced_model.maps import critical_lambda, damping_ratio
 
     def values(name):
         out = []
@@ -251,15 +252,15 @@ CSV_COLUMNS = ("point", "drive_velocity", "spring_constant", "normal_pressure", 
                "eta_source", "run_dir")
 
 
-def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
-    """Combine every point of a finished sweep; write the aggregate files.
+def build_aggregate(sweep_dir: Path) -> tuple[dict, list[dict]]:
+    """Combine every point of a finished sweep (nothing written).
 
-    Writes ``aggregate.json``, ``aggregate.csv``, ``velocity_map.png`` and,
-    when both V and K are swept, ``vk_map.png``, each atomically.
+    The figures (:mod:`.sweep_figures`) and :func:`write_aggregate` take the
+    result; :func:`filmfriction.workflows.sweep.aggregate` chains the three.
 
     Returns
     -------
-    dict
+    (dict, list of dict)
         The ``aggregate.json`` document (schema ``filmfriction.sweep-aggregate/1``):
         ``points`` (one row per point: parameters, ``regime`` from the analysis and
         ``sweep_regime`` — ``unresolved`` when the run was too short to tell —, static
@@ -267,12 +268,9 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
         ``critical_velocity`` (one :class:`CriticalVelocity` per group of the other swept
         keys), ``power_law`` (η_eff = c·γ̇^α, or None with the reason in ``notes``),
         ``reduced_model_boundary`` (or None), ``calibration_runs``, ``run_dirs``,
-        ``outputs`` and ``notes``.
+        and ``notes``; and the per-point rows of ``aggregate.csv``.
     """
-    from analysis.viscosity import power_law_fit
-
-    # the figures import this module's regime names: imported here, not at the top
-    from .sweep_figures import _numeric_axes, fig_velocity_map, fig_vk_map
+    from filmfriction.analysis.viscosity import power_law_fit
 
     sweep_dir = Path(sweep_dir)
     plan = json.loads((sweep_dir / "sweep.json").read_text())
@@ -340,17 +338,13 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
     # what the calibration takes: runs with slips to fit
     doc["calibration_runs"] = [r["run_dir"] for r in rows if r["regime"] == STICK_SLIP]
     doc["run_dirs"] = [r["run_dir"] for r in rows]
-    outputs = ["aggregate.json", "aggregate.csv"]
-    if figures and not _numeric_axes(doc):
-        doc["notes"].append("no velocity_map.png: every grid axis is a choice (e.g. "
-                            "wall_model); the table compares the points")
-    elif figures:
-        write_atomic(sweep_dir / "velocity_map.png", fig_velocity_map(doc))
-        outputs.append("velocity_map.png")
-        if vk:
-            write_atomic(sweep_dir / "vk_map.png", fig_vk_map(doc))
-            outputs.append("vk_map.png")
-    doc["outputs"] = outputs
+    doc["outputs"] = ["aggregate.json", "aggregate.csv"]
+    return doc, rows
+
+
+def write_aggregate(sweep_dir: Path, doc: dict, rows: list[dict]) -> dict:
+    """Write ``aggregate.csv`` and ``aggregate.json`` atomically; returns the document."""
+    sweep_dir = Path(sweep_dir)
     write_atomic(sweep_dir / "aggregate.csv", _csv(rows).encode())
     write_atomic(sweep_dir / "aggregate.json", _dumps(_clean(doc)).encode())
     return doc
@@ -395,7 +389,7 @@ class Aggregate:
     run_dirs : tuple of Path
         Every point's run directory, in grid order.
     calibration_runs : tuple of Path
-        The stick-slip points (slips to fit), for ``workflows.calibrate.calibrate``.
+        The stick-slip points (slips to fit), for ``filmfriction.workflows.calibrate.calibrate``.
     figures : dict
         ``velocity_map`` / ``vk_map`` → Path, for those written.
     """

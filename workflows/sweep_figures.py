@@ -1,6 +1,6 @@
 """Sweep figures: friction vs V with η_eff vs γ̇, and the (V, K) regime map.
 
-Part of :mod:`workflows.sweep`.
+Part of :mod:`filmfriction.workflows.sweep`.
 """
 from __future__ import annotations
 

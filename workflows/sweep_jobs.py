@@ -1,6 +1,6 @@
 """Sweep jobs: the Snakemake command and the per-point jobs the Snakefile runs.
 
-Part of :mod:`workflows.sweep`.
+Part of :mod:`filmfriction.workflows.sweep`.
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """Sweep planning: the grid, its points, and the sweep directory's plan and lock.
 
-Part of :mod:`workflows.sweep` (which documents the sweep directory).
+Part of :mod:`filmfriction.workflows.sweep` (which documents the sweep directory).
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.atomic import write_atomic
+from filmfriction.analysis.atomic import write_atomic
 
 PLAN_SCHEMA = "filmfriction.sweep/1"
 POINT_SCHEMA = "filmfriction.sweep-point/1"
@@ -37,7 +37,7 @@ class GridAxis:
     Attributes
     ----------
     key : str
-        A scene parameter (:data:`workflows.scene.PARAMETERS`).
+        A scene parameter (:data:`filmfriction.workflows.scene.PARAMETERS`).
     values : tuple
         The values, typed as the parameter (int or float), in the order given.
     spec : str

@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.atomic import write_atomic
+from filmfriction.analysis.atomic import write_atomic
 
 from .scene import WCA_CUTOFF as WCA
 SCENE = "stick-slip"
@@ -326,9 +326,9 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     trace_stride : int
         Keep every n-th trace row (a coarser ``trace_every``).
     """
-    from analysis import energy
-    from analysis.report import analyze
-    from analysis.trace import read_trace
+    from filmfriction.analysis import energy
+    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.trace import read_trace
 
     trace = read_trace(run_dir)
     if prefix < 1.0 or trace_stride > 1:
@@ -391,7 +391,7 @@ REDUCED = {"mass": 500.0, "stiffness": 100.0, "drive_velocity": 0.02, "damping":
 
 
 def _reduced_block():
-    from reduced_model import SpringBlock, laws
+    from filmfriction.reduced_model import SpringBlock, laws
 
     r = REDUCED
     return SpringBlock(mass=r["mass"], stiffness=r["stiffness"],
@@ -440,7 +440,7 @@ def _rk45_cycles(rtol: float, duration: float):
 
 
 def _reduced_measure(t, f, x, yields, sticks) -> dict:
-    from analysis.stickslip import cycle_table
+    from filmfriction.analysis.stickslip import cycle_table
 
     table = cycle_table(t, f, yields, sticks, spring_constant=REDUCED["stiffness"],
                         wall_position=x)

@@ -42,10 +42,10 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from workflows.cli import UserError
+    from filmfriction.workflows.cli import UserError
 
-    from .report import analyze, to_json, write_outputs
-    from .trace import read_trace
+    from filmfriction.analysis.report import analyze, to_json, write_outputs
+    from filmfriction.analysis.trace import read_trace
 
     try:
         trace = read_trace(args.path, spring_constant=args.spring_constant,

@@ -31,7 +31,7 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def _user_error(message):
-    from workflows.cli import UserError
+    from filmfriction.workflows.cli import UserError
     return UserError(message)
 
 
@@ -48,7 +48,7 @@ def run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
 
     import numpy as np
-    from . import maps
+    from filmfriction.reduced_model import maps
 
     if args.kind == "lambda-zeta":
         n = n or 100
