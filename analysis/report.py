@@ -308,6 +308,12 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         skipped["viscosity.from_slip"] = str(exc)
     doc["viscosity"] = visc
 
+    # --- Klein's slip equation tested: F_film = F_k + B·v over the slips
+    try:
+        doc["slip_law"] = _slip_law_section(trace, table[skip:], n - skip, lab, per_cycle, skip)
+    except MissingInput as exc:
+        skipped["slip_law"] = str(exc)
+
     # --- structure
     if structure and trace.run_dir is not None:
         traj = trace.optional_path("trajectory.dcd")
@@ -323,6 +329,42 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
             skipped["structure"] = "no trajectory.dcd + topology.data in the run directory"
     doc["skipped"] = skipped
     return doc, per_cycle
+
+
+def _slip_law_section(trace: Trace, table, n: int, lab, per_cycle: dict, skip: int) -> dict:
+    """``slip_law``: F_film = F_k + B·v fitted over the slips (:mod:`.sliplaw`)."""
+    from .sliplaw import fit_slip_law
+
+    p = trace.parameters
+    if n <= 0:
+        raise MissingInput("slips", "the slip-law fit")
+    if not trace.has("wall_velocity"):
+        raise MissingInput("wall_velocity", "the film force during the slip")
+    mass = p.require("mass", "the film force F_spring − M·a")
+    v_drive, _ = _drive_velocity(trace)
+    fit = fit_slip_law(trace.time, trace.spring_force, trace.columns["wall_velocity"], table,
+                       mass=mass, drive_velocity=v_drive or 0.0,
+                       mount_damping=p.mount_damping or 0.0)
+    pad = [math.nan] * skip
+    per_cycle["slip_law_kinetic_force"] = pad + fit.per_slip_kinetic_force.tolist()
+    per_cycle["slip_law_damping"] = pad + fit.per_slip_damping.tolist()
+    out = {"kinetic_force": _value(fit.kinetic_force, fit.kinetic_force_stderr, lab("force")),
+           "damping": _value(fit.damping, fit.damping_stderr, lab("damping")),
+           "mean_slip_velocity": _value(fit.mean_slip_velocity, None, lab("velocity")),
+           "viscous_share": _num(fit.viscous_share), "verdict": fit.verdict,
+           "reason": fit.reason, "samples": fit.samples,
+           "residual_rms": _value(fit.residual_rms, None, lab("force")),
+           "r_squared": _num(fit.r_squared),
+           "law": "F_film = kinetic_force + damping * v, F_film = F_spring - M a - "
+                  "mount_damping (v - V)"}
+    if p.area is not None and math.isfinite(fit.damping) and (
+            trace.has("gap") or p.thickness is not None):
+        d, d_src = _thickness(trace)
+        eta = fit.damping * d / p.area
+        eta_err = fit.damping_stderr * d / p.area
+        out["eta_from_damping"] = _value(eta, eta_err, lab("viscosity"), thickness=_num(d),
+                                         thickness_source=d_src, form="B·D/A")
+    return out
 
 
 def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half) -> dict:
