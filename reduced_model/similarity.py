@@ -1,0 +1,165 @@
+"""Dimensionless numbers of a driven stick-slip contact: how MD speaks to an SFB experiment.
+
+An MD film slides 10⁹ times faster than an SFB contact; unit conversion cannot
+bridge that, similarity can.  Two stick-slip contacts are alike when these
+numbers are alike (K spring, M slider mass, V drive velocity, L normal load,
+F_s static force at yield, F_b spring force at re-stick, B the film's viscous
+drag, γM the mount's dashpot, k_f the stuck film's shear stiffness, a the
+molecular diameter):
+
+``static_friction_coefficient``      μ_s = F_s / L
+``kinetic_friction_coefficient``     μ_k = F_k / L with F_k = (F_s + F_b)/2, the
+                                     cycle-averaged spring force of a sawtooth
+                                     (exact for Coulomb stick-slip: F_b = 2F_k − F_s)
+``extension_over_lattice``           x0 / a, x0 = F_s / K
+``slip_over_extension``              Δx0 / x0
+``film_damping_ratio``               ζ_film = B / (2√(KM))
+``mount_damping_ratio``              ζ_mount = γM / (2√(KM))
+``compliance_ratio``                 K / k_f (the stuck film's share of the
+                                     elastic energy at yield: E_film/E_spring)
+``viscous_fraction``                 share of a slip's dissipation that is viscous
+                                     heating of the film during the slip
+``lambda``                           λ = (F_s − F_k)/(V√(KM)), Nakano–Maegawa
+``lambda_critical``                  λ_c(ζ) at ζ = ζ_film + ζ_mount
+                                     (:func:`.maps.critical_lambda`; ∞ for ζ ≥ 1)
+``reduced_pressure``                 P σ³/ε (needs ε/σ³)
+
+Uncertainties are propagated to first order from the inputs' standard errors,
+taken independent (each input moved by its error, the changes added in quadrature).
+
+Example
+-------
+A Coulomb stick-slip of unit mass and spring, V = 0.1, F_s = 1, F_b = 0, load 2:
+
+>>> c = SlidingContact(spring_constant=1.0, mass=1.0, drive_velocity=0.1, static_force=1.0,
+...                    restick_force=0.0, normal_load=2.0, slip_distance=1.0)
+>>> n = similarity_numbers(c)
+>>> n["kinetic_friction_coefficient"].value, n["lambda"].value
+(0.25, 5.0)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+from .maps import critical_lambda
+
+__all__ = ["SlidingContact", "Number", "similarity_numbers", "NUMBERS"]
+
+#: The numbers :func:`similarity_numbers` returns, in order, with what each needs.
+NUMBERS = ("static_friction_coefficient", "kinetic_friction_coefficient",
+           "extension_over_lattice", "slip_over_extension", "film_damping_ratio",
+           "mount_damping_ratio", "compliance_ratio", "viscous_fraction", "lambda",
+           "lambda_critical", "reduced_pressure")
+
+
+@dataclass(frozen=True)
+class Number:
+    """A dimensionless number with its standard error (NaN: not available)."""
+
+    value: float
+    stderr: float = math.nan
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class SlidingContact:
+    """A stick-slip contact's measured parameters, in any one consistent unit system.
+
+    Every ``*_err`` is a one-standard-error uncertainty (0: exact or not known).
+    ``None`` marks a quantity that was not measured; the numbers that need it are NaN.
+    """
+
+    spring_constant: float
+    mass: float
+    drive_velocity: float
+    static_force: float
+    restick_force: float
+    normal_load: float | None = None
+    slip_distance: float | None = None
+    film_damping: float | None = None
+    mount_damping: float = 0.0
+    film_stiffness: float | None = None
+    molecular_diameter: float | None = None
+    viscous_fraction: float | None = None
+    pressure: float | None = None
+    stress_unit: float | None = None        # ε/σ³, for the reduced pressure
+    static_force_err: float = 0.0
+    restick_force_err: float = 0.0
+    slip_distance_err: float = 0.0
+    film_damping_err: float = 0.0
+    film_stiffness_err: float = 0.0
+    viscous_fraction_err: float = 0.0
+    mass_err: float = 0.0
+    spring_constant_err: float = 0.0
+    normal_load_err: float = 0.0
+
+    def __post_init__(self):
+        for name in ("spring_constant", "mass", "drive_velocity"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} = {v!r}: must be a positive number")
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise ValueError(f"{f.name} = {v!r}: must be a finite number or None")
+            if f.name.endswith("_err") and v < 0:
+                raise ValueError(f"{f.name} = {v!r}: an error cannot be negative")
+
+
+def _values(c: SlidingContact) -> dict:
+    nan = math.nan
+    opt = lambda v: nan if v is None else float(v)  # noqa: E731
+    K, M, V = c.spring_constant, c.mass, c.drive_velocity
+    fs, fb = c.static_force, c.restick_force
+    fk = 0.5 * (fs + fb)
+    root = math.sqrt(K * M)
+    x0 = fs / K
+    load = opt(c.normal_load)
+    zf = opt(c.film_damping) / (2 * root)
+    zm = c.mount_damping / (2 * root)
+    return {
+        "static_friction_coefficient": fs / load,
+        "kinetic_friction_coefficient": fk / load,
+        "extension_over_lattice": x0 / opt(c.molecular_diameter),
+        "slip_over_extension": opt(c.slip_distance) / x0,
+        "film_damping_ratio": zf,
+        "mount_damping_ratio": zm,
+        "compliance_ratio": K / opt(c.film_stiffness),
+        "viscous_fraction": opt(c.viscous_fraction),
+        "lambda": (fs - fk) / (V * root),
+        "lambda_critical": (float(critical_lambda(zf + zm)) if math.isfinite(zf + zm)
+                            and zf + zm >= 0 else nan),
+        "reduced_pressure": opt(c.pressure) / opt(c.stress_unit),
+    }
+
+
+def similarity_numbers(contact: SlidingContact) -> dict[str, Number]:
+    """The dimensionless numbers of ``contact`` (see the module text), with errors.
+
+    Returns
+    -------
+    dict
+        ``{name: Number}`` for every name in :data:`NUMBERS`.
+    """
+    base = _values(contact)
+    var = {k: 0.0 for k in base}
+    for f in fields(contact):
+        if not f.name.endswith("_err"):
+            continue
+        err = getattr(contact, f.name)
+        name = f.name[:-4]
+        if not err or getattr(contact, name) is None:
+            continue
+        moved = _values(replace(contact, **{name: getattr(contact, name) + err}))
+        for k, v in moved.items():
+            if math.isfinite(v) and math.isfinite(base[k]):
+                var[k] += (v - base[k]) ** 2
+    out = {}
+    for k in NUMBERS:
+        v = base[k]
+        note = ""
+        if k == "lambda_critical" and math.isinf(v):
+            note = "total damping ratio >= 1: no stick-slip for a purely viscous law"
+        out[k] = Number(v, math.sqrt(var[k]) if math.isfinite(v) else math.nan, note)
+    return out
