@@ -16,6 +16,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import lfilter
 
+from filmfriction.md_inputs.contract import AtomType
+from filmfriction.md_inputs.geometry import fcc111, plane_spacing
+
 __all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
 
 
@@ -147,24 +150,13 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
 
     directory = Path(directory)
     rng = np.random.default_rng(seed)
-    a = spacing
-    h = np.sqrt(2.0 / 3.0) * a
-    lx, ly = nx * a, ny * np.sqrt(3.0) * a
-    i, j = np.meshgrid(np.arange(nx), np.arange(2 * ny), indexing="ij")
-    base = np.column_stack([(i + 0.5 * (j % 2)).ravel() * a,
-                            (j * np.sqrt(3.0) / 2).ravel() * a])
-    shifts = [np.array([0.0, 0.0]), np.array([0.5 * a, a / (2 * np.sqrt(3))]),
-              np.array([a, a / np.sqrt(3)])]
-    planes, types = [], []
     n_planes = 2 * wall_planes + layers
-    for p in range(n_planes):
-        xy = np.mod(base + shifts[p % 3], [lx, ly])
-        z = np.full((xy.shape[0], 1), (p + 1) * h)
-        planes.append(np.hstack([xy, z]))
-        kind = 2 if p < wall_planes else 3 if p >= wall_planes + layers else 1
-        types.append(np.full(xy.shape[0], kind))
-    pos0 = np.vstack(planes)
-    types = np.concatenate(types)
+    h = plane_spacing(spacing)
+    stack = fcc111(spacing, (nx, ny), n_planes, z0=h)
+    lx, ly = stack.box
+    pos0 = stack.positions
+    types = np.select([stack.plane < wall_planes, stack.plane >= wall_planes + layers],
+                      [AtomType.BOTTOM_WALL, AtomType.TOP_WALL], AtomType.FILM)
     n = pos0.shape[0]
     lz = (n_planes + 2) * h
     top = directory / "topology.data"
@@ -175,7 +167,7 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     lines += [f"{k + 1} {types[k]} {x:.6f} {y:.6f} {z:.6f}"
               for k, (x, y, z) in enumerate(pos0)]
     top.write_text("\n".join(lines) + "\n")
-    film = types == 1
+    film = types == AtomType.FILM
     coords = np.empty((frames, n, 3), np.float32)
     for f in range(frames):
         pos = pos0 + rng.normal(0.0, thermal, pos0.shape) * film[:, None]
