@@ -17,7 +17,6 @@ engine's own message) at the end; a failed run keeps its partial trace.
 """
 from __future__ import annotations
 
-import io
 import json
 import os
 import platform
@@ -233,10 +232,10 @@ def write_trace_csv(dat: np.ndarray, path: Path) -> None:
     """trace.csv in TRACE_COLUMNS order, written atomically."""
     index = [DAT_COLUMNS.index(c) for c in TRACE_COLUMNS]
     table = dat[:, index] if len(dat) else np.empty((0, len(TRACE_COLUMNS)))
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     fmt = ["%d" if c == "step" else "%.10g" for c in TRACE_COLUMNS]
-    text = io.StringIO()
-    np.savetxt(text, table, delimiter=",", header=",".join(TRACE_COLUMNS), comments="", fmt=fmt)
-    write_atomic(path, text.getvalue())
+    np.savetxt(tmp, table, delimiter=",", header=",".join(TRACE_COLUMNS), comments="", fmt=fmt)
+    os.replace(tmp, path)
 
 
 # Largest energy-ledger residual accepted, as a fraction of the energy turned
