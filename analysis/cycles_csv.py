@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import write_atomic
+from .util import write_atomic
 
 __all__ = ["cycles_csv_text", "write_cycles_csv", "parse_cycles_csv", "read_cycles_csv"]
 

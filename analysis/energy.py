@@ -44,6 +44,8 @@ from filmfriction.reduced_model.cycles import CycleTable, stats as _stats
 
 __all__ = ["EnergyTable", "energy_table", "ledger"]
 
+# trace columns (md_inputs/contract.py) the ledger needs; mount_heat is optional
+# (traces written before the mount dashpot lack it)
 LEDGER_COLUMNS = ("drive_work", "load_work", "potential_energy",
                   "kinetic_energy", "spring_energy", "thermostat_heat")
 
@@ -211,12 +213,19 @@ def ledger(columns: dict) -> dict:
     + mount_heat + residual  (``mount_heat``, the mount dashpot's heat, when the
     trace has it).
 
+    The one ledger of an MD run: the analysis reports it, and the runner
+    (``filmfriction.workflows.runner.ledger_problem``) fails a run whose
+    residual exceeds a share of ``turnover``.
+
     Returns
     -------
     dict
         ``residual`` (array, cumulative, zero at the first sample),
         ``input`` (drive_work + load_work at the end, relative to the start),
-        ``closure`` (|final residual| / |input|; NaN when no work was done).
+        ``closure`` (|final residual| / |input|; NaN when no work was done),
+        ``thermostat_heat`` and ``mount_heat`` (at the end, relative to the
+        start), ``turnover`` (the energy turned over: the larger of |input|
+        and |thermostat_heat + mount_heat|).
     """
     c = {n: np.asarray(columns[n], float) for n in LEDGER_COLUMNS}
     work = c["drive_work"] + c["load_work"]
@@ -229,5 +238,7 @@ def ledger(columns: dict) -> dict:
     residual = (work - work[0]) - (stored - stored[0]) - heat - mount
     total = float(work[-1] - work[0])
     closure = abs(float(residual[-1])) / abs(total) if total else math.nan
+    turnover = max(abs(total), abs(float(heat[-1] + mount[-1])))
     return {"residual": residual, "input": total, "closure": closure,
-            "thermostat_heat": float(heat[-1]), "mount_heat": float(mount[-1])}
+            "thermostat_heat": float(heat[-1]), "mount_heat": float(mount[-1]),
+            "turnover": turnover}

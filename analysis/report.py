@@ -19,6 +19,7 @@ from . import energy as _energy
 from . import stickslip, viscosity
 from .stickslip import Regime
 from .trace import MissingInput, Trace, unit
+from .util import finite_or_none as _num, json_safe, write_atomic
 
 SCHEMA = "filmfriction.analysis/1"
 
@@ -31,14 +32,6 @@ _ENERGY_UNITS = {"spring_released": "energy", "spring_released_exact": "energy",
                  "viscous_fraction": "1", "at_stick_fraction": "1",
                  "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy",
                  "mount_dissipation_slip": "energy"}
-
-
-def _num(x):
-    """JSON-safe float (NaN/inf → None)."""
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def _entry(stats: dict, units: str) -> dict:
@@ -393,24 +386,11 @@ def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half)
             "film_edges": [ps.z_bottom, ps.z_top], "frames": "last half"}
 
 
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, (float, np.floating)):
-        return _num(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
-
-
 def to_json(doc: dict) -> str:
     """Strict JSON (NaN → null)."""
-    return json.dumps(_clean(doc), indent=2, ensure_ascii=False, allow_nan=False)
+    return json.dumps(json_safe(doc), indent=2, ensure_ascii=False, allow_nan=False)
 
 
-from .atomic import write_atomic as _atomic_write  # noqa: E402  (kept name for callers)
 from .cycles_csv import write_cycles_csv  # noqa: E402
 
 
@@ -421,5 +401,5 @@ def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Pa
     doc = dict(doc)
     doc["cycles_csv"] = csv_path.name
     write_cycles_csv(per_cycle, csv_path)
-    _atomic_write(json_path, to_json(doc) + "\n")
+    write_atomic(json_path, to_json(doc) + "\n")
     return json_path, csv_path

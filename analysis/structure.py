@@ -14,7 +14,10 @@ Velocity profiles come from ``fix ave/chunk`` files (see
 :mod:`filmfriction.analysis.report`), not from trajectories (DCD holds positions only).
 Lengths are in the trajectory's units (σ for an LJ run).
 
-Atom types of a filmfriction run: 1 film, 2 bottom wall, 3 top wall.
+Atom types of a filmfriction run are the script's contract
+(:mod:`filmfriction.md_inputs.contract`): the film, and each wall as all of
+its types (its rigid part and, with ``wall_model = flexible``, its mobile
+planes facing the film).
 """
 from __future__ import annotations
 
@@ -24,6 +27,8 @@ import numpy as np
 from MDAnalysis.analysis.base import AnalysisBase
 from scipy.signal import find_peaks
 from scipy.spatial import cKDTree
+
+from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
 __all__ = ["DensityProfile", "HexaticOrder", "FilmThickness", "find_layers",
            "frame_steps", "summarize_run"]
@@ -224,16 +229,22 @@ class HexaticOrder(AnalysisBase):
 class FilmThickness(AnalysisBase):
     """Gap between the facing planes of the two walls, per frame.
 
-    The facing plane of each wall is the set of its atoms within ``plane``
-    of its innermost atom in the first analysed frame (rigid walls: the set
-    does not change); the gap is the difference of the planes' mean z.
+    The facing plane of each wall is found in the first analysed frame: its
+    innermost atom and every atom reached from it in steps along z shorter
+    than ``plane`` (atoms sorted by z; the step to the next plane, 0.9 σ in
+    the default walls, is longer).  The set is kept for every frame; the gap
+    is the difference of the planes' mean z.  Rigid walls' planes are flat;
+    a flexible wall's atoms rattle about their plane, which this finds whole
+    (the trace's ``gap`` column averages the same atoms).
 
     Parameters
     ----------
     bottom, top : AtomGroup
-        Bottom and top wall atoms.
+        Bottom and top wall atoms: every atom of each wall (for a
+        filmfriction run, the types ``BOTTOM_WALL_TYPES`` and
+        ``TOP_WALL_TYPES`` of :mod:`filmfriction.md_inputs.contract`).
     plane : float
-        Thickness of the facing plane's slab.
+        Largest z step between neighbouring atoms of one plane.
 
     Attributes
     ----------
@@ -242,8 +253,8 @@ class FilmThickness(AnalysisBase):
 
     Examples
     --------
-    >>> gap = FilmThickness(u.select_atoms("type 2"),
-    ...                     u.select_atoms("type 3")).run()  # doctest: +SKIP
+    >>> gap = FilmThickness(u.select_atoms("type 2 4"),
+    ...                     u.select_atoms("type 3 5")).run()  # doctest: +SKIP
     >>> gap.results.gap.mean()                                # doctest: +SKIP
     """
 
@@ -253,10 +264,8 @@ class FilmThickness(AnalysisBase):
 
     def _prepare(self):
         self._bottom.universe.trajectory[self.start or 0]
-        zb = self._bottom.positions[:, 2]
-        zt = self._top.positions[:, 2]
-        self._bsel = self._bottom[zb > zb.max() - self._plane]
-        self._tsel = self._top[zt < zt.min() + self._plane]
+        self._bsel = self._bottom[_facing_plane(-self._bottom.positions[:, 2], self._plane)]
+        self._tsel = self._top[_facing_plane(self._top.positions[:, 2], self._plane)]
         self._gap = np.full(self.n_frames, np.nan)
 
     def _single_frame(self):
@@ -266,6 +275,18 @@ class FilmThickness(AnalysisBase):
     def _conclude(self):
         self.results.gap = self._gap
         self.results.frames = np.asarray(self.frames)
+
+
+def _facing_plane(depth, step: float) -> np.ndarray:
+    """Indices of the plane nearest the film: from the smallest ``depth`` (the
+    distance into the wall) up to the first gap between neighbours longer than ``step``."""
+    order = np.argsort(depth, kind="stable")
+    gaps = np.flatnonzero(np.diff(depth[order]) > step)
+    return order[:gaps[0] + 1] if gaps.size else order
+
+
+def _select_types(universe, types):
+    return universe.select_atoms("type " + " ".join(str(int(t)) for t in types))
 
 
 def frame_steps(universe) -> np.ndarray | None:
@@ -278,14 +299,15 @@ def frame_steps(universe) -> np.ndarray | None:
 
 
 def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
-                  film_type: int = 1, bottom_type: int = 2, top_type: int = 3,
-                  step: int = 1) -> dict:
+                  film_types=FILM_TYPES, bottom_types=BOTTOM_WALL_TYPES,
+                  top_types=TOP_WALL_TYPES, step: int = 1) -> dict:
     """Structure section of ``analysis.json`` for one run.
 
     Layers from the mean density profile; ψ6 per layer and the gap per
     frame; with a trace that has a ``step`` column and a slip table, frames
     are split into stick and slip (t(y) <= t <= t(s)) and the means of ψ6
-    and gap are reported for each.
+    and gap are reported for each.  The film and each wall are the atoms of
+    the given types (default: the script's contract, either wall model).
     """
     import warnings
 
@@ -295,9 +317,10 @@ def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
         warnings.simplefilter("ignore", DeprecationWarning)
         u = mda.Universe(str(topology), str(trajectory), format="DCD",
                          topology_format="DATA", atom_style="id type x y z")
-    film = u.select_atoms(f"type {film_type}")
+    film = _select_types(u, film_types)
     if film.n_atoms == 0:
-        raise ValueError(f"no film atoms (type {film_type}) in {topology}")
+        raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "
+                         f"in {topology}")
     prof = DensityProfile(film).run(step=step)
     layers = prof.results.layers
     out = {"frames": int(prof.n_frames), "units": units,
@@ -305,8 +328,8 @@ def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
                       "positions": layers["positions"].tolist(),
                       "spacing": {"mean": layers["spacing"], "std": layers["spacing_std"]}}}
     hex_ = HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
-    bottom = u.select_atoms(f"type {bottom_type}")
-    top = u.select_atoms(f"type {top_type}")
+    bottom = _select_types(u, bottom_types)
+    top = _select_types(u, top_types)
     gap = FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
     if hex_ is not None:
         out["psi6"] = {"per_layer_mean": np.nanmean(hex_.results.psi6, axis=0).tolist()}

@@ -16,6 +16,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import lfilter
 
+from filmfriction.md_inputs.contract import AtomType
+from filmfriction.md_inputs.geometry import fcc111, plane_spacing
+
 __all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
 
 
@@ -126,7 +129,8 @@ def write_csv(path, columns: dict) -> None:
 
 
 def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2,
-                 frames=20, thermal=0.05, melt_frames=(), nsavc=100, seed=0):
+                 frames=20, thermal=0.05, melt_frames=(), nsavc=100, seed=0,
+                 flexible_walls=False):
     """Write ``topology.data`` + ``trajectory.dcd`` of a film of ``layers``
     close-packed (111) planes between two walls, for structure tests.
 
@@ -134,8 +138,12 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     box ``nx·a`` × ``ny·√3·a``); planes are ``√(2/3)·a`` apart, stacked ABC.
     Each frame adds Gaussian displacements of ``thermal``; frames listed in
     ``melt_frames`` have the film's in-plane positions randomised (a
-    shear-melted film keeps its layers but loses in-plane order).  Types:
-    1 film, 2 bottom wall, 3 top wall.
+    shear-melted film keeps its layers but loses in-plane order).  Types as
+    the MD script's (:class:`filmfriction.md_inputs.contract.AtomType`): 1
+    film, 2 bottom wall, 3 top wall; with ``flexible_walls`` (the script's
+    ``wall_model = flexible``) only each wall's outermost plane keeps type 2
+    or 3, its planes facing the film are types 4 and 5 and rattle as the
+    film does.
 
     Returns
     -------
@@ -147,38 +155,32 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
 
     directory = Path(directory)
     rng = np.random.default_rng(seed)
-    a = spacing
-    h = np.sqrt(2.0 / 3.0) * a
-    lx, ly = nx * a, ny * np.sqrt(3.0) * a
-    i, j = np.meshgrid(np.arange(nx), np.arange(2 * ny), indexing="ij")
-    base = np.column_stack([(i + 0.5 * (j % 2)).ravel() * a,
-                            (j * np.sqrt(3.0) / 2).ravel() * a])
-    shifts = [np.array([0.0, 0.0]), np.array([0.5 * a, a / (2 * np.sqrt(3))]),
-              np.array([a, a / np.sqrt(3)])]
-    planes, types = [], []
     n_planes = 2 * wall_planes + layers
-    for p in range(n_planes):
-        xy = np.mod(base + shifts[p % 3], [lx, ly])
-        z = np.full((xy.shape[0], 1), (p + 1) * h)
-        planes.append(np.hstack([xy, z]))
-        kind = 2 if p < wall_planes else 3 if p >= wall_planes + layers else 1
-        types.append(np.full(xy.shape[0], kind))
-    pos0 = np.vstack(planes)
-    types = np.concatenate(types)
+    h = plane_spacing(spacing)
+    stack = fcc111(spacing, (nx, ny), n_planes, z0=h)
+    lx, ly = stack.box
+    pos0 = stack.positions
+    bottom, top_ = stack.plane < wall_planes, stack.plane >= wall_planes + layers
+    types = np.select([bottom, top_], [AtomType.BOTTOM_WALL, AtomType.TOP_WALL], AtomType.FILM)
+    if flexible_walls:
+        types[bottom & (stack.plane > 0)] = AtomType.BOTTOM_FLEXIBLE
+        types[top_ & (stack.plane < n_planes - 1)] = AtomType.TOP_FLEXIBLE
+    n_types = int(types.max())
     n = pos0.shape[0]
     lz = (n_planes + 2) * h
     top = directory / "topology.data"
     lines = ["LAMMPS data file (filmfriction synthetic)", "", f"{n} atoms",
-             "3 atom types", "", f"0 {lx} xlo xhi", f"0 {ly} ylo yhi",
-             f"0 {lz} zlo zhi", "", "Masses", "", "1 1.0", "2 1.0", "3 1.0", "",
-             "Atoms # atomic", ""]
+             f"{n_types} atom types", "", f"0 {lx} xlo xhi", f"0 {ly} ylo yhi",
+             f"0 {lz} zlo zhi", "", "Masses", ""]
+    lines += [f"{t} 1.0" for t in range(1, n_types + 1)] + ["", "Atoms # atomic", ""]
     lines += [f"{k + 1} {types[k]} {x:.6f} {y:.6f} {z:.6f}"
               for k, (x, y, z) in enumerate(pos0)]
     top.write_text("\n".join(lines) + "\n")
-    film = types == 1
+    film = types == AtomType.FILM
+    mobile = film | (types == AtomType.BOTTOM_FLEXIBLE) | (types == AtomType.TOP_FLEXIBLE)
     coords = np.empty((frames, n, 3), np.float32)
     for f in range(frames):
-        pos = pos0 + rng.normal(0.0, thermal, pos0.shape) * film[:, None]
+        pos = pos0 + rng.normal(0.0, thermal, pos0.shape) * mobile[:, None]
         if f in melt_frames:
             pos[film, :2] = rng.uniform(0, 1, (film.sum(), 2)) * [lx, ly]
         coords[f] = pos

@@ -8,7 +8,9 @@ needs (spring constant, wall mass, contact area, film thickness, drive
 velocity) and the unit system come from the command line or, for a run
 directory, from ``run.json``'s ``trace_parameters`` (the command line wins).
 
-A run directory holds ``trace.csv`` and ``run.json``, and optionally
+A run directory holds ``trace.csv`` (the columns of the MD script's contract,
+:data:`filmfriction.md_inputs.contract.TRACE`, whose ``quantity`` names the
+entry of :data:`UNITS` that labels it) and ``run.json``, and optionally
 ``profiles/density.profile``, ``profiles/velocity.profile`` (``fix
 ave/chunk``) and ``trajectory.dcd`` + ``topology.data``.
 
@@ -35,11 +37,11 @@ UNITS = {
     "lj": {"time": "τ", "force": "ε/σ", "length": "σ", "energy": "ε",
            "velocity": "σ/τ", "mass": "m", "area": "σ²", "stiffness": "ε/σ²",
            "damping": "m/τ", "viscosity": "ετ/σ³", "shear_rate": "1/τ",
-           "stress": "ε/σ³", "number_density": "σ⁻³", "1": "1"},
+           "stress": "ε/σ³", "number_density": "σ⁻³", "temperature": "ε/k_B", "1": "1"},
     "si": {"time": "s", "force": "N", "length": "m", "energy": "J",
            "velocity": "m/s", "mass": "kg", "area": "m²", "stiffness": "N/m",
            "damping": "kg/s", "viscosity": "Pa·s", "shear_rate": "1/s",
-           "stress": "Pa", "number_density": "m⁻³", "1": "1"},
+           "stress": "Pa", "number_density": "m⁻³", "temperature": "K", "1": "1"},
 }
 
 

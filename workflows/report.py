@@ -676,7 +676,7 @@ def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str,
     return "\n".join(lines) + "\n", files
 
 
-from filmfriction.analysis.atomic import write_atomic as _write_atomic  # noqa: E402
+from filmfriction.analysis.util import write_atomic as _write_atomic  # noqa: E402
 
 
 # ---------------------------------------------------------------------------

@@ -32,27 +32,19 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction import md_inputs
+from filmfriction.analysis import energy
+from filmfriction.analysis.util import json_default, write_atomic
+from filmfriction.md_inputs import contract
 from . import engine
 from .scene import Scene, SceneError
 
 SCRIPT = "film_slide.lmp"
 
-# trace.dat (fix print) columns, in order
-DAT_COLUMNS = ("step time drive_position spring_force wall_position wall_velocity wall_z gap "
-               "film_temperature drive_work load_work thermostat_heat potential_energy "
-               "kinetic_energy spring_energy mount_heat").split()
-# trace.csv columns, in order (LJ units)
-TRACE_COLUMNS = ("time", "step", "drive_position", "spring_force", "wall_position",
-                 "wall_velocity", "wall_z", "gap", "film_temperature", "drive_work",
-                 "load_work", "thermostat_heat", "potential_energy", "kinetic_energy",
-                 "spring_energy", "mount_heat")
-TRACE_UNITS = {
-    "time": "tau", "step": "-", "drive_position": "sigma", "spring_force": "epsilon/sigma",
-    "wall_position": "sigma", "wall_velocity": "sigma/tau", "wall_z": "sigma",
-    "gap": "sigma", "film_temperature": "epsilon/k_B", "drive_work": "epsilon",
-    "load_work": "epsilon", "thermostat_heat": "epsilon", "potential_energy": "epsilon",
-    "kinetic_energy": "epsilon", "spring_energy": "epsilon", "mount_heat": "epsilon",
-}
+# the columns of trace.dat (fix print) and trace.csv, and their LJ units: the
+# script's contract (md_inputs/contract.py), re-exported here for callers
+DAT_COLUMNS = contract.DAT_COLUMNS
+TRACE_COLUMNS = contract.TRACE_COLUMNS
+TRACE_UNITS = contract.TRACE_UNITS
 
 
 class RunFailed(RuntimeError):
@@ -63,21 +55,8 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
-from filmfriction.analysis.atomic import write_atomic  # noqa: E402  (re-exported for callers)
-
-
 def write_json(path: Path, data: dict) -> None:
-    write_atomic(path, json.dumps(data, indent=2, default=_json_default) + "\n")
-
-
-def _json_default(obj):
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.floating,)):
-        return float(obj)
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(type(obj))
+    write_atomic(path, json.dumps(data, indent=2, default=json_default) + "\n")
 
 
 def versions() -> dict:
@@ -254,8 +233,7 @@ def write_trace_csv(dat: np.ndarray, path: Path) -> None:
     index = [DAT_COLUMNS.index(c) for c in TRACE_COLUMNS]
     table = dat[:, index] if len(dat) else np.empty((0, len(TRACE_COLUMNS)))
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    fmt = ["%.10g"] * len(TRACE_COLUMNS)
-    fmt[1] = "%d"
+    fmt = ["%d" if c == "step" else "%.10g" for c in TRACE_COLUMNS]
     np.savetxt(tmp, table, delimiter=",", header=",".join(TRACE_COLUMNS), comments="", fmt=fmt)
     os.replace(tmp, path)
 
@@ -300,14 +278,9 @@ def lost_atoms_hint(scene: Scene) -> str:
 
 def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
     """The integrator created or destroyed energy beyond LEDGER_LIMIT of the turnover."""
-    c = {n: dat[:, DAT_COLUMNS.index(n)] for n in (
-        "drive_work", "load_work", "potential_energy", "kinetic_energy", "spring_energy",
-        "thermostat_heat", "mount_heat")}
-    work = c["drive_work"] + c["load_work"]
-    stored = c["potential_energy"] + c["kinetic_energy"] + c["spring_energy"]
-    heat = c["thermostat_heat"] + c["mount_heat"]
-    residual = float((work[-1] - work[0]) - (stored[-1] - stored[0]) - (heat[-1] - heat[0]))
-    turnover = max(abs(float(work[-1] - work[0])), abs(float(heat[-1] - heat[0])))
+    led = energy.ledger({n: dat[:, DAT_COLUMNS.index(n)]
+                         for n in energy.LEDGER_COLUMNS + ("mount_heat",)})
+    residual, turnover = float(led["residual"][-1]), led["turnover"]
     if turnover > 0 and abs(residual) > LEDGER_LIMIT * turnover:
         return (f"energy ledger does not close: residual {residual:.3g} epsilon is "
                 f"{100 * abs(residual) / turnover:.0f} % of the energy turned over "

@@ -27,6 +27,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from filmfriction.md_inputs.geometry import fcc111, plane_spacing
+
 
 class SceneError(ValueError):
     """A scene or a parameter value is not acceptable; the message says why."""
@@ -224,23 +226,21 @@ class Scene:
 def derived_quantities(p: dict) -> dict[str, float]:
     """Box, atom counts and time scales implied by the parameters (before LAMMPS runs)."""
     d = p["wall_spacing"]
-    lx = p["cells_x"] * d
-    ly = p["cells_y"] * math.sqrt(3.0) * d
-    fs = p["film_spacing"]
-    fx = max(1, round(lx / fs))
-    fy = max(1, round(ly / (math.sqrt(3.0) * fs)))
-    per_layer = 2 * fx * fy
-    hw = math.sqrt(2.0 / 3.0) * d
-    wall_layers = p["wall_layers"] or math.ceil(p["cutoff"] / hw) + 1
+    # the walls' (111) planes, and the film's, stretched to fit the walls' box
+    # (the same geometry film_slide.lmp builds with its lattice commands)
+    wall_layers = p["wall_layers"] or math.ceil(p["cutoff"] / plane_spacing(d)) + 1
+    wall = fcc111(d, (p["cells_x"], p["cells_y"]), wall_layers)
+    film = fcc111(p["film_spacing"], planes=p["film_layers"], fit=wall.box)
+    lx, ly = wall.box
     omega = math.sqrt(p["spring_constant"] / p["wall_mass"])
     flexible = p["wall_model"] == "flexible"
-    wall_per_layer = 2 * p["cells_x"] * p["cells_y"]
+    wall_per_layer = wall.atoms_per_plane
     return {
         "box_x": lx, "box_y": ly, "area": lx * ly,
-        "film_atoms_per_layer": per_layer,
-        "film_atoms": per_layer * p["film_layers"],
-        "film_strain_x": lx / fx / fs - 1.0,
-        "film_strain_y": ly / fy / (math.sqrt(3.0) * fs) - 1.0,
+        "film_atoms_per_layer": film.atoms_per_plane,
+        "film_atoms": film.n_atoms,
+        "film_strain_x": film.strain[0],
+        "film_strain_y": film.strain[1],
         "wall_layers": wall_layers,
         "wall_atoms_per_layer": wall_per_layer,
         # the top wall's planes facing the film, mobile when the walls are flexible

@@ -37,7 +37,7 @@ def _step(name: str, failures: dict, fn, *args):
 
 
 def _write_sfb(run_dir: Path, check) -> Path:
-    from filmfriction.analysis.atomic import write_atomic as _atomic_write
+    from filmfriction.analysis.util import write_atomic as _atomic_write
 
     path = run_dir / "sfb.json"
     _atomic_write(path, json.dumps(check.rows, indent=2, allow_nan=False) + "\n")

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime
 
 from .sweep_plan import _dumps, format_value
@@ -130,13 +130,6 @@ def _get(doc: dict, *path):
     return doc
 
 
-def _finite(x) -> float | None:
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
 def point_summary(sweep_dir: Path, point: dict) -> dict:
     """One row of the aggregate: parameters, regime, forces, η_eff for a completed point."""
     sweep_dir = Path(sweep_dir)
@@ -152,14 +145,14 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
            "wall_mass": p["wall_mass"], "mount_damping": p["mount_damping"],
            "regime": doc.get("regime"), "slips": _get(doc, "slips", "count")}
     for q in ("static_force", "backward_force", "period", "slip_distance"):
-        row[q] = _finite(_get(doc, "slips", q, "mean"))
-        row[f"{q}_stderr"] = _finite(_get(doc, "slips", q, "stderr"))
+        row[q] = finite_or_none(_get(doc, "slips", q, "mean"))
+        row[f"{q}_stderr"] = finite_or_none(_get(doc, "slips", q, "stderr"))
     # the time-averaged friction: the spring force over the last half of the drive
     # (the start-up ramp from a relaxed spring is in the first half), as analysed
-    row["mean_force"] = _finite(_get(doc, "sliding", "mean_force", "mean"))
-    row["mean_force_stderr"] = _finite(_get(doc, "sliding", "mean_force", "stderr"))
+    row["mean_force"] = finite_or_none(_get(doc, "sliding", "mean_force", "mean"))
+    row["mean_force_stderr"] = finite_or_none(_get(doc, "sliding", "mean_force", "stderr"))
     # an older analysis' "smooth" for a wall that mostly stood still (see STUCK_RATIO)
-    ratio = _finite(_get(doc, "sliding", "wall_velocity_ratio"))
+    ratio = finite_or_none(_get(doc, "sliding", "wall_velocity_ratio"))
     row["wall_velocity_ratio"] = ratio
     row["sweep_regime"] = row["regime"]
     if row["regime"] == SMOOTH and not (ratio is not None and ratio > STUCK_RATIO):
@@ -178,7 +171,7 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
         if d and dx and ts:
             eta, eta_err = _get(slip, "eta_eff", "mean"), _get(slip, "eta_eff", "stderr")
             rate, source = dx / ts / d, "from_slip"
-    row.update(eta_eff=_finite(eta), eta_eff_stderr=_finite(eta_err), shear_rate=_finite(rate),
+    row.update(eta_eff=finite_or_none(eta), eta_eff_stderr=finite_or_none(eta_err), shear_rate=finite_or_none(rate),
                eta_source=source, run_dir=str(run_dir.resolve()))
     return row
 
@@ -346,19 +339,8 @@ def write_aggregate(sweep_dir: Path, doc: dict, rows: list[dict]) -> dict:
     """Write ``aggregate.csv`` and ``aggregate.json`` atomically; returns the document."""
     sweep_dir = Path(sweep_dir)
     write_atomic(sweep_dir / "aggregate.csv", _csv(rows).encode())
-    write_atomic(sweep_dir / "aggregate.json", _dumps(_clean(doc)).encode())
+    write_atomic(sweep_dir / "aggregate.json", _dumps(json_safe(doc)).encode())
     return doc
-
-
-def _clean(obj):
-    """NaN → None, recursively (JSON has no NaN)."""
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def _csv(rows: list[dict]) -> str:

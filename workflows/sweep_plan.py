@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.util import json_default, write_atomic
 
 PLAN_SCHEMA = "filmfriction.sweep/1"
 POINT_SCHEMA = "filmfriction.sweep-point/1"
@@ -264,17 +264,7 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
 # the sweep directory
 # ---------------------------------------------------------------------------
 def _dumps(doc) -> str:
-    return json.dumps(doc, indent=2, sort_keys=True, default=_json_default) + "\n"
-
-
-def _json_default(obj):
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(type(obj))
+    return json.dumps(doc, indent=2, sort_keys=True, default=json_default) + "\n"
 
 
 def _write_if_changed(path: Path, text: str) -> bool:

@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.util import json_safe, write_atomic
 
 from .scene import WCA_CUTOFF as WCA
 SCENE = "stick-slip"
@@ -608,15 +608,6 @@ def _fmt(v):
     return "" if v is None else v
 
 
-def _clean(v):
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    if isinstance(v, (np.floating,)):
-        return _clean(float(v))
-    if isinstance(v, (np.integer,)):
-        return int(v)
-    return v
-
 
 def pareto_front(cost, error) -> np.ndarray:
     """Indices of the points no other point beats in both cost and |error|, by cost."""
@@ -703,7 +694,7 @@ def study(quick: bool, out: Path, nprocs: int = 2, log=print) -> list[dict]:
     p = plan(quick)
     log(f"tradeoff ({p.description}); output in {out}")
     rows = md_rows(p, out, nprocs, log) + reduced_rows()
-    rows = [{k: _clean(v) for k, v in r.items()} for r in rows]
+    rows = json_safe(rows)
     write_csv(rows, out / "tradeoff.csv")
     write_atomic(out / "tradeoff.json", json.dumps(rows, indent=1, allow_nan=False) + "\n")
     plot([{k: (math.nan if v is None else v) for k, v in r.items()} for r in rows], out)

@@ -1,0 +1,142 @@
+"""The contract between ``film_slide.lmp`` and the Python that runs and reads it.
+
+One table each for what the script and its readers must agree on:
+
+* :data:`ATOM_TYPES` -- the atom types the script creates and what they are;
+* :data:`TRACE` -- the columns of ``trace.dat`` (the script's ``fix print``),
+  in the order LAMMPS prints them, with the LAMMPS expression and format
+  that print them, their unit and their meaning.
+
+The runner (``filmfriction.workflows.runner``) and the analysis
+(``filmfriction.analysis``) import these names; nothing else lists them.
+
+Why the script's ``fix print`` line is *checked against* this table (by
+``tests/test_md_contract.py``, which parses the script) rather than generated
+from it and passed in as a variable: the script must stay a plain LAMMPS
+input that runs by hand with its ``index`` defaults, and a print line handed
+over through ``-var`` would need a default copy of itself in the script
+anyway (a second copy, the thing this module removes), plus LAMMPS's rules
+for when ``$(...)`` inside a substituted variable is evaluated (once, when
+the command is read, instead of at every print).  So the script keeps its
+literal line, :func:`fix_print_text` and :func:`fix_print_title` say what it
+must read, and the test fails the moment the two differ.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import IntEnum
+
+__all__ = ["AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
+           "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
+           "column", "fix_print_text", "fix_print_title"]
+
+
+# ---------------------------------------------------------------- atom types
+class AtomType(IntEnum):
+    """Atom types of ``film_slide.lmp`` (``create_box 5``)."""
+
+    FILM = 1
+    BOTTOM_WALL = 2        # rigid walls: the whole bottom wall (fixed); flexible: its outer plane
+    TOP_WALL = 3           # rigid walls: the whole top wall (one rigid body); flexible: its outer plane
+    BOTTOM_FLEXIBLE = 4    # wall_model = flexible: the bottom wall's planes facing the film
+    TOP_FLEXIBLE = 5       # wall_model = flexible: the top wall's planes facing the film
+
+
+#: What each type is, for labels (a figure's legend, an error message).
+ATOM_TYPES: dict[AtomType, str] = {
+    AtomType.FILM: "film",
+    AtomType.BOTTOM_WALL: "bottom wall (rigid part)",
+    AtomType.TOP_WALL: "top wall (rigid part)",
+    AtomType.BOTTOM_FLEXIBLE: "bottom wall (flexible planes)",
+    AtomType.TOP_FLEXIBLE: "top wall (flexible planes)",
+}
+
+#: The types that make up each body, whatever the wall model: with rigid walls
+#: the flexible types have no atoms.
+FILM_TYPES = (AtomType.FILM,)
+BOTTOM_WALL_TYPES = (AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE)
+TOP_WALL_TYPES = (AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE)
+WALL_TYPES = BOTTOM_WALL_TYPES + TOP_WALL_TYPES
+
+
+# ---------------------------------------------------------------- the trace
+@dataclass(frozen=True)
+class Column:
+    """One column of ``trace.dat`` / ``trace.csv``.
+
+    ``unit`` is the LJ unit as ``run.json`` records it (``trace_units``);
+    ``quantity`` is its kind, a key of ``filmfriction.analysis.trace.UNITS``
+    (for labels in either unit system); ``expression`` and ``format`` are how
+    the script's ``fix print`` prints it (``$(expression:format)``).
+    """
+
+    name: str
+    unit: str
+    quantity: str
+    expression: str
+    format: str | None
+    meaning: str
+
+    def lammps(self) -> str:
+        """The column's item in the ``fix print`` line."""
+        return f"$({self.expression}:{self.format})" if self.format else f"$({self.expression})"
+
+
+C = Column
+#: ``trace.dat`` columns in the order the script's ``fix print`` writes them.
+TRACE: tuple[Column, ...] = (
+    C("step", "-", "1", "step", None, "MD step since the drive started"),
+    C("time", "tau", "time", "time", "%.8g", "time since the drive started"),
+    C("drive_position", "sigma", "length", "v_xdrel", "%.8g",
+      "spring end, relative to the wall's position at the start"),
+    C("spring_force", "epsilon/sigma", "force", "v_fs", "%.8g",
+      "K * (drive_position - wall_position)"),
+    C("wall_position", "sigma", "length", "v_xwrel", "%.8g",
+      "top wall's centre of mass along x, relative to the start"),
+    C("wall_velocity", "sigma/tau", "velocity", "v_vxw", "%.8g",
+      "top wall's centre-of-mass velocity along x"),
+    C("wall_z", "sigma", "length", "v_zw", "%.8g", "top wall's centre of mass along z"),
+    C("gap", "sigma", "length", "v_gap", "%.8g",
+      "distance between the walls' innermost planes (the planes facing the film)"),
+    C("film_temperature", "epsilon/k_B", "temperature", "v_T", "%.6g",
+      "film temperature along y (the thermostatted, flow-free direction)"),
+    C("drive_work", "epsilon", "energy", "v_wdrive", "%.10g",
+      "work of the drive on spring and mount dashpot, V * integral of the force, "
+      "sampled every work_every steps"),
+    C("load_work", "epsilon", "energy", "v_wload", "%.10g",
+      "work of the load, -P*A*(z - z0)"),
+    C("thermostat_heat", "epsilon", "energy", "v_heat", "%.10g",
+      "heat removed by the Langevin thermostat(s) since the drive started"),
+    C("potential_energy", "epsilon", "energy", "v_pe", "%.10g", "sum of the pair energies"),
+    C("kinetic_energy", "epsilon", "energy", "v_ke", "%.10g", "sum of m v^2 / 2"),
+    C("spring_energy", "epsilon", "energy", "v_espring", "%.10g", "K (x_d - x)^2 / 2"),
+    C("mount_heat", "epsilon", "energy", "v_qmount", "%.10g",
+      "heat taken by the mount dashpot since the drive started"),
+)
+del C
+
+#: ``trace.dat`` (fix print) column names, in order.
+DAT_COLUMNS: tuple[str, ...] = tuple(c.name for c in TRACE)
+#: ``trace.csv`` column names, in order: time first, then as in ``trace.dat``.
+TRACE_COLUMNS: tuple[str, ...] = ("time",) + tuple(n for n in DAT_COLUMNS if n != "time")
+#: LJ unit of each column (``run.json``'s ``trace_units``).
+TRACE_UNITS: dict[str, str] = {
+    c.name: c.unit for c in sorted(TRACE, key=lambda c: TRACE_COLUMNS.index(c.name))}
+
+
+def column(name: str) -> Column:
+    """The contract's entry for column ``name``."""
+    for c in TRACE:
+        if c.name == name:
+            return c
+    raise KeyError(f"no trace column {name!r}; the contract has: {', '.join(DAT_COLUMNS)}")
+
+
+def fix_print_text() -> str:
+    """The quoted text of the script's ``fix print`` (one row of ``trace.dat``)."""
+    return " ".join(c.lammps() for c in TRACE)
+
+
+def fix_print_title() -> str:
+    """The ``title`` of the script's ``fix print`` (the header of ``trace.dat``)."""
+    return "# " + " ".join(DAT_COLUMNS)
