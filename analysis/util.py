@@ -24,8 +24,19 @@ import numpy as np
 __all__ = ["write_atomic", "finite_or_none", "json_safe", "json_default"]
 
 
+def _umask() -> int:
+    """The process umask (read by setting it and setting it back: there is no getter)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def write_atomic(path, data: str | bytes) -> Path:
     """Write ``data`` (text or bytes) to ``path`` atomically; return the path.
+
+    The file gets the mode a plain ``open(path, "w")`` would give (0666 less the
+    process umask), not the 0600 of a temporary file: a group can read a run on a
+    shared cluster when the umask says so.
 
     Examples
     --------
@@ -38,6 +49,7 @@ def write_atomic(path, data: str | bytes) -> Path:
     mode = "wb" if isinstance(data, (bytes, bytearray)) else "w"
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
+        os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, mode) as fh:
             fh.write(data)
         os.replace(tmp, path)

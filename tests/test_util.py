@@ -72,3 +72,18 @@ def test_no_module_defines_its_own_copy_of_a_helper():
             if names:
                 copies[rel] = sorted(names)
     assert not copies, f"use filmfriction.analysis.util instead: {copies}"
+
+
+def test_write_atomic_keeps_the_umask(tmp_path):
+    import os
+    import stat
+
+    from filmfriction.analysis.util import write_atomic
+
+    for mask, expected in ((0o022, 0o644), (0o002, 0o664), (0o077, 0o600)):
+        old = os.umask(mask)
+        try:
+            p = write_atomic(tmp_path / f"f{mask:o}.json", "{}")
+        finally:
+            os.umask(old)
+        assert stat.S_IMODE(p.stat().st_mode) == expected, oct(mask)
