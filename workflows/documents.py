@@ -4,12 +4,15 @@
 :func:`filmfriction.analysis.write_calibration` (``filmfriction calibrate``
 and the study); ``sfb.json`` (+ ``sfb_slips.csv``, the slips' traces) by
 :func:`write_sfb` (``filmfriction sfb --out`` and the study).  The readers
-here only read: a file that is not there is ``None``, never recomputed.
+here only read: a file that is not there is ``None``, never recomputed;
+:func:`read_report_inputs` says, for the report, what is missing or out of date
+and the command that makes it.
 """
 from __future__ import annotations
 
 import csv
 import json
+import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,7 +23,8 @@ from filmfriction.analysis.report import to_json
 from filmfriction.reduced_model.sfb_rows import find_row
 
 __all__ = ["CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
-           "read_calibration", "read_sfb", "SFBDocument", "SlipTrace"]
+           "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",
+           "read_report_inputs"]
 
 CALIBRATION_FILE = "calibration.json"
 SFB_FILE = "sfb.json"
@@ -159,3 +163,111 @@ def read_sfb(path):
              for k, s in (doc.get("slips") or {}).items()}
     return SFBDocument(rows=doc.get("rows", []), notes=tuple(doc.get("notes", ())), slips=slips,
                        calibration=doc.get("calibration"), doc=doc)
+
+
+def _failed(failures: dict, step: str) -> str | None:
+    """The reason ``step`` (or its write) failed in the study, if it did."""
+    for key, why in failures.items():
+        if key == step or key.startswith(step + " "):
+            return f"{key}: {why}" if key != step else why
+    return None
+
+
+def _same_runs(recorded, given) -> bool:
+    """Whether ``calibration.json``'s runs are the report's (paths as written may be relative)."""
+    def same(a, b):
+        a, b = Path(a), Path(b)
+        if a.exists() and b.exists():
+            return a.resolve() == b.resolve()
+        return a.name == b.name
+    return (len(recorded) == len(given) and all(any(same(r, g) for g in given) for r in recorded)
+            and all(any(same(r, g) for r in recorded) for g in given))
+
+
+@dataclass
+class ReportInputs:
+    """What the report reads besides the main run: documents, or why they are not used."""
+
+    calibration: dict | None = None
+    sfb: object = None
+    why_no_calibration: str = ""
+    why_no_sfb: str = ""
+    calibration_remarks: list = field(default_factory=list)
+    sfb_remarks: list = field(default_factory=list)
+    missing: list = field(default_factory=list)       # (what, command that makes it)
+
+
+def _command(*words) -> str:
+    return " ".join(shlex.quote(str(w)) for w in words)
+
+
+def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dict) -> ReportInputs:
+    """Read ``calibration.json`` and ``sfb.json`` of the main run for the report; never compute them.
+
+    Parameters
+    ----------
+    run_dir : Path
+        The main run's directory.
+    run_dirs : list of Path
+        The report's runs (a sweep's runs included).
+    given : list of Path
+        What the user named (run or sweep directories): the commands printed use them.
+    failures : dict
+        Steps that failed in the study: a failed ``calibration`` or ``sfb`` is not read.
+
+    Returns
+    -------
+    ReportInputs
+    """
+    got = ReportInputs()
+    cal_path, sfb_path = run_dir / CALIBRATION_FILE, run_dir / SFB_FILE
+    cal_cmd = _command("filmfriction", "calibrate", *given)
+    failed = _failed(failures, "calibration")
+    if failed:
+        got.why_no_calibration = f"Calibration failed: {failed}."
+    else:
+        try:
+            got.calibration = read_calibration(cal_path)
+        except ValueError as exc:
+            got.why_no_calibration = f"Not computed — calibration: {exc}; `{cal_cmd}` rewrites it."
+            got.missing.append((f"{cal_path} (unreadable)", cal_cmd))
+        else:
+            if got.calibration is None:
+                got.why_no_calibration = (f"No `calibration.json` in `{run_dir}`: the report renders what the "
+                                          f"study wrote and does not calibrate. `{cal_cmd}` writes it.")
+                got.missing.append((str(cal_path), cal_cmd))
+    cal = got.calibration
+    if cal is not None:
+        covered = [r.get("run_dir") for r in cal.get("runs", [])]
+        if not _same_runs(covered, run_dirs):
+            got.calibration_remarks.append(
+                f"`calibration.json` covers the runs {', '.join('`' + str(c) + '`' for c in covered)}, "
+                f"not the {len(run_dirs)} of this report; `{cal_cmd}` writes the calibration across them.")
+            got.missing.append((f"{cal_path} across the runs given", cal_cmd))
+    # as the study runs it: with the MD calibration, unless calibration.json has none
+    no_md = cal is not None and cal.get("md_calibration") is None
+    sfb_cmd = (_command("filmfriction", "sfb", "--out", sfb_path) if no_md
+               else _command("filmfriction", "sfb", "--calibration", cal_path, "--out", sfb_path))
+    failed = _failed(failures, "sfb")
+    if failed:
+        got.why_no_sfb = f"The SFB check failed: {failed}."
+        return got
+    try:
+        got.sfb = read_sfb(sfb_path)
+    except ValueError as exc:
+        got.why_no_sfb = f"Not computed — SFB check: {exc}; `{sfb_cmd}` rewrites it."
+        got.missing.append((f"{sfb_path} (unreadable)", sfb_cmd))
+        return got
+    if got.sfb is None:
+        got.why_no_sfb = (f"No `sfb.json` in `{run_dir}`: the report does not run the SFB check. "
+                          f"`{sfb_cmd}` writes it.")
+        got.missing.append((str(sfb_path), sfb_cmd))
+    elif "calibration" not in got.sfb.doc:
+        got.sfb_remarks.append(f"`sfb.json` is of an older version (the table only, no figure); "
+                               f"`{sfb_cmd}` rewrites it.")
+        got.missing.append((f"{sfb_path} (older version)", sfb_cmd))
+    elif cal is not None and got.sfb.calibration != cal.get("md_calibration"):
+        got.sfb_remarks.append(f"`sfb.json` was computed with another MD calibration than the one in "
+                               f"`calibration.json`; `{sfb_cmd}` recomputes it.")
+        got.missing.append((f"{sfb_path} for this calibration.json", sfb_cmd))
+    return got
