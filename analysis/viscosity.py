@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import curve_fit
 
+from filmfriction.reduced_model.oscillator import DampedOscillator
+
 from .stickslip import CycleTable
 
 __all__ = ["SteadyViscosity", "steady_viscosity", "ProfileShear", "profile_shear",
@@ -194,6 +196,14 @@ def slip_force(t, spring_force_at_yield: float, damping: float, mass: float,
     Solves M x'' + B x' = K(x0 + V t − x), x(0) = 0, x'(0) = v0 (x measured
     from the yield point, x0 = Fs/K) in closed form and returns
     F(t) = K(x0 + V t − x(t)).  With V = v0 = 0 this is Klein's Eq. (2).
+    About the steady sliding x_p = x0 + V t − B V/K the slip is the damped
+    oscillator M u'' + B u' + K u = 0
+    (:class:`filmfriction.reduced_model.oscillator.DampedOscillator`).
+
+    Examples
+    --------
+    >>> float(slip_force(0.0, 2.0, damping=1.0, mass=1.0, spring_constant=1.0))
+    2.0
     """
     t = np.asarray(t, float)
     m, b, k, v = mass, damping, spring_constant, drive_velocity
@@ -201,17 +211,7 @@ def slip_force(t, spring_force_at_yield: float, damping: float, mass: float,
     # x = x_p + u,  x_p = x0 + V t − B V / K,  M u'' + B u' + K u = 0
     u0 = -x0 + b * v / k
     du0 = wall_velocity0 - v
-    disc = complex(b * b - 4 * m * k)
-    root = np.sqrt(disc)
-    r2 = (-b - root) / (2 * m)          # the fast root, no cancellation
-    r1 = k / (m * r2)                   # r1 r2 = K/M
-    if abs(r1 - r2) < 1e-9 * abs(r1 + r2):       # critical damping
-        r = r1.real
-        u = (u0 + (du0 - r * u0) * t) * np.exp(r * t)
-    else:
-        c1 = (du0 - r2 * u0) / (r1 - r2)
-        c2 = u0 - c1
-        u = (c1 * np.exp(r1 * t) + c2 * np.exp(r2 * t)).real
+    u = DampedOscillator(mass=m, damping=b, stiffness=k).value(t, u0, du0)
     x = x0 + v * t - b * v / k + u
     return k * (x0 + v * t - x)
 

@@ -2,7 +2,9 @@
 
 A block on a spring with a friction law from the literature, integrated with
 an exact stick phase (no regularisation), closed forms where they exist, an
-energy ledger on every run, the Prandtl-Tomlinson model and stability maps.
+energy ledger on every run, the Prandtl-Tomlinson model and stability maps;
+and the SFB check, the model at the scale of Klein's surface-force-balance
+experiment (:func:`sfb_check`, :mod:`filmfriction.reduced_model.sfb`).
 
 Example
 -------
@@ -18,9 +20,13 @@ if __name__ != "filmfriction.reduced_model":  # one name only: two would give tw
     raise ImportError(f"import filmfriction.reduced_model, not {__name__}")
 from . import laws
 from ._checks import SimulationLimitError
+from .klein import KLEIN, KleinExperiment
+from .md_film import MDCalibration
 from .result import EnergyLedger, Event, SimulationResult
+from .sfb import SFBCheck, sfb_check, sfb_table
 from .springblock import SpringBlock
 from .tomlinson import PrandtlTomlinson
 
 __all__ = ["SpringBlock", "laws", "PrandtlTomlinson", "SimulationResult", "Event",
-           "EnergyLedger", "SimulationLimitError"]
+           "EnergyLedger", "SimulationLimitError", "sfb_check", "sfb_table", "SFBCheck",
+           "MDCalibration", "KleinExperiment", "KLEIN"]

@@ -14,13 +14,15 @@ This is the fast path taken by :meth:`SpringBlock.simulate` for
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
+from scipy.optimize import brentq
 
 from .oscillator import DampedOscillator
 from .trajectory import Problem
 
-__all__ = ["run_closed_form", "stick_break_time"]
+__all__ = ["run_closed_form", "stick_break_time", "freeze_velocity_for"]
 
 
 def settle(held_force: float, static: float) -> tuple[str, float]:
@@ -184,3 +186,60 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
         jump = 0.5 * M * (u * u - creep * creep) if mode == "stick" else 0.0
         rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
     return rec.finish()
+
+
+def freeze_velocity_for(block, static_force: float, restick_force: float) -> float:
+    """Slip speed at which the film must freeze for ``block`` to re-stick at ``restick_force``.
+
+    The re-stick force of the model's steady cycle rises monotonically with the
+    freeze velocity, up to ``static_force``; brentq finds it.  An overdamped
+    slip (B + d >= 2 sqrt(K M)) needs one above V to re-stick at all; an
+    underdamped one that already re-sticks at or above ``restick_force`` gets 0.
+
+    Parameters
+    ----------
+    block : SpringBlock
+        With a :class:`~filmfriction.reduced_model.laws.Coulomb` law (its
+        ``freeze_velocity`` is what is searched).
+    static_force, restick_force : float
+        F_s of the law, and the re-stick force F_b to reach.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        ``restick_force`` is not reachable (not between those ends).
+    """
+    k, v = block.stiffness, abs(block.drive_velocity)
+    law = block.law
+    # one cycle's stick and a slip: (Fs - Fb)/(K V) plus margin; two cycles give a steady one
+    horizon = 3.0 * static_force / (k * max(v, 1e-300))
+
+    def last_restick(result):
+        fb = np.asarray(result.cycles().backward_force, float)
+        return float(fb[-1]) if fb.size else -math.inf
+
+    def run(vf):
+        return replace(block, law=replace(law, freeze_velocity=vf)).simulate(horizon)
+
+    def restick(vf):
+        return last_restick(run(vf))
+
+    # the film can only freeze below the slip's peak speed, and an overdamped
+    # slip only above the steady sliding speed V, which it approaches from above
+    free = run(0.0)
+    peak = float(np.max(np.abs(free.v)))
+    lo, hi = (v * (1.0 + 1e-3) if len(free.cycles()) == 0 else 0.0), 0.999 * peak
+    # at lo = 0 the film never freezes early: that is the free run itself
+    f_lo = (last_restick(free) if lo == 0.0 else restick(lo)) - restick_force
+    f_hi = restick(hi) - restick_force
+    if f_lo >= 0.0 and lo == 0.0:
+        return 0.0      # it already re-sticks at or above F_b: freezing could only raise it
+    if not (f_lo < 0.0 < f_hi):
+        raise ValueError(f"re-stick force {restick_force:.4g} is outside what a freeze velocity "
+                         f"in [{lo:.3g}, {hi:.3g}] gives ({f_lo + restick_force:.4g} .. "
+                         f"{f_hi + restick_force:.4g})")
+    return float(brentq(lambda vf: restick(vf) - restick_force, lo, hi, xtol=1e-9 * peak))

@@ -39,8 +39,8 @@ from ._checks import at_least, finite, in_range, non_negative, positive
 
 __all__ = [
     "FrictionLaw", "Coulomb", "StribeckExponential", "StribeckSchnelle",
-    "ExponentialWeakening", "NewtonianFilm", "ShearThinningFilm", "ContactAge",
-    "RateState", "LubricatedFilm",
+    "ExponentialWeakening", "NewtonianFilm", "ShearThinningFilm", "ThinningFilmWithSliding",
+    "ContactAge", "RateState", "LubricatedFilm", "newtonian_damping", "carreau_viscosity",
 ]
 
 _EMPTY = np.empty(0)
@@ -310,6 +310,32 @@ class ExponentialWeakening(FrictionLaw):
 # ---------------------------------------------------------------------------
 # Confined films
 # ---------------------------------------------------------------------------
+def newtonian_damping(area, viscosity, thickness):
+    """B = A η / D: drag per unit slip velocity of a Newtonian film with no-slip walls.
+
+    Klein's damping (PRL 98, 056101, Eq. 1); any consistent units.
+
+    Example
+    -------
+    >>> round(newtonian_damping(4e-10, 27.0, 3.5e-9), 4)      # Klein's B, N s/m
+    3.0857
+    """
+    return area * viscosity / thickness
+
+
+def carreau_viscosity(viscosity, shear_rate, onset_rate, exponent):
+    """Carreau law ``eta0 (1 + (rate/onset_rate)**2) ** (-exponent/2)``.
+
+    Newtonian (``eta0``) below the onset rate, ``eta ~ rate**-exponent`` above it.
+
+    Example
+    -------
+    >>> carreau_viscosity(8.0, 1.0, 1.0, 2.0)     # at the onset: eta0 / 2**(n/2)
+    4.0
+    """
+    return viscosity * (1.0 + (shear_rate / onset_rate) ** 2) ** (-0.5 * exponent)
+
+
 @dataclass(frozen=True)
 class NewtonianFilm(FrictionLaw):
     """Newtonian film of viscosity eta, contact area A, thickness D (Klein, seed 004).
@@ -341,7 +367,7 @@ class NewtonianFilm(FrictionLaw):
     @property
     def drag_coefficient(self) -> float:
         """B = A eta / D, force per unit slip velocity."""
-        return self.area * self.viscosity / self.thickness
+        return newtonian_damping(self.area, self.viscosity, self.thickness)
 
     def sliding_force(self, speed, state, normal_load):
         return self.drag_coefficient * speed
@@ -398,11 +424,11 @@ class ShearThinningFilm(FrictionLaw):
             non_negative("ShearThinningFilm.yield_force", self.yield_force, "force the solid film holds at rest")
 
     def low_speed_drag(self):
-        return self.area * self.viscosity / self.thickness
+        return newtonian_damping(self.area, self.viscosity, self.thickness)
 
     def viscosity_at(self, shear_rate):
-        """Effective viscosity at the given shear rate."""
-        return self.viscosity * (1.0 + (shear_rate / self.onset_rate) ** 2) ** (-0.5 * self.exponent)
+        """Effective viscosity at the given shear rate (:func:`carreau_viscosity`)."""
+        return carreau_viscosity(self.viscosity, shear_rate, self.onset_rate, self.exponent)
 
     def sliding_force(self, speed, state, normal_load):
         rate = speed / self.thickness
@@ -414,6 +440,39 @@ class ShearThinningFilm(FrictionLaw):
 
     def static_force(self, state, normal_load):
         return self.yield_force
+
+
+@dataclass(frozen=True)
+class ThinningFilmWithSliding(ShearThinningFilm):
+    """Shear-thinning film that also carries a rate-independent sliding force.
+
+    Friction ``sign(s) kinetic + A eta(gamma) gamma`` while sliding; at rest the
+    film holds up to ``kinetic`` (so a block released below it stays put).  The
+    MD film carried to the SFB (a molten film dragging over the walls'
+    corrugation) in :mod:`filmfriction.reduced_model.md_film`.
+
+    Example
+    -------
+    >>> film = ThinningFilmWithSliding(viscosity=27.0, area=4e-10, thickness=3.5e-9,
+    ...                                exponent=0.5, onset_rate=1e3, kinetic=2e-6)
+    >>> film.static_force((), 1.0), film.sliding_force(0.0, (), 1.0)
+    (2e-06, 2e-06)
+    """
+
+    kinetic: float = 0.0
+
+    def __post_init__(self):
+        super().__post_init__()
+        non_negative("ThinningFilmWithSliding.kinetic", self.kinetic, "a sliding force")
+
+    def sliding_force(self, speed, state, normal_load):
+        return self.kinetic + super().sliding_force(speed, state, normal_load)
+
+    def friction(self, s, state, normal_load):
+        return (math.copysign(self.kinetic, s) if s else 0.0) + super().friction(s, state, normal_load)
+
+    def static_force(self, state, normal_load):
+        return self.kinetic
 
 
 # ---------------------------------------------------------------------------

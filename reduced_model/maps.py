@@ -46,7 +46,8 @@ from .laws import ContactAge, Coulomb, RateState
 from .oscillator import DampedOscillator
 from .springblock import SpringBlock
 
-__all__ = ["stick_slip_parameter", "damping_ratio", "critical_lambda", "coulomb_stick_slip",
+__all__ = ["stick_slip_parameter", "damping_ratio", "critical_lambda", "coulomb_critical_velocity",
+           "coulomb_stick_slip",
            "lambda_zeta_map", "velocity_stiffness_map", "rate_state_critical_stiffness",
            "contact_age_critical_velocity", "RegimeMap"]
 
@@ -112,6 +113,40 @@ def critical_lambda(zeta):
     if z.ndim == 0:
         return _critical_lambda_scalar(float(z))
     return np.vectorize(_critical_lambda_scalar, otypes=[float])(z)
+
+
+def coulomb_critical_velocity(force_drop, damping, stiffness, mass):
+    """Drive velocity below which a Coulomb (+ viscous) block sticks and slips.
+
+    Stick-slip iff ``lambda = dF/(V sqrt(K M)) > lambda_c(zeta)`` with
+    ``zeta = d/(2 sqrt(K M))`` (:func:`critical_lambda`), so
+    ``V_c = dF / (lambda_c(zeta) sqrt(K M))``; 0 for zeta >= 1 (no stick-slip).
+
+    Parameters
+    ----------
+    force_drop : float
+        dF = Fs - Fk.
+    damping : float
+        All the damping of the slip (film's viscous B plus any damper d).
+    stiffness : float or array_like
+        K (one V_c per value).
+    mass : float
+        M.
+
+    Returns
+    -------
+    numpy.ndarray
+        V_c for each K.
+
+    Example
+    -------
+    >>> coulomb_critical_velocity(1.0, 3.0, [1.0], 1.0).tolist()      # zeta = 1.5: never
+    [0.0]
+    """
+    k = np.asarray(stiffness, float)
+    lam = np.atleast_1d(critical_lambda(damping_ratio(damping, k, mass)))
+    with np.errstate(divide="ignore"):
+        return np.where(np.isfinite(lam), force_drop / (lam * np.sqrt(k * mass)), 0.0)
 
 
 def coulomb_stick_slip(lam: float, zeta: float) -> bool:

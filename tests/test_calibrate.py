@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from filmfriction.reduced_model import SpringBlock, laws
-from filmfriction.workflows import calibrate as cal_mod
+from filmfriction.analysis import calibration as cal_mod
 from filmfriction.workflows import cli
 
 # a heavy wall on a stiff spring, like the MD scene (LJ units)
@@ -104,7 +104,7 @@ def test_md_calibration_and_json(calibration):
     doc = json.loads(path.read_text())
     assert doc["schema"] == cal_mod.SCHEMA
     assert doc["runs"][0]["static_force"]["value"] == pytest.approx(FS, rel=0.03)
-    from filmfriction.workflows.sfb import MDCalibration
+    from filmfriction.reduced_model import MDCalibration
     MDCalibration.from_dict(doc["md_calibration"])      # round-trips into the SFB check
 
 
@@ -139,7 +139,7 @@ def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     from types import SimpleNamespace
 
     from filmfriction.analysis.trace import TraceParameters
-    from filmfriction.workflows.calibrate import _no_restick
+    from filmfriction.analysis.replay import _no_restick
 
     def run(mass, mount=None):
         p = TraceParameters(spring_constant=100.0, mass=mass, drive_velocity=0.02,

@@ -87,6 +87,72 @@ def test_film_figure_from_a_trajectory(tmp_path):
     assert "side view" in note
 
 
+def _analysed_synthetic_run(directory):
+    """A synthetic run directory (no LAMMPS) with its analysis written, as `filmfriction analyze` does."""
+    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.trace import read_trace
+
+    d = run_directory(directory, trajectory=False)
+    doc, per_cycle = analyze(read_trace(d))
+    write_outputs(doc, per_cycle, d / "analysis.json")
+    return d
+
+
+def test_report_without_calibration_says_so_and_does_not_calibrate(tmp_path, monkeypatch, capsys):
+    from filmfriction.analysis import calibration
+    from filmfriction.reduced_model import SpringBlock, sfb
+
+    d = _analysed_synthetic_run(tmp_path / "run")
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the report computed a calibration or a model run")
+
+    # the report must neither calibrate nor run the reduced model (replay, SFB slips)
+    monkeypatch.setattr(calibration, "calibrate", refuse)
+    monkeypatch.setattr(calibration, "calibrate_run", refuse)
+    monkeypatch.setattr(sfb, "sfb_check", refuse)
+    monkeypatch.setattr(SpringBlock, "simulate", refuse)
+    assert cli.main(["report", str(d)]) == 0
+    out = capsys.readouterr().out
+    # the CLI prints what is missing and the command that makes it
+    assert f"{d / 'calibration.json'}; make it with: filmfriction calibrate {d}" in out
+    assert f"filmfriction sfb --calibration {d / 'calibration.json'} --out {d / 'sfb.json'}" in out
+    md = (d / "report.md").read_text()
+    assert "No `calibration.json` in" in md and "does not calibrate" in md
+    assert f"`filmfriction calibrate {d}`" in md
+    assert "No `sfb.json` in" in md and "Braun & Tosatti" in md
+    assert "## Inputs the report did not find" in md
+    assert not (d / "calibration.json").exists() and not (d / "sfb.json").exists()
+    # without an analysis it renders nothing and says which command makes it
+    (d / "analysis.json").unlink()
+    assert cli.main(["report", str(d)]) == 2
+    assert f"filmfriction analyze {d}" in capsys.readouterr().err
+
+
+def test_the_study_writes_what_the_report_renders(tmp_path):
+    """The post-MD study on a synthetic run (no LAMMPS): files first, then the report reads them."""
+    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.workflows.documents import read_calibration, read_sfb
+    from filmfriction.workflows.study import finish_study
+
+    d = run_directory(tmp_path / "run", trajectory=False)
+    assert finish_study(d) == 0
+    cal, check = read_calibration(d / "calibration.json"), read_sfb(d / "sfb.json")
+    assert cal["replay_trace"] is not None and len(cal["replay_trace"]["t"]) > 10
+    assert check.calibration == cal["md_calibration"] is not None
+    assert {"klein", "bulk", "md"} <= set(check.slips) and check.slips["md"].t is not None
+    md = (d / "report.md").read_text()
+    for title in SECTIONS:
+        assert title in md, title
+    assert "Inputs the report did not find" not in md and "Steps that failed" not in md
+    for name in ("trace", "viscosity", "replay", "replay-errors", "sfb"):
+        assert (d / f"report-{name}.png").exists(), name
+    # the SFB table of the report is the one in sfb.json, md-calibrated rows included
+    row = check.row("slip_time", "md-calibrated")
+    assert f"| slip_time | md-calibrated | {row['klein']:.3g} |" in md
+
+
 def _chromium():
     for name in ("chromium", "chromium-browser", "google-chrome", "chrome"):
         path = shutil.which(name)

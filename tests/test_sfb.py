@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from filmfriction.reduced_model import klein, sfb
+from filmfriction.reduced_model.klein import KLEIN
+from filmfriction.reduced_model.md_film import MDCalibration
+from filmfriction.reduced_model.sfb import ROW_KEYS, SOURCES
 from filmfriction.reduced_model.units import OMCTS, LJUnits
 from filmfriction.workflows import cli
-from filmfriction.workflows import sfb
-from filmfriction.workflows.sfb import KLEIN, MDCalibration, ROW_KEYS, SOURCES
 
 K, M, A, D = KLEIN.spring_constant, KLEIN.mass, KLEIN.contact_area, KLEIN.film_thickness
 
@@ -57,7 +59,7 @@ def test_model_slip_matches_klein_closed_form(check):
 
 @pytest.mark.parametrize("eta", [27.0, 2.5e-3, 0.3])   # over-, under-damped, near critical
 def test_closed_form_against_direct_integration(eta):
-    B = sfb.newtonian_damping(A, eta, D)
+    B = klein.newtonian_damping(A, eta, D)
     x0 = 100e-9
 
     def rhs(t, y):
@@ -65,20 +67,20 @@ def test_closed_form_against_direct_integration(eta):
 
     t = np.linspace(0.0, 0.05, 400)
     sol = solve_ivp(rhs, (0, 0.05), [0.0, 0.0], t_eval=t, rtol=1e-11, atol=1e-20, method="DOP853")
-    np.testing.assert_allclose(sfb.klein_closed_form(t, x0, M, K, B), sol.y[0], atol=1e-7 * x0)
+    np.testing.assert_allclose(klein.klein_closed_form(t, x0, M, K, B), sol.y[0], atol=1e-7 * x0)
 
 
 def test_slip_geometry_from_klein_statements():
-    geo = sfb.klein_slip_geometry()
+    geo = klein.klein_slip_geometry()
     assert geo.x0 == pytest.approx(1e-14 / (97 * 1e-9))
     assert K * (geo.x0 - geo.slip_distance / 2) * geo.slip_distance == pytest.approx(4e-13, rel=1e-12)
     assert 0 < geo.slip_distance < geo.x0
-    full = sfb.klein_slip_geometry(assumption="full-relaxation")
+    full = klein.klein_slip_geometry(assumption="full-relaxation")
     assert full.x0 == full.slip_distance == pytest.approx(math.sqrt(2 * 4e-13 / 97))
     with pytest.raises(ValueError):
-        sfb.klein_slip_geometry(assumption="guess")
+        klein.klein_slip_geometry(assumption="guess")
     with pytest.raises(ValueError):      # dE_f too small to store dE_spring
-        sfb.klein_slip_geometry(sfb.KleinExperiment(film_energy=5e-15))
+        klein.klein_slip_geometry(klein.KleinExperiment(film_energy=5e-15))
 
 
 def test_bulk_viscosity_cannot_give_kleins_slip(check):
@@ -107,8 +109,8 @@ def test_alternative_full_relaxation_reading_is_reported(check):
 
 
 def test_braun_tosatti_note_is_in_the_notes(check):
-    assert check.notes[-1] == sfb.BRAUN_TOSATTI_NOTE
-    assert "Braun" in sfb.BRAUN_TOSATTI_NOTE and "normal" in sfb.BRAUN_TOSATTI_NOTE
+    assert check.notes[-1] == klein.BRAUN_TOSATTI_NOTE
+    assert "Braun" in klein.BRAUN_TOSATTI_NOTE and "normal" in klein.BRAUN_TOSATTI_NOTE
 
 
 def test_rows_schema_and_ratios(check):
@@ -127,7 +129,7 @@ def test_rows_schema_and_ratios(check):
 # -- the MD path --------------------------------------------------------------------
 def klein_as_md(units=OMCTS, **extra):
     """Klein's own film written as an MD calibration in LJ units."""
-    geo = sfb.klein_slip_geometry()
+    geo = klein.klein_slip_geometry()
     return MDCalibration(
         yield_stress=units.from_si(K * geo.x0 / A, "stress"),
         restick_stress=units.from_si(geo.restick_force(K) / A, "stress"),
@@ -220,6 +222,29 @@ def test_cli_with_calibration_file(tmp_path, capsys):
     assert cli.main(["sfb", "--json", "--calibration", str(path), "--sigma-nm", "0.875"]) == 0
     md2 = rows_by_name(json.loads(capsys.readouterr().out), "md-calibrated")
     assert md2["yield_stress"]["model"] == pytest.approx(md["yield_stress"]["model"] * (0.82 / 0.875) ** 3)
+
+
+def test_cli_reads_a_calibration_json_and_writes_what_the_report_reads(tmp_path, capsys):
+    from filmfriction.workflows.documents import read_sfb
+
+    md = {"yield_stress": 0.5, "restick_stress": 0.25, "eta_zero": 50.0}
+    cal = tmp_path / "calibration.json"
+    cal.write_text(json.dumps({"schema": "filmfriction.calibration/1", "md_calibration": md}))
+    out = tmp_path / "sfb.json"
+    assert cli.main(["sfb", "--json", "--calibration", str(cal), "--out", str(out)]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    doc = read_sfb(out)
+    assert doc.rows == rows
+    assert doc.calibration == MDCalibration.from_dict(md).as_dict()
+    assert doc.notes[-1] == klein.BRAUN_TOSATTI_NOTE
+    assert doc.row("slip_time", "md-calibrated")["model"] == rows_by_name(rows, "md-calibrated")["slip_time"]["model"]
+    run = doc.slips["klein"]
+    assert run.t[0] == 0.0 and run.t[-1] <= 2 * run.slip_time and run.x.size == run.t.size
+    # a calibration.json whose calibration failed has nothing for the SFB check
+    cal.write_text(json.dumps({"schema": "filmfriction.calibration/1", "md_calibration": None,
+                               "failures": {"md_calibration": "no slips"}}))
+    assert cli.main(["sfb", "--calibration", str(cal)]) == 2
+    assert "no slips" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("content, message", [

@@ -1,12 +1,15 @@
 """``filmfriction calibrate RUN_DIR... [--json]``: fit the reduced model to MD runs.
 
-Writes ``calibration.json`` into the first run directory and prints the
-fitted parameters (LJ units, ± one standard error), the replay's errors and
-the MD calibration handed to the SFB check; ``--json`` prints the document.
+Writes ``calibration.json`` (and the replay's trace, ``calibration_replay.csv``)
+into the first run directory and prints the fitted parameters (LJ units, ± one
+standard error), the replay's errors and the MD calibration handed to the SFB
+check; ``--json`` prints the document.  The calibration itself is
+:func:`filmfriction.analysis.calibrate`.
 """
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 __all__ = ["register", "run", "format_calibration"]
@@ -34,7 +37,7 @@ def _fmt(e) -> str:
 
 
 def format_calibration(cal) -> str:
-    """Human-readable summary of a :class:`filmfriction.workflows.calibrate.Calibration`."""
+    """Human-readable summary of a :class:`filmfriction.analysis.calibration.Calibration`."""
     out = []
     for r in cal.runs:
         out.append(f"{r.run.run_dir}: {r.regime}, {r.run.n_slips} slips")
@@ -67,8 +70,7 @@ def format_calibration(cal) -> str:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from filmfriction.analysis.report import to_json
-    from filmfriction.workflows.calibrate import calibrate, write_calibration
+    from filmfriction.analysis import calibrate, write_calibration
     from filmfriction.workflows.cli import UserError
 
     from filmfriction.workflows.report import _split_sweeps
@@ -87,7 +89,7 @@ def run(args) -> int:
         raise UserError(str(exc)) from None
     path = write_calibration(cal)
     if args.json:
-        print(to_json(cal.as_dict()))
+        sys.stdout.write(path.read_text())     # the document as written
     else:
         print(format_calibration(cal))
         print(f"calibration: {path}")
@@ -95,6 +97,5 @@ def run(args) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    import sys
     from filmfriction.workflows.cli import main
     sys.exit(main(["calibrate"] + sys.argv[1:]))

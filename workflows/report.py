@@ -1,12 +1,16 @@
 """The study report: one self-contained HTML page and its Markdown twin.
 
 :func:`build_report` reads one or several run directories (the first is the
-main run), takes (or computes) the analysis, the calibration and the SFB
-check, and writes ``report.html`` (figures embedded as base64 PNG) and
+main run) and renders what the study wrote there (:mod:`filmfriction.workflows.study`):
+the analysis (``analysis.json``), the calibration (``calibration.json``) and
+the SFB check (``sfb.json``).  It computes none of them: a file that is not
+there is said in the report, with the command that makes it
+(``filmfriction analyze``, ``filmfriction calibrate``, ``filmfriction sfb
+--out``).  It writes ``report.html`` (figures embedded as base64 PNG) and
 ``report.md`` (figures as ``report-*.png`` next to it) into the first run
-directory, atomically.  Every number in the text comes from those results;
-a step that failed is reported as failed, with its reason, and the rest of
-the report is still written.
+directory, atomically.  Every number in the text comes from those files; a
+step that failed is reported as failed, with its reason, and the rest of the
+report is still written.
 
 The document is built once as a list of sections of blocks (paragraph,
 figure, table) and rendered twice, so the two files cannot disagree.
@@ -87,6 +91,11 @@ def _fmt(x, digits: int = 4) -> str:
     if not math.isfinite(x):
         return "–"
     return f"{x:.{digits}g}"
+
+
+def _fixed(x, decimals: int) -> str:
+    """``x`` with fixed decimals; "–" for a value the document has not (null)."""
+    return "–" if x is None else f"{x:.{decimals}f}"
 
 
 def _pm(e, digits: int = 3) -> str:
@@ -187,17 +196,19 @@ def fig_energy(bars) -> bytes:
     return _png(fig)
 
 
-def fig_viscosity(cal) -> bytes:
+def fig_viscosity(cal: dict) -> bytes:
+    """η_eff against γ̇, one point per run, with the rate law (a ``calibration.json`` document)."""
     plt = _plt()
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
-    pts = np.array(cal.rate_points, float).reshape(-1, 3)
+    pts = np.array(cal["rate_points"], float).reshape(-1, 3)
     err = np.where(np.isfinite(pts[:, 2]), pts[:, 2], 0.0)
     ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3, label="MD runs")
-    if cal.rate_law is not None:
-        law = cal.rate_law
+    law = cal.get("rate_law")
+    if law is not None:
+        # the fitted law as written, drawn over the runs' range (rendering, not fitting)
         g = np.geomspace(pts[:, 0].min() / 2, pts[:, 0].max() * 2, 50)
-        ax.plot(g, law.prefactor * g ** law.exponent, "-", color="tab:red",
-                label=f"η ∝ γ̇^({law.exponent:.2f} ± {law.exponent_stderr:.2f})")
+        ax.plot(g, law["prefactor"] * g ** law["exponent"], "-", color="tab:red",
+                label=f"η ∝ γ̇^({law['exponent']:.2f} ± {_fixed(law['exponent_stderr'], 2)})")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("shear rate γ̇ [1/τ]")
@@ -274,14 +285,15 @@ def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
     return _png(fig), "; ".join(note)
 
 
-def fig_replay(run, rc) -> bytes:
+def fig_replay(run, trace: dict, start_time: float) -> bytes:
+    """The MD spring force and the calibrated model's (``trace``: ``t``, ``spring_force``)."""
     plt = _plt()
     tr = run.trace
     fig, ax = plt.subplots(figsize=(9, 3.2))
     ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label="MD")
-    ax.plot(rc.replay.t, rc.replay.spring_force, lw=1.2, color="tab:red", alpha=0.85,
+    ax.plot(trace["t"], trace["spring_force"], lw=1.2, color="tab:red", alpha=0.85,
             label="calibrated model")
-    ax.axvline(rc.replay.start_time, color="tab:red", lw=0.6, ls=":")
+    ax.axvline(start_time, color="tab:red", lw=0.6, ls=":")
     ax.set_xlabel("time [τ]")
     ax.set_ylabel("spring force [ε/σ]")
     ax.legend(fontsize=8, loc="upper left")
@@ -315,7 +327,7 @@ def fig_sfb(check) -> bytes:
     labels = {"klein": "Klein's parameters (η_eff = 27 Pa·s)", "bulk": "bulk viscosity",
               "md": "MD-calibrated film"}
     for key, run in check.slips.items():
-        if key not in labels:
+        if key not in labels or run.t is None:
             continue
         t = np.asarray(run.t)
         end = run.slip_time if math.isfinite(run.slip_time) else t[-1]
@@ -415,29 +427,31 @@ def _energy_section(run, failures) -> Section:
     return sec
 
 
-def _viscosity_section(cal, failures) -> Section:
+def _viscosity_section(cal, why_none: str, failures) -> Section:
     sec = Section("Effective viscosity η_eff(γ̇)")
-    if cal is None or not cal.rate_points:
-        sec.p("No η_eff: " + (failures.get("calibration") or
-                              (cal.main.failures.get("eta_eff") if cal else "no calibration")) + ".")
+    if cal is None or not cal.get("rate_points"):
+        main_failures = cal["runs"][0].get("failures", {}) if cal else {}
+        sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
+                              "“Calibrated reduced model”)" if cal is None else
+                              main_failures.get("eta_eff") or "no run with η_eff") + ".")
         return sec
     png = _attempt(failures, "figure: viscosity", fig_viscosity, cal)
+    law = cal.get("rate_law")
     if png:
         sec.add(Figure("viscosity", png, "Film η_eff against shear rate, one point per run"
-                       + (" with the power-law fit." if cal.rate_law is not None else ".")))
-    if cal.rate_law is not None:
-        law = cal.rate_law
-        sec.p(f"Power law over {law.n} runs: η_eff = {_fmt(law.prefactor, 3)} · γ̇^({law.exponent:.3f} ± "
-              f"{law.exponent_stderr:.3f}) (LJ units); a thinning exponent n = {-law.exponent:.3f}.")
+                       + (" with the power-law fit." if law is not None else ".")))
+    if law is not None:
+        sec.p(f"Power law over {law['n']} runs: η_eff = {_fmt(law['prefactor'], 3)} · γ̇^({law['exponent']:.3f} ± "
+              f"{_fixed(law['exponent_stderr'], 3)}) (LJ units); a thinning exponent n = {-law['exponent']:.3f}.")
     else:
-        g, eta, err = cal.rate_points[0]
+        g, eta, err = cal["rate_points"][0]
         sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} ετ/σ³ "
               f"(= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s) at γ̇ = {_fmt(g, 3)} 1/τ "
               f"(= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s). "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
-    for r in cal.runs:
-        if r.eta_eff is not None:
-            sec.p(f"`{r.run.run_dir.name}`: {r.eta_eff.method}.")
+    for r in cal["runs"]:
+        if r.get("eta_eff") is not None:
+            sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")
     return sec
 
 
@@ -457,38 +471,49 @@ def _film_section(run, failures) -> Section:
     return sec
 
 
-def _calibration_section(cal, failures) -> Section:
+def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Section:
+    """The calibrated model from a ``calibration.json`` document (None: ``why_none`` is said)."""
     sec = Section("Calibrated reduced model")
+    for r in remarks:
+        sec.p(r)
     if cal is None:
-        sec.p(f"Calibration failed: {failures.get('calibration', 'not run')}.")
+        sec.p(why_none)
         return sec
-    rc = cal.main
+    rc = cal["runs"][0]
     sec.p("Model: the MD wall's mass M, spring K, drive V and mount dashpot d in "
           "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
           "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
           "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
-          "jackknife over slips (see `workflows/calibrate.py`).")
+          "jackknife over slips (see `analysis/calibration.py`).")
     rows = []
     for name in ("static_force", "kinetic_force", "restick_force", "first_yield_force", "film_damping",
                  "eta_eff", "shear_rate", "ageing"):
-        e = getattr(rc, name)
+        e = rc.get(name)
         if e is not None:
-            rows.append((name.replace("_", " "), _pm(e), e.method))
+            rows.append((name.replace("_", " "), _pm(e), e["method"]))
     sec.add(Table(("parameter", "value (LJ)", "how"), tuple(rows)))
-    if rc.ageing is not None:
-        sig = abs(rc.ageing.value) > 2 * rc.ageing.stderr
-        sec.p(f"Contact ageing: dF_s/d ln(t_stick) = {_pm(rc.ageing)}; "
+    ageing = rc.get("ageing")
+    if ageing is not None:
+        stderr = math.nan if ageing["stderr"] is None else ageing["stderr"]
+        sig = abs(ageing["value"]) > 2 * stderr
+        sec.p(f"Contact ageing: dF_s/d ln(t_stick) = {_pm(ageing)}; "
               + ("more than two standard errors from zero" if sig else "not resolved (within two standard errors of zero)")
               + " (a correlation over the detected slips; small secondary slips with short sticks, if the "
                 "detector counts them, push it up too).")
-    for k, v in rc.failures.items():
+    for k, v in rc.get("failures", {}).items():
         sec.p(f"Not computed — {k}: {v}.")
-    if rc.replay is not None:
-        png = _attempt(failures, "figure: replay", fig_replay, cal.main.run, rc)
-        if png:
-            sec.add(Figure("replay", png, f"The calibrated model over the MD trace; it starts at "
-                           f"t = {_fmt(rc.replay.start_time)} τ (dotted line) from the MD's state there."))
-        errs = rc.replay.errors
+    replay = rc.get("replay")
+    if replay is not None:
+        trace = cal.get("replay_trace")
+        if trace is not None:
+            png = _attempt(failures, "figure: replay", fig_replay, run, trace, replay["start_time"])
+            if png:
+                sec.add(Figure("replay", png, f"The calibrated model over the MD trace; it starts at "
+                               f"t = {_fmt(replay['start_time'])} τ (dotted line) from the MD's state there."))
+        else:
+            sec.p("No replay trace beside `calibration.json` (`calibration_replay.csv`): the figure of the "
+                  "model over the MD trace is left out; `filmfriction calibrate` writes it.")
+        errs = replay["errors"]
         png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs)
         if png:
             sec.add(Figure("replay-errors", png, "Relative error of the model's mean peak force, slip "
@@ -500,28 +525,33 @@ def _calibration_section(cal, failures) -> Section:
         sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
               "predicting anything; slip distance and period are predictions. The model sticks at the "
               "first zero of the wall velocity and has no ringing after s, which the MD wall shows.")
-    md = cal.md_calibration
+    md = cal.get("md_calibration")
     if md is not None:
-        sec.p(f"Handed to the SFB check (LJ): yield stress {md.yield_stress:.4g} ± {md.yield_stress_err:.2g}, "
-              f"sliding stress {md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g}, re-stick stress "
-              f"{_fmt(md.restick_stress)}, η0 {md.eta_zero:.4g} ± {md.eta_zero_err:.2g}, thinning "
-              f"exponent {md.thinning_exponent:.3g} ± {md.thinning_exponent_err:.2g}.")
-    for k, v in cal.failures.items():
+        sec.p(f"Handed to the SFB check (LJ): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
+              f"sliding stress {md['sliding_stress']:.4g} ± {md['sliding_stress_err']:.2g}, re-stick stress "
+              f"{_fmt(md['restick_stress'])}, η0 {md['eta_zero']:.4g} ± {md['eta_zero_err']:.2g}, thinning "
+              f"exponent {md['thinning_exponent']:.3g} ± {md['thinning_exponent_err']:.2g}.")
+    for k, v in cal.get("failures", {}).items():
         sec.p(f"Not computed — {k}: {v}.")
-    for n in cal.notes:
+    for n in cal.get("notes", []):
         sec.p(f"Note: {n}.")
     return sec
 
 
-def _sfb_section(check, failures) -> Section:
-    from filmfriction.workflows.sfb import BRAUN_TOSATTI_NOTE
+def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
+    """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.documents.SFBDocument`)."""
+    from filmfriction.reduced_model.klein import BRAUN_TOSATTI_NOTE
 
     sec = Section("Comparison with the SFB experiment (Klein, OMCTS)")
+    for r in remarks:
+        sec.p(r)
     if check is None:
-        sec.p(f"The SFB check failed: {failures.get('sfb', 'not run')}.")
+        sec.p(why_none)
         sec.p(BRAUN_TOSATTI_NOTE)
         return sec
-    png = _attempt(failures, "figure: sfb", fig_sfb, check)
+    png = None
+    if any(run.t is not None for run in check.slips.values()):
+        png = _attempt(failures, "figure: sfb", fig_sfb, check)
     if png:
         sec.add(Figure("sfb", png, "SFB-scale slips of the reduced model: Klein's parameters, the same "
                                    "with bulk viscosity, and (if calibrated) the MD film."))
@@ -646,7 +676,7 @@ def _render_html(title: str, intro: list, sections: list) -> str:
                 parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
             else:
                 cls = " class='fail'" if b.startswith(("Not computed", "Calibration failed",
-                                                       "The SFB check failed")) else ""
+                                                       "The SFB check failed", "No `")) else ""
                 parts.append(f"<p{cls}>{_inline_html(b)}</p>")
     parts.append(f"<script>{_SCRIPT}</script></body></html>")
     return "\n".join(parts)
@@ -732,8 +762,14 @@ def _sweep_section(sweeps) -> Section:
     return sec
 
 
-def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=None) -> Path:
+def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
     """Write ``report.html`` and ``report.md`` for one or several runs.
+
+    The report renders what is in the main run's directory: ``analysis.json``
+    (with ``analysis_cycles.csv``), ``calibration.json`` (with
+    ``calibration_replay.csv``) and ``sfb.json`` (with ``sfb_slips.csv``).
+    It computes none of them; a file that is not there is said in the report
+    with the command that writes it (and passed to ``log``).
 
     Parameters
     ----------
@@ -743,19 +779,24 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     out : path-like, optional
         HTML file to write (default ``<first run>/report.html``); the Markdown
         twin and its PNG figures go next to it (same stem).
-    calibration : workflows.calibrate.Calibration, optional
-        Computed here when not given.
-    sfb : workflows.sfb.SFBCheck, optional
-        Computed here (with the calibration's MD rows) when not given.
     failures : dict, optional
-        Step → reason for earlier steps that failed (recorded in the report).
+        Step → reason for earlier steps that failed (recorded in the report;
+        a failed ``calibration`` or ``sfb`` step is reported as failed, not read).
+    log : callable, optional
+        Called with one line per input that is missing and the command that makes it.
 
     Returns
     -------
     Path
         The HTML file.
+
+    Raises
+    ------
+    ValueError
+        No run directory, or the main run has no analysis (``filmfriction analyze``).
     """
-    from filmfriction.workflows.calibrate import calibrate, load_run
+    from filmfriction.analysis.rundata import load_run
+    from filmfriction.workflows.documents import read_report_inputs
 
     if isinstance(run_dirs, (str, os.PathLike)):
         run_dirs = [run_dirs]
@@ -766,15 +807,11 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
     if not run_dirs:
         raise ValueError("no run directory given (a sweep without completed runs?)")
     failures = dict(failures or {})
-    if calibration is None and "calibration" not in failures:
-        calibration = _attempt(failures, "calibration", calibrate, run_dirs)
-    if sfb is None and "sfb" not in failures:
-        from filmfriction.workflows.sfb import sfb_check
-        md = calibration.md_calibration if calibration is not None else None
-        sfb = _attempt(failures, "sfb", sfb_check, md)
-    # the calibration has read the main run already; without one, the report
-    # still needs at least the main run's trace
-    run = calibration.main.run if calibration is not None else load_run(run_dirs[0])
+    run = load_run(run_dirs[0], analyse=False)
+    inputs = read_report_inputs(run.run_dir, run_dirs, given, failures)
+    for what, command in inputs.missing:
+        if log is not None:
+            log(f"missing or out of date: {what}; make it with: {command}")
     out = Path(out) if out is not None else run.run_dir / "report.html"
     scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
     title = f"filmfriction report — {scene} ({run.run_dir.name})"
@@ -782,11 +819,20 @@ def build_report(run_dirs, out=None, *, calibration=None, sfb=None, failures=Non
              "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
              f"({OMCTS.name})."]
     sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
-                _viscosity_section(calibration, failures), _film_section(run, failures),
-                _calibration_section(calibration, failures), _sfb_section(sfb, failures),
+                _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
+                _film_section(run, failures),
+                _calibration_section(inputs.calibration, inputs.why_no_calibration,
+                                     inputs.calibration_remarks, run, failures),
+                _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
                 _cost_section(run)]
     if sweeps:
         sections.insert(4, _sweep_section(sweeps))
+    if inputs.missing:
+        sec = Section("Inputs the report did not find")
+        sec.p("The report renders the files the study writes and computes none of them. These commands "
+              "write what is missing or out of date:")
+        sec.add(Table(("file", "command"), tuple((w, f"`{c}`") for w, c in inputs.missing)))
+        sections.append(sec)
     if failures:
         sec = Section("Steps that failed")
         sec.add(Table(("step", "reason"), tuple((k, v) for k, v in failures.items())))

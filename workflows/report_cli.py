@@ -1,9 +1,12 @@
 """``filmfriction report RUN_DIR... [--out FILE]``: the study report (HTML + Markdown).
 
-Computes the calibration and the SFB check (with the MD-calibrated rows)
-from the run directories and writes ``report.html`` (self-contained) and
-``report.md`` (with ``report-*.png``) into the first run directory, or to
-``--out`` and next to it.
+Renders what the study wrote into the first run directory (``analysis.json``,
+``calibration.json``, ``sfb.json``; ``filmfriction run`` writes them all) and
+writes ``report.html`` (self-contained) and ``report.md`` (with
+``report-*.png``) there, or to ``--out`` and next to it.  It computes none of
+them: a missing one is said in the report and printed with the command that
+makes it (for several runs or a sweep, ``filmfriction calibrate RUN_DIR...``
+writes the calibration across them).
 """
 from __future__ import annotations
 
@@ -17,10 +20,18 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "report", help="write the study report (HTML with embedded figures + Markdown twin)",
         description="Scene, stick-slip trace, energy partition, viscosity, film structure, calibrated "
-                    "model, SFB comparison, cost and provenance of one or several runs.")
+                    "model, SFB comparison, cost and provenance of one or several runs. The report "
+                    "renders what is in the first run directory and computes nothing: analysis.json "
+                    "('filmfriction analyze RUN_DIR', required), calibration.json ('filmfriction "
+                    "calibrate RUN_DIR...'; across several runs or a sweep, give them all) and "
+                    "sfb.json ('filmfriction sfb --calibration RUN_DIR/calibration.json --out "
+                    "RUN_DIR/sfb.json'). 'filmfriction run' writes all three. A file that is "
+                    "missing or out of date is said in the report and printed with the command "
+                    "that makes it.")
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
-                   help="run directories (the first is the main run; several give the rate law) "
-                        "or finished sweep directories (a sweep section and their runs)")
+                   help="run directories (the first is the main run, whose calibration.json and "
+                        "sfb.json are rendered) or finished sweep directories (a sweep section "
+                        "and their runs)")
     p.add_argument("--out", type=Path, default=None, metavar="FILE",
                    help="HTML file to write (default RUN_DIR/report.html; the .md goes next to it)")
     p.set_defaults(func=run)
@@ -38,7 +49,7 @@ def run(args) -> int:
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     try:
-        path = build_report(args.run_dirs, out=args.out)
+        path = build_report(args.run_dirs, out=args.out, log=print)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     print(f"report: {path}")

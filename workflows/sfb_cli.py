@@ -1,17 +1,21 @@
 """``filmfriction sfb``: the reduced model against Klein's SFB numbers.
 
-    filmfriction sfb [--json] [--calibration FILE.json] [--sigma-nm S] [--epsilon-K E]
+    filmfriction sfb [--json] [--calibration FILE.json] [--out sfb.json] [--sigma-nm S] [--epsilon-K E]
 
 Prints the comparison table (name, Klein, model, ratio, units, source) and
 the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
-``--calibration`` reads an :class:`filmfriction.workflows.sfb.MDCalibration` (LJ units) from
-a JSON object with its field names and adds the ``md-calibrated`` rows;
-``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to carry
-it to SI.
+``--calibration`` reads an :class:`filmfriction.reduced_model.MDCalibration` (LJ units) from
+a JSON object with its field names, or the ``md_calibration`` of a
+``calibration.json`` (``filmfriction calibrate``), and adds the ``md-calibrated``
+rows; ``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to
+carry it to SI.  ``--out`` also writes the check as the study does
+(``sfb.json`` + ``sfb_slips.csv``), for ``filmfriction report`` to read.
+The check itself is :func:`filmfriction.reduced_model.sfb_check`.
 """
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 from filmfriction.reduced_model.units import OMCTS, LJUnits
@@ -27,7 +31,11 @@ def register(subparsers) -> None:
                     "quantity beside Klein's number with the ratio; optional MD-calibrated rows.")
     p.add_argument("--json", action="store_true", help="print the table as a JSON list")
     p.add_argument("--calibration", metavar="FILE.json", type=Path,
-                   help="MD calibration (LJ units, MDCalibration fields) to add md-calibrated rows")
+                   help="MD calibration to add md-calibrated rows: MDCalibration fields (LJ units) "
+                        "or a calibration.json from 'filmfriction calibrate'")
+    p.add_argument("--out", metavar="FILE.json", type=Path, default=None,
+                   help="also write the check as the study does (e.g. RUN_DIR/sfb.json, with its "
+                        "slips' traces beside it), for 'filmfriction report'")
     p.add_argument("--sigma-nm", type=float, default=None,
                    help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
     p.add_argument("--epsilon-K", type=float, default=None,
@@ -51,14 +59,20 @@ def _units(args) -> LJUnits:
 def _calibration(path: Path | None):
     if path is None:
         return None
+    from filmfriction.reduced_model import MDCalibration
     from filmfriction.workflows.cli import UserError
-    from filmfriction.workflows.sfb import MDCalibration
     try:
         data = json.loads(Path(path).read_text())
     except FileNotFoundError:
         raise UserError(f"calibration file {path} does not exist") from None
     except (OSError, json.JSONDecodeError) as exc:
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
+    if isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction.calibration/"):
+        # a calibration.json: its md_calibration is what the SFB check takes
+        if data.get("md_calibration") is None:
+            why = (data.get("failures") or {}).get("md_calibration", "no md_calibration in it")
+            raise UserError(f"calibration file {path}: no MD calibration for the SFB check ({why})")
+        data = data["md_calibration"]
     try:
         return MDCalibration.from_dict(data)
     except (ValueError, TypeError) as exc:
@@ -93,17 +107,25 @@ def format_table(rows, notes=()) -> str:
 
 def run(args) -> int:
     """Entry point of ``filmfriction sfb``; returns the exit code."""
+    from filmfriction.reduced_model import sfb_check
     from filmfriction.workflows.cli import UserError
-    from filmfriction.workflows.sfb import sfb_check
 
+    if args.out is not None and not args.out.parent.is_dir():
+        raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     units = _units(args)
     calibration = _calibration(args.calibration)
     try:
         check = sfb_check(calibration=calibration, units=units)
     except ValueError as exc:
         raise UserError(str(exc)) from None
+    path = None
+    if args.out is not None:
+        from filmfriction.workflows.documents import write_sfb
+        path = write_sfb(check, args.out)
     if args.json:
         print(json.dumps(check.rows, indent=2, allow_nan=False))
+        if path is not None:
+            print(f"sfb check: {path}", file=sys.stderr)
         return 0
     print("SFB check: Klein, PRL 98, 056101 (2007), OMCTS, n = 4 layers "
           f"(K = {check.experiment.spring_constant:g} N/m, M = {check.experiment.mass * 1e3:g} g, "
@@ -116,4 +138,6 @@ def run(args) -> int:
     print("Row notes:")
     for name, source, note in notes_by_row:
         print(f"  {name} [{source}]: {note}")
+    if path is not None:
+        print(f"\nsfb check: {path}")
     return 0

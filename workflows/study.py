@@ -1,13 +1,13 @@
 """The study that follows an MD run: analysis → calibration → SFB check → report.
 
-Each step writes its own file into the run directory (``analysis.json``,
-``calibration.json``, ``sfb.json``, ``report.html`` + ``report.md``); a step
-that fails is printed and recorded in the report, and does not hide the
-others' results.
+The one place that chains the steps.  Each step writes its own file into the
+run directory (``analysis.json``, ``calibration.json``, ``sfb.json``,
+``report.html`` + ``report.md``) and the next reads what it needs; the report
+only renders those files.  A step that fails is printed and recorded in the
+report, and does not hide the others' results.
 """
 from __future__ import annotations
 
-import json
 import sys
 import time
 import traceback
@@ -37,11 +37,9 @@ def _step(name: str, failures: dict, fn, *args):
 
 
 def _write_sfb(run_dir: Path, check) -> Path:
-    from filmfriction.analysis.util import write_atomic as _atomic_write
+    from filmfriction.workflows.documents import SFB_FILE, write_sfb
 
-    path = run_dir / "sfb.json"
-    _atomic_write(path, json.dumps(check.rows, indent=2, allow_nan=False) + "\n")
-    return path
+    return write_sfb(check, run_dir / SFB_FILE)
 
 
 def finish_study(run_dir: Path) -> int:
@@ -62,7 +60,7 @@ def finish_study(run_dir: Path) -> int:
               f"{fs['mean'] if fs['mean'] is not None else float('nan'):.4g} ± {fs['stderr'] or 0:.2g} "
               f"{fs['units']} -> {run_dir / 'analysis.json'}")
 
-    from filmfriction.workflows.calibrate import calibrate, write_calibration
+    from filmfriction.analysis import calibrate, write_calibration
     cal = _step("calibration", failures, calibrate, [run_dir])
     if cal is not None:
         path = _step("calibration (write)", failures, write_calibration, cal)
@@ -73,7 +71,7 @@ def finish_study(run_dir: Path) -> int:
               f"{rc.film_damping.value if rc.film_damping else float('nan'):.4g}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
-    from filmfriction.workflows.sfb import sfb_check
+    from filmfriction.reduced_model import sfb_check
     md = cal.md_calibration if cal is not None else None
     check = _step("sfb", failures, sfb_check, md)
     if check is not None:
@@ -82,12 +80,7 @@ def finish_study(run_dir: Path) -> int:
         print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated) -> {path}")
 
     from filmfriction.workflows import report
-    kwargs = {"failures": failures}
-    if cal is not None:
-        kwargs["calibration"] = cal
-    if check is not None:
-        kwargs["sfb"] = check
-    path = _step("report", failures, lambda: report.build_report([run_dir], **kwargs))
+    path = _step("report", failures, lambda: report.build_report([run_dir], failures=dict(failures)))
     print(f"post-MD steps took {time.perf_counter() - t0:.1f} s"
           + (f"; failed: {', '.join(failures)}" if failures else ""))
     if path is None:

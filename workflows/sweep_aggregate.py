@@ -191,10 +191,9 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     """The calibrated spring-block model's stick-slip boundary V_c(K).
 
     The calibrated film is Coulomb (static F_s, kinetic F_k) plus a viscous
-    B, on the MD's wall mass M and mount dashpot d = γ·M.  For such a block
-    stick-slip happens iff λ = (F_s − F_k)/(V√(KM)) exceeds
-    λ_c(ζ), ζ = (d + B)/(2√(KM)) (:func:`filmfriction.reduced_model.maps.critical_lambda`),
-    so V_c(K) = (F_s − F_k)/(λ_c √(KM)); V_c = 0 for ζ ≥ 1.
+    B, on the MD's wall mass M and mount dashpot d = γ·M; its V_c(K) is
+    :func:`filmfriction.reduced_model.maps.coulomb_critical_velocity` with
+    d + B and F_s − F_k averaged over the runs.
 
     Parameters
     ----------
@@ -211,7 +210,7 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     dict
         ``stiffness``, ``velocity`` lists and the parameters used.
     """
-    from filmfriction.reduced_model.maps import critical_lambda, damping_ratio
+    from filmfriction.reduced_model.maps import coulomb_critical_velocity
 
     def values(name):
         out = []
@@ -228,10 +227,7 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     drop = float(np.mean(fs) - np.mean(fk))
     damping = mount_damping + float(np.mean(b))
     k = np.asarray(stiffnesses, float)
-    zeta = damping_ratio(damping, k, mass)
-    lam = np.atleast_1d(critical_lambda(zeta))
-    with np.errstate(divide="ignore"):
-        vc = np.where(np.isfinite(lam), drop / (lam * np.sqrt(k * mass)), 0.0)
+    vc = coulomb_critical_velocity(drop, damping, k, mass)
     return {"stiffness": k.tolist(), "velocity": vc.tolist(), "force_drop": drop,
             "damping": damping, "mass": mass,
             "model": "Coulomb(F_s, F_k) + viscous B + mount dashpot; V_c = (F_s - F_k) / "

@@ -400,45 +400,6 @@ def _reduced_block():
                                         viscous=r["viscous"]))
 
 
-def _rk45_cycles(rtol: float, duration: float):
-    """The same block integrated by hand with ``solve_ivp`` RK45: what a user writes.
-
-    Slips are integrated to the event v = 0; sticks are linear ramps solved in
-    closed form (exactly as a careful user would).  Returns (t, F, yields,
-    sticks, wall position, work, dissipated) sampled at the event times.
-    """
-    from scipy.integrate import solve_ivp
-
-    r = REDUCED
-    M, K, V, d = r["mass"], r["stiffness"], r["drive_velocity"], r["damping"]
-    fs, fk, b = r["static"], r["kinetic"], r["viscous"]
-    t, x = 0.0, 0.0
-    ts, fs_, xs, kinds = [0.0], [0.0], [0.0], ["start"]
-    while t < duration:
-        # stick: the force K (V t - x) rises linearly to Fs (SpringBlock's damper acts
-        # on the block's own velocity, zero while stuck)
-        t = max(t, (fs / K + x) / V)
-        if t >= duration:
-            break
-        ts.append(t), fs_.append(K * (V * t - x)), xs.append(x), kinds.append("slip")
-        t0, x0 = t, x
-
-        def rhs(tau, y, t0=t0):
-            f = K * (V * (t0 + tau) - y[0]) - d * y[1] - fk - b * y[1]
-            return [y[1], f / M]
-
-        def stop(tau, y):
-            return y[1]
-        stop.terminal, stop.direction = True, -1
-        sol = solve_ivp(rhs, (0.0, duration - t0), [x0, 1e-12], method="RK45", rtol=rtol,
-                        atol=1e-9, events=stop)
-        x, t = float(sol.y[0, -1]), t0 + float(sol.t[-1])
-        ts.append(t), fs_.append(K * (V * t - x)), xs.append(x), kinds.append("stick")
-        if sol.status != 1:
-            break
-    return np.array(ts), np.array(fs_), np.array(xs), kinds
-
-
 def _reduced_measure(t, f, x, yields, sticks) -> dict:
     from filmfriction.analysis.stickslip import cycle_table
 
@@ -453,7 +414,15 @@ def _reduced_measure(t, f, x, yields, sticks) -> dict:
 
 
 def reduced_rows(repeat: int = 3) -> list[dict]:
-    """Cost and error of the reduced model's integrators against the closed form."""
+    """Cost and error of the reduced model's integrators against the closed form.
+
+    The closed form and the event-driven ODE path at several tolerances
+    (:meth:`SpringBlock.simulate <filmfriction.reduced_model.SpringBlock.simulate>`), and a
+    plain ``solve_ivp`` RK45 loop as a user writes it
+    (:func:`filmfriction.reduced_model.rk45.rk45_stick_slip`).
+    """
+    from filmfriction.reduced_model.rk45 import rk45_stick_slip
+
     block = _reduced_block()
     T = REDUCED["duration"]
     variants = [("closed_form", {"method": "closed_form"}),
@@ -469,7 +438,7 @@ def reduced_rows(repeat: int = 3) -> list[dict]:
         for _ in range(repeat):
             t0 = time.perf_counter()
             if "rk45" in kw:
-                t, f, x, kinds = _rk45_cycles(kw["rk45"], T)
+                t, f, x, kinds = rk45_stick_slip(block, T, rtol=kw["rk45"])
                 yi = np.array([i for i, k in enumerate(kinds) if k == "slip"])
                 si = np.array([i for i, k in enumerate(kinds) if k == "stick"])
                 n = min(len(yi), len(si))

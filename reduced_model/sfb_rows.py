@@ -1,0 +1,48 @@
+"""A row of the SFB comparison table: one model number beside Klein's.
+
+Example
+-------
+>>> row = table_row("slip_time", 0.025, 0.02, "s", "sfb-parameters", uncertainty=(0.03, 0.01))
+>>> round(row["ratio"], 12), row["uncertainty"]
+(0.8, [0.01, 0.03])
+>>> tuple(row) == ROW_KEYS
+True
+"""
+from __future__ import annotations
+
+import math
+
+__all__ = ["ROW_KEYS", "SOURCES", "table_row", "find_row"]
+
+#: Keys of every table row (``note`` and ``uncertainty`` are extras to the issue's six).
+ROW_KEYS = ("name", "klein", "model", "ratio", "units", "source", "uncertainty", "note")
+
+#: The two values of a row's ``source``.
+SOURCES = ("sfb-parameters", "md-calibrated")
+
+
+def _finite_or_none(v):
+    if v is None:
+        return None
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def table_row(name, klein, model, units_, source, note="", uncertainty=None) -> dict:
+    """One row (keys :data:`ROW_KEYS`): non-finite numbers become ``None``, the ratio is
+    model/Klein when both exist, the uncertainty a sorted [low, high] or ``None``."""
+    klein, model = _finite_or_none(klein), _finite_or_none(model)
+    ratio = model / klein if (klein not in (None, 0.0) and model is not None) else None
+    if uncertainty is not None:
+        lo, hi = (_finite_or_none(u) for u in uncertainty)
+        uncertainty = None if lo is None or hi is None else [min(lo, hi), max(lo, hi)]
+    return {"name": name, "klein": klein, "model": model, "ratio": ratio, "units": units_,
+            "source": source, "uncertainty": uncertainty, "note": note}
+
+
+def find_row(rows, name: str, source: str = "sfb-parameters") -> dict:
+    """The row called ``name`` from ``source`` (KeyError if there is none)."""
+    for r in rows:
+        if r["name"] == name and r["source"] == source:
+            return r
+    raise KeyError(f"no row {name!r} with source {source!r}")

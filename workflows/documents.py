@@ -1,0 +1,273 @@
+"""The files the study writes into a run directory for the report to read.
+
+``calibration.json`` (+ ``calibration_replay.csv``) is written by
+:func:`filmfriction.analysis.write_calibration` (``filmfriction calibrate``
+and the study); ``sfb.json`` (+ ``sfb_slips.csv``, the slips' traces) by
+:func:`write_sfb` (``filmfriction sfb --out`` and the study).  The readers
+here only read: a file that is not there is ``None``, never recomputed;
+:func:`read_report_inputs` says, for the report, what is missing or out of date
+and the command that makes it.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import shlex
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.report import to_json
+from filmfriction.reduced_model.sfb_rows import find_row
+
+__all__ = ["CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
+           "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",
+           "read_report_inputs"]
+
+CALIBRATION_FILE = "calibration.json"
+SFB_FILE = "sfb.json"
+#: The slips' traces go to ``<stem><suffix>`` beside ``sfb.json``.
+SFB_TRACES_SUFFIX = "_slips.csv"
+#: The traces kept run from y to this many slip times.
+TRACE_SPAN = 2.0
+
+
+def write_sfb(check, path) -> Path:
+    """Write an SFB check (:class:`filmfriction.reduced_model.SFBCheck`) as ``sfb.json``.
+
+    The document is ``check.as_dict()`` plus ``traces``, the name of the CSV
+    (``slip,time,x``, SI) with every slip's trace from the yield point y to
+    twice its slip time (the whole run when s was not reached), written
+    beside it.
+
+    Returns
+    -------
+    Path
+        The JSON file.
+    """
+    path = Path(path)
+    traces = path.with_name(path.stem + SFB_TRACES_SUFFIX)
+    lines = ["slip,time,x\n"]
+    for key, run in check.slips.items():
+        t, x = np.asarray(run.t, float), np.asarray(run.x, float)
+        if np.isfinite(run.slip_time):
+            keep = t <= TRACE_SPAN * run.slip_time
+            t, x = t[keep], x[keep]
+        lines += [f"{key},{a!r},{b!r}\n" for a, b in zip(t.tolist(), x.tolist())]
+    write_atomic(traces, "".join(lines))
+    doc = check.as_dict()
+    doc["traces"] = traces.name
+    return write_atomic(path, to_json(doc) + "\n")
+
+
+def read_json(path):
+    """The JSON document at ``path``, or ``None`` if there is no such file.
+
+    Raises
+    ------
+    ValueError
+        The file is not valid JSON.
+    """
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        return json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read: {exc}") from None
+
+
+def _columns(path: Path) -> dict:
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    header, body = rows[0], rows[1:]
+    return {name: [row[i] for row in body] for i, name in enumerate(header)}
+
+
+def read_calibration(path):
+    """``calibration.json`` with its replay trace, or ``None`` if the file is not there.
+
+    Returns
+    -------
+    dict or None
+        The document; ``replay_trace`` is replaced by ``{"t", "spring_force"}``
+        arrays when its CSV exists (else ``None``).
+    """
+    path = Path(path)
+    doc = read_json(path)
+    if doc is None:
+        return None
+    name = doc.get("replay_trace")
+    trace = path.with_name(name) if name else None
+    if trace is not None and trace.is_file():
+        cols = _columns(trace)
+        doc["replay_trace"] = {"t": np.array(cols["time"], float),
+                               "spring_force": np.array(cols["spring_force"], float)}
+    else:
+        doc["replay_trace"] = None
+    return doc
+
+
+@dataclass(frozen=True)
+class SlipTrace:
+    """One slip of ``sfb.json``: its scalars and, when written, its trace (SI)."""
+
+    slip_time: float
+    slip_distance: float
+    t: np.ndarray | None = None
+    x: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class SFBDocument:
+    """``sfb.json`` as read back: the table, the notes, the slips, the calibration used."""
+
+    rows: list
+    notes: tuple = ()
+    slips: dict = field(default_factory=dict)
+    calibration: dict | None = None
+    doc: dict = field(default_factory=dict)
+
+    def row(self, name: str, source: str = "sfb-parameters") -> dict:
+        """The row called ``name`` from ``source``."""
+        return find_row(self.rows, name, source)
+
+
+def _nan(x) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def read_sfb(path):
+    """``sfb.json`` (and its traces), or ``None`` if the file is not there.
+
+    An ``sfb.json`` of an older version (a bare list of rows) gives the rows
+    only (no notes, no slips).
+    """
+    path = Path(path)
+    doc = read_json(path)
+    if doc is None:
+        return None
+    if isinstance(doc, list):
+        return SFBDocument(rows=doc, doc={"rows": doc})
+    traces = {}
+    name = doc.get("traces")
+    if name and path.with_name(name).is_file():
+        cols = _columns(path.with_name(name))
+        keys = np.array(cols["slip"])
+        t, x = np.array(cols["time"], float), np.array(cols["x"], float)
+        traces = {k: (t[keys == k], x[keys == k]) for k in dict.fromkeys(cols["slip"])}
+    slips = {k: SlipTrace(_nan(s.get("slip_time")), _nan(s.get("slip_distance")),
+                          *traces.get(k, (None, None)))
+             for k, s in (doc.get("slips") or {}).items()}
+    return SFBDocument(rows=doc.get("rows", []), notes=tuple(doc.get("notes", ())), slips=slips,
+                       calibration=doc.get("calibration"), doc=doc)
+
+
+def _failed(failures: dict, step: str) -> str | None:
+    """The reason ``step`` (or its write) failed in the study, if it did."""
+    for key, why in failures.items():
+        if key == step or key.startswith(step + " "):
+            return f"{key}: {why}" if key != step else why
+    return None
+
+
+def _same_runs(recorded, given) -> bool:
+    """Whether ``calibration.json``'s runs are the report's (paths as written may be relative)."""
+    def same(a, b):
+        a, b = Path(a), Path(b)
+        if a.exists() and b.exists():
+            return a.resolve() == b.resolve()
+        return a.name == b.name
+    return (len(recorded) == len(given) and all(any(same(r, g) for g in given) for r in recorded)
+            and all(any(same(r, g) for r in recorded) for g in given))
+
+
+@dataclass
+class ReportInputs:
+    """What the report reads besides the main run: documents, or why they are not used."""
+
+    calibration: dict | None = None
+    sfb: object = None
+    why_no_calibration: str = ""
+    why_no_sfb: str = ""
+    calibration_remarks: list = field(default_factory=list)
+    sfb_remarks: list = field(default_factory=list)
+    missing: list = field(default_factory=list)       # (what, command that makes it)
+
+
+def _command(*words) -> str:
+    return " ".join(shlex.quote(str(w)) for w in words)
+
+
+def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dict) -> ReportInputs:
+    """Read ``calibration.json`` and ``sfb.json`` of the main run for the report; never compute them.
+
+    Parameters
+    ----------
+    run_dir : Path
+        The main run's directory.
+    run_dirs : list of Path
+        The report's runs (a sweep's runs included).
+    given : list of Path
+        What the user named (run or sweep directories): the commands printed use them.
+    failures : dict
+        Steps that failed in the study: a failed ``calibration`` or ``sfb`` is not read.
+
+    Returns
+    -------
+    ReportInputs
+    """
+    got = ReportInputs()
+    cal_path, sfb_path = run_dir / CALIBRATION_FILE, run_dir / SFB_FILE
+    cal_cmd = _command("filmfriction", "calibrate", *given)
+    failed = _failed(failures, "calibration")
+    if failed:
+        got.why_no_calibration = f"Calibration failed: {failed}."
+    else:
+        try:
+            got.calibration = read_calibration(cal_path)
+        except ValueError as exc:
+            got.why_no_calibration = f"Not computed — calibration: {exc}; `{cal_cmd}` rewrites it."
+            got.missing.append((f"{cal_path} (unreadable)", cal_cmd))
+        else:
+            if got.calibration is None:
+                got.why_no_calibration = (f"No `calibration.json` in `{run_dir}`: the report renders what the "
+                                          f"study wrote and does not calibrate. `{cal_cmd}` writes it.")
+                got.missing.append((str(cal_path), cal_cmd))
+    cal = got.calibration
+    if cal is not None:
+        covered = [r.get("run_dir") for r in cal.get("runs", [])]
+        if not _same_runs(covered, run_dirs):
+            got.calibration_remarks.append(
+                f"`calibration.json` covers the runs {', '.join('`' + str(c) + '`' for c in covered)}, "
+                f"not the {len(run_dirs)} of this report; `{cal_cmd}` writes the calibration across them.")
+            got.missing.append((f"{cal_path} across the runs given", cal_cmd))
+    # as the study runs it: with the MD calibration, unless calibration.json has none
+    no_md = cal is not None and cal.get("md_calibration") is None
+    sfb_cmd = (_command("filmfriction", "sfb", "--out", sfb_path) if no_md
+               else _command("filmfriction", "sfb", "--calibration", cal_path, "--out", sfb_path))
+    failed = _failed(failures, "sfb")
+    if failed:
+        got.why_no_sfb = f"The SFB check failed: {failed}."
+        return got
+    try:
+        got.sfb = read_sfb(sfb_path)
+    except ValueError as exc:
+        got.why_no_sfb = f"Not computed — SFB check: {exc}; `{sfb_cmd}` rewrites it."
+        got.missing.append((f"{sfb_path} (unreadable)", sfb_cmd))
+        return got
+    if got.sfb is None:
+        got.why_no_sfb = (f"No `sfb.json` in `{run_dir}`: the report does not run the SFB check. "
+                          f"`{sfb_cmd}` writes it.")
+        got.missing.append((str(sfb_path), sfb_cmd))
+    elif "calibration" not in got.sfb.doc:
+        got.sfb_remarks.append(f"`sfb.json` is of an older version (the table only, no figure); "
+                               f"`{sfb_cmd}` rewrites it.")
+        got.missing.append((f"{sfb_path} (older version)", sfb_cmd))
+    elif cal is not None and got.sfb.calibration != cal.get("md_calibration"):
+        got.sfb_remarks.append(f"`sfb.json` was computed with another MD calibration than the one in "
+                               f"`calibration.json`; `{sfb_cmd}` recomputes it.")
+        got.missing.append((f"{sfb_path} for this calibration.json", sfb_cmd))
+    return got
