@@ -104,7 +104,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .estimators import Estimate, _num, ageing, shear_stiffness, summary_estimate
+from .estimators import Estimate, ageing, shear_stiffness, summary_estimate
+from .util import finite_or_none as _num
 from .md_calibration import md_calibration
 from .replay import Replay, _no_restick, replay
 from .rundata import RunData, load_run
@@ -373,7 +374,7 @@ def write_calibration(cal: Calibration, path=None) -> Path:
     Path
         The JSON file.
     """
-    from filmfriction.analysis.atomic import write_atomic
+    from filmfriction.analysis.util import write_atomic
     from filmfriction.analysis.report import to_json
 
     path = Path(path) if path is not None else cal.main.run.run_dir / "calibration.json"

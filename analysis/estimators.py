@@ -20,6 +20,7 @@ import numpy as np
 
 from .rundata import RunData
 from .trace import UNITS
+from .util import finite_or_none as _num
 
 __all__ = ["Estimate", "summary_estimate", "ageing", "shear_stiffness"]
 
@@ -51,13 +52,6 @@ class Estimate:
     def rel(self) -> float:
         """Relative uncertainty (NaN if undefined)."""
         return abs(self.stderr / self.value) if self.value else math.nan
-
-
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def summary_estimate(doc: dict, name: str, units: str, method: str) -> Estimate | None:

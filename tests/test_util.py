@@ -52,11 +52,10 @@ def test_write_atomic_replaces_whole_or_not_at_all(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]   # no temporary left
 
 
-# helpers that live in analysis/util.py only; the files that still hold a copy
-# are being moved by another change (workflows/sfb.py, workflows/calibrate.py)
+# helpers that live in analysis/util.py only
 HELPERS = {"write_atomic", "_num", "_finite", "_clean", "_json_default", "finite_or_none",
            "json_safe", "json_default"}
-PENDING = {"workflows/calibrate.py": {"_num"}}
+PENDING: dict = {}
 
 
 def test_no_module_defines_its_own_copy_of_a_helper():

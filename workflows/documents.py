@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.atomic import write_atomic
+from filmfriction.analysis.util import write_atomic
 from filmfriction.analysis.report import to_json
 from filmfriction.reduced_model.sfb_rows import find_row
 
