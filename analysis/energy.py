@@ -11,7 +11,10 @@ Per slip y → s:
     Klein's approximation; counted here when the drive is known).
 ``film_dissipation``
     Work the film absorbs during the slip, from the wall's equation of motion
-    M v' = F_spring − F_film: ∫F_film v dt = ∫F_spring v dt − ΔKE_wall.
+    M v' = F_spring − F_film − γM(v − V): ∫F_film v dt = ∫F_spring v dt − ΔKE_wall
+    − ∫γM(v − V) v dt, the last term the work of an MD run's mount dashpot on
+    the wall (γM = ``mount_damping``; it acts on the wall's velocity relative to
+    the drive, so its work on the wall is not its heat ∫γM(v − V)² dt).
     Needs the wall velocity (column, else derivative of the wall position).
     The integral runs from 10 % of the preceding stick before y to 10 % of
     the following stick after s (the wall is at rest there, so the margin
@@ -21,10 +24,45 @@ Per slip y → s:
     spring delivers, ``spring_released_exact + drive_work_slip``, is
     dissipated viscously (``film_dissipation_method = "klein-eq1"``).
 ``ringing_energy``
-    ΔE_osc, the oscillator energy left at re-stick, as Klein estimates it
-    from the largest ringing amplitude: A²/(2K) with A the largest excursion
-    of the force about a straight line fitted to the first quarter of the
-    next stick (0 when A < 4 σ_noise: no ringing resolved).
+    ΔE_osc, the oscillator energy left at re-stick.  With the wall's velocity
+    and mass: the largest ½M(v − v̄)² over the first quarter of the next stick
+    (v̄ its mean: the stuck wall's creep), which is the energy of the wall's
+    oscillation on K + k_f whatever its stiffness (``ringing_method =
+    "wall-kinetic"``).  Without them, Klein's estimate from the largest ringing
+    amplitude of the force, A²/(2K) (``"force-amplitude"``: it misses the
+    film's share k_f of the ringing stiffness); 0 when the ringing is within
+    4 σ of the noise.
+``film_elastic_released``
+    The stuck film's elastic energy released by the slip, (Fs² − Fb²)/(2k_f),
+    with k_f its shear stiffness (from the stick ramps): the spring is not the
+    only store a slip empties.
+``mount_dissipation_slip``
+    Heat of an MD run's mount dashpot over the slip window, ∫γM(v − V)² dt along
+    x (plus ∫γM v_z² dt along z when the trace has the engine's ``mount_heat``).
+``dilation_work``
+    Work against the normal load, P·A·Δz of the top wall over the slip window
+    (from the ``load_work`` column).
+``balance_residual``
+    Per slip: (released − accounted)/released over the slip window, with
+    released = spring energy released + drive work (both ends of the drive:
+    spring and mount) + ``film_elastic_released`` and accounted = film heat
+    + the dashpot's heat along x + ΔKE_wall + ``dilation_work``, the film heat
+    being ``film_dissipation`` + ``film_elastic_released`` − ``dilation_work``
+    (what the film received and released, less the work it did lifting the
+    wall).  It checks the bookkeeping (the trace's sampled forces against the
+    engine's integrated work, the dashpot's reference velocity), not the film:
+    the thermostat's own measure of the film's heat is ``thermostat_heat_slip``.
+``film_heat``
+    What the film turns into heat in a slip: ``film_dissipation`` +
+    ``film_elastic_released`` − ``dilation_work``.
+``thermostat_heat_slip``
+    Heat the thermostat removed over the slip window (MD): an independent
+    measure of ``film_heat``, noisy by the film's thermal fluctuations (and
+    short of it when the window ends before the film has cooled).
+``dashpot_static_bias``
+    γM (V − v̄) at the end of each stick: the mount dashpot's force that the
+    film carries at yield besides the spring's (the film's static force is
+    Fs + this).
 ``thermostat_heat_cycle`` / ``ledger_residual_cycle``
     From the MD ledger columns (y → next y), when present.
 
@@ -69,11 +107,20 @@ class EnergyTable:
     # the trace has no mount_heat): the share of the released energy that is
     # neither the film's nor the ringing's
     mount_dissipation_slip: np.ndarray | None = None
+    film_elastic_released: np.ndarray | None = None
+    dilation_work: np.ndarray | None = None
+    balance_residual: np.ndarray | None = None
+    thermostat_heat_slip: np.ndarray | None = None
+    dashpot_static_bias: np.ndarray | None = None
+    film_heat: np.ndarray | None = None
+    ringing_method: str = "force-amplitude"
 
     _NAMES = ("spring_released", "spring_released_exact", "drive_work_slip",
               "film_dissipation", "wall_ke_change", "ringing_energy",
               "viscous_fraction", "at_stick_fraction", "thermostat_heat_cycle",
-              "ledger_residual_cycle", "mount_dissipation_slip")
+              "ledger_residual_cycle", "mount_dissipation_slip", "film_elastic_released",
+              "dilation_work", "balance_residual", "thermostat_heat_slip",
+              "dashpot_static_bias", "film_heat")
 
     def _column(self, name):
         value = getattr(self, name)
@@ -88,6 +135,7 @@ class EnergyTable:
     def as_dict(self) -> dict:
         out = {n: self._column(n).tolist() for n in self._NAMES}
         out["film_dissipation_method"] = self.film_dissipation_method
+        out["ringing_method"] = self.ringing_method
         return out
 
 
@@ -103,11 +151,21 @@ def _ringing(t, f, s, stop, k, noise, fraction=0.25):
     return amp ** 2 / (2 * k) if amp > 4 * noise else 0.0
 
 
+def _wall_ringing(t, v, s, stop, mass, fraction=0.25):
+    """Largest ½M(v − v̄)² over the first ``fraction`` of the stick after s."""
+    hi = s + max(int(fraction * (stop - s)), 0)
+    if hi - s < 4:
+        return math.nan
+    vv = v[s:hi]
+    return float(0.5 * mass * np.max((vv - vv.mean()) ** 2))
+
+
 def energy_table(time, spring_force, table: CycleTable, spring_constant: float, *,
                  mass: float | None = None, wall_velocity=None,
                  wall_position=None, drive_position=None,
                  drive_velocity: float | None = None, noise: float = 0.0,
-                 ledger_columns: dict | None = None) -> EnergyTable:
+                 ledger_columns: dict | None = None, mount_damping: float = 0.0,
+                 film_stiffness: float | None = None, ringing: str = "auto") -> EnergyTable:
     """Energy partition of each slip in ``table``.
 
     Parameters
@@ -129,7 +187,14 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     noise : float
         Noise standard deviation of the force (subtracted from the ringing).
     ledger_columns : dict, optional
-        MD ledger columns (``thermostat_heat`` etc.) by name.
+        MD ledger columns (``thermostat_heat``, ``mount_heat``, ``load_work`` …) by name.
+    mount_damping : float
+        γM of an MD run's mount dashpot on v − V (force per velocity), 0 for none.
+    film_stiffness : float, optional
+        k_f of the stuck film (:func:`.stickslip.stick_stiffness`).
+    ringing : {"auto", "wall-kinetic", "force-amplitude"}
+        How the ringing energy is measured (module text); ``auto`` takes the
+        wall's kinetic energy when the wall velocity and mass are known.
 
     Returns
     -------
@@ -162,40 +227,85 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     elif wall_position is not None:
         v = np.gradient(np.asarray(wall_position, float), t)
     film, dke, mount = nan(), nan(), nan()
+    mount_x = np.zeros(m)
+    cols = ledger_columns or {}
+    v_drive = 0.0 if drive_velocity is None else float(drive_velocity)
+    starts = np.concatenate([[0], si[:-1]])
+    stops = np.concatenate([yi[1:], [t.size - 1]])
+    lo = yi - ((yi - starts) // 10)
+    hi = si + ((stops - si) // 10)
     if v is not None:
         method = "equation-of-motion"
-        starts = np.concatenate([[0], si[:-1]])
-        stops = np.concatenate([yi[1:], [t.size - 1]])
-        lo = yi - ((yi - starts) // 10)
-        hi = si + ((stops - si) // 10)
         work = np.array([trapezoid(f[a:b + 1] * v[a:b + 1], t[a:b + 1])
                          for a, b in zip(lo, hi)])
         dke = 0.5 * mass * (v[hi] ** 2 - v[lo] ** 2) if mass else np.zeros(m)
         if not mass:
             method += " (no mass: ΔKE neglected)"
         film = work - dke
-        mount_heat = (ledger_columns or {}).get("mount_heat")
-        if mount_heat is not None:
-            # the mount dashpot's heat over the same window is not the film's
-            mh = np.asarray(mount_heat, float)
-            mount = mh[hi] - mh[lo]
-            film = film - mount
-            method += " (mount dashpot heat subtracted)"
+        if mount_damping:
+            # the dashpot acts on v − V: its work on the wall, ∫γM(v − V)v, is taken off
+            mount_work = np.array([trapezoid(mount_damping * (v[a:b + 1] - v_drive) * v[a:b + 1],
+                                             t[a:b + 1]) for a, b in zip(lo, hi)])
+            film = film - mount_work
+            # heat of the dashpot along x; an MD run's mount_heat column also has the
+            # dashpot along z, whose energy comes from the film's work in z (as the dilation)
+            mount_x = np.array([trapezoid(mount_damping * (v[a:b + 1] - v_drive) ** 2,
+                                          t[a:b + 1]) for a, b in zip(lo, hi)])
+            mount = mount_x
+            if "mount_heat" in cols:   # the engine's own integral, x and z
+                mh = np.asarray(cols["mount_heat"], float)
+                mount = mh[hi] - mh[lo]
+            method += " (mount dashpot's work on the wall subtracted)"
     else:
         method = "klein-eq1"
         film = exact + drive
-
     ring = nan()
+    if ringing not in ("auto", "wall-kinetic", "force-amplitude"):
+        raise ValueError(f"ringing = {ringing!r}: allowed values are 'auto', 'wall-kinetic', "
+                         "'force-amplitude'")
+    kinetic_ok = v is not None and bool(mass)
+    if ringing == "wall-kinetic" and not kinetic_ok:
+        raise ValueError("ringing = 'wall-kinetic' needs the wall velocity (or position) and mass")
+    ring_method = ("wall-kinetic" if kinetic_ok and ringing != "force-amplitude"
+                   else "force-amplitude")
     for i in range(m):
         stop = yi[i + 1] if i + 1 < m else t.size
-        ring[i] = _ringing(t, f, si[i], stop, k, noise)
+        ring[i] = (_wall_ringing(t, v, si[i], stop, mass) if ring_method == "wall-kinetic"
+                   else _ringing(t, f, si[i], stop, k, noise))
     total = film + ring
     with np.errstate(invalid="ignore", divide="ignore"):
         visc_frac = film / total
         stick_frac = ring / total
 
+    elastic = nan()
+    if film_stiffness is not None and film_stiffness > 0:
+        elastic = (table.static_force ** 2 - table.backward_force ** 2) / (2 * film_stiffness)
+    dilation = nan()
+    if "load_work" in cols:
+        lw = np.asarray(cols["load_work"], float)     # −P A (z − z0)
+        dilation = -(lw[hi] - lw[lo])
+    bias = nan()
+    if v is not None and mount_damping:
+        bias = np.array([mount_damping * (v_drive - np.mean(v[max(y - (y - a) // 10, a):y + 1]))
+                         for a, y in zip(starts, yi)])
+    balance, q_slip = nan(), nan()
+    film_heat = film + np.where(np.isfinite(elastic), elastic, 0.0) \
+        - np.where(np.isfinite(dilation), dilation, 0.0)
+    if v is not None and mass and all(c in cols for c in ("spring_energy", "drive_work")):
+        es = np.asarray(cols["spring_energy"], float)
+        wd = np.asarray(cols["drive_work"], float)
+        el = np.nan_to_num(elastic) if np.all(np.isfinite(elastic)) else np.zeros(m)
+        dil = dilation if np.all(np.isfinite(dilation)) else np.zeros(m)
+        mnt = mount_x
+        into = (es[lo] - es[hi]) + (wd[hi] - wd[lo]) + el
+        accounted = (film + el - dil) + mnt + dke + dil
+        with np.errstate(invalid="ignore", divide="ignore"):
+            balance = (into - accounted) / into
+    if "thermostat_heat" in cols:
+        q = np.asarray(cols["thermostat_heat"], float)
+        q_slip = q[hi] - q[lo]
+
     heat, resid = nan(), nan()
-    cols = ledger_columns or {}
     if m > 1 and "thermostat_heat" in cols:
         q = np.asarray(cols["thermostat_heat"], float)
         heat[:-1] = np.diff(q[yi])
@@ -203,7 +313,8 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         r = ledger(cols)["residual"]
         resid[:-1] = np.diff(r[yi])
     return EnergyTable(released, exact, drive, film, dke, ring, visc_frac,
-                       stick_frac, heat, resid, method, mount)
+                       stick_frac, heat, resid, method, mount, elastic, dilation, balance,
+                       q_slip, bias, film_heat, ring_method)
 
 
 def ledger(columns: dict) -> dict:

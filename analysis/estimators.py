@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from filmfriction.reduced_model.cycles import cycle_table
+
 from .rundata import RunData
 from .trace import UNITS
 from .util import finite_or_none as _num
@@ -83,36 +85,21 @@ def ageing(run: RunData) -> Estimate | None:
 
 
 def shear_stiffness(run: RunData) -> Estimate | None:
-    """The stuck film's elastic shear stiffness k_f from the slopes of the stick ramps.
+    """The stuck film's elastic shear stiffness k_f from the slopes of the stick ramps
+    (:func:`filmfriction.analysis.stickslip.stick_stiffness`); None when not measurable."""
+    from .stickslip import stick_stiffness
 
-    A stuck film strains like a spring in series with the drive spring: the
-    force rises at K_eff V with 1/K_eff = 1/K + 1/k_f.  Each ramp (re-stick to
-    the next yield, its first quarter and last tenth left out: ringing and
-    creep before the yield) gives a slope; k_f = K K_eff/(K − K_eff) from
-    their mean, its error propagated from theirs.  None with fewer than 2
-    ramps or when K_eff is not below K (no measurable compliance).
-    """
     tr = run.trace
     k = tr.parameters.spring_constant
     v = tr.parameters.drive_velocity
     if not (k and v):
         return None
-    t, f = tr.time, tr.spring_force
     sticks = np.asarray(run.cycles.get("stick_index", []), int)
     yields = np.asarray(run.cycles.get("yield_index", []), int)
-    slopes = []
-    for i0, i1 in zip(sticks[:-1], yields[1:]):
-        lo, hi = i0 + (i1 - i0) // 4, i1 - (i1 - i0) // 10
-        if hi - lo >= 5:
-            slopes.append(np.polyfit(t[lo:hi], f[lo:hi], 1)[0] / v)
-    if len(slopes) < 2:
+    table = cycle_table(tr.time, tr.spring_force, yields, sticks)
+    st = stick_stiffness(tr.time, tr.spring_force, table, spring_constant=k, drive_velocity=v)
+    if st is None:
         return None
-    k_eff = float(np.mean(slopes))
-    se = float(np.std(slopes, ddof=1) / math.sqrt(len(slopes)))
-    if not 0.0 < k_eff < k - 2.0 * se:
-        return None
-    k_f = k * k_eff / (k - k_eff)
-    dk = se * (k / (k - k_eff)) ** 2          # d k_f / d K_eff
-    return Estimate(k_f, dk, UNITS[tr.units]["stiffness"],
-                    f"stick ramps' slope K_eff = {k_eff:.4g} (K = {k:g}) from {len(slopes)} "
-                    "ramps: 1/k_f = 1/K_eff - 1/K")
+    return Estimate(st.film_stiffness, st.film_stiffness_stderr, UNITS[tr.units]["stiffness"],
+                    f"stick ramps' slope K_eff = {st.effective_stiffness:.4g} (K = {k:g}) from "
+                    f"{st.ramps} ramps: 1/k_f = 1/K_eff - 1/K")

@@ -31,7 +31,10 @@ _ENERGY_UNITS = {"spring_released": "energy", "spring_released_exact": "energy",
                  "wall_ke_change": "energy", "ringing_energy": "energy",
                  "viscous_fraction": "1", "at_stick_fraction": "1",
                  "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy",
-                 "mount_dissipation_slip": "energy"}
+                 "mount_dissipation_slip": "energy", "film_elastic_released": "energy",
+                 "dilation_work": "energy", "balance_residual": "1",
+                 "thermostat_heat_slip": "energy", "dashpot_static_bias": "force",
+                 "film_heat": "energy"}
 
 
 def _entry(stats: dict, units: str) -> dict:
@@ -194,17 +197,30 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
             raise MissingInput("slips", "the energy per slip")
         kk = p.require("spring_constant", "the spring energy")
         v_drive, _ = _drive_velocity(trace)
+        stiff = (stickslip.stick_stiffness(t, f, table, spring_constant=kk,
+                                           drive_velocity=v_drive) if v_drive else None)
         et = _energy.energy_table(
             t, f, table, kk, mass=p.mass,
             wall_velocity=trace.columns.get("wall_velocity"), wall_position=wall,
             drive_position=trace.columns.get("drive_position"),
-            drive_velocity=v_drive, noise=events.noise, ledger_columns=ledger_cols)
+            drive_velocity=v_drive, noise=events.noise, ledger_columns=ledger_cols,
+            mount_damping=p.mount_damping or 0.0,
+            film_stiffness=None if stiff is None else stiff.film_stiffness)
+        if stiff is not None:
+            energy["film_stiffness"] = _value(stiff.film_stiffness, stiff.film_stiffness_stderr,
+                                              lab("stiffness"),
+                                              effective_stiffness=_num(stiff.effective_stiffness),
+                                              ramps=stiff.ramps)
+        else:
+            skipped["energy.film_elastic_released"] = "the stuck film's stiffness k_f is not " \
+                "measurable (fewer than 2 stick ramps, or their slope not below K V)"
         es = et.summary(skip=skip)
         for name, q in _ENERGY_UNITS.items():
             energy[name] = _entry(es[name], lab(q))
         energy["film_dissipation_method"] = et.film_dissipation_method
+        energy["ringing_method"] = et.ringing_method
         per_cycle.update({f"energy_{k_}": v for k_, v in et.as_dict().items()
-                          if k_ != "film_dissipation_method"})
+                          if not k_.endswith("_method")})
         if p.mass is None and et.film_dissipation_method != "klein-eq1":
             skipped["energy.wall_ke_change"] = str(MissingInput("--mass", "ΔKE of the wall"))
     except MissingInput as exc:
