@@ -17,8 +17,8 @@ __all__ = ["ROW_KEYS", "SOURCES", "table_row", "find_row"]
 #: Keys of every table row (``note`` and ``uncertainty`` are extras to the issue's six).
 ROW_KEYS = ("name", "klein", "model", "ratio", "units", "source", "uncertainty", "note")
 
-#: The two values of a row's ``source``.
-SOURCES = ("sfb-parameters", "md-calibrated")
+#: The values of a row's ``source``.
+SOURCES = ("sfb-parameters", "md-calibrated", "similarity")
 
 
 def _finite_or_none(v):

@@ -42,9 +42,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
+from .klein import KLEIN, KleinExperiment, klein_slip_geometry
 from .maps import critical_lambda
+from .sfb_rows import table_row
+from .units import OMCTS, LJUnits
 
-__all__ = ["SlidingContact", "Number", "similarity_numbers", "NUMBERS"]
+__all__ = ["SlidingContact", "Number", "similarity_numbers", "NUMBERS", "klein_contact",
+           "similarity_rows", "KLEIN_RINGDOWN_TIME", "SIMILARITY_SOURCE"]
+
+#: ``source`` of the similarity rows of the SFB table.
+SIMILARITY_SOURCE = "similarity"
+#: Decay time of Klein's ringing after the stick, s ("ca. 80 ms for the trace shown", PRL 98,
+#: 056101): the mount's damping ratio is 1/(2π ν_c τ) at ν_c = 45 Hz.
+KLEIN_RINGDOWN_TIME = 0.08
 
 #: The numbers :func:`similarity_numbers` returns, in order, with what each needs.
 NUMBERS = ("static_friction_coefficient", "kinetic_friction_coefficient",
@@ -163,3 +173,87 @@ def similarity_numbers(contact: SlidingContact) -> dict[str, Number]:
             note = "total damping ratio >= 1: no stick-slip for a purely viscous law"
         out[k] = Number(v, math.sqrt(var[k]) if math.isfinite(v) else math.nan, note)
     return out
+
+
+def klein_contact(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS) -> SlidingContact:
+    """Klein's SFB cycle as a :class:`SlidingContact` (SI), from his printed numbers.
+
+    * x0 and Δx0 from his energy statements (:func:`.klein.klein_slip_geometry`);
+      F_s = K x0, F_b = K (x0 − Δx0);
+    * V = Δx0/τ_ss: in steady stick-slip the spring's end advances one slip per
+      cycle (his drive velocity is not printed);
+    * B = Aη_eff/D with its ±20 % (his errors of η_eff, A, D);
+    * the mount's damping from the ringing's decay (45 Hz, ~80 ms): ζ ≈ 0.044;
+    * k_f = F_s/δ with δ ≈ 1 nm, the film's strain before yield in his ΔE_f ≈ K x0 δ,
+      so K/k_f = δ/x0;
+    * viscous fraction ΔE_spring/(ΔE_spring + ΔE_osc) from his energies (he states
+      "of order 90 % or more");
+    * the molecular diameter and ε/σ³ of the OMCTS unit mapping ``units``.
+
+    Example
+    -------
+    >>> n = similarity_numbers(klein_contact())
+    >>> round(n["film_damping_ratio"].value, 2), round(n["extension_over_lattice"].value)
+    (4.09, 126)
+    """
+    ex = experiment
+    geo = klein_slip_geometry(ex)
+    K, M = ex.spring_constant, ex.mass
+    fs = K * geo.x0
+    fb = K * (geo.x0 - geo.slip_distance)
+    zeta_mount = 1.0 / (2 * math.pi * ex.ringing_frequency * KLEIN_RINGDOWN_TIME)
+    return SlidingContact(
+        spring_constant=K, mass=M, drive_velocity=geo.slip_distance / ex.cycle_time,
+        static_force=fs, restick_force=fb, normal_load=ex.load,
+        slip_distance=geo.slip_distance, film_damping=ex.damping,
+        film_damping_err=ex.damping * ex.damping_rel_err,
+        mount_damping=zeta_mount * 2 * math.sqrt(K * M),
+        film_stiffness=fs / ex.film_energy_length,
+        molecular_diameter=units.sigma,
+        viscous_fraction=ex.spring_energy_released / (ex.spring_energy_released
+                                                      + ex.ringing_energy),
+        pressure=ex.load / ex.contact_area, stress_unit=units.stress)
+
+
+#: What each similarity row compares, for its note.
+_ROW_NOTES = {
+    "static_friction_coefficient": "F_s/L; at low load adhesion carries much of F_s: see the shear stress",
+    "kinetic_friction_coefficient": "(F_s + F_b)/(2L), the cycle-averaged spring force over the load",
+    "extension_over_lattice": "x0/a, spring extension at yield in molecular diameters",
+    "slip_over_extension": "slip distance over the spring extension at yield",
+    "film_damping_ratio": "B/(2 sqrt(KM)), B the film's viscous drag (Klein: A eta_eff/D)",
+    "mount_damping_ratio": "gamma M/(2 sqrt(KM)) (Klein: ringing decay ~80 ms at 45 Hz)",
+    "compliance_ratio": "K/k_f (Klein: delta/x0 with delta ~ 1 nm; his dE_f/dE_spring reads 0.025)",
+    "viscous_fraction": "film heat over film heat + ringing (Klein: from dE_spring and dE_osc)",
+    "lambda": "Nakano-Maegawa (F_s - F_k)/(V sqrt(KM)) (Klein: V = slip/cycle time)",
+    "lambda_critical": "lambda_c at zeta = film + mount (inf: no stick-slip for a viscous law)",
+    "reduced_pressure": "P sigma^3/epsilon",
+}
+
+
+def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) -> list[dict]:
+    """Rows of the SFB table (``source = "similarity"``): each number, Klein's beside the model's.
+
+    ``uncertainty`` is the model's ±1 standard error interval; a row whose
+    interval spans more than a decade (or reaches zero) has no ratio and says so.
+    """
+    mk = similarity_numbers(model)
+    kl = similarity_numbers(klein if klein is not None else klein_contact())
+    rows = []
+    for name in NUMBERS:
+        m, k = mk[name], kl[name]
+        unc = None
+        note = _ROW_NOTES[name]
+        if math.isfinite(m.stderr) and math.isfinite(m.value):
+            lo, hi = m.value - m.stderr, m.value + m.stderr
+            unc = (lo, hi)
+            if lo <= 0 < m.value or (lo > 0 and hi / lo > 10):
+                note += "; the model's interval spans more than a decade: no ratio"
+        for n in (m.note, k.note):
+            if n:
+                note += f"; {n}"
+        row = table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)
+        if "no ratio" in note:
+            row["ratio"] = None
+        rows.append(row)
+    return rows
