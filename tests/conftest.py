@@ -24,6 +24,10 @@ another; what several of them need is here, as fixtures:
 ``synthetic_run``
     A run directory in the runner's format with a known answer
     (:func:`filmfriction.analysis.synthetic.run_directory`), in ``tmp_path``.
+
+Per folder: ``analysis/conftest.py`` (``slip_table``: detection, cycle table and
+ramp fits on a trace) and ``workflows/conftest.py`` (``report_study`` and
+``report_checks``: the post-MD study and the checks of its report).
 """
 from __future__ import annotations
 
