@@ -1,9 +1,10 @@
 """The report builds from a small real MD run and renders in headless Chromium.
 
-One real LAMMPS run (a 5x3-cell stick-slip film, 10k steps, ~10-30 s on 2
-cores) is made once for the module; the post-MD study (analysis, calibration,
-SFB check, report) runs on it.  The Chromium test skips when no chromium
-binary is found (install: ``apt-get install -y chromium``).
+The session's small real run (``film_run`` in conftest.py: a 5x3-cell
+film-structure film, 14k steps) is copied once for the module; the post-MD study
+(analysis, calibration, SFB check, report) runs on the copy, and its report is
+checked as the synthetic one is (test_report_content.py).  The Chromium test
+skips when no chromium binary is found (install: ``apt-get install -y chromium``).
 """
 import os
 import re
@@ -25,64 +26,45 @@ CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic
 
 
 @pytest.fixture(scope="module")
-def study(tmp_path_factory):
-    """A small real run, then the post-MD study on it."""
-    from filmfriction.workflows import runner, scene, study as study_mod
-
-    out = tmp_path_factory.mktemp("report") / "run"
-    # drive_velocity 0.1 (5x the default) so that the short run reaches its first yield
-    sc = scene.load("stick-slip", {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 2000,
-                                   "slide_steps": 8000, "trace_every": 20, "drive_velocity": 0.1})
-    try:
-        run_dir = runner.execute(sc, out=out, nprocs=2, progress=False)
-    except runner.RunFailed as exc:
-        pytest.fail(f"the small LAMMPS run failed: {exc}")
-    assert study_mod.finish_study(run_dir) == 0
+def study(film_run, tmp_path_factory, report_study):
+    """A copy of the session's small real run (the study writes into it), then the
+    post-MD study on it."""
+    run_dir = tmp_path_factory.mktemp("report") / "run"
+    shutil.copytree(film_run.path, run_dir)
+    report_study(run_dir)
     return run_dir
 
 
 @pytest.mark.md
-def test_study_writes_every_output(study):
-    for name in ("analysis.json", "calibration.json", "sfb.json", "report.html", "report.md"):
-        assert (study / name).exists(), name
+def test_study_writes_every_output(study, report_checks):
+    report_checks.outputs(study)
 
 
 @pytest.mark.md
-def test_report_sections_and_figures(study):
+def test_report_sections_and_figures(study, report_checks):
+    # sections, figures as images (the film's too: the run wrote a trajectory), the
+    # analysis' numbers with their units, Braun & Tosatti and the provenance
+    report_checks.content(study)
     html = (study / "report.html").read_text()
-    md = (study / "report.md").read_text()
-    for title in SECTIONS:
-        assert title in html and title in md, title
-    imgs = re.findall(r"<img alt='([^']+)' src='data:image/png;base64,([A-Za-z0-9+/=]+)'", html)
-    names = {n for n, _ in imgs}
-    assert {"trace", "energy", "sfb"} <= names or {"trace", "sfb"} <= names, names
-    assert all(len(data) > 1000 for _, data in imgs)
-    # the markdown twin links PNG files that exist next to it
-    links = re.findall(r"!\[[^\]]*\]\(([^)]+\.png)\)", md)
-    assert links and all((study / link).stat().st_size > 1000 for link in links)
-    assert len(links) == len(imgs)
-    # no trajectory in this scene: the report says which scene gives the film picture
-    assert "film-structure" in md
-    # the Braun & Tosatti statement and provenance are there
-    assert "Braun & Tosatti" in md
-    assert "atom-steps per second" in md and "versions" in md
+    assert report_checks.sections == SECTIONS
+    assert "film" in report_checks.images(html)
 
 
 @pytest.mark.md
-def test_report_cli_with_out(study, tmp_path):
+def test_report_cli_with_out(study, tmp_path, report_checks):
     out = tmp_path / "r.html"
     assert cli.main(["report", str(study), "--out", str(out)]) == 0
-    assert out.exists() and (tmp_path / "r.md").exists()
+    # the same report, written elsewhere under the name asked for
+    report_checks.content(study, out)
+    assert (tmp_path / "r-trace.png").stat().st_size > 5000
     assert cli.main(["report", str(tmp_path / "nothing")]) == 2
 
 
-def test_film_figure_from_a_trajectory(tmp_path):
+def test_film_figure_from_a_trajectory(synthetic_run):
     """The film picture and density profile from a (synthetic) trajectory."""
-    from filmfriction.analysis.synthetic import run_directory
     from filmfriction.workflows.report import fig_film
 
-    d = run_directory(tmp_path / "synth", trajectory=True)
-    png, note = fig_film(d)
+    png, note = fig_film(synthetic_run)
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
     assert "side view" in note
 
@@ -182,7 +164,7 @@ def test_report_renders_in_headless_chromium(study):
 
 
 @pytest.mark.md
-def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path):
+def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path, report_checks):
     """A finished sweep directory given to the report adds its section and its runs."""
     import json
 
@@ -208,5 +190,8 @@ def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path):
     assert cli.main(["report", str(sweep)]) == 0
     text = (sweep / "report.md").read_text()
     assert "## Sweeps" in text and "0.22" in text and "−2/3" in text
-    assert (sweep / "report-sweep-velocity_map.png").exists()
+    # the sweep's figure, as the sweep drew it, in both twins
+    drawn = (sweep / "velocity_map.png").read_bytes()
+    assert (sweep / "report-sweep-velocity_map.png").read_bytes() == drawn
+    assert report_checks.images((sweep / "report.html").read_text())["sweep-velocity_map"] == drawn
     assert str(study) in text  # the sweep's run is the report's main run

@@ -101,5 +101,9 @@ def test_invalid_units_rejected():
 
 
 def test_units_are_frozen():
-    with pytest.raises(Exception):
+    import dataclasses
+
+    sigma = OMCTS.sigma
+    with pytest.raises(dataclasses.FrozenInstanceError):
         OMCTS.sigma = 1.0
+    assert OMCTS.sigma == sigma == 0.82e-9

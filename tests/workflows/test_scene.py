@@ -1,9 +1,10 @@
 """Scenes and validation: every value is checked before LAMMPS starts."""
 import math
+import re
 
 import pytest
 
-from filmfriction.workflows import cli, scene
+from filmfriction.workflows import scene
 from filmfriction.workflows.scene import PARAMETERS, SceneError, load, parse_assignment, resolve
 
 
@@ -105,21 +106,37 @@ def test_injection_via_scene_file_is_rejected(tmp_path):
         load(str(bad))
 
 
-def test_variables_are_plain_numbers():
-    for name, value in load("film-structure").lammps_variables().items():
-        float(value)  # raises if anything but a number
+# what a -var value may look like: a plain decimal number, nothing LAMMPS could expand
+NUMBER = re.compile(r"-?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
-def test_cli_rejects_bad_value_before_lammps(tmp_path, capsys):
+@pytest.mark.parametrize("name", sorted(scene.available()))
+def test_variables_are_plain_numbers(name):
+    s = load(name)
+    variables = s.lammps_variables()
+    for key, text in variables.items():
+        assert NUMBER.fullmatch(text), (key, text)     # no spaces, $, quotes, nan or inf
+    # and each is the scene's own value (a choice by its index; outputs the scene
+    # does not write are switched off)
+    off = {"dump_every"} if not s.writes_trajectory else set()
+    off |= {"profile_every"} if not s.writes_profiles else set()
+    for key, value in s.parameters.items():
+        spec = PARAMETERS[key]
+        expected = 0 if key in off else spec.choices.index(value) if spec.choices else value
+        assert float(variables[key]) == float(expected), (key, variables[key], value)
+
+
+def test_cli_rejects_bad_value_before_lammps(tmp_path, run_cli):
     out = tmp_path / "run"
-    code = cli.main(["run", "--set", "timestep=0.02", "--out", str(out), "--quiet"])
-    assert code == 2
-    err = capsys.readouterr().err
-    assert "timestep 0.02 tau is above the stability limit" in err
+    r = run_cli("run", "--set", "timestep=0.02", "--out", out, "--quiet")
+    assert r.code == 2
+    assert "timestep 0.02 tau is above the stability limit" in r.err
     assert not out.exists()  # nothing was started
 
 
-def test_cli_scenes_lists_descriptions(capsys):
-    assert cli.main(["scenes"]) == 0
-    text = capsys.readouterr().out
-    assert "stick-slip" in text and "cost:" in text
+def test_cli_scenes_lists_descriptions(run_cli):
+    r = run_cli("scenes")
+    assert r.code == 0
+    for name in scene.available():
+        s = load(name)
+        assert name in r.out and s.description in r.out and s.expected_cost in r.out, name

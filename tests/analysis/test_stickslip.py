@@ -4,20 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.stickslip import (classify_regime, cycle_table, detect_slips,
-                                noise_level, ramp_forces)
+from filmfriction.analysis.stickslip import classify_regime, cycle_table, detect_slips, noise_level
 from filmfriction.analysis.synthetic import sawtooth, smooth_trace
 
 FS, FB, PERIOD, K = 3.0, 1.0, 2.0, 2.0
-
-
-def _table(tr, refine=True):
-    t, f = tr["time"], tr["spring_force"]
-    ev = detect_slips(t, f)
-    tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=K,
-                      wall_position=tr.get("wall_position"))
-    return (ramp_forces(t, f, tab, wall_position=tr.get("wall_position"))
-            if refine else tab), ev
 
 
 def test_cycle_table_known_indices():
@@ -54,8 +44,8 @@ def test_cycle_table_rejects_bad_pairs():
         cycle_table(t, t, [1, 2], [4, 5])
 
 
-def test_cycle_table_csv_and_dict(tmp_path):
-    tab, _ = _table(sawtooth(cycles=4))
+def test_cycle_table_csv_and_dict(slip_table, tmp_path):
+    tab, _ = slip_table(sawtooth(cycles=4), K)
     from filmfriction.analysis.cycles_csv import read_cycles_csv, write_cycles_csv
     path = write_cycles_csv(tab.as_dict(), tmp_path / "c.csv")
     rows = path.read_text().splitlines()
@@ -69,9 +59,9 @@ def test_cycle_table_csv_and_dict(tmp_path):
     assert len(d["static_force"]) == len(tab)
 
 
-def test_clean_sawtooth_no_missed_event():
+def test_clean_sawtooth_no_missed_event(slip_table):
     tr = sawtooth(cycles=10)
-    tab, ev = _table(tr, refine=False)
+    tab, ev = slip_table(tr, K, refine=False)
     assert ev.count == 10
     np.testing.assert_allclose(tab.period[:-1], PERIOD, rtol=1e-9)
     assert classify_regime(tab) == "stick-slip"
@@ -79,10 +69,10 @@ def test_clean_sawtooth_no_missed_event():
 
 @pytest.mark.parametrize("rho", [0.0, 0.8])
 @pytest.mark.parametrize("seed", [1, 2])
-def test_noisy_sawtooth_recovers_cycle_values(rho, seed):
+def test_noisy_sawtooth_recovers_cycle_values(slip_table, rho, seed):
     noise = 0.01 * (FS - FB)
     tr = sawtooth(cycles=12, noise=noise, rho=rho, seed=seed, dt=0.002)
-    tab, ev = _table(tr)
+    tab, ev = slip_table(tr, K)
     assert ev.count == 12
     s = tab.summary()
     # the sampled ramp tops out one sample before the drop
@@ -95,9 +85,9 @@ def test_noisy_sawtooth_recovers_cycle_values(rho, seed):
 
 @pytest.mark.parametrize("rho", [0.0, 0.9, 0.99])
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_smooth_noisy_sliding_has_no_events(rho, seed):
+def test_smooth_noisy_sliding_has_no_events(slip_table, rho, seed):
     tr = smooth_trace(noise=0.05, rho=rho, n=50_000, seed=seed)
-    tab, ev = _table(tr, refine=False)
+    tab, ev = slip_table(tr, K, refine=False)
     assert ev.count == 0
     assert classify_regime(tab) == "smooth"
 
@@ -110,11 +100,11 @@ def test_noise_level_white_and_correlated():
     assert sigma == pytest.approx(0.2, rel=0.15) and lag > 1
 
 
-def test_single_slip():
+def test_single_slip(slip_table):
     t = np.arange(0, 30, 0.01)
     f = np.where(t < 10, 0.3 * t, 0.3 * (t - 10) + 1.0)
     f = f + np.random.default_rng(0).normal(0, 0.005, t.size)
-    tab, ev = _table({"time": t, "spring_force": f})
+    tab, ev = slip_table({"time": t, "spring_force": f}, K)
     assert ev.count == 1
     assert tab.static_force[0] == pytest.approx(3.0, rel=0.01)
     assert tab.backward_force[0] == pytest.approx(1.0, rel=0.01)
@@ -126,7 +116,8 @@ def test_unfinished_last_slip_is_not_counted():
     t = np.arange(0, 10.0, 0.01)
     f = np.where(t < 5, t, 5 - 20 * (t - 5))     # drop runs to the end
     ev = detect_slips(t, f)
-    assert ev.count == 0 and ev.unfinished_yield is not None
+    # the drop is seen: its yield is the top of the ramp, at t = 5
+    assert ev.count == 0 and ev.unfinished_yield == 500 and t[ev.unfinished_yield] == 5.0
 
 
 def test_constant_input():
@@ -142,9 +133,9 @@ def test_nan_is_a_clear_error():
         detect_slips(t, f)
 
 
-def test_irregular_regime():
+def test_irregular_regime(slip_table):
     rng = np.random.default_rng(5)
-    t, f, x = [], [], 0.0
+    t, f = [], []
     now = 0.0
     for _ in range(10):                      # random Fs and stick times
         fs = rng.uniform(1.5, 4.0)
@@ -152,15 +143,15 @@ def test_irregular_regime():
         t.append(now + 0.01 * np.arange(n))
         f.append(np.linspace(0.5, fs, n))
         now += 0.01 * n
-    tab, ev = _table({"time": np.concatenate(t), "spring_force": np.concatenate(f)},
-                     refine=False)
+    tab, ev = slip_table({"time": np.concatenate(t), "spring_force": np.concatenate(f)}, K,
+                         refine=False)
     assert ev.count >= 8
     assert classify_regime(tab) == "irregular"
 
 
-def test_cycle_table_iterates_row_by_row_and_ends():
+def test_cycle_table_iterates_row_by_row_and_ends(slip_table):
     # a CycleTable is a sequence of slips: iteration ends, an index out of range raises
-    tab, _ = _table(sawtooth(cycles=4))
+    tab, _ = slip_table(sawtooth(cycles=4), K)
     rows = list(tab)
     assert len(rows) == len(tab) >= 3
     assert [float(r.static_force[0]) for r in rows] == list(tab.static_force)

@@ -4,21 +4,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from filmfriction.analysis.energy import energy_table, ledger, LEDGER_COLUMNS
-from filmfriction.analysis.stickslip import cycle_table, detect_slips, ramp_forces
 from filmfriction.analysis.synthetic import klein_trace
 from filmfriction.analysis.viscosity import (power_law_fit, profile_shear, slip_force,
                                 slip_viscosity, steady_viscosity)
 
 KLEIN = dict(spring_constant=97.0, mass=1.47e-3, damping=3.09,
              drive_velocity=100e-9, static_force=9.7e-6, backward_force=3.0e-6)
-
-
-def _slips(tr, k):
-    t, f = tr["time"], tr["spring_force"]
-    ev = detect_slips(t, f)
-    tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k,
-                      wall_position=tr.get("wall_position"))
-    return ramp_forces(t, f, tab, wall_position=tr.get("wall_position")), ev
 
 
 @pytest.mark.parametrize("v", [0.0, 100e-9])
@@ -44,9 +35,9 @@ def test_klein_eq2_fixed_spring_end():
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_klein_slips_recover_damping_within_2_percent(seed):
+def test_klein_slips_recover_damping_within_2_percent(slip_table, seed):
     tr = klein_trace(**KLEIN, cycles=4, noise=0.005 * KLEIN["static_force"], seed=seed)
-    tab, _ = _slips(tr, KLEIN["spring_constant"])
+    tab, _ = slip_table(tr, KLEIN["spring_constant"])
     assert len(tab) == 4
     area, d = 4e-10, 3.5e-9
     sv = slip_viscosity(tr["time"], tr["spring_force"], tab, mass=KLEIN["mass"],
@@ -57,22 +48,22 @@ def test_klein_slips_recover_damping_within_2_percent(seed):
     assert 0 < sv.eta_eff_stderr < 0.02 * sv.eta_eff
 
 
-def test_heavy_wall_md_like_slips():
+def test_heavy_wall_md_like_slips(slip_table):
     p = dict(spring_constant=8.0, mass=500.0, damping=40.0, drive_velocity=0.01,
              static_force=3.0, backward_force=1.0)
     tr = klein_trace(**p, cycles=4, dt=0.1, noise=0.01, seed=3)
-    tab, _ = _slips(tr, 8.0)
+    tab, _ = slip_table(tr, 8.0)
     sv = slip_viscosity(tr["time"], tr["spring_force"], tab, mass=500.0,
                         spring_constant=8.0, area=1.0, thickness=1.0,
                         drive_velocity=0.01)
     assert np.nanmean(sv.damping) == pytest.approx(40.0, rel=0.02)
 
 
-def test_energy_partition_klein_trace():
+def test_energy_partition_klein_trace(slip_table):
     ring = 2e-7
     tr = klein_trace(**KLEIN, cycles=4, noise=0.002 * KLEIN["static_force"], ringing=ring)
     k = KLEIN["spring_constant"]
-    tab, ev = _slips(tr, k)
+    tab, ev = slip_table(tr, k)
     # the synthetic trace rings in its force only (the wall's motion has no ringing):
     # Klein's amplitude estimate is the one to check here
     et = energy_table(tr["time"], tr["spring_force"], tab, k, mass=KLEIN["mass"],
@@ -97,9 +88,9 @@ def test_energy_partition_klein_trace():
     assert 1e-13 < np.mean(et.spring_released) < 1e-12
 
 
-def test_energy_without_wall_kinematics_uses_eq1():
+def test_energy_without_wall_kinematics_uses_eq1(slip_table):
     tr = klein_trace(**KLEIN, cycles=3)
-    tab, ev = _slips(tr, KLEIN["spring_constant"])
+    tab, ev = slip_table(tr, KLEIN["spring_constant"])
     et = energy_table(tr["time"], tr["spring_force"], tab, KLEIN["spring_constant"])
     assert et.film_dissipation_method == "klein-eq1"
     np.testing.assert_allclose(et.film_dissipation, et.spring_released_exact)

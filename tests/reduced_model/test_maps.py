@@ -76,17 +76,32 @@ def test_tomlinson_thermal_runs_and_validates():
                          lattice_constant=1.0, damping=0.0, temperature=0.1)
 
 
-def test_velocity_stiffness_map_runs():
-    m = maps.velocity_stiffness_map(np.array([1e-3, 1.0]), np.array([1.0]), processes=1)
-    assert m.stick_slip.tolist() == [[True, False]]       # stick-slip slow, smooth fast
+def test_velocity_stiffness_map_against_perssons_velocity():
+    # the default contact-age law (Fs = 1, Fb = 0.5, tau = 1) at K = 1: Persson's estimate
+    # v_c ~ N (Fs - Fb)/(K tau) = 0.5; a decade either side of it the regime is clear
+    m = maps.velocity_stiffness_map(np.array([1e-3, 0.05, 5.0]), np.array([1.0]), processes=1)
+    assert m.boundary_x.tolist() == [pytest.approx(0.5)]
+    assert m.stick_slip.tolist() == [[True, True, False]]   # stick-slip slow, smooth fast
 
 
-def test_map_cli_writes_files(tmp_path, capsys):
-    from filmfriction.workflows.cli import main
-    assert main(["map", "lambda-zeta", "--out", str(tmp_path), "--resolution", "6"]) == 0
-    out = capsys.readouterr().out.split()
-    assert (tmp_path / "lambda_zeta.csv").exists() and (tmp_path / "lambda_zeta.png").exists()
-    assert str(tmp_path / "lambda_zeta.csv") in out
+def test_map_cli_writes_files(tmp_path, run_cli):
+    r = run_cli("map", "lambda-zeta", "--out", tmp_path, "--resolution", "6")
+    assert r.code == 0, r.err
+    printed = r.out.split()
+    assert str(tmp_path / "lambda_zeta.csv") in printed and str(tmp_path / "lambda_zeta.png") in printed
+    assert (tmp_path / "lambda_zeta.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "lambda_zeta.csv").read_text().splitlines()[0] == "zeta,lambda,stick_slip"
     rows = np.loadtxt(tmp_path / "lambda_zeta.csv", delimiter=",", skiprows=1)
     assert rows.shape == (36, 3)
-    assert main(["map", "lambda-zeta", "--out", str(tmp_path), "--resolution", "1"]) == 2
+    zeta, lam, stick_slip = rows.T
+    np.testing.assert_allclose(np.unique(zeta), np.logspace(-3, 1, 6), rtol=1e-9)
+    np.testing.assert_allclose(np.unique(lam), np.logspace(-2, 2, 6), rtol=1e-9)
+    # every cell is on the side of the Nakano-Maegawa boundary the module documents:
+    # no stick-slip for zeta >= 1, and for small zeta the asymptote lambda^2 = 4 pi zeta
+    assert not stick_slip[zeta >= 1].any()
+    small = zeta == zeta.min()                                  # zeta = 1e-3: lambda_c ~ 0.11
+    assert np.array_equal(stick_slip[small] == 1, lam[small] > math.sqrt(4 * math.pi * 1e-3))
+    assert np.array_equal(stick_slip == 1, lam > maps.critical_lambda(zeta))
+    assert 0 < stick_slip.sum() < stick_slip.size
+    bad = run_cli("map", "lambda-zeta", "--out", tmp_path, "--resolution", "1")
+    assert bad.code == 2 and "--resolution 1" in bad.err

@@ -5,11 +5,10 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from filmfriction.workflows import runner
 from filmfriction.workflows.scene import SceneError, load, parse_assignment
 
-SMALL = {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 2000, "slide_steps": 6000,
-         "trace_every": 20, "wall_mass": 300.0}
+# on the md fixture's 5 x 3 box
+SMALL = {"equilibrate_steps": 2000, "slide_steps": 6000, "trace_every": 20, "wall_mass": 300.0}
 
 
 def test_choices_are_checked_and_passed_as_indices():
@@ -56,27 +55,22 @@ def _wall_spread(run_dir):
 
 
 @pytest.fixture(scope="module")
-def walls_run(tmp_path_factory):
-    scene = load("film-structure", {**SMALL, "wall_model": "flexible",
-                                    "thermostat_placement": "walls", "dump_every": 200})
-    out = tmp_path_factory.mktemp("walls") / "run"
-    return scene, runner.execute(scene, out=out, nprocs=2, progress=False)
+def walls_run(md):
+    run = md.shared("film-structure", **SMALL, wall_model="flexible",
+                    thermostat_placement="walls", dump_every=200, nprocs=2)
+    return run.scene, run.path
 
 
 @pytest.mark.md
-def test_walls_alone_hold_the_film_temperature(walls_run):
+def test_walls_alone_hold_the_film_temperature(walls_run, md):
     scene, run_dir = walls_run
-    d = np.genfromtxt(run_dir / "trace.csv", delimiter=",", names=True)
+    d = md.trace(run_dir)
     target = scene.parameters["temperature"]
     # the film has no thermostat of its own: it stays at T only through the walls
     assert abs(d["film_temperature"].mean() - target) < 0.1 * target
     # heat leaves through the walls' thermostats, and the ledger closes with it
     assert d["thermostat_heat"][-1] - d["thermostat_heat"][0] > 0
-    work = d["drive_work"] + d["load_work"]
-    stored = d["potential_energy"] + d["kinetic_energy"] + d["spring_energy"]
-    heat = d["thermostat_heat"] + d["mount_heat"]
-    residual = (work - work[0]) - (stored - stored[0]) - (heat - heat[0])
-    assert abs(residual[-1]) < 0.02 * np.abs(heat - heat[0]).max()
+    assert md.ledger_closure(d) < 0.02
 
 
 @pytest.mark.md
@@ -92,17 +86,17 @@ def test_flexible_walls_stay_crystalline_and_follow_the_backing(walls_run):
 
 
 @pytest.mark.md
-def test_flexible_walls_at_their_hottest_allowed_temperature_stay_crystalline(tmp_path):
+def test_flexible_walls_at_their_hottest_allowed_temperature_stay_crystalline(tmp_path, md):
     # the film melts at kT = 1 (it slides smoothly), the walls must not
-    scene = load("film-structure", {**SMALL, "wall_model": "flexible",
-                                    "thermostat_placement": "both", "temperature": 1.0,
-                                    "slide_steps": 3000, "dump_every": 200})
-    run_dir = runner.execute(scene, out=tmp_path / "hot", nprocs=2, progress=False)
+    scene = md.scene("film-structure", **{**SMALL, "wall_model": "flexible",
+                                          "thermostat_placement": "both", "temperature": 1.0,
+                                          "slide_steps": 3000, "dump_every": 200})
+    run_dir = md.execute(scene, tmp_path / "hot", nprocs=2)
     assert _wall_spread(run_dir) < 0.3
 
 
 @pytest.mark.md
-def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path):
+def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path, md):
     # energy-partition: M = 20, no mount dashpot.  The film is then the only sink
     # of the slider's energy: what the spring releases in a slip must show up as
     # the film's dissipation during the slip, with little left ringing at the
@@ -113,11 +107,9 @@ def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path):
     from filmfriction.analysis.trace import read_trace
 
     area = 15 / 28  # the 5 x 3 box against the scene's 7 x 4: same drive per area
-    scene = load("energy-partition", {"cells_x": 5, "cells_y": 3,
-                                      "spring_constant": 100.0 * area, "wall_mass": 20.0 * area,
-                                      "equilibrate_steps": 2000, "slide_steps": 30000,
-                                      "trace_every": 20, "restart_every": 0})
-    run_dir = runner.execute(scene, out=tmp_path / "run", nprocs=2, progress=False)
+    scene = md.scene("energy-partition", spring_constant=100.0 * area, wall_mass=20.0 * area,
+                     equilibrate_steps=2000, slide_steps=30000, trace_every=20, restart_every=0)
+    run_dir = md.execute(scene, tmp_path / "run", nprocs=2)
     doc, _ = analyze(read_trace(run_dir), structure=False)
     energy = doc["energy"]
     assert doc["slips"]["count"] >= 2

@@ -5,9 +5,8 @@ import warnings
 import numpy as np
 import pytest
 
-from filmfriction.analysis.synthetic import klein_trace, run_directory, smooth_trace, write_csv
+from filmfriction.analysis.synthetic import klein_trace, smooth_trace, write_csv
 from filmfriction.analysis.trace import MissingInput, TraceParameters, read_trace
-from filmfriction.workflows.cli import main
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 
@@ -57,22 +56,26 @@ def test_bad_parameters():
         TraceParameters(mass=-1.0)
 
 
-def test_analyze_sfb_csv(sfb_csv, capsys):
-    assert main(["analyze", str(sfb_csv), "--json", *SFB]) == 0
-    printed = json.loads(capsys.readouterr().out)
+def test_analyze_sfb_csv(sfb_csv, run_cli):
+    r = run_cli("analyze", sfb_csv, "--json", *SFB)
+    assert r.code == 0, r.err
+    printed = r.json()
     doc = json.loads((sfb_csv.parent / "analysis.json").read_text())
     assert printed == doc
     assert doc["regime"] == "stick-slip" and doc["units"] == "si"
     assert doc["slips"]["count"] == 5
     for key in ("static_force", "backward_force", "slip_distance", "slip_duration", "period"):
         entry = doc["slips"][key]
-        assert {"mean", "stderr", "units"} <= set(entry) and entry["mean"] is not None
+        assert {"mean", "stderr", "units"} <= set(entry)
+        assert entry["mean"] > 0 and 0 <= entry["stderr"] < 0.1 * entry["mean"], (key, entry)
     assert doc["slips"]["static_force"]["units"] == "N"
     assert doc["slips"]["static_force"]["mean"] == pytest.approx(9.7e-6, rel=0.01)
     e = doc["energy"]
     assert e["spring_released"]["units"] == "J"
     assert 0.9 < e["viscous_fraction"]["mean"] <= 1.0
-    assert e["at_stick_fraction"]["mean"] >= 0.0
+    # what the film does not dissipate during the slip is left at the stick
+    assert e["at_stick_fraction"]["mean"] == pytest.approx(1.0 - e["viscous_fraction"]["mean"],
+                                                           abs=1e-12)
     eta = doc["viscosity"]["from_slip"]["eta_eff"]
     assert eta["units"] == "Pa·s"
     assert eta["mean"] == pytest.approx(3.09 * 3.5e-9 / 4e-10, rel=0.02)   # 27 Pa·s
@@ -81,22 +84,22 @@ def test_analyze_sfb_csv(sfb_csv, capsys):
     assert len(csv_rows) == 1 + 5 and "eta_eff" in csv_rows[0]
 
 
-def test_analyze_without_parameters_skips_with_reasons(sfb_csv, tmp_path, capsys):
+def test_analyze_without_parameters_skips_with_reasons(sfb_csv, tmp_path, run_cli):
     out = tmp_path / "a.json"
-    assert main(["analyze", str(sfb_csv), "--units", "si", "--output", str(out)]) == 0
+    assert run_cli("analyze", sfb_csv, "--units", "si", "--output", out).code == 0
     doc = json.loads(out.read_text())
     assert doc["slips"]["count"] == 5 and doc["slips"]["period"]["mean"] > 0
     assert "--spring-constant" in doc["skipped"]["energy"]
     assert "--spring-constant" in doc["skipped"]["viscosity.from_slip"]
 
 
-def test_analyze_smooth_sliding_steady_viscosity(tmp_path, capsys):
+def test_analyze_smooth_sliding_steady_viscosity(tmp_path, run_cli):
     tr = smooth_trace(mean_force=2.0, noise=0.05, rho=0.9, n=20000, velocity=0.01, gap=4.0)
     p = tmp_path / "smooth.csv"
     write_csv(p, tr)
-    assert main(["analyze", str(p), "--json", "--area", "50",
-                 "--drive-velocity", "0.01"]) == 0
-    doc = json.loads(capsys.readouterr().out)
+    r = run_cli("analyze", p, "--json", "--area", "50", "--drive-velocity", "0.01")
+    assert r.code == 0, r.err
+    doc = r.json()
     assert doc["regime"] == "smooth" and doc["slips"]["count"] == 0
     st = doc["viscosity"]["steady"]
     assert st["eta_eff"]["units"] == "ετ/σ³"
@@ -104,19 +107,21 @@ def test_analyze_smooth_sliding_steady_viscosity(tmp_path, capsys):
     assert st["thickness"]["source"] == "mean of gap column"
 
 
-def test_user_errors(tmp_path, capsys):
-    assert main(["analyze", str(tmp_path / "nope.csv")]) == 2
+def test_user_errors(tmp_path, run_cli):
+    missing = run_cli("analyze", tmp_path / "nope.csv")
+    assert missing.code == 2 and "nope.csv" in missing.err
     p = tmp_path / "nan.csv"
     p.write_text("time,spring_force\n0,1\n1,nan\n2,1\n3,2\n")
-    assert main(["analyze", str(p)]) == 2
-    assert "non-finite" in capsys.readouterr().err
+    r = run_cli("analyze", p)
+    assert r.code == 2 and "non-finite" in r.err
 
 
-def test_analyze_run_directory(tmp_path, capsys):
-    run = run_directory(tmp_path / "run", layers=3)
-    assert main(["analyze", str(run), "--json"]) == 0
-    doc = json.loads(capsys.readouterr().out)
-    assert (run / "analysis.json").exists()
+def test_analyze_run_directory(synthetic_run, run_cli):
+    run = synthetic_run
+    r = run_cli("analyze", run, "--json")
+    assert r.code == 0, r.err
+    doc = r.json()
+    assert json.loads((run / "analysis.json").read_text()) == doc
     assert doc["regime"] == "stick-slip" and doc["units"] == "lj"
     assert doc["slips"]["count"] == 4
     assert doc["energy"]["ledger"]["closure"]["mean"] < 0.02
@@ -126,7 +131,7 @@ def test_analyze_run_directory(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("case", ["stuck", "late-slip", "startup-then-sliding"])
-def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, capsys, case):
+def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, run_cli, case):
     # K = 100, V = 0.02: a ramp of 2 eps/sigma per tau
     k, v = 100.0, 0.02
     t = np.arange(0.0, 100.0, 0.25)
@@ -143,9 +148,9 @@ def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, caps
     p = tmp_path / "trace.csv"
     write_csv(p, {"time": t, "spring_force": f, "wall_position": wall,
                   "drive_position": v * t})
-    assert main(["analyze", str(p), "--json", "--spring-constant", str(k),
-                 "--drive-velocity", str(v)]) == 0
-    doc = json.loads(capsys.readouterr().out)
+    r = run_cli("analyze", p, "--json", "--spring-constant", k, "--drive-velocity", v)
+    assert r.code == 0, r.err
+    doc = r.json()
     want = "smooth" if case == "startup-then-sliding" else "unresolved"
     assert doc["regime"] == want, (doc["regime"], doc.get("regime_note"))
     if want == "unresolved":

@@ -6,7 +6,6 @@ import math
 import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -18,17 +17,23 @@ from filmfriction.analysis.trace import read_trace
 from filmfriction.workflows import sweep
 from filmfriction.workflows.scene import SceneError
 
-# about 330 atoms, 4000 steps: a few seconds per point on one rank
-SMALL = ["--set", "cells_x=5", "--set", "cells_y=3", "--set", "equilibrate_steps=1000",
-         "--set", "slide_steps=3000", "--set", "trace_every=20"]
-# the installed command (``python -m filmfriction.workflows.cli`` would define a second UserError)
-FILMFRICTION = str(Path(sys.executable).with_name("filmfriction"))
+# on the md fixture's box (about 330 atoms), 4000 steps: a few seconds per point on one rank
+STEPS = {"equilibrate_steps": 1000, "slide_steps": 3000, "trace_every": 20}
 
 
-def cli(*args, **kw):
-    """``filmfriction sweep ...`` in a subprocess (as a user runs it)."""
-    return subprocess.run([FILMFRICTION, "sweep", *args],
-                          capture_output=True, text=True, **kw)
+@pytest.fixture(scope="module")
+def small_args(md):
+    """``--set`` options of the small sweeps."""
+    return [arg for k, v in {**md.box, **STEPS}.items() for arg in ("--set", f"{k}={v}")]
+
+
+@pytest.fixture
+def cli(filmfriction_command):
+    """``cli(*args)``: ``filmfriction sweep ARGS`` in a subprocess (as a user runs it)."""
+    def run(*args, **kw):
+        return subprocess.run([filmfriction_command, "sweep", *args],
+                              capture_output=True, text=True, **kw)
+    return run
 
 
 def completed(out: Path) -> list[Path]:
@@ -109,7 +114,7 @@ def test_every_point_is_validated_with_key_value_and_range():
         sweep.plan_sweep("stick-slip", ["seed=1,2", "seed=3,4"])
 
 
-def test_cli_refuses_a_bad_grid_before_snakemake_starts(tmp_path):
+def test_cli_refuses_a_bad_grid_before_snakemake_starts(tmp_path, cli):
     out = tmp_path / "sweep"
     r = cli("stick-slip", "--grid", "drive_velocity=0.1:6:3", "--out", str(out))
     assert r.returncode == 2
@@ -237,21 +242,21 @@ def test_launcher_replaces_mpiexec_by_srun():
     assert plain[0].endswith("mpiexec")
 
 
-def test_a_second_sweep_in_the_same_directory_is_refused(tmp_path):
+def test_a_second_sweep_in_the_same_directory_is_refused(tmp_path, cli, small_args):
     out = tmp_path / "sweep"
     with sweep.SweepLock(out):
-        r = cli("stick-slip", "--grid", "drive_velocity=0.05,0.5", "--out", str(out), *SMALL)
+        r = cli("stick-slip", "--grid", "drive_velocity=0.05,0.5", "--out", str(out), *small_args)
     assert r.returncode == 2 and "another sweep is running" in r.stderr
     assert not (out / "sweep.json").exists()          # it wrote nothing
 
 
 # ---------------------------------------------------------------- Slurm profile
-def test_slurm_profile_dry_run_declares_mpi_on_every_run(tmp_path):
+def test_slurm_profile_dry_run_declares_mpi_on_every_run(tmp_path, cli, small_args):
     pytest.importorskip("snakemake_executor_plugin_slurm",
                         reason="pip install snakemake-executor-plugin-slurm (the sweep extra)")
     out = tmp_path / "sweep"
     r = cli("stick-slip", "--grid", "drive_velocity=0.05,0.5", "--grid", "seed=1,2",
-            "--out", str(out), "--profile", "slurm", "--dry-run", *SMALL, timeout=120)
+            "--out", str(out), "--profile", "slurm", "--dry-run", *small_args, timeout=120)
     assert r.returncode == 0, r.stderr[-3000:]
     blocks = [b for b in r.stdout.split("rule ")[1:] if b.startswith("point:")]
     assert len(blocks) == 4
@@ -265,10 +270,10 @@ def test_slurm_profile_dry_run_declares_mpi_on_every_run(tmp_path):
 
 # ---------------------------------------------------------------- real sweeps
 @pytest.mark.md
-def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path):
+def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path, cli, small_args):
     out = tmp_path / "sweep"
     args = ["stick-slip", "--grid", "drive_velocity=0.05,0.5", "--grid", "seed=1,2",
-            "--np", "1", "--cores", "2", "--out", str(out), *SMALL]
+            "--np", "1", "--cores", "2", "--out", str(out), *small_args]
     r = cli(*args, timeout=300)
     assert r.returncode == 0, r.stderr[-3000:]
     assert "sweep directory:" in r.stdout and "critical velocity" in r.stdout
@@ -279,7 +284,8 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path):
         assert record["status"] == "completed"
         assert record["scene"]["parameters"]["slide_steps"] == 3000
         assert "-n 1" in (run_dir / "command.txt").read_text()
-        assert (run_dir / "analysis.json").exists()
+        analysis = json.loads((run_dir / "analysis.json").read_text())
+        assert analysis["regime"] in ("stick-slip", "smooth", "irregular", "unresolved")
     by_name = {p["point"]: p for p in agg.points}
     fast = by_name["drive_velocity=0.5__seed=2"]
     assert fast["drive_velocity"] == 0.5 and fast["seed"] == 2
@@ -288,7 +294,12 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path):
     # seeds differ: different trajectories
     slow = [by_name[f"drive_velocity=0.05__seed={s}"]["mean_force"] for s in (1, 2)]
     assert slow[0] != slow[1]
-    assert agg.critical_velocity and agg.critical_velocity[0]["status"]
+    # the aggregate's critical velocity is the one its points' regimes give
+    expected = sweep.critical_velocity([p["drive_velocity"] for p in agg.points],
+                                       [p["sweep_regime"] for p in agg.points])
+    assert len(agg.critical_velocity) == 1
+    assert agg.critical_velocity[0]["status"] == expected.status
+    assert agg.critical_velocity[0]["value"] == expected.value
     assert set(agg.figures) == {"velocity_map"} and agg.figures["velocity_map"].stat().st_size
     rows = (out / "aggregate.csv").read_text().splitlines()
     assert len(rows) == 5 and rows[0].startswith("point,grid.drive_velocity,grid.seed")
@@ -302,11 +313,11 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path):
 
 
 @pytest.mark.md
-def test_killed_sweep_resumes_without_losing_a_point(tmp_path):
+def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, filmfriction_command):
     out = tmp_path / "sweep"
     args = ["stick-slip", "--grid", "drive_velocity=0.05,0.2,0.5", "--np", "1",
-            "--cores", "1", "--out", str(out), *SMALL]
-    proc = subprocess.Popen([FILMFRICTION, "sweep", *args],
+            "--cores", "1", "--out", str(out), *small_args]
+    proc = subprocess.Popen([filmfriction_command, "sweep", *args],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.time() + 120
     try:

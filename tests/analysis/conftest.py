@@ -1,0 +1,22 @@
+"""Fixtures of the analysis tests."""
+import pytest
+
+
+@pytest.fixture
+def slip_table():
+    """``slip_table(trace, spring_constant, refine=True)`` -> (CycleTable, SlipEvents):
+    the analysis' chain on a trace dict (``time``, ``spring_force``, optional
+    ``wall_position``): detect the slips, tabulate the cycles and, with ``refine``,
+    place each slip's static and backward force on its ramps' fitted lines."""
+    from filmfriction.analysis.stickslip import cycle_table, detect_slips, ramp_forces
+
+    def table(trace, spring_constant, refine=True):
+        t, f = trace["time"], trace["spring_force"]
+        wall = trace.get("wall_position")
+        events = detect_slips(t, f)
+        tab = cycle_table(t, f, events.yield_index, events.stick_index,
+                          spring_constant=spring_constant, wall_position=wall)
+        if refine:
+            tab = ramp_forces(t, f, tab, wall_position=wall)
+        return tab, events
+    return table

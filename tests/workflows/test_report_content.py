@@ -1,0 +1,44 @@
+"""What the report says, on a synthetic run with a known answer (no LAMMPS).
+
+The study (analysis, calibration, SFB check, report) runs once on a run
+directory made by :func:`filmfriction.analysis.synthetic.run_directory`: four
+Klein-type slips from 3 to 1 eps/sigma and a 3-layer trajectory.  The same
+content checks run on the real small run in test_report.py (marker md).
+"""
+import json
+from types import SimpleNamespace
+
+import pytest
+
+
+@pytest.fixture(scope="module")
+def synthetic_study(tmp_path_factory, report_study):
+    from filmfriction.analysis.synthetic import run_directory
+
+    run_dir = run_directory(tmp_path_factory.mktemp("report-synthetic") / "run", layers=3)
+    return SimpleNamespace(path=run_dir, labels=report_study(run_dir))
+
+
+def test_synthetic_study_writes_every_output(synthetic_study, report_checks):
+    report_checks.outputs(synthetic_study.path)
+
+
+def test_synthetic_report_shows_the_analysis(synthetic_study, report_checks):
+    report_checks.content(synthetic_study.path)
+    # the synthetic run's known answer
+    doc = json.loads((synthetic_study.path / "analysis.json").read_text())
+    assert doc["slips"]["static_force"]["mean"] == pytest.approx(3.0, rel=0.1)
+    assert doc["structure"]["layers"]["count"] == 3
+
+
+def test_every_figure_has_units_on_its_axes(synthetic_study, report_checks):
+    report_checks.axes_units(synthetic_study.labels)
+
+
+def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
+    from filmfriction.workflows import report
+
+    assert report.fig_film(tmp_path) == (None, "")
+    sec = report._film_section(SimpleNamespace(run_dir=tmp_path, analysis={}), {})
+    assert sec.title == "The film: density profile and picture"
+    assert any("`film-structure` scene" in b for b in sec.blocks if isinstance(b, str))
