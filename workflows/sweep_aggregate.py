@@ -198,7 +198,7 @@ def reduced_model_boundary(calibration: dict, stiffnesses, mass: float,
     Parameters
     ----------
     calibration : dict
-        A ``calibration.json`` document (``filmfriction.workflows.calibrate``); the runs
+        A ``calibration.json`` document (``filmfriction.analysis.calibration``); the runs
         with F_s, F_k and B are averaged.
     stiffnesses : array_like
         K values (ε/σ²).
@@ -367,7 +367,7 @@ class Aggregate:
     run_dirs : tuple of Path
         Every point's run directory, in grid order.
     calibration_runs : tuple of Path
-        The stick-slip points (slips to fit), for ``filmfriction.workflows.calibrate.calibrate``.
+        The stick-slip points (slips to fit), for ``filmfriction.analysis.calibrate``.
     figures : dict
         ``velocity_map`` / ``vk_map`` → Path, for those written.
     """

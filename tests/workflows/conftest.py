@@ -57,13 +57,15 @@ def images(html: str) -> dict[str, bytes]:
 
 def check_outputs(run_dir: Path) -> None:
     """Every file of the study is there and well formed."""
-    from filmfriction.workflows.calibrate import SCHEMA
+    from filmfriction.analysis.calibration import SCHEMA
 
     doc = json.loads((run_dir / "analysis.json").read_text())
     assert doc["slips"]["count"] >= 2 and doc["regime"] in ("stick-slip", "irregular")
     cal = json.loads((run_dir / "calibration.json").read_text())
     assert cal["schema"] == SCHEMA and len(cal["runs"]) == 1
-    rows = json.loads((run_dir / "sfb.json").read_text())
+    sfb = json.loads((run_dir / "sfb.json").read_text())
+    assert sfb["schema"] == "filmfriction.sfb/1"
+    rows = sfb["rows"]
     assert rows and {"name", "source", "klein", "model", "ratio", "units"} <= set(rows[0])
     assert "slip_time" in {r["name"] for r in rows}
 

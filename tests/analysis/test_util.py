@@ -9,7 +9,7 @@ import pytest
 
 from filmfriction.analysis import util
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_finite_or_none():
