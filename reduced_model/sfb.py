@@ -179,8 +179,22 @@ ASSUMPTIONS = (
 )
 
 
+def _decade_rule(row: dict) -> dict:
+    """An absolute row whose interval reaches zero or spans more than a decade has no ratio."""
+    unc = row.get("uncertainty")
+    if unc is None or row.get("model") is None:
+        return row
+    lo, hi = unc
+    if lo <= 0 or hi / lo > 10:
+        row = dict(row, ratio=None)
+        row["note"] = (row["note"] + "; " if row["note"] else "") + (
+            "the interval reaches zero or spans more than a decade: an extrapolation that does "
+            "not fix the value, so no ratio")
+    return row
+
+
 def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperiment = KLEIN,
-              liquid: LiquidProperties = OMCTS_LIQUID) -> SFBCheck:
+              liquid: LiquidProperties = OMCTS_LIQUID, contact=None) -> SFBCheck:
     """Run the SFB check.
 
     Parameters
@@ -193,6 +207,10 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         Klein's numbers (override to test sensitivity).
     liquid : LiquidProperties
         Heat capacity for the temperature rise.
+    contact : SlidingContact, optional
+        An MD run's measured contact (:func:`filmfriction.analysis.contact.contact_from_run`):
+        adds the ``similarity`` rows, its dimensionless numbers beside Klein's
+        (:func:`.similarity.similarity_rows`).
 
     Returns
     -------
@@ -294,9 +312,15 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
     if calibration is not None:
         calibration = MDCalibration.coerce(calibration)
         extra_rows, md_run, md_notes = md_rows(calibration, units, ex, geo, liquid)
-        rows += extra_rows
+        rows += [_decade_rule(r) for r in extra_rows]
         slips["md"] = md_run
         notes += md_notes
+    if contact is not None:
+        from .similarity import klein_contact, similarity_rows
+        rows += similarity_rows(contact, klein_contact(ex, units))
+        notes.append("similarity rows: dimensionless numbers of the MD run (its own units) beside "
+                     "Klein's; his drive velocity is taken as slip distance / cycle time, his "
+                     "film compliance as delta/x0, his mount damping from the ringing's decay")
     notes.append(BRAUN_TOSATTI_NOTE)
     return SFBCheck(rows=rows, geometry=geo, slips=slips, closed_form_deviation=deviation,
                     ode_deviation=ode_deviation, notes=tuple(notes), units=units, experiment=ex,

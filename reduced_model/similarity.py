@@ -247,13 +247,15 @@ def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) 
         if math.isfinite(m.stderr) and math.isfinite(m.value):
             lo, hi = m.value - m.stderr, m.value + m.stderr
             unc = (lo, hi)
-            if lo <= 0 < m.value or (lo > 0 and hi / lo > 10):
-                note += "; the model's interval spans more than a decade: no ratio"
+            if lo <= 0 or hi / lo > 10:   # every number here is positive by nature
+                note += "; the model's interval reaches zero or spans more than a decade: no ratio"
         for n in (m.note, k.note):
             if n:
                 note += f"; {n}"
         row = table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)
-        if "no ratio" in note:
+        if "no ratio" in note or (math.isfinite(m.value) and m.value <= 0):
+            if "no ratio" not in note:
+                note += "; the model's value is not positive: no ratio"
             row["ratio"] = None
         rows.append(row)
     return rows

@@ -1,6 +1,6 @@
 """``filmfriction sfb``: the reduced model against Klein's SFB numbers.
 
-    filmfriction sfb [--json] [--calibration FILE.json] [--out sfb.json] [--sigma-nm S] [--epsilon-K E]
+    filmfriction sfb [--json] [--calibration FILE.json] [--run RUN_DIR] [--out sfb.json] [--sigma-nm S] [--epsilon-K E]
 
 Prints the comparison table (name, Klein, model, ratio, units, source) and
 the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
@@ -8,7 +8,8 @@ the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
 a JSON object with its field names, or the ``md_calibration`` of a
 ``calibration.json`` (``filmfriction calibrate``), and adds the ``md-calibrated``
 rows; ``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to
-carry it to SI.  ``--out`` also writes the check as the study does
+carry it to SI.  ``--run`` adds the ``similarity`` rows: the dimensionless
+numbers of an analysed MD run beside Klein's.  ``--out`` also writes the check as the study does
 (``sfb.json`` + ``sfb_slips.csv``), for ``filmfriction report`` to read.
 The check itself is :func:`filmfriction.reduced_model.sfb_check`.
 """
@@ -33,6 +34,9 @@ def register(subparsers) -> None:
     p.add_argument("--calibration", metavar="FILE.json", type=Path,
                    help="MD calibration to add md-calibrated rows: MDCalibration fields (LJ units) "
                         "or a calibration.json from 'filmfriction calibrate'")
+    p.add_argument("--run", metavar="RUN_DIR", type=Path, default=None,
+                   help="an analysed MD run (analysis.json + run.json): adds the similarity rows, "
+                        "its dimensionless numbers beside Klein's")
     p.add_argument("--out", metavar="FILE.json", type=Path, default=None,
                    help="also write the check as the study does (e.g. RUN_DIR/sfb.json, with its "
                         "slips' traces beside it), for 'filmfriction report'")
@@ -114,8 +118,21 @@ def run(args) -> int:
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     units = _units(args)
     calibration = _calibration(args.calibration)
+    contact = None
+    if args.run is not None:
+        from filmfriction.analysis.contact import contact_from_run
+        for name in ("analysis.json", "run.json"):
+            if not (args.run / name).is_file():
+                raise UserError(f"--run {args.run}: no {name} there (run 'filmfriction analyze "
+                                f"{args.run}' on a run directory first)")
+        try:
+            contact = contact_from_run(args.run)
+        except (ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
+            raise UserError(f"--run {args.run}: {exc}") from None
+        except json.JSONDecodeError as exc:
+            raise UserError(f"--run {args.run}: not valid JSON ({exc})") from None
     try:
-        check = sfb_check(calibration=calibration, units=units)
+        check = sfb_check(calibration=calibration, units=units, contact=contact)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     path = None

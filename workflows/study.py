@@ -24,10 +24,10 @@ def analyse(run_dir: Path) -> dict:
     return doc
 
 
-def _step(name: str, failures: dict, fn, *args):
+def _step(name: str, failures: dict, fn, *args, **kwargs):
     """Run one step; on failure print and record the reason, return None."""
     try:
-        return fn(*args)
+        return fn(*args, **kwargs)
     except Exception as exc:  # noqa: BLE001 -- one failed step must not stop the study
         failures[name] = f"{type(exc).__name__}: {exc}"
         print(f"{name}: FAILED: {failures[name]}", file=sys.stderr)
@@ -71,13 +71,17 @@ def finish_study(run_dir: Path) -> int:
               f"{rc.film_damping.value if rc.film_damping else float('nan'):.4g}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
+    from filmfriction.analysis.contact import contact_from_run
     from filmfriction.reduced_model import sfb_check
     md = cal.md_calibration if cal is not None else None
-    check = _step("sfb", failures, sfb_check, md)
+    contact = _step("similarity", failures, contact_from_run, run_dir)
+    check = _step("sfb", failures, sfb_check, md, contact=contact)
     if check is not None:
         path = _step("sfb (write)", failures, _write_sfb, run_dir, check)
         n_md = sum(r["source"] == "md-calibrated" for r in check.rows)
-        print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated) -> {path}")
+        n_sim = sum(r["source"] == "similarity" for r in check.rows)
+        print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated, {n_sim} similarity) "
+              f"-> {path}")
 
     from filmfriction.workflows import report
     path = _step("report", failures, lambda: report.build_report([run_dir], failures=dict(failures)))
