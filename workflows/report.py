@@ -196,6 +196,66 @@ def fig_energy(bars) -> bytes:
     return _png(fig)
 
 
+def fig_slip_law(run) -> bytes:
+    """The film's force against the wall's velocity during the slips, with the fitted line."""
+    from filmfriction.analysis.sliplaw import film_force
+
+    plt = _plt()
+    tr = run.trace
+    law = run.analysis.get("slip_law") or {}
+    p = tr.parameters
+    t, f, v = tr.time, tr.spring_force, tr.columns["wall_velocity"]
+    v_drive = p.drive_velocity or 0.0
+    ff = film_force(t, f, v, mass=p.mass, drive_velocity=v_drive,
+                    mount_damping=p.mount_damping or 0.0)
+    yi = np.asarray(run.cycles.get("yield_index", []), int)[run.skip:]
+    si = np.asarray(run.cycles.get("stick_index", []), int)[run.skip:]
+    fig, ax = plt.subplots(figsize=(6.4, 4.0))
+    cmap = plt.get_cmap("viridis")
+    vmax = 0.0
+    for i, (y, s_) in enumerate(zip(yi, si)):
+        seg = slice(int(y), int(s_) + 1)
+        ax.plot(v[seg], ff[seg], ".-", lw=0.5, ms=3, color=cmap(i / max(len(yi) - 1, 1)),
+                alpha=0.8, label="slips (colour: order)" if i == 0 else None)
+        vmax = max(vmax, float(np.max(v[seg])) if v[seg].size else 0.0)
+    fk = (law.get("kinetic_force") or {}).get("mean")
+    b = (law.get("damping") or {}).get("mean")
+    if fk is not None and b is not None and vmax > 0:
+        vv = np.linspace(0.0, vmax, 50)
+        ax.plot(vv, fk + b * vv, "k--", lw=1.5,
+                label=f"fit F_k + B·v: F_k = {fk:.3g} ε/σ, B = {b:.3g} m/τ")
+    ax.axhline(0, color="0.6", lw=0.5)
+    ax.set_xlabel("wall velocity during the slip v [σ/τ]")
+    ax.set_ylabel("film force F_spring − M·a − γM(v − V) [ε/σ]")
+    ax.legend(loc="best", fontsize=8)
+    return _png(fig)
+
+
+def fig_lambda_zeta(points: list) -> bytes:
+    """Nakano–Maegawa's plane: (ζ, λ) of each contact with ±1 σ bars and the boundary λ_c(ζ)."""
+    from filmfriction.reduced_model.maps import critical_lambda
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    zz = np.geomspace(1e-3, 0.999, 200)
+    ax.plot(zz, critical_lambda(zz), color="k", lw=1.2, label="λ_c(ζ): stick-slip above (Coulomb)")
+    ax.axvline(1.0, color="k", ls=":", lw=1.0, label="ζ = 1: none for a viscous law")
+    markers = iter("o^sDvP*X")
+    for label, zeta, zeta_err, lam, lam_err in points:
+        if not (math.isfinite(zeta) and math.isfinite(lam)) or zeta <= 0 or lam <= 0:
+            continue
+        ax.errorbar([zeta], [lam], xerr=[[min(zeta_err, 0.999 * zeta)], [zeta_err]]
+                    if math.isfinite(zeta_err) else None,
+                    yerr=[[min(lam_err, 0.999 * lam)], [lam_err]] if math.isfinite(lam_err) else None,
+                    fmt=next(markers, "o"), ms=7, capsize=3, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("damping ratio ζ = (B + γM)/(2√(KM)) [1]")
+    ax.set_ylabel("λ = (F_s − F_k)/(V√(KM)) [1]")
+    ax.legend(loc="lower right", fontsize=7)
+    return _png(fig)
+
+
 def fig_viscosity(cal: dict) -> bytes:
     """η_eff against γ̇, one point per run, with the rate law (a ``calibration.json`` document)."""
     plt = _plt()
@@ -557,6 +617,8 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
                                    "with bulk viscosity, and (if calibrated) the MD film."))
     rows = []
     for r in check.rows:
+        if r["source"] == "similarity":   # their own section
+            continue
         unc = r.get("uncertainty")
         rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
                      "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
@@ -568,6 +630,82 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     for n in check.notes:
         if n != BRAUN_TOSATTI_NOTE:
             sec.p(f"Assumption: {n}")
+    return sec
+
+
+def _slip_law_section(run, failures) -> Section:
+    sec = Section("Klein's slip equation on the MD slips: viscous or kinetic?")
+    law = run.analysis.get("slip_law")
+    if not law:
+        why = run.analysis.get("skipped", {}).get("slip_law", "not analysed")
+        sec.p(f"No slip-law fit: {why}.")
+        return sec
+    if run.trace.has("wall_velocity") and run.trace.parameters.mass:
+        png = _attempt(failures, "figure: slip law", fig_slip_law, run)
+        if png:
+            sec.add(Figure("slip_law", png,
+                           "The film's own shear force during each slip (the spring's force less "
+                           "the wall's inertia and the mount dashpot) against the wall's velocity, "
+                           "with the fit F_film = F_k + B·v. A line through the origin is Klein's "
+                           "viscous film (his Eq. 1); a flat line at F_k is a kinetic friction "
+                           "stress (Braun & Tosatti)."))
+    rows = [("kinetic force F_k", _pm(law.get("kinetic_force"))),
+            ("damping B", _pm(law.get("damping"))),
+            ("mean slip velocity v̄", _pm(law.get("mean_slip_velocity"))),
+            ("viscous share B·v̄/(F_k + B·v̄)", _fmt(law.get("viscous_share"), 3)),
+            ("share of F_film's variance the line explains", _fmt(law.get("r_squared"), 3)),
+            ("verdict", f"**{law.get('verdict', '?')}**")]
+    if law.get("eta_from_damping"):
+        rows.append(("η from B (B·D/A)", _pm(law["eta_from_damping"])))
+    sec.add(Table(("slip law (mean ± stderr over slips)", "value"), tuple(rows)))
+    sec.p(f"Why: {law.get('reason', '')}. Klein himself proposed this test (his note 27: the "
+          "friction force against the sliding velocity during the slip).")
+    return sec
+
+
+def _similarity_section(check, run_dirs, failures) -> Section:
+    """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given."""
+    from filmfriction.analysis.contact import contact_from_run
+    from filmfriction.reduced_model.similarity import klein_contact, similarity_numbers
+
+    sec = Section("Similarity with the SFB experiment: dimensionless numbers")
+    rows = [r for r in (check.rows if check is not None else []) if r["source"] == "similarity"]
+    if rows:
+        sec.p("An MD film slides ~10⁹ times faster than an SFB contact: what carries over is "
+              "similarity. Each number of this run beside Klein's (model range: ±1 standard error).")
+        sec.add(Table(("number", "Klein", "this run", "ratio", "run's range", "what it is"),
+                      tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+                             "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
+                             "–" if not r.get("uncertainty") else
+                             f"{_fmt(r['uncertainty'][0], 2)} … {_fmt(r['uncertainty'][1], 2)}",
+                             r["note"]) for r in rows)))
+    else:
+        sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
+              "--out RUN_DIR/sfb.json`).")
+
+    def point(label, contact):
+        n = similarity_numbers(contact)
+        zf, zm, lam = n["film_damping_ratio"], n["mount_damping_ratio"], n["lambda"]
+        zeta = (zf.value if math.isfinite(zf.value) and zf.value > 0 else 0.0) + zm.value
+        return (label, zeta, zf.stderr if math.isfinite(zf.stderr) else math.nan,
+                lam.value, lam.stderr)
+    points = [point("Klein (SFB, OMCTS)", klein_contact())]
+    for d in run_dirs:
+        try:
+            scene = json.loads((Path(d) / "run.json").read_text()).get("scene", {}).get("name", "")
+            points.append(point(f"{scene or Path(d).name} (MD)", contact_from_run(d)))
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            failures.setdefault(f"λ–ζ point of {Path(d).name}", str(exc))
+    png = _attempt(failures, "figure: lambda-zeta", fig_lambda_zeta, points)
+    if png:
+        sec.add(Figure("lambda_zeta", png,
+                       "Nakano–Maegawa's plane for every run given and Klein's contact: λ against "
+                       "the total damping ratio (film + mount; an unresolved film drag counts as 0). "
+                       "Left of ζ = 1 stick-slip needs λ > λ_c(ζ); right of it, a purely viscous "
+                       "film cannot stick again, so a stick-slip there (Klein's) says the film "
+                       "re-solidifies. Run the Klein-similar scene with `filmfriction run "
+                       "sfb-similar` and give its directory to `filmfriction report` beside this "
+                       "one to place it here."))
     return sec
 
 
@@ -819,11 +957,13 @@ def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
              "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
              f"({OMCTS.name})."]
     sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
+                _slip_law_section(run, failures),
                 _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
                 _film_section(run, failures),
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
                 _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
+                _similarity_section(inputs.sfb, run_dirs, failures),
                 _cost_section(run)]
     if sweeps:
         sections.insert(4, _sweep_section(sweeps))
