@@ -274,6 +274,10 @@ class Calibration:
         η_eff = c γ̇^α across runs (≥ 3 distinct rates).
     rate_points : list of (float, float, float)
         (γ̇, η_eff, stderr) per run that has both.
+    rate_dependence : dict or None
+        The sliding stress τ = η_eff γ̇ against γ̇, Eyring-like and power law, the
+        one with the smaller residual chosen, carried to the mean shear rate of
+        Klein's slip with its 68 % interval (:func:`rate_dependence`).
     md_calibration : filmfriction.reduced_model.MDCalibration or None
     notes : list of str
     failures : dict
@@ -284,6 +288,7 @@ class Calibration:
     rate_law: object = None
     rate_points: list = field(default_factory=list)
     md_calibration: object = None
+    rate_dependence: dict | None = None
     notes: list = field(default_factory=list)
     failures: dict = field(default_factory=dict)
     units: str = "lj"
@@ -305,7 +310,7 @@ class Calibration:
                 "model": "SpringBlock + Coulomb(static F_s, kinetic F_k, viscous B) + mount dashpot d",
                 "runs": [r.as_dict() for r in self.runs],
                 "rate_points": [[_num(a), _num(b), _num(c)] for a, b, c in self.rate_points],
-                "rate_law": law, "md_calibration": md,
+                "rate_law": law, "rate_dependence": self.rate_dependence, "md_calibration": md,
                 "notes": list(self.notes), "failures": dict(self.failures)}
 
 
@@ -357,8 +362,56 @@ def calibrate(run_dirs) -> Calibration:
         md = md_calibration(runs, law, points, notes)
     except ValueError as exc:
         failures["md_calibration"] = str(exc)
+    dependence = None
+    if distinct >= 3:
+        try:
+            dependence = rate_dependence(points)
+        except ValueError as exc:
+            failures["rate_dependence"] = str(exc)
     return Calibration(runs=runs, rate_law=law, rate_points=points, md_calibration=md,
-                       notes=notes, failures=failures, units=units.pop())
+                       notes=notes, failures=failures, units=units.pop(),
+                       rate_dependence=dependence)
+
+
+def rate_dependence(points, units=None) -> dict:
+    """The sliding stress's rate law across runs, carried to Klein's slip rate.
+
+    ``points`` are (γ̇, η_eff, stderr) in LJ units; the stress is τ = η_eff·γ̇ (error
+    stderr·γ̇).  Both an Eyring-like τ0 + τ1 ln(γ̇/γ̇_ref) and a power law c γ̇^n are
+    fitted (:mod:`.ratelaw`); the one with the smaller residual in stress is chosen
+    and both are evaluated at the mean shear rate of Klein's slip, Δx0/(τ_s D)
+    (≈ 6×10² s⁻¹), converted to LJ with ``units`` (default OMCTS), each with its 68 %
+    interval and whether that interval spans more than a decade.
+    """
+    from filmfriction.reduced_model.klein import KLEIN, klein_slip_geometry
+    from filmfriction.reduced_model.units import OMCTS
+
+    from .ratelaw import choose_rate_law, eyring_fit, power_fit
+
+    units = units or OMCTS
+    rate = np.array([p[0] for p in points], float)
+    stress = np.array([p[1] * p[0] for p in points], float)
+    err = np.array([p[2] * p[0] for p in points], float)
+    err = err if np.all(np.isfinite(err) & (err > 0)) else None
+    geo = klein_slip_geometry(KLEIN)
+    sfb_rate_si = geo.slip_distance / (KLEIN.slip_time * KLEIN.film_thickness)
+    sfb_rate = float(units.from_si(sfb_rate_si, "shear_rate"))
+    out = {"stress": "eta_eff * shear_rate (LJ stress units)", "weighted": err is not None,
+           "sfb_shear_rate": sfb_rate, "sfb_shear_rate_si": sfb_rate_si,
+           "decades_extrapolated": float(np.log10(rate.min() / sfb_rate))}
+    fits = {"eyring": eyring_fit(rate, stress, err)}
+    try:
+        fits["power"] = power_fit(rate, stress, err)
+    except ValueError as exc:
+        out["power_failure"] = str(exc)
+    chosen = choose_rate_law(rate, stress, err)
+    out["chosen"] = chosen.form
+    for name, law in fits.items():
+        e = law.extrapolate(sfb_rate)
+        out[name] = {**law.as_dict(), "stress_at_sfb_rate": e.as_dict(),
+                     "stress_at_sfb_rate_si": {
+                         k: float(units.to_si(getattr(e, k), "stress")) for k in ("value", "low", "high")}}
+    return out
 
 
 def write_calibration(cal: Calibration, path=None) -> Path:

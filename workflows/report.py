@@ -509,6 +509,23 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
               f"(= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s) at γ̇ = {_fmt(g, 3)} 1/τ "
               f"(= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s). "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
+    dep = cal.get("rate_dependence")
+    if dep:
+        parts = []
+        for form in ("eyring", "power"):
+            law_ = dep.get(form)
+            if not law_:
+                continue
+            e, si = law_["stress_at_sfb_rate"], law_["stress_at_sfb_rate_si"]
+            where = ("spans more than a decade: not a prediction" if e["spans_decade"] else
+                     f"{_fmt(si['low'], 2)} … {_fmt(si['high'], 2)} Pa")
+            parts.append(f"{form} (residual {_fmt(law_['residual'], 3)}): τ = {_fmt(e['value'], 3)} "
+                         f"ε/σ³ = {_fmt(si['value'], 3)} Pa, 68 % interval {where}")
+        sec.p(f"Sliding stress τ = η_eff·γ̇ against the rate, carried "
+              f"{dep['decades_extrapolated']:.1f} decades down to the mean shear rate of Klein's "
+              f"slip ({_fmt(dep['sfb_shear_rate_si'], 3)} 1/s): " + "; ".join(parts)
+              + f". Chosen by residual: **{dep['chosen']}**. Klein's viscous stress η_eff·γ̇ is "
+              "≈ 17 kPa at that rate.")
     for r in cal["runs"]:
         if r.get("eta_eff") is not None:
             sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")

@@ -54,3 +54,21 @@ def test_negative_stress_falls_back_to_eyring_and_bad_input():
         eyring_fit([1, -2, 3], [1, 2, 3])
     with pytest.raises(ValueError, match="equal"):
         eyring_fit([1, 1, 1], [1, 2, 3])
+
+
+def test_rate_dependence_carries_both_laws_to_klein_rate():
+    from filmfriction.analysis.calibration import rate_dependence
+    from filmfriction.reduced_model.units import OMCTS
+
+    # an Eyring-like film: tau = 1 + 0.2 ln(rate/0.01), eta = tau/rate
+    rates = [0.003, 0.01, 0.03, 0.1]
+    pts = [(g, (1 + 0.2 * np.log(g / 0.01)) / g, 0.01 / g) for g in rates]
+    d = rate_dependence(pts)
+    assert d["chosen"] == "eyring"
+    assert d["sfb_shear_rate_si"] == pytest.approx(620, rel=0.05)    # Klein: dx0/(tau_s D)
+    g = d["sfb_shear_rate"]
+    assert g == pytest.approx(OMCTS.from_si(d["sfb_shear_rate_si"], "shear_rate"))
+    e = d["eyring"]["stress_at_sfb_rate"]
+    assert e["value"] == pytest.approx(1 + 0.2 * np.log(g / 0.01), rel=1e-6)
+    assert e["spans_decade"]          # negative: the log law does not reach 6 decades down
+    assert d["decades_extrapolated"] > 5
