@@ -488,6 +488,8 @@ def _energy_section(run, failures) -> Section:
 
 
 def _viscosity_section(cal, why_none: str, failures) -> Section:
+    from filmfriction.reduced_model.klein import KLEIN
+
     sec = Section("Effective viscosity η_eff(γ̇)")
     if cal is None or not cal.get("rate_points"):
         main_failures = cal["runs"][0].get("failures", {}) if cal else {}
@@ -525,7 +527,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
               f"{dep['decades_extrapolated']:.1f} decades down to the mean shear rate of Klein's "
               f"slip ({_fmt(dep['sfb_shear_rate_si'], 3)} 1/s): " + "; ".join(parts)
               + f". Chosen by residual: **{dep['chosen']}**. Klein's viscous stress η_eff·γ̇ is "
-              "≈ 17 kPa at that rate.")
+              f"{_fmt(KLEIN.eta_eff * dep['sfb_shear_rate_si'] / 1e3, 3)} kPa at that rate.")
     for r in cal["runs"]:
         if r.get("eta_eff") is not None:
             sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")
