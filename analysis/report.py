@@ -113,8 +113,23 @@ def _not_sliding(s: dict) -> str | None:
 
 
 def _thickness(trace: Trace, sel=slice(None)) -> tuple[float, str]:
+    """The film thickness D, as Klein counts it: n layers times their spacing.
+
+    The ``gap`` column is the distance between the walls' innermost atom planes;
+    n film layers between them sit n + 1 layer spacings apart, so D = gap·n/(n+1)
+    when the run records its film layers (Klein: D = 3.5 nm for n = 4), else the
+    gap itself.  A ``--thickness`` given by the user is taken as it is.
+    """
+    if trace.parameters.thickness is not None:
+        return float(trace.parameters.thickness), "--thickness"
     if trace.has("gap"):
-        return float(np.mean(trace.columns["gap"][sel])), "mean of gap column"
+        gap = float(np.mean(trace.columns["gap"][sel]))
+        n = ((trace.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
+        if n:
+            return gap * n / (n + 1), (f"film layers x layer spacing: mean gap x n/(n+1), "
+                                       f"n = {n} (the gap between the walls' innermost planes "
+                                       f"holds n + 1 spacings)")
+        return gap, "mean of gap column (wall plane to wall plane)"
     return trace.parameters.require("thickness", "viscosity"), "--thickness"
 
 
@@ -286,6 +301,20 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     if prof_v is not None:
         try:
             visc["profile"] = _profile_section(trace, prof_v, prof_d, lab, half)
+            prof, steady = visc["profile"], visc.get("steady")
+            # η from the film's own shear rate, where it shears inside (steady sliding)
+            g = (prof.get("shear_rate") or {}).get("mean")
+            if steady and g and g > 0 and prof.get("shears") == "inside the film":
+                stress = steady["shear_stress"]["mean"]
+                visc["internal"] = {
+                    "eta_eff": _value(stress / g, None, lab("viscosity")),
+                    "shear_rate": _value(g, None, lab("shear_rate")),
+                    "note": "steady shear stress over the velocity profile's internal shear "
+                            "rate (the film shears inside)"}
+            elif steady:
+                skipped["viscosity.internal"] = (
+                    f"the film shears {prof.get('shears', 'nowhere measurable')}: no internal "
+                    "shear rate to divide by")
         except (ValueError, RuntimeError, KeyError) as exc:
             skipped["viscosity.profile"] = f"{prof_v}: {exc}"
     try:
@@ -396,10 +425,20 @@ def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half)
     if v_top is None:
         raise ValueError("top-wall velocity unknown (no wall_velocity column or drive velocity)")
     ps = viscosity.profile_shear(z, vx, rho, wall_velocity_top=v_top)
-    return {"shear_rate": _value(ps.shear_rate, ps.shear_rate_stderr, lab("shear_rate")),
-            "slip_bottom": _value(ps.slip_bottom, None, lab("velocity")),
-            "slip_top": _value(ps.slip_top, None, lab("velocity")),
-            "film_edges": [ps.z_bottom, ps.z_top], "frames": "last half"}
+    out = {"shear_rate": _value(ps.shear_rate, ps.shear_rate_stderr, lab("shear_rate")),
+           "slip_bottom": _value(ps.slip_bottom, None, lab("velocity")),
+           "slip_top": _value(ps.slip_top, None, lab("velocity")),
+           "film_edges": [ps.z_bottom, ps.z_top], "frames": "last half"}
+    # where the wall's velocity is taken up: inside the film, or by slip at a wall
+    if v_top:
+        inside = ps.shear_rate * (ps.z_top - ps.z_bottom) / v_top
+        shares = {"inside": inside, "bottom_wall": ps.slip_bottom / v_top,
+                  "top_wall": ps.slip_top / v_top}
+        out["velocity_shares"] = {k: _num(v) for k, v in shares.items()}
+        out["shears"] = ("inside the film" if inside >= 0.5 else
+                         "by slip at the " + ("bottom" if ps.slip_bottom >= ps.slip_top else "top")
+                         + " wall")
+    return out
 
 
 def to_json(doc: dict) -> str:

@@ -229,9 +229,12 @@ def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0)
             "spring_energy": spring}
     write_csv(directory / "trace.csv", cols)
     area = 12 * 1.1 * 7 * np.sqrt(3) * 1.1
-    run = {"status": "done", "scene": {"film_layers": layers},
+    # run.json as the runner writes it: the film's thickness comes from the gap column
+    run = {"status": "done",
+           "scene": {"name": "synthetic", "parameters": {"film_layers": layers,
+                                                         "normal_pressure": 1.0}},
            "trace_parameters": {"spring_constant": k, "mass": m, "area": area,
-                                "thickness": gap, "drive_velocity": v, "units": "lj"}}
+                                "thickness": None, "drive_velocity": v, "units": "lj"}}
     (directory / "run.json").write_text(json.dumps(run, indent=2))
     if trajectory:
         frames = 60
