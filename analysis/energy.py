@@ -25,10 +25,13 @@ Per slip y → s:
     dissipated viscously (``film_dissipation_method = "klein-eq1"``).
 ``ringing_energy``
     ΔE_osc, the oscillator energy left at re-stick.  With the wall's velocity
-    and mass: the largest ½M(v − v̄)² over the first quarter of the next stick
-    (v̄ its mean: the stuck wall's creep), which is the energy of the wall's
-    oscillation on K + k_f whatever its stiffness (``ringing_method =
-    "wall-kinetic"``).  Without them, Klein's estimate from the largest ringing
+    and mass: Klein's M v0²/2 with v0 the largest velocity of the wall's
+    oscillation after s, i.e. the largest ½M(v − v̄)² over the first quarter of
+    the next stick from the wall's first reversal on (v̄ its mean: the stuck
+    wall's creep), less the largest that the wall's thermal motion alone
+    reaches over as many samples: the energy of the oscillation on K + k_f
+    whatever its stiffness, and 0 for an overdamped approach that never
+    reverses (``ringing_method = "wall-kinetic"``).  Without them, Klein's estimate from the largest ringing
     amplitude of the force, A²/(2K) (``"force-amplitude"``: it misses the
     film's share k_f of the ringing stiffness); 0 when the ringing is within
     4 σ of the noise.
@@ -68,7 +71,8 @@ Per slip y → s:
 
 Fractions as Klein reports them: ``viscous_fraction`` = E_film /
 (E_film + ΔE_osc) (viscous, during the slip) and ``at_stick_fraction`` =
-ΔE_osc / (E_film + ΔE_osc) (lost at the stick).
+ΔE_osc / (E_film + ΔE_osc) (lost at the stick), with E_film = ``film_heat``
+(which is ``film_dissipation`` when k_f and the dilation are not known).
 """
 from __future__ import annotations
 
@@ -152,12 +156,26 @@ def _ringing(t, f, s, stop, k, noise, fraction=0.25):
 
 
 def _wall_ringing(t, v, s, stop, mass, fraction=0.25):
-    """Largest ½M(v − v̄)² over the first ``fraction`` of the stick after s."""
+    """Kinetic energy of the wall's oscillation after s (see ``ringing_energy``).
+
+    The largest ½M(v − v̄)² over the first ``fraction`` of the stick, from the
+    wall's first reversal on (v̄ the stick's mean creep), less what the wall's
+    thermal motion alone would reach there: ½M σ_v² · 2 ln n, the expected
+    largest square of n Gaussian samples, with σ_v the velocity's scatter over
+    the stick's second half.  0 when the wall never reverses (an overdamped
+    approach does not ring) or rings within its thermal motion.
+    """
     hi = s + max(int(fraction * (stop - s)), 0)
     if hi - s < 4:
         return math.nan
-    vv = v[s:hi]
-    return float(0.5 * mass * np.max((vv - vv.mean()) ** 2))
+    dv = v[s:hi] - v[s:hi].mean()
+    flips = np.flatnonzero(np.sign(dv[1:]) != np.sign(dv[:-1]))
+    if flips.size == 0:
+        return 0.0
+    tail = dv[flips[0] + 1:]
+    late = v[s + (stop - s) // 2:stop - (stop - s) // 10]
+    thermal = float(np.var(late)) * 2.0 * math.log(max(tail.size, 2)) if late.size > 3 else 0.0
+    return float(0.5 * mass * max(float(np.max(tail ** 2)) - thermal, 0.0))
 
 
 def energy_table(time, spring_force, table: CycleTable, spring_constant: float, *,
@@ -251,11 +269,15 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
             # dashpot along z, whose energy comes from the film's work in z (as the dilation)
             mount_x = np.array([trapezoid(mount_damping * (v[a:b + 1] - v_drive) ** 2,
                                           t[a:b + 1]) for a, b in zip(lo, hi)])
-            mount = mount_x
-            if "mount_heat" in cols:   # the engine's own integral, x and z
-                mh = np.asarray(cols["mount_heat"], float)
-                mount = mh[hi] - mh[lo]
             method += " (mount dashpot's work on the wall subtracted)"
+        mount = mount_x
+        if "mount_heat" in cols:   # the engine's own integral, x and z
+            mh = np.asarray(cols["mount_heat"], float)
+            mount = mh[hi] - mh[lo]
+            if not mount_damping and np.any(mount != 0):
+                # a dashpot whose γM was not given: its heat stands in for its work
+                film = film - mount
+                method += " (mount dashpot heat subtracted: its damping was not given)"
     else:
         method = "klein-eq1"
         film = exact + drive
@@ -272,10 +294,6 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         stop = yi[i + 1] if i + 1 < m else t.size
         ring[i] = (_wall_ringing(t, v, si[i], stop, mass) if ring_method == "wall-kinetic"
                    else _ringing(t, f, si[i], stop, k, noise))
-    total = film + ring
-    with np.errstate(invalid="ignore", divide="ignore"):
-        visc_frac = film / total
-        stick_frac = ring / total
 
     elastic = nan()
     if film_stiffness is not None and film_stiffness > 0:
@@ -291,6 +309,11 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     balance, q_slip = nan(), nan()
     film_heat = film + np.where(np.isfinite(elastic), elastic, 0.0) \
         - np.where(np.isfinite(dilation), dilation, 0.0)
+    # Klein's fractions, with everything the film turns into heat in the slip
+    total = film_heat + ring
+    with np.errstate(invalid="ignore", divide="ignore"):
+        visc_frac = film_heat / total
+        stick_frac = ring / total
     if v is not None and mass and all(c in cols for c in ("spring_energy", "drive_work")):
         es = np.asarray(cols["spring_energy"], float)
         wd = np.asarray(cols["drive_work"], float)
