@@ -100,6 +100,10 @@ class NewtonianFilm(FrictionLaw):
         return force / self.drag_coefficient
 
 
+#: the shear-thinning films' example() (a block with M = K = 1, driven at V = 0.1)
+_EXAMPLE_FILM = dict(viscosity=0.5, area=1.0, thickness=1.0, exponent=0.6, onset_rate=0.05)
+
+
 @dataclass(frozen=True)
 class ShearThinningFilm(FrictionLaw):
     """Shear-thinning film: eta falls as a power of the shear rate gamma = s / D.
@@ -137,8 +141,7 @@ class ShearThinningFilm(FrictionLaw):
 
     @classmethod
     def example(cls):
-        return cls(viscosity=0.5, area=1.0, thickness=1.0, exponent=0.6, onset_rate=0.05,
-                   yield_force=1.0)
+        return cls(**_EXAMPLE_FILM, yield_force=1.0)
 
     @classmethod
     def invalid_examples(cls):
@@ -189,8 +192,7 @@ class ThinningFilmWithSliding(ShearThinningFilm):
 
     @classmethod
     def example(cls):
-        return cls(viscosity=0.5, area=1.0, thickness=1.0, exponent=0.6, onset_rate=0.05,
-                   kinetic=0.5)
+        return cls(**_EXAMPLE_FILM, kinetic=0.5)
 
     @classmethod
     def invalid_examples(cls):
