@@ -42,7 +42,7 @@ def _imports(path: Path) -> set[str]:
 
 
 def _graph() -> dict[str, set[str]]:
-    files = {_module_name(p): p for layer in LAYERS for p in (ROOT / layer).glob("*.py")}
+    files = {_module_name(p): p for layer in LAYERS for p in (ROOT / layer).rglob("*.py")}
     graph = {}
     for mod, path in files.items():
         # keep only names that are modules (``from .x import f`` also yields ``.x.f``)
