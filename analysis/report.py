@@ -102,7 +102,7 @@ def _not_sliding(s: dict) -> str | None:
     (its change over the half is below 10 % of its mean).
     """
     if s["wall_velocity_ratio"] is not None:
-        if abs(s["wall_velocity_ratio"] - 1.0) > 0.2:
+        if not stickslip.sliding_steadily(s["wall_velocity_ratio"]):
             return (f"the wall moves at {s['wall_velocity_ratio']:.3g} × the drive's "
                     "velocity on average: it is not sliding steadily")
         return None

@@ -29,7 +29,7 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CYCLE_COLUMNS, CycleTable, cycle_table, stats
 
-__all__ = ["Regime", "CycleTable", "SlipEvents", "StickStiffness", "stick_stiffness", "cycle_table", "detect_slips",
+__all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTable", "SlipEvents", "StickStiffness", "stick_stiffness", "cycle_table", "detect_slips",
            "noise_level", "classify_regime", "ramp_forces", "REGIME_CV_MAX"]
 
 class Regime(enum.StrEnum):
@@ -44,6 +44,20 @@ class Regime(enum.StrEnum):
     IRREGULAR = "irregular"    #: >= 2 slips that fail the regularity test
     SMOOTH = "smooth"          #: < 2 slips and the wall slides steadily
     UNRESOLVED = "unresolved"  #: < 2 slips without steady sliding: stuck, or too short to tell
+
+
+#: Steady sliding: the wall's mean velocity within this fraction of the drive's.
+STEADY_VELOCITY_TOLERANCE = 0.2
+
+
+def sliding_steadily(wall_velocity_ratio: float) -> bool:
+    """Whether a wall moving at ``wall_velocity_ratio`` × V slides steadily (the one rule
+    that tells a ``smooth`` run from an ``unresolved`` one: a stuck wall has no slips either).
+
+    >>> sliding_steadily(0.95), sliding_steadily(0.3)
+    (True, False)
+    """
+    return abs(float(wall_velocity_ratio) - 1.0) <= STEADY_VELOCITY_TOLERANCE
 
 
 #: Largest coefficient of variation of Fs and of the period still called

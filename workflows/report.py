@@ -318,23 +318,33 @@ def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
         z, rho = 0.5 * (edges[1:] + edges[:-1]), hist / hist.max()
         src = "film atoms' z over the last half of the trajectory (normalised)"
     ax.plot(rho, z, color="tab:blue")
-    ax.set_xlabel("density")
+    if src.startswith("profiles/density.profile (density"):
+        ax.set_xlabel("number density [σ⁻³]")
+    elif src.startswith("profiles"):
+        ax.set_xlabel("atoms per bin [1]")
+    else:
+        ax.set_xlabel("number density (normalised) [1]")
     ax.set_ylabel("z [σ]")
     ax.set_title("density across the gap", fontsize=9)
     note.append(f"density from {src}")
     if has_traj:
         u.trajectory[-1]
         ax2 = axes[0, 1]
-        colors = {1: "tab:orange", 2: "0.45", 3: "0.65"}
+        from filmfriction.md_inputs import contract
+
+        # every atom type of the contract (flexible walls have two per wall)
+        colors = {contract.AtomType.FILM: "tab:orange", contract.AtomType.BOTTOM_WALL: "0.45",
+                  contract.AtomType.TOP_WALL: "0.65", contract.AtomType.BOTTOM_FLEXIBLE: "tab:green",
+                  contract.AtomType.TOP_FLEXIBLE: "tab:olive"}
         lx = float(u.dimensions[0])
         for typ, c in colors.items():
-            g = u.select_atoms(f"type {typ}")
+            g = u.select_atoms(f"type {int(typ)}")
             if g.n_atoms:
                 # the trajectory is unwrapped (for the analyses); the picture
                 # shows the periodic box
                 x = np.mod(g.positions[:, 0], lx) if lx > 0 else g.positions[:, 0]
                 ax2.scatter(x, g.positions[:, 2], s=9, color=c,
-                            label={1: "film", 2: "bottom wall", 3: "top wall"}[typ])
+                            label=contract.ATOM_TYPES[typ])
         ax.set_ylim(ax2.get_ylim())
         ax2.set_aspect("equal")
         ax2.set_xlabel("x [σ] (sliding direction)")

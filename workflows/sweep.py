@@ -42,9 +42,11 @@ from pathlib import Path
 
 # The sweep is split by purpose; this module is the command line and the one
 # place the rest of the project imports from.
-from .sweep_aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, STUCK_RATIO, Aggregate,
+from .sweep_aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, Aggregate,
                               CriticalVelocity, build_aggregate, critical_velocity, load_aggregate,
                               reduced_model_boundary, write_aggregate)
+from filmfriction.analysis.stickslip import STEADY_VELOCITY_TOLERANCE
+
 from .sweep_figures import _numeric_axes, fig_velocity_map, fig_vk_map
 from .sweep_jobs import (PROFILES, SNAKEFILE, _interrupt, analyse_point, profile_path, run_point,
                          run_sweep, snakemake_command)
@@ -171,8 +173,9 @@ def summary(agg: Aggregate) -> str:
                                          if regimes.count(r)))
     if STUCK in regimes:
         lines.append(f"note: {STUCK}: < 2 slips without steady sliding (a stuck wall, one "
-                     f"late slip, or a wall below {STUCK_RATIO:g} V): the run is too short to tell "
-                     "its regime (raise slide_steps; each point's analysis.json has the reason)")
+                     f"late slip, or a wall off V by more than {STEADY_VELOCITY_TOLERANCE:.0%}): "
+                     "the run is too short to tell its regime (raise slide_steps; each "
+                     "point's analysis.json has the reason)")
     for cv in agg.critical_velocity:
         group = ", ".join(f"{k}={format_value(v)}" for k, v in cv["group"].items())
         prefix = f"critical velocity{' (' + group + ')' if group else ''}: "

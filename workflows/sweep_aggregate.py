@@ -15,18 +15,15 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
-from filmfriction.analysis.stickslip import Regime
+from filmfriction.analysis.stickslip import Regime, sliding_steadily
 
 from .sweep_plan import _dumps, format_value
 
 AGGREGATE_SCHEMA = "filmfriction.sweep-aggregate/1"
 # regimes of the analysis (filmfriction.analysis.stickslip.Regime)
 STICK_SLIP, SMOOTH, IRREGULAR = Regime.STICK_SLIP, Regime.SMOOTH, Regime.IRREGULAR
-# The analysis itself now calls a run with fewer than 2 slips and no steady sliding
-# "unresolved".  An analysis.json written before it did says "smooth"; the sweep marks such
-# a point unresolved when its wall moved slower than this fraction of V over its last half.
-# Unresolved points are left out of V_c and of η_eff.
-STUCK, STUCK_RATIO = Regime.UNRESOLVED, 0.5
+# Unresolved points (fewer than 2 slips without steady sliding) are left out of V_c and of η_eff.
+STUCK = Regime.UNRESOLVED
 
 
 # ---------------------------------------------------------------------------
@@ -151,11 +148,12 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
     # (the start-up ramp from a relaxed spring is in the first half), as analysed
     row["mean_force"] = finite_or_none(_get(doc, "sliding", "mean_force", "mean"))
     row["mean_force_stderr"] = finite_or_none(_get(doc, "sliding", "mean_force", "stderr"))
-    # an older analysis' "smooth" for a wall that mostly stood still (see STUCK_RATIO)
+    # the analysis' own rule (sliding_steadily), applied again to an analysis.json
+    # that reads "smooth" for a wall that did not slide steadily
     ratio = finite_or_none(_get(doc, "sliding", "wall_velocity_ratio"))
     row["wall_velocity_ratio"] = ratio
     row["sweep_regime"] = row["regime"]
-    if row["regime"] == SMOOTH and not (ratio is not None and ratio > STUCK_RATIO):
+    if row["regime"] == SMOOTH and ratio is not None and not sliding_steadily(ratio):
         row["sweep_regime"] = STUCK
     # η_eff at its shear rate: steady sliding (V/D), else the slip fits (slip velocity / D)
     eta = rate = eta_err = None

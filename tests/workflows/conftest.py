@@ -119,10 +119,8 @@ def check_axes_units(labels: list) -> None:
     """Every axis label of every figure names its unit in brackets."""
     assert len(labels) >= 5
     named = [label for fig in labels for axis in fig for label in axis if label]
-    # a density axis without a unit is the one gap known (its profile may be a number
-    # density in 1/sigma^3 or normalised to 1): reported, left out here
     missing = [label for label in named
-               if not re.search(r"\[[^\]]+\]", label) and label != "density"]
+               if not re.search(r"\[[^\]]+\]", label)]
     assert not missing, f"axis labels without a unit: {missing}"
     units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
     assert AXIS_UNITS <= units, units
