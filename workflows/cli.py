@@ -36,6 +36,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="filmfriction",
         description="Stick-slip friction of confined films: MD scenes, analysis, "
                     "reduced model and comparison with SFB experiments.")
+    from filmfriction import __version__
+
+    parser.add_argument("--version", action="version", version=f"filmfriction {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     registered = set()
     for name, module_name in COMMANDS.items():

@@ -140,3 +140,14 @@ def test_cli_scenes_lists_descriptions(run_cli):
     for name in scene.available():
         s = load(name)
         assert name in r.out and s.description in r.out and s.expected_cost in r.out, name
+
+
+def test_version(capsys):
+    from filmfriction import __version__
+    from filmfriction.workflows.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"filmfriction {__version__}"
+    assert __version__ != "0+unknown"
