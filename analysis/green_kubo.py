@@ -78,7 +78,7 @@ def read_correlate(path) -> CorrelationData:
     """
     path = Path(path)
     names: tuple[str, ...] = ()
-    sections: list[tuple[int, list[list[float]]]] = []
+    sections: list[tuple[int, int, list[list[float]]]] = []   # step, rows declared, rows
     current: list[list[float]] | None = None
     for number, line in enumerate(path.read_text().splitlines(), 1):
         fields = line.split()
@@ -89,19 +89,17 @@ def read_correlate(path) -> CorrelationData:
                 names = tuple(fields[4:])
             continue
         if len(fields) == 2:                # a section header: step, rows
-            expected = int(fields[1])
             current = []
-            sections.append((int(fields[0]), current))
+            sections.append((int(fields[0]), int(fields[1]), current))
         elif current is None or len(fields) != 3 + len(names):
             raise ValueError(f"{path}:{number}: not a correlation row: {line!r}")
         else:
             current.append([float(x) for x in fields])
     if not names:
         raise ValueError(f"{path}: no '# Index TimeDelta Ncount ...' header")
-    rows_per_block = max((len(rows) for _, rows in sections), default=0)
     # a section cut short (a run stopped while writing) is not a block either
-    complete = [(s, np.array(rows)) for s, rows in sections
-                if rows and len(rows) == rows_per_block and rows[-1][2] > 0]
+    complete = [(s, np.array(rows)) for s, n, rows in sections
+                if rows and len(rows) == n and rows[-1][2] > 0]
     if not complete:
         raise ValueError(f"{path}: no complete correlation block")
     arr = np.stack([rows for _, rows in complete])

@@ -234,33 +234,56 @@ def run(settings: Settings, run_dir: Path, progress=_progress) -> dict:
              f"rho = {settings.density:g}, rc = {settings.cutoff:g}; {total} steps on "
              f"{settings.np} rank(s) in {run_dir}")
     start = time.monotonic()
-    screen, errors = [], []
-    with subprocess.Popen(cmd, cwd=run_dir, env=engine.engine_env(), stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True, bufsize=1) as proc:
+    screen_path, blocks_path = run_dir / "lammps.screen", run_dir / "gk.blocks"
+    reported, first = 0, None
+    # LAMMPS's screen output is block-buffered in a pipe, so progress comes
+    # from gk.blocks, which LAMMPS opens, appends and closes once per block
+    with open(screen_path, "w") as screen, \
+            subprocess.Popen(cmd, cwd=run_dir, env=engine.engine_env(), stdout=screen,
+                             stderr=subprocess.STDOUT) as proc:
         try:
-            for line in proc.stdout:
-                screen.append(line)
-                if line.startswith("ERROR") or "ERROR:" in line:
-                    errors.append(line.strip())
-                if line.startswith("FILMFRICTION block"):
-                    # FILMFRICTION block i of n step s eta e T t
-                    f = line.split()
-                    i, n = int(f[2]), int(f[4])
-                    elapsed = time.monotonic() - start
-                    progress(f"  block {i}/{n}: eta = {float(f[8]):.3g}, T = {float(f[10]):.4g}"
-                             f"  ({elapsed:.0f} s, about {elapsed / i * (n - i):.0f} s to go)")
-                elif line.startswith("FILMFRICTION production"):
-                    progress(f"  equilibrated ({time.monotonic() - start:.0f} s); production")
+            while True:
+                done = proc.poll() is not None
+                rows = _block_rows(blocks_path)
+                for row in rows[reported:]:
+                    reported += 1
+                    now = time.monotonic()
+                    first = first or now
+                    left = ""
+                    if reported > 1:
+                        per_block = (now - first) / (reported - 1)
+                        left = f", about {per_block * (settings.blocks - reported):.0f} s to go"
+                    progress(f"  block {reported}/{settings.blocks}: eta = {row[-1]:.3g}, "
+                             f"T = {row[1]:.4g}  ({now - start:.0f} s elapsed{left})")
+                if done:
+                    break
+                time.sleep(0.5)
         except KeyboardInterrupt:
             proc.terminate()
             proc.wait()
             raise
     wall = time.monotonic() - start
-    (run_dir / "lammps.screen").write_text("".join(screen))
+    text = screen_path.read_text(errors="replace")
+    errors = [l.strip() for l in text.splitlines() if l.startswith("ERROR")]
     if proc.returncode != 0 or errors:
         raise RunFailed(errors[0] if errors else
-                        f"LAMMPS exited with code {proc.returncode}; see {run_dir / 'lammps.screen'}")
+                        f"LAMMPS exited with code {proc.returncode}; see {screen_path}")
     return analyse(settings, run_dir, wall_time=wall)
+
+
+def _block_rows(path: Path) -> list[list[float]]:
+    """The finished rows of gk.blocks so far (none before the file exists)."""
+    try:
+        # only whole lines: LAMMPS may be writing the last one
+        lines = path.read_text().split("\n")[:-1]
+    except FileNotFoundError:
+        return []
+    rows = []
+    for line in lines:
+        fields = line.split()
+        if fields and not line.startswith("#") and len(fields) == len(gk.BLOCK_COLUMNS):
+            rows.append([float(x) for x in fields])
+    return rows
 
 
 def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> dict:
