@@ -53,3 +53,15 @@ def test_bad_viscosities_raise(bad):
         U.viscosity_time_unit(bad)
     with pytest.raises(ValueError, match="eta_si"):
         U.viscosity_time_unit(3.0, eta_si=bad)
+
+
+def test_the_film_state_point_mapping():
+    m = U.OMCTS_VISCOSITY_MATCHED
+    assert m.to_si(U.LJ_ETA_FILM, "viscosity") == pytest.approx(2.5e-3, rel=1e-12)
+    assert m.tau == pytest.approx(U.viscosity_time_unit(U.LJ_ETA_FILM), rel=1e-12)
+    # tau_eta ~ 67 ps, ~9 times the mapping's sigma sqrt(m/eps) ~ 7.6 ps
+    assert m.tau == pytest.approx(66.9e-12, rel=0.01)
+    assert OMCTS.tau == pytest.approx(7.55e-12, rel=0.01)
+    # with the usual tau the LJ liquid is ~0.28 mPa s, ~9 times less viscous than OMCTS
+    assert OMCTS.to_si(U.LJ_ETA_FILM, "viscosity") == pytest.approx(0.28e-3, rel=0.02)
+    assert 0 < U.LJ_ETA_FILM_STDERR < 0.1 * U.LJ_ETA_FILM
