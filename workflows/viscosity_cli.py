@@ -49,11 +49,11 @@ UNITS = "epsilon*tau/sigma^3"
 #: Defaults of the options (LJ units); see the module docstring.
 DEFAULTS = {
     "cutoff": 2.5,
-    "steps": 100_000,            # production steps
+    "steps": 150_000,            # production steps (10 blocks of 75 tau)
     "blocks": 10,                # independent Green-Kubo blocks
     "cells": 6,                  # 6^3 fcc cells = 864 atoms
     "timestep": 0.005,
-    "correlation_time": 2.5,     # tau: upper limit of the Green-Kubo integral
+    "correlation_time": 3.0,     # tau: upper limit of the Green-Kubo integral
     "sample_every": 5,           # steps between pressure-tensor samples
     "equilibrate_steps": 10_000,
     "melt_steps": 2_000,
@@ -154,38 +154,41 @@ def _fail(message: str):
     raise UserError(message)
 
 
-def _finite(name: str, value) -> float:
+def _ok(value, low: float, high: float = math.inf, *, low_open=True, high_open=False) -> bool:
+    """``value`` is a finite number within the interval (NaN and inf never are)."""
     if not isinstance(value, (int, float)) or not math.isfinite(value):
-        _fail(f"{name} {value!r}: must be a finite number")
-    return float(value)
+        return False
+    above = value > low if low_open else value >= low
+    below = value < high if high_open else value <= high
+    return above and below
 
 
 def settings_from_args(args: argparse.Namespace) -> Settings:
     """Check every input before anything runs; a bad one raises UserError naming it and its range."""
     get = lambda name: getattr(args, name, DEFAULTS.get(name))  # noqa: E731
-    t = _finite("--temperature", args.temperature)
-    if t <= 0:
+    t = args.temperature
+    if not _ok(t, 0.0):
         _fail(f"--temperature {t:g}: must be > 0 (epsilon/k_B; the LJ triple point is 0.722)")
-    rho = _finite("--density", args.density)
-    if not 0 < rho < CLOSE_PACKING:
+    rho = args.density
+    if not _ok(rho, 0.0, CLOSE_PACKING, high_open=True):
         _fail(f"--density {rho:g}: must be in (0, {CLOSE_PACKING:.4f}) sigma^-3 "
               "(sqrt(2) is fcc close packing of spheres of diameter sigma)")
     cells = get("cells")
     if not isinstance(cells, int) or not 2 <= cells <= 40:
         _fail(f"--cells {cells!r}: must be an integer in [2, 40] (4*cells^3 atoms)")
     edge = cells * (4.0 / rho) ** (1.0 / 3.0)
-    rc = _finite("--cutoff", get("cutoff"))
-    if not 1.0 <= rc <= edge / 2:
+    rc = get("cutoff")
+    if not _ok(rc, 1.0, edge / 2, low_open=False):
         _fail(f"--cutoff {rc:g}: must be in [1, {edge / 2:.3g}] sigma (half the box edge "
               f"{edge:.3g} sigma at --cells {cells}; more cells allow a longer cutoff)")
-    dt = _finite("--timestep", get("timestep"))
-    if not 0 < dt <= 0.01:
+    dt = get("timestep")
+    if not _ok(dt, 0.0, 0.01):
         _fail(f"--timestep {dt:g}: must be in (0, 0.01] tau (LJ liquid stability)")
     every = get("sample_every")
     if not isinstance(every, int) or every < 1:
         _fail(f"--sample-every {every!r}: must be an integer >= 1 step")
-    tc = _finite("--correlation-time", get("correlation_time"))
-    if tc < 2 * every * dt:
+    tc = get("correlation_time")
+    if not _ok(tc, 2 * every * dt, low_open=False):
         _fail(f"--correlation-time {tc:g}: must be >= {2 * every * dt:g} tau "
               f"(two sampling intervals of {every} steps)")
     blocks = get("blocks")
@@ -299,12 +302,13 @@ def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> d
                                           timestep=settings.timestep)
     np.savetxt(run_dir / "gk_integral.csv", np.column_stack([t, eta_t, err_t]), delimiter=",",
                header="correlation_time_tau,eta,eta_stderr", comments="", fmt="%.8g")
-    half = int(np.searchsorted(t, t[-1] / 2))
+    # the last quarter of the window: a plateau has stopped moving there
+    late = int(np.searchsorted(t, 0.75 * t[-1]))
     notes = []
-    if abs(eta_t[-1] - eta_t[half]) > 2 * err_t[-1]:
-        notes.append(f"the integral still moves between t_c/2 and t_c ({eta_t[half]:.3g} -> "
-                     f"{eta_t[-1]:.3g}, more than twice the error): try a longer "
-                     "--correlation-time")
+    if abs(eta_t[-1] - eta_t[late]) > 2 * err_t[-1]:
+        notes.append(f"the integral still moves over the last quarter of the window "
+                     f"({eta_t[late]:.3g} at {t[late]:.3g} tau -> {eta_t[-1]:.3g} at {t[-1]:.3g} tau, "
+                     "more than twice the error): try a longer --correlation-time")
     if result.diffusion < 0.005:
         notes.append(f"the sample barely diffuses (D = {result.diffusion:.2g} sigma^2/tau): it "
                      "may have crystallised, and eta is then not a liquid's")
@@ -331,7 +335,7 @@ def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> d
         "eta_blocks": [float(x) for x in result.eta_blocks],
         "eta_components": result.components,
         "correlation_time": float(t[-1]),
-        "eta_half_correlation_time": float(eta_t[half]),
+        "eta_three_quarter_correlation_time": float(eta_t[late]),
         "measured_temperature": result.temperature,
         "measured_temperature_stderr": result.temperature_stderr,
         "pressure": result.pressure,
@@ -368,7 +372,7 @@ def format_result(r: dict) -> str:
         f"rho = {r['density']:g}, rc = {r['cutoff']:g} (truncated), {r['n_atoms']} atoms; "
         f"P = {r['pressure']:.3f} epsilon/sigma^3, D = {r['diffusion']:.4f} sigma^2/tau",
         f"  Green-Kubo: {r['steps']} NVE steps of {r['timestep']:g} tau, integral to "
-        f"{r['correlation_time']:g} tau (at half of it: {r['eta_half_correlation_time']:.3f}); "
+        f"{r['correlation_time']:g} tau (at 3/4 of it: {r['eta_three_quarter_correlation_time']:.3f}); "
         f"xy {c['xy']:.3f}, xz {c['xz']:.3f}, yz {c['yz']:.3f}",
         f"  OMCTS: tau = sigma sqrt(m/epsilon) = {o['tau_s'] * 1e12:.2f} ps gives "
         f"eta = {o['eta_si_Pa_s'] * 1e3:.3f} mPa s; the viscosity-matched "
