@@ -318,3 +318,94 @@ def to_si(value, quantity: str, units: LJUnits = OMCTS):
 def from_si(value, quantity: str, units: LJUnits = OMCTS):
     """Convert SI ``value`` of ``quantity`` to LJ with ``units`` (default :data:`OMCTS`)."""
     return units.from_si(value, quantity)
+
+
+# ---------------------------------------------------------------------------
+# Viscosity-matched time unit
+# ---------------------------------------------------------------------------
+# The mapping above fixes τ = σ√(m/ε) by OMCTS's molecular mass.  With it the
+# bulk LJ liquid is about ten times less viscous than OMCTS (η* ≈ 3 ετ/σ³ is
+# ≈ 0.25 mPa·s, OMCTS 2.5 mPa·s): one sphere does not carry the friction of a
+# floppy ring molecule.  A second, equally defensible choice keeps σ and ε and
+# sets the time unit so that the MD liquid's viscosity *is* OMCTS's:
+#
+#     η_SI = η* · ε τ_η / σ³   ⇒   τ_η = η_SI σ³ / (η* ε).
+#
+# Keeping σ and ε while changing τ is the same as changing the mass unit to
+# m_η = ε τ_η² / σ² (τ = σ√(m/ε) must hold for the conversions to stay
+# consistent), so the viscosity-matched system is an ordinary LJUnits with
+# that effective mass: lengths, energies, forces and stresses convert as
+# before, times, rates, velocities, viscosities and damping by τ_η.
+
+#: Bulk viscosity of OMCTS at room temperature, Pa·s (Klein's η_bulk, seed 004).
+OMCTS_BULK_VISCOSITY = 2.5e-3
+
+
+def viscosity_time_unit(eta_lj: float, eta_si: float = OMCTS_BULK_VISCOSITY,
+                        units: LJUnits = OMCTS) -> float:
+    """Time unit τ_η (s) that maps the LJ viscosity ``eta_lj`` onto ``eta_si``.
+
+    τ_η = η_SI σ³ / (η* ε), with σ and ε of ``units``.
+
+    Parameters
+    ----------
+    eta_lj : float
+        Bulk shear viscosity of the LJ liquid, ετ/σ³ (e.g. from
+        ``filmfriction viscosity``).
+    eta_si : float
+        The real liquid's viscosity, Pa·s (default OMCTS, 2.5 mPa·s).
+    units : LJUnits
+        Supplies σ and ε (default :data:`OMCTS`).
+
+    Examples
+    --------
+    >>> tau = viscosity_time_unit(3.0)
+    >>> round(3.0 * OMCTS.epsilon * tau / OMCTS.sigma**3 * 1e3, 9)   # back to mPa·s
+    2.5
+    """
+    for name, value in (("eta_lj", eta_lj), ("eta_si", eta_si)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be a positive finite viscosity, got {value!r}")
+    return eta_si * units.sigma**3 / (eta_lj * units.epsilon)
+
+
+def viscosity_matched(eta_lj: float, eta_si: float = OMCTS_BULK_VISCOSITY,
+                      units: LJUnits = OMCTS, name: str | None = None,
+                      source: str = "") -> LJUnits:
+    """``units`` with the time unit τ_η of :func:`viscosity_time_unit`.
+
+    σ and ε are kept; the mass unit becomes m_η = ε τ_η²/σ², the mass for
+    which σ√(m/ε) = τ_η.  Note that ``to_si(x, "mass")`` then converts with
+    that effective mass, not with the molecule's.
+    """
+    tau = viscosity_time_unit(eta_lj, eta_si, units)
+    mass = units.epsilon * tau**2 / units.sigma**2
+    note = (f"viscosity-matched: tau = eta_SI sigma^3/(eta* epsilon) with eta* = {eta_lj:g} "
+            f"epsilon tau/sigma^3 -> {eta_si:g} Pa s; effective mass {mass / units.mass:.4g} "
+            f"x that of '{units.name}'")
+    return LJUnits(sigma=units.sigma, epsilon=units.epsilon, mass=mass,
+                   name=name or f"{units.name} (viscosity-matched)",
+                   source="; ".join(s for s in (note, source or units.source) if s))
+
+
+#: Bulk shear viscosity of the LJ liquid (rc = 2.5 σ, truncated) at the film's
+#: state point, T = 0.71 ε/k_B and ρ = 0.85 σ⁻³, in ετ/σ³: 3.55 ± 0.10 (standard
+#: error over 20 blocks), measured with
+#: ``filmfriction viscosity --temperature 0.71 --density 0.85 --steps 800000
+#: --blocks 20 --seed 4928459`` (864 atoms; measured T 0.708, P 0.92 ε/σ³ ≈ the
+#: film's load of 1 ε/σ³, D 0.029 σ²/τ: a liquid).  See docs/viscosity.md.
+LJ_ETA_FILM = 3.55
+#: Its standard error, ετ/σ³.
+LJ_ETA_FILM_STDERR = 0.10
+
+#: The OMCTS mapping with the viscosity-matched time unit: τ_η ≈ 67 ps
+#: (≈ 8.8 × the mapping's τ = σ√(m/ε) ≈ 7.6 ps), so that the MD liquid's
+#: η* = :data:`LJ_ETA_FILM` is OMCTS's 2.5 mPa·s.  Convert SFB numbers with
+#: ``units=OMCTS`` or ``units=OMCTS_VISCOSITY_MATCHED`` to see both.
+OMCTS_VISCOSITY_MATCHED = viscosity_matched(
+    LJ_ETA_FILM, name="OMCTS (viscosity-matched)",
+    source=f"eta* = {LJ_ETA_FILM} +- {LJ_ETA_FILM_STDERR} at T = 0.71, rho = 0.85, rc = 2.5 "
+           "(filmfriction viscosity); " + OMCTS.source)
+
+__all__ += ["OMCTS_BULK_VISCOSITY", "viscosity_time_unit", "viscosity_matched",
+            "LJ_ETA_FILM", "LJ_ETA_FILM_STDERR", "OMCTS_VISCOSITY_MATCHED"]

@@ -24,6 +24,8 @@ COMMANDS = {
     "report": "filmfriction.workflows.report_cli",
     "tradeoff": "filmfriction.workflows.tradeoff",
     "sweep": "filmfriction.workflows.sweep",
+    # bulk LJ viscosity by Green-Kubo (branch viscosity)
+    "viscosity": "filmfriction.workflows.viscosity_cli",
 }
 
 
