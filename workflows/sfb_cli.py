@@ -40,6 +40,10 @@ def register(subparsers) -> None:
     p.add_argument("--out", metavar="FILE.json", type=Path, default=None,
                    help="also write the check as the study does (e.g. RUN_DIR/sfb.json, with its "
                         "slips' traces beside it), for 'filmfriction report'")
+    p.add_argument("--time-unit", choices=("mass", "viscosity"), default="mass",
+                   help="the LJ time unit carried to SI: sigma*sqrt(m/eps) of the OMCTS molecule "
+                        "(mass, default) or the one that maps the LJ liquid's eta onto OMCTS's "
+                        "2.5 mPa s (viscosity; see docs/viscosity.md)")
     p.add_argument("--sigma-nm", type=float, default=None,
                    help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
     p.add_argument("--epsilon-K", type=float, default=None,
@@ -48,6 +52,13 @@ def register(subparsers) -> None:
 
 
 def _units(args) -> LJUnits:
+    if getattr(args, "time_unit", "mass") == "viscosity":
+        from filmfriction.workflows.cli import UserError
+        if args.sigma_nm is not None or args.epsilon_K is not None:
+            raise UserError("--time-unit viscosity: the matched mapping keeps OMCTS's sigma and "
+                            "epsilon; --sigma-nm/--epsilon-K are accepted with --time-unit mass only")
+        from filmfriction.reduced_model.units import OMCTS_VISCOSITY_MATCHED
+        return OMCTS_VISCOSITY_MATCHED
     if args.sigma_nm is None and args.epsilon_K is None:
         return OMCTS
     from filmfriction.workflows.cli import UserError

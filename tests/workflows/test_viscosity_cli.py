@@ -170,3 +170,31 @@ def test_read_blocks_checks_header_and_rows(tmp_path):
     _write_blocks(p, [[1, 2, 3]])
     with pytest.raises(ValueError, match="columns"):
         gk.read_blocks(p)
+
+
+def test_sfb_with_the_viscosity_matched_time_unit(run_cli):
+    import json
+
+    from filmfriction.reduced_model import MDCalibration
+    from filmfriction.reduced_model.units import OMCTS, OMCTS_VISCOSITY_MATCHED
+
+    cal = {"yield_stress": 5.0, "eta_zero": 3.0, "sliding_stress": 1.0, "restick_stress": 2.0}
+    rows = {}
+    for unit in ("mass", "viscosity"):
+        import tempfile
+        from pathlib import Path
+        path = Path(tempfile.mkdtemp()) / "cal.json"
+        path.write_text(json.dumps(cal))
+        r = run_cli("sfb", "--json", "--calibration", path, "--time-unit", unit)
+        assert r.code == 0, r.err
+        rows[unit] = {x["name"]: x for x in r.json() if x["source"] == "md-calibrated"}
+    ratio = OMCTS_VISCOSITY_MATCHED.tau / OMCTS.tau
+    # eta = eta* eps tau / sigma^3: the matched unit scales it by the ratio of the time units
+    assert rows["viscosity"]["eta_eff"]["model"] == pytest.approx(
+        rows["mass"]["eta_eff"]["model"] * ratio, rel=1e-6)
+    # stresses do not involve time
+    assert rows["viscosity"]["yield_stress"]["model"] == pytest.approx(
+        rows["mass"]["yield_stress"]["model"])
+    assert MDCalibration.from_dict(cal).yield_stress == 5.0
+    bad = run_cli("sfb", "--time-unit", "viscosity", "--sigma-nm", "0.9")
+    assert bad.code == 2 and "--time-unit viscosity" in bad.err
