@@ -5,9 +5,10 @@ and the run's own parameters (``run.json``'s ``trace_parameters`` and scene) int
 :class:`filmfriction.reduced_model.similarity.SlidingContact` in the run's units:
 
 * F_s, F_b, Δx0 — the slips' means and standard errors (start-up slip left out);
-* B — the film's drag from the slip-law fit (``slip_law.damping``: F_film = F_k + B·v,
-  the mount's dashpot taken off), when the fit resolved it; else the Klein-style
-  slip fit less the mount's dashpot (``viscosity.from_slip.damping`` − γM);
+* B — the film's drag measured as Klein measured his: his Eq. (1) fitted to the slips
+  (``viscosity.from_slip.damping``), less the mount's dashpot γM; without that fit, the
+  slip law's B (``slip_law.damping``).  Whether a viscous B describes the film at all
+  is the slip law's verdict, reported beside it;
 * γM — the mount dashpot; k_f — the stick ramps' film stiffness;
 * the viscous fraction — film heat over film heat + ringing, per slip;
 * L = P·A with P the scene's normal pressure and A the wall area; the molecular
@@ -59,14 +60,13 @@ def contact_from_analysis(analysis: dict, run: dict) -> SlidingContact:
     if fs is None or fb is None:
         raise ValueError("the analysis has no static or backward force")
     gm = float(tp.get("mount_damping") or 0.0)
-    law = analysis.get("slip_law") or {}
-    b, b_err = _mean(law.get("damping")), _err(law.get("damping"))
-    if b is None or law.get("verdict") in (None, "none"):
-        fit = (analysis.get("viscosity") or {}).get("from_slip") or {}
-        b = _mean(fit.get("damping"))
-        b_err = _err(fit.get("damping"))
-        if b is not None:
-            b -= gm
+    fit = (analysis.get("viscosity") or {}).get("from_slip") or {}
+    b, b_err = _mean(fit.get("damping")), _err(fit.get("damping"))
+    if b is not None:
+        b -= gm
+    else:
+        law = analysis.get("slip_law") or {}
+        b, b_err = _mean(law.get("damping")), _err(law.get("damping"))
     energy = analysis.get("energy") or {}
     pressure = scene.get("normal_pressure")
     return SlidingContact(

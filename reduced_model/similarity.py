@@ -221,7 +221,8 @@ _ROW_NOTES = {
     "kinetic_friction_coefficient": "(F_s + F_b)/(2L), the cycle-averaged spring force over the load",
     "extension_over_lattice": "x0/a, spring extension at yield in molecular diameters",
     "slip_over_extension": "slip distance over the spring extension at yield",
-    "film_damping_ratio": "B/(2 sqrt(KM)), B the film's viscous drag (Klein: A eta_eff/D)",
+    "film_damping_ratio": "B/(2 sqrt(KM)), B from Klein's Eq. (1) fitted to the slips, as he "
+                          "measured his (A eta_eff/D); the slip law says whether B is viscous",
     "mount_damping_ratio": "gamma M/(2 sqrt(KM)) (Klein: ringing decay ~80 ms at 45 Hz)",
     "compliance_ratio": "K/k_f (Klein: delta/x0 with delta ~ 1 nm; his dE_f/dE_spring reads 0.025)",
     "viscous_fraction": "film heat over film heat + ringing (Klein: from dE_spring and dE_osc)",
