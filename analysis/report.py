@@ -3,10 +3,10 @@
 :func:`analyze` runs detection → cycle table → energy → viscosity (→ film
 structure when a trajectory exists) on a :class:`~filmfriction.analysis.trace.Trace`,
 then every registered observable (:mod:`filmfriction.analysis.observables`, one
-file each: the slip law ...), and returns a JSON-ready dict; an output whose
-input is missing is listed under ``skipped`` with the reason instead.  :func:`write_outputs` writes the
-document and the per-cycle CSV atomically.  The schema is documented in the
-README ("Analysis output").
+file each: the slip law ...; :func:`run_observable`), and returns a JSON-ready
+dict; an output whose input is missing is listed under ``skipped`` with the
+reason instead.  :func:`write_outputs` writes the document and the per-cycle
+CSV atomically.  The schema is documented in docs/analysis.md ("Schema").
 """
 from __future__ import annotations
 

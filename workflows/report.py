@@ -13,13 +13,15 @@ step that failed is reported as failed, with its reason, and the rest of the
 report is still written.
 
 The document is built once as a list of sections of blocks (paragraph,
-figure, table) and rendered twice, so the two files cannot disagree.
+figure, table) and rendered twice, so the two files cannot disagree.  Each
+observable of the analysis (:mod:`filmfriction.analysis.observables`) gets a
+section from one function, :func:`_observable_section`: its title, its figure
+with its caption, its table and its notes, or why it is not there.
 """
 from __future__ import annotations
 
 import base64
 import html
-import io
 import json
 import math
 import os

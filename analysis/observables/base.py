@@ -263,6 +263,9 @@ def _register(cls) -> None:
         raise TypeError(f"observable {where}: key {key!r} is a built-in section of analysis.json")
     if not cls.title:
         raise TypeError(f"observable {where}: no title (the report section's)")
+    if not isinstance(cls.needs, (tuple, list)):
+        raise TypeError(f"observable {where}: needs must be a tuple of column(...) and "
+                        f"parameter(...), got {cls.needs!r}")
     for need in cls.needs:
         if not isinstance(need, Need):
             raise TypeError(f"observable {where}: needs holds {need!r}; use column(...) or "
