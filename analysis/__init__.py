@@ -9,6 +9,8 @@ Modules (one sitting each):
   power-law fits across runs, and Klein's slip equation;
 * :mod:`filmfriction.analysis.structure` — layers, hexatic order, gap (MDAnalysis);
 * :mod:`filmfriction.analysis.report` — the ``analysis.json`` document;
+* :mod:`filmfriction.analysis.observables` — sections of ``analysis.json`` and of the
+  report declared one file each (Klein's slip law ...), with their contract;
 * :mod:`filmfriction.analysis.synthetic` — traces and films with known answers;
 * :mod:`filmfriction.analysis.calibration` — the reduced model calibrated on MD runs
   (:func:`calibrate`), from :mod:`~filmfriction.analysis.rundata`,

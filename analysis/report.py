@@ -1,11 +1,12 @@
 """The ``analysis.json`` document: every analysis that the inputs allow.
 
 :func:`analyze` runs detection → cycle table → energy → viscosity (→ film
-structure when a trajectory exists) on a :class:`~filmfriction.analysis.trace.Trace` and
-returns a JSON-ready dict; an output whose input is missing is listed under
-``skipped`` with the reason instead.  :func:`write_outputs` writes the
-document and the per-cycle CSV atomically.  The schema is documented in the
-README ("Analysis output").
+structure when a trajectory exists) on a :class:`~filmfriction.analysis.trace.Trace`,
+then every registered observable (:mod:`filmfriction.analysis.observables`, one
+file each: the slip law ...; :func:`run_observable`), and returns a JSON-ready
+dict; an output whose input is missing is listed under ``skipped`` with the
+reason instead.  :func:`write_outputs` writes the document and the per-cycle
+CSV atomically.  The schema is documented in docs/analysis.md ("Schema").
 """
 from __future__ import annotations
 
@@ -16,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from . import energy as _energy
-from . import stickslip, viscosity
+from . import observables, stickslip, viscosity
+from .observables.base import Context, Observable, entry as _entry, value as _value
 from .stickslip import Regime
 from .trace import MissingInput, Trace, unit
 from .util import finite_or_none as _num, json_safe, write_atomic
@@ -37,34 +39,13 @@ _ENERGY_UNITS = {"spring_released": "energy", "spring_released_exact": "energy",
                  "film_heat": "energy"}
 
 
-def _entry(stats: dict, units: str) -> dict:
-    return {"mean": _num(stats["mean"]), "std": _num(stats["std"]),
-            "stderr": _num(stats["stderr"]), "n": stats["n"], "units": units}
-
-
-def _value(mean, stderr, units, **extra) -> dict:
-    out = {"mean": _num(mean), "stderr": _num(stderr), "units": units}
-    out.update(extra)
-    return out
-
-
-def _drive_velocity(trace: Trace) -> tuple[float | None, str]:
-    p = trace.parameters.drive_velocity
-    if p is not None:
-        return p, "--drive-velocity"
-    if trace.has("drive_position") and len(trace) > 1:
-        slope = np.polyfit(trace.time, trace.columns["drive_position"], 1)[0]
-        return float(slope), "slope of drive_position"
-    return None, ""
-
-
 def _sliding(trace: Trace, half: slice) -> dict:
     """The last half of the trace as a sliding state: time-averaged spring force
     (block-average error), the wall's mean velocity (slope of wall_position,
     else mean of wall_velocity) and its ratio to the drive's, the force's trend."""
     t = np.asarray(trace.columns["time"], float)[half]
     f = np.asarray(trace.columns["spring_force"], float)[half]
-    v_drive, _ = _drive_velocity(trace)
+    v_drive, _ = trace.drive_velocity()
     wall = None
     if trace.has("wall_position") and t.size > 2:
         wall = float(np.polyfit(t, np.asarray(trace.columns["wall_position"], float)[half], 1)[0])
@@ -110,27 +91,6 @@ def _not_sliding(s: dict) -> str | None:
         return (f"the force changes by {s['force_trend']:.3g} over the last half (mean "
                 f"{s['mean_force']:.3g}): not steady")
     return None
-
-
-def _thickness(trace: Trace, sel=slice(None)) -> tuple[float, str]:
-    """The film thickness D, as Klein counts it: n layers times their spacing.
-
-    The ``gap`` column is the distance between the walls' innermost atom planes;
-    n film layers between them sit n + 1 layer spacings apart, so D = gap·n/(n+1)
-    when the run records its film layers (Klein: D = 3.5 nm for n = 4), else the
-    gap itself.  A ``--thickness`` given by the user is taken as it is.
-    """
-    if trace.parameters.thickness is not None:
-        return float(trace.parameters.thickness), "--thickness"
-    if trace.has("gap"):
-        gap = float(np.mean(trace.columns["gap"][sel]))
-        n = ((trace.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
-        if n:
-            return gap * n / (n + 1), (f"film layers x layer spacing: mean gap x n/(n+1), "
-                                       f"n = {n} (the gap between the walls' innermost planes "
-                                       f"holds n + 1 spacings)")
-        return gap, "mean of gap column (wall plane to wall plane)"
-    return trace.parameters.require("thickness", "viscosity"), "--thickness"
 
 
 def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) -> tuple[dict, dict]:
@@ -211,7 +171,7 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         if n == 0:
             raise MissingInput("slips", "the energy per slip")
         kk = p.require("spring_constant", "the spring energy")
-        v_drive, _ = _drive_velocity(trace)
+        v_drive, _ = trace.drive_velocity()
         stiff = (stickslip.stick_stiffness(t, f, table, spring_constant=kk,
                                            drive_velocity=v_drive) if v_drive else None)
         et = _energy.energy_table(
@@ -281,10 +241,10 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
             why = doc.get("regime_note", f"regime is {regime}")
             raise MissingInput("steady sliding", f"steady viscosity ({why})")
         area = p.require("area", "η_eff = (F/A)/γ̇")
-        v_drive, v_src = _drive_velocity(trace)
+        v_drive, v_src = trace.drive_velocity()
         if v_drive is None:
             raise MissingInput("--drive-velocity", "γ̇ = V/D")
-        d, d_src = _thickness(trace, half)
+        d, d_src = trace.film_thickness(half)
         # the run's mount dashpot acts on the wall's velocity relative to the
         # drive: in steady sliding it exerts no mean force
         sv = viscosity.steady_viscosity(f[half], area, v_drive, d)
@@ -323,8 +283,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         kk = p.require("spring_constant", "the slip fit")
         mass = p.require("mass", "the slip fit")
         area = p.require("area", "η_eff = B·D/A")
-        d, d_src = _thickness(trace)
-        v_drive, v_src = _drive_velocity(trace)
+        d, d_src = trace.film_thickness()
+        v_drive, v_src = trace.drive_velocity()
         if v_drive is None:
             v_drive, v_src = 0.0, "spring end taken fixed (no drive velocity given)"
         sl = viscosity.slip_viscosity(t, f, table[skip:], mass=mass, spring_constant=kk,
@@ -346,12 +306,6 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
         skipped["viscosity.from_slip"] = str(exc)
     doc["viscosity"] = visc
 
-    # --- Klein's slip equation tested: F_film = F_k + B·v over the slips
-    try:
-        doc["slip_law"] = _slip_law_section(trace, table[skip:], n - skip, lab, per_cycle, skip)
-    except MissingInput as exc:
-        skipped["slip_law"] = str(exc)
-
     # --- structure
     if structure and trace.run_dir is not None:
         traj = trace.optional_path("trajectory.dcd")
@@ -365,44 +319,54 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                 skipped["structure"] = f"{traj}: {exc}"
         else:
             skipped["structure"] = "no trajectory.dcd + topology.data in the run directory"
+
+    # --- the observables (analysis/observables/, one file each): Klein's slip law ...
+    ctx = Context(trace=trace, table=table[skip:], skip=skip, events=events)
+    for obs in observables.registered():
+        try:
+            doc[obs.key], columns = run_observable(obs, ctx)
+        except MissingInput as exc:
+            skipped[obs.key] = str(exc)
+            continue
+        pad = [math.nan] * skip
+        per_cycle.update({f"{obs.key}_{name}": pad + values for name, values in columns.items()})
     doc["skipped"] = skipped
     return doc, per_cycle
 
 
-def _slip_law_section(trace: Trace, table, n: int, lab, per_cycle: dict, skip: int) -> dict:
-    """``slip_law``: F_film = F_k + B·v fitted over the slips (:mod:`.sliplaw`)."""
-    from .sliplaw import fit_slip_law
+def run_observable(obs: Observable, ctx: Context) -> tuple[dict, dict]:
+    """``obs``'s section (made JSON-safe) and per-slip columns (as lists) on ``ctx``.
 
-    p = trace.parameters
-    if n <= 0:
-        raise MissingInput("slips", "the slip-law fit")
-    if not trace.has("wall_velocity"):
-        raise MissingInput("wall_velocity", "the film force during the slip")
-    mass = p.require("mass", "the film force F_spring − M·a")
-    v_drive, _ = _drive_velocity(trace)
-    fit = fit_slip_law(trace.time, trace.spring_force, trace.columns["wall_velocity"], table,
-                       mass=mass, drive_velocity=v_drive or 0.0,
-                       mount_damping=p.mount_damping or 0.0)
-    pad = [math.nan] * skip
-    per_cycle["slip_law_kinetic_force"] = pad + fit.per_slip_kinetic_force.tolist()
-    per_cycle["slip_law_damping"] = pad + fit.per_slip_damping.tolist()
-    out = {"kinetic_force": _value(fit.kinetic_force, fit.kinetic_force_stderr, lab("force")),
-           "damping": _value(fit.damping, fit.damping_stderr, lab("damping")),
-           "mean_slip_velocity": _value(fit.mean_slip_velocity, None, lab("velocity")),
-           "viscous_share": _num(fit.viscous_share), "verdict": fit.verdict,
-           "reason": fit.reason, "samples": fit.samples,
-           "residual_rms": _value(fit.residual_rms, None, lab("force")),
-           "r_squared": _num(fit.r_squared),
-           "law": "F_film = kinetic_force + damping * v, F_film = F_spring - M a - "
-                  "mount_damping (v - V)"}
-    if p.area is not None and math.isfinite(fit.damping) and (
-            trace.has("gap") or p.thickness is not None):
-        d, d_src = _thickness(trace)
-        eta = fit.damping * d / p.area
-        eta_err = fit.damping_stderr * d / p.area
-        out["eta_from_damping"] = _value(eta, eta_err, lab("viscosity"), thickness=_num(d),
-                                         thickness_source=d_src, form="B·D/A")
-    return out
+    Raises
+    ------
+    MissingInput
+        One of ``obs.needs`` is absent (the first, in their order), or ``compute``
+        found an input missing.
+    TypeError, ValueError
+        ``compute`` broke its contract: a section that is not a dict or not JSON
+        data, a per-slip column without one value per analysed slip.
+    """
+    for need in obs.needs:
+        missing = need.missing(ctx.trace)
+        if missing is not None:
+            raise missing
+    section, columns = obs.compute(ctx)
+    who = f"observable {obs.key!r} ({type(obs).__module__}.{type(obs).__qualname__})"
+    if not isinstance(section, dict):
+        raise TypeError(f"{who}: compute() gave a {type(section).__name__} section, not a dict")
+    section = json_safe(section)
+    try:
+        json.dumps(section, allow_nan=False)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"{who}: its section is not JSON data: {exc}") from None
+    out = {}
+    for name, values in (columns or {}).items():
+        values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
+        if len(values) != len(ctx.table):
+            raise ValueError(f"{who}: per-slip column {name!r} has {len(values)} values for "
+                             f"{len(ctx.table)} analysed slips")
+        out[name] = values
+    return section, out
 
 
 def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half) -> dict:
@@ -421,7 +385,7 @@ def _profile_section(trace: Trace, prof_v: Path, prof_d: Path | None, lab, half)
     else:
         rho = np.array([np.mean(c["ncount"][last]) for c in vel.chunks])
     v_top, _ = (float(np.mean(trace.columns["wall_velocity"][half])), "") \
-        if trace.has("wall_velocity") else _drive_velocity(trace)
+        if trace.has("wall_velocity") else trace.drive_velocity()
     if v_top is None:
         raise ValueError("top-wall velocity unknown (no wall_velocity column or drive velocity)")
     ps = viscosity.profile_shear(z, vx, rho, wall_velocity_top=v_top)

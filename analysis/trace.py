@@ -170,6 +170,40 @@ class Trace:
             return self.columns["drive_position"] - self.spring_force / k
         return None
 
+    def drive_velocity(self) -> tuple[float | None, str]:
+        """The spring end's velocity V and where it came from: ``--drive-velocity``,
+        else the slope of ``drive_position``, else ``(None, "")``."""
+        v = self.parameters.drive_velocity
+        if v is not None:
+            return v, "--drive-velocity"
+        if self.has("drive_position") and len(self) > 1:
+            slope = np.polyfit(self.time, self.columns["drive_position"], 1)[0]
+            return float(slope), "slope of drive_position"
+        return None, ""
+
+    def film_thickness(self, sel=slice(None)) -> tuple[float, str]:
+        """The film thickness D, as Klein counts it: n layers times their spacing,
+        and where it came from.
+
+        The ``gap`` column is the distance between the walls' innermost atom planes;
+        n film layers between them sit n + 1 layer spacings apart, so D = gap·n/(n+1)
+        (the mean gap over the samples ``sel``) when the run records its film layers
+        (Klein: D = 3.5 nm for n = 4), else the gap itself.  A ``--thickness`` given
+        by the user is taken as it is; without it and without ``gap``,
+        :class:`MissingInput` names the flag.
+        """
+        if self.parameters.thickness is not None:
+            return float(self.parameters.thickness), "--thickness"
+        if self.has("gap"):
+            gap = float(np.mean(self.columns["gap"][sel]))
+            n = ((self.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
+            if n:
+                return gap * n / (n + 1), (f"film layers x layer spacing: mean gap x n/(n+1), "
+                                           f"n = {n} (the gap between the walls' innermost planes "
+                                           f"holds n + 1 spacings)")
+            return gap, "mean of gap column (wall plane to wall plane)"
+        return self.parameters.require("thickness", "viscosity"), "--thickness"
+
     def optional_path(self, relative: str) -> Path | None:
         """A file of the run directory when it exists."""
         if self.run_dir is None:

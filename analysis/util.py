@@ -1,5 +1,5 @@
 """Small helpers the analysis and the workflows share: files written atomically,
-JSON-safe numbers.
+JSON-safe numbers, numbers as report text, figures as PNG bytes.
 
 * :func:`write_atomic` -- one way to write a file: readers (a report, a resumed
   sweep, another process) never see a half-written file: the data go to a
@@ -11,9 +11,14 @@ JSON-safe numbers.
   None, NumPy scalars -> Python numbers), for ``json.dumps(allow_nan=False)``.
 * :func:`json_default` -- the ``default=`` of ``json.dumps`` for NumPy scalars
   and paths.
+* :func:`format_value`, :func:`format_estimate` -- a number, or an
+  ``analysis.json`` entry ``{"mean", "stderr", "units"}``, as the report writes it.
+* :func:`pyplot`, :func:`png_bytes` -- matplotlib without a display, and a
+  figure as PNG bytes (the figure closed).
 """
 from __future__ import annotations
 
+import io
 import math
 import os
 import tempfile
@@ -21,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_atomic", "finite_or_none", "json_safe", "json_default"]
+__all__ = ["write_atomic", "finite_or_none", "json_safe", "json_default",
+           "format_value", "format_estimate", "pyplot", "png_bytes"]
 
 
 def _umask() -> int:
@@ -91,3 +97,60 @@ def json_default(obj):
     if isinstance(obj, Path):
         return str(obj)
     raise TypeError(type(obj))
+
+
+def format_value(x, digits: int = 4) -> str:
+    """``x`` to ``digits`` significant figures; "–" for None, NaN or infinity.
+
+    >>> format_value(3.14159), format_value(7), format_value(None), format_value(float("nan"))
+    ('3.142', '7', '–', '–')
+    """
+    if x is None:
+        return "–"
+    if isinstance(x, int) and not isinstance(x, bool):
+        return str(x)
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        return str(x)
+    if not math.isfinite(x):
+        return "–"
+    return f"{x:.{digits}g}"
+
+
+def format_estimate(e, digits: int = 3) -> str:
+    """'value ± stderr units' of an ``analysis.json`` entry (``mean`` or ``value``,
+    ``stderr``, ``units``; units ``"1"`` not written) or of an object with
+    ``value``, ``stderr`` and ``units``; "–" for None.
+
+    >>> format_estimate({"mean": 2.5, "stderr": 0.1234, "units": "ε/σ"})
+    '2.5 ± 0.12 ε/σ'
+    >>> format_estimate({"mean": 0.5, "stderr": None, "units": "1"})
+    '0.5'
+    """
+    if e is None:
+        return "–"
+    if isinstance(e, dict):
+        v, s, u = e.get("mean", e.get("value")), e.get("stderr"), e.get("units", "")
+    else:
+        v, s, u = e.value, e.stderr, e.units
+    err = f" ± {format_value(s, 2)}" if s is not None and math.isfinite(float(s)) else ""
+    return f"{format_value(v, digits)}{err} {'' if u == '1' else u}".strip()
+
+
+def pyplot():
+    """``matplotlib.pyplot`` on the Agg backend (no display needed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def png_bytes(fig) -> bytes:
+    """The matplotlib figure ``fig`` as PNG bytes (110 dpi, tight); the figure is closed."""
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()

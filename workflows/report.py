@@ -13,13 +13,15 @@ step that failed is reported as failed, with its reason, and the rest of the
 report is still written.
 
 The document is built once as a list of sections of blocks (paragraph,
-figure, table) and rendered twice, so the two files cannot disagree.
+figure, table) and rendered twice, so the two files cannot disagree.  Each
+observable of the analysis (:mod:`filmfriction.analysis.observables`) gets a
+section from one function, :func:`_observable_section`: its title, its figure
+with its caption, its table and its notes, or why it is not there.
 """
 from __future__ import annotations
 
 import base64
 import html
-import io
 import json
 import math
 import os
@@ -28,6 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.observables import Observable, registered as registered_observables
+from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
+from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.reduced_model.units import OMCTS
 
 __all__ = ["build_report", "Section", "Figure", "Table", "PARAMETER_QUANTITIES"]
@@ -79,51 +84,9 @@ class Section:
         self.blocks.append(block)
 
 
-def _fmt(x, digits: int = 4) -> str:
-    if x is None:
-        return "–"
-    if isinstance(x, int) and not isinstance(x, bool):
-        return str(x)
-    try:
-        x = float(x)
-    except (TypeError, ValueError):
-        return str(x)
-    if not math.isfinite(x):
-        return "–"
-    return f"{x:.{digits}g}"
-
-
 def _fixed(x, decimals: int) -> str:
     """``x`` with fixed decimals; "–" for a value the document has not (null)."""
     return "–" if x is None else f"{x:.{decimals}f}"
-
-
-def _pm(e, digits: int = 3) -> str:
-    """'value ± err units' from an Estimate or an analysis entry dict."""
-    if e is None:
-        return "–"
-    if isinstance(e, dict):
-        v, s, u = e.get("mean", e.get("value")), e.get("stderr"), e.get("units", "")
-    else:
-        v, s, u = e.value, e.stderr, e.units
-    err = f" ± {_fmt(s, 2)}" if s is not None and math.isfinite(float(s)) else ""
-    return f"{_fmt(v, digits)}{err} {'' if u == '1' else u}".strip()
-
-
-def _png(fig) -> bytes:
-    import matplotlib.pyplot as plt
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return buf.getvalue()
-
-
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 # ---------------------------------------------------------------------------
@@ -193,41 +156,6 @@ def fig_energy(bars) -> bytes:
     ax.invert_yaxis()
     ax.axvline(0, color="k", lw=0.6)
     ax.set_xlabel("energy per slip / per cycle [ε] (mean ± stderr over analysed cycles)")
-    return _png(fig)
-
-
-def fig_slip_law(run) -> bytes:
-    """The film's force against the wall's velocity during the slips, with the fitted line."""
-    from filmfriction.analysis.sliplaw import film_force
-
-    plt = _plt()
-    tr = run.trace
-    law = run.analysis.get("slip_law") or {}
-    p = tr.parameters
-    t, f, v = tr.time, tr.spring_force, tr.columns["wall_velocity"]
-    v_drive = p.drive_velocity or 0.0
-    ff = film_force(t, f, v, mass=p.mass, drive_velocity=v_drive,
-                    mount_damping=p.mount_damping or 0.0)
-    yi = np.asarray(run.cycles.get("yield_index", []), int)[run.skip:]
-    si = np.asarray(run.cycles.get("stick_index", []), int)[run.skip:]
-    fig, ax = plt.subplots(figsize=(6.4, 4.0))
-    cmap = plt.get_cmap("viridis")
-    vmax = 0.0
-    for i, (y, s_) in enumerate(zip(yi, si)):
-        seg = slice(int(y), int(s_) + 1)
-        ax.plot(v[seg], ff[seg], ".-", lw=0.5, ms=3, color=cmap(i / max(len(yi) - 1, 1)),
-                alpha=0.8, label="slips (colour: order)" if i == 0 else None)
-        vmax = max(vmax, float(np.max(v[seg])) if v[seg].size else 0.0)
-    fk = (law.get("kinetic_force") or {}).get("mean")
-    b = (law.get("damping") or {}).get("mean")
-    if fk is not None and b is not None and vmax > 0:
-        vv = np.linspace(0.0, vmax, 50)
-        ax.plot(vv, fk + b * vv, "k--", lw=1.5,
-                label=f"fit F_k + B·v: F_k = {fk:.3g} ε/σ, B = {b:.3g} m/τ")
-    ax.axhline(0, color="0.6", lw=0.5)
-    ax.set_xlabel("wall velocity during the slip v [σ/τ]")
-    ax.set_ylabel("film force F_spring − M·a − γM(v − V) [ε/σ]")
-    ax.legend(loc="best", fontsize=8)
     return _png(fig)
 
 
@@ -662,33 +590,25 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     return sec
 
 
-def _slip_law_section(run, failures) -> Section:
-    sec = Section("Klein's slip equation on the MD slips: viscous or kinetic?")
-    law = run.analysis.get("slip_law")
-    if not law:
-        why = run.analysis.get("skipped", {}).get("slip_law", "not analysed")
-        sec.p(f"No slip-law fit: {why}.")
+def _observable_section(obs: Observable, run, failures) -> Section:
+    """The report's section of one observable (``filmfriction.analysis.observables``):
+    why it is not there, or its figure, its table and its notes."""
+    sec = Section(obs.title)
+    section = run.analysis.get(obs.key)
+    if not section:
+        why = run.analysis.get("skipped", {}).get(
+            obs.key, f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
+        sec.p(f"{obs.absent}: {why}.")
         return sec
-    if run.trace.has("wall_velocity") and run.trace.parameters.mass:
-        png = _attempt(failures, "figure: slip law", fig_slip_law, run)
-        if png:
-            sec.add(Figure("slip_law", png,
-                           "The film's own shear force during each slip (the spring's force less "
-                           "the wall's inertia and the mount dashpot) against the wall's velocity, "
-                           "with the fit F_film = F_k + B·v. A line through the origin is Klein's "
-                           "viscous film (his Eq. 1); a flat line at F_k is a kinetic friction "
-                           "stress (Braun & Tosatti)."))
-    rows = [("kinetic force F_k", _pm(law.get("kinetic_force"))),
-            ("damping B", _pm(law.get("damping"))),
-            ("mean slip velocity v̄", _pm(law.get("mean_slip_velocity"))),
-            ("viscous share B·v̄/(F_k + B·v̄)", _fmt(law.get("viscous_share"), 3)),
-            ("share of F_film's variance the line explains", _fmt(law.get("r_squared"), 3)),
-            ("verdict", f"**{law.get('verdict', '?')}**")]
-    if law.get("eta_from_damping"):
-        rows.append(("η from B (B·D/A)", _pm(law["eta_from_damping"])))
-    sec.add(Table(("slip law (mean ± stderr over slips)", "value"), tuple(rows)))
-    sec.p(f"Why: {law.get('reason', '')}. Klein himself proposed this test (his note 27: the "
-          "friction force against the sliding velocity during the slip).")
+    what = obs.key.replace("_", " ")
+    png = _attempt(failures, f"figure: {what}", obs.figure, run)
+    if png:
+        sec.add(Figure(obs.key, png, obs.caption))
+    rows = _attempt(failures, f"table: {what}", obs.rows, section)
+    if rows:
+        sec.add(Table(tuple(obs.table_header), tuple((str(a), str(b)) for a, b in rows)))
+    for text in _attempt(failures, f"notes: {what}", obs.notes, section) or ():
+        sec.p(text)
     return sec
 
 
@@ -985,8 +905,9 @@ def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
     intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. MD quantities are in LJ units "
              "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
              f"({OMCTS.name})."]
+    observed = [_observable_section(obs, run, failures) for obs in registered_observables()]
     sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
-                _slip_law_section(run, failures),
+                *observed,
                 _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
                 _film_section(run, failures),
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
@@ -995,7 +916,7 @@ def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
                 _similarity_section(inputs.sfb, run_dirs, failures),
                 _cost_section(run)]
     if sweeps:
-        sections.insert(4, _sweep_section(sweeps))
+        sections.insert(3 + len(observed), _sweep_section(sweeps))
     if inputs.missing:
         sec = Section("Inputs the report did not find")
         sec.p("The report renders the files the study writes and computes none of them. These commands "

@@ -23,20 +23,24 @@ PNG = b"\x89PNG\r\n\x1a\n"
 CYCLE_ROWS = ("static_force", "backward_force", "slip_distance", "slip_duration",
               "stick_duration", "period")
 #: units that the figures' axes show between them
-AXIS_UNITS = {"τ", "ε/σ", "σ", "ε", "1/τ", "ετ/σ³", "ms", "nm", "%"}
+AXIS_UNITS = {"τ", "ε/σ", "σ", "ε", "1/τ", "ετ/σ³", "ms", "nm", "%", "σ/τ"}
 
 
 def _study(run_dir: Path) -> list:
-    from filmfriction.workflows import report, study as study_mod
+    from matplotlib.figure import Figure
 
-    labels, png = [], report._png
+    from filmfriction.workflows import study as study_mod
 
-    def capture(fig):
+    # every figure the study draws is saved through Figure.savefig, wherever its
+    # code lives (the report's own figures, an observable's in the analysis layer)
+    labels, savefig = [], Figure.savefig
+
+    def capture(fig, *args, **kwargs):
         labels.append([(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes])
-        return png(fig)
+        return savefig(fig, *args, **kwargs)
 
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(report, "_png", capture)
+        mp.setattr(Figure, "savefig", capture)
         assert study_mod.finish_study(run_dir) == 0
     return labels
 

@@ -1,0 +1,259 @@
+"""The contract every observable keeps (``filmfriction.analysis.observables``).
+
+Each registered observable, and one defined in this file (the mean film
+temperature of each slip: what a user would drop into
+``analysis/observables/`` as a file of its own), on a synthetic run directory
+(:func:`filmfriction.analysis.synthetic.run_directory`):
+
+* its section is JSON data and lands in ``analysis.json``, its per-slip columns
+  (``<key>_<name>``, one value per slip) in ``analysis_cycles.csv``;
+* with any one of its ``needs`` taken from the run, it is skipped with a reason
+  naming that need, and the analysis and the report still go through;
+* on a trace of nothing but ``time``, ``spring_force`` and its needs it gives
+  its section or a reason, never an error (no need left undeclared);
+* ``rows()`` gives (label, value) strings, ``figure()`` PNG bytes or None, and
+  the report shows its title, table and figure.
+"""
+from __future__ import annotations
+
+import base64
+import csv
+import json
+import re
+import shutil
+from html import escape
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from filmfriction.analysis import observables
+from filmfriction.analysis.observables import REGISTRY, Observable
+
+PNG = b"\x89PNG\r\n\x1a\n"
+HERE = "slip_temperature"      # the key of the observable defined in this file
+
+
+def define_slip_temperature() -> type[Observable]:
+    """The whole of what ``analysis/observables/slip_temperature.py`` would hold
+    (defined here in a function, so that it registers for this module's tests only)."""
+    from filmfriction.analysis.observables.base import (Observable, column, format_estimate,
+                                                        png_bytes, pyplot)
+
+    class SlipTemperature(Observable):
+        """The film's mean temperature during each slip (y → s)."""
+
+        key = "slip_temperature"
+        title = "Film temperature during the slips"
+        needs = (column("film_temperature", "the film's temperature during each slip"),)
+        table_header = ("film temperature (mean ± stderr over slips)", "value")
+        caption = "The film's mean temperature during each analysed slip."
+
+        def compute(self, ctx):
+            temp = ctx.trace.columns["film_temperature"]
+            per_slip = [float(np.mean(temp[y:s + 1]))
+                        for y, s in zip(ctx.table.yield_index, ctx.table.stick_index)]
+            return {"mean": ctx.statistic(per_slip, "temperature")}, {"mean": per_slip}
+
+        def rows(self, section):
+            return [("mean film temperature of a slip", format_estimate(section["mean"]))]
+
+        def figure(self, run):
+            temp = run.cycles.get("slip_temperature_mean", np.empty(0))[run.skip:]
+            if not temp.size:
+                return None
+            plt = pyplot()
+            fig, ax = plt.subplots(figsize=(5, 3))
+            ax.plot(np.arange(1, temp.size + 1), temp, "o-")
+            ax.set_xlabel("analysed slip [1]")
+            ax.set_ylabel(f"film temperature [{run.analysis[self.key]['mean']['units']}]")
+            return png_bytes(fig)
+
+    return SlipTemperature
+
+
+@pytest.fixture(scope="module")
+def slip_temperature():
+    """The observable of this file, registered while this module's tests run."""
+    cls = define_slip_temperature()
+    assert REGISTRY[HERE] is cls, "a class statement registers the observable"
+    yield cls
+    del REGISTRY[HERE]
+
+
+#: every observable of the package, and the one of this file
+KEYS = sorted(set(REGISTRY) | {HERE})
+
+
+@pytest.fixture(params=KEYS)
+def observable(request, slip_temperature) -> Observable:
+    return REGISTRY[request.param]()
+
+
+def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
+    """``analyze`` (written out) and ``build_report`` on ``run_dir``: the document,
+    the per-slip CSV's columns, report.html and report.md."""
+    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.trace import read_trace
+    from filmfriction.workflows.report import build_report
+
+    doc, per_cycle = analyze(read_trace(run_dir))
+    write_outputs(doc, per_cycle, run_dir / "analysis.json")
+    out = build_report(run_dir)
+    with open(run_dir / "analysis_cycles.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    columns = {name: [row[i] for row in rows[1:]] for i, name in enumerate(rows[0])}
+    return (json.loads((run_dir / "analysis.json").read_text()), columns, out.read_text(),
+            out.with_suffix(".md").read_text())
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory, slip_temperature):
+    """The synthetic run analysed and reported with every observable registered."""
+    from filmfriction.analysis.rundata import load_run
+    from filmfriction.analysis.synthetic import run_directory
+
+    run_dir = run_directory(tmp_path_factory.mktemp("observables") / "run", trajectory=False)
+    doc, columns, html, md = analyse_and_report(run_dir)
+    return dict(dir=run_dir, doc=doc, columns=columns, html=html, md=md,
+                run=load_run(run_dir, analyse=False))
+
+
+def images(html: str) -> dict[str, bytes]:
+    return {name: base64.b64decode(data) for name, data in
+            re.findall(r"<img alt='([^']+)' src='data:image/png;base64,([A-Za-z0-9+/=]+)'", html)}
+
+
+# ---------------------------------------------------------------------------- registration
+def test_every_module_of_the_folder_is_imported_and_registers():
+    folder = Path(observables.__file__).parent
+    files = {p.stem for p in folder.glob("*.py")} - {"__init__", "base"}
+    assert files, "no observable in the package"
+    modules = {cls.__module__.rsplit(".", 1)[1] for cls in REGISTRY.values()
+               if cls.__module__.startswith(observables.__name__ + ".")}
+    assert files <= modules, f"modules that register no observable: {files - modules}"
+
+
+def test_the_class_statement_registers_and_refuses_a_taken_key(slip_temperature):
+    from filmfriction.analysis.observables.base import BUILT_IN
+
+    assert REGISTRY[HERE] is slip_temperature and HERE in {o.key for o in observables.registered()}
+    before = dict(REGISTRY)
+    try:
+        for key in (HERE, *sorted(BUILT_IN), "Not A Key"):
+            with pytest.raises(TypeError, match="key"):
+                type("Again", (Observable,), {"key": key, "title": "t"})
+        with pytest.raises(TypeError, match="title"):
+            type("Untitled", (Observable,), {"key": "untitled"})
+        with pytest.raises(TypeError, match="needs"):
+            type("Bare", (Observable,), {"key": "bare", "title": "t", "needs": "mass"})
+        type("Helper", (Observable,), {"key": "helper", "title": "t"}, register=False)
+        assert REGISTRY == before
+    finally:                        # whatever a failure registered goes again
+        REGISTRY.clear()
+        REGISTRY.update(before)
+
+
+# ---------------------------------------------------------------------------- the analysis
+def test_its_section_is_json_and_lands_in_analysis_json(observable, study):
+    key, doc = observable.key, study["doc"]
+    assert key in doc, (f"{key} not in analysis.json of the synthetic run "
+                        f"(skipped: {doc['skipped'].get(key)}); give the synthetic run what it needs")
+    assert key not in doc["skipped"]
+    section = doc[key]
+    assert isinstance(section, dict) and section
+    assert json.loads(json.dumps(section, allow_nan=False)) == section
+    # its per-slip columns: <key>_<name>, one value a slip (the start-up slips empty)
+    mine = [c for c in study["columns"] if c.startswith(key + "_")]
+    n = doc["slips"]["count"]
+    for name in mine:
+        cells = study["columns"][name]
+        assert len(cells) == n, name
+        assert all(c == "" for c in cells[:doc["slips"]["summary_skips_first"]]), name
+
+
+def _without(run_dir: Path, need, dest: Path) -> Path:
+    """A copy of ``run_dir`` without the column or parameter ``need``."""
+    shutil.copytree(run_dir, dest)
+    for stale in ("analysis.json", "analysis_cycles.csv"):
+        (dest / stale).unlink()
+    if need.kind == "column":
+        with open(dest / "trace.csv", newline="") as fh:
+            rows = list(csv.reader(fh))
+        assert need.name in rows[0], f"the synthetic run has no column {need.name!r} to take away"
+        i = rows[0].index(need.name)
+        with open(dest / "trace.csv", "w", newline="") as fh:
+            csv.writer(fh).writerows([row[:i] + row[i + 1:] for row in rows])
+    else:
+        run = json.loads((dest / "run.json").read_text())
+        assert run["trace_parameters"].get(need.name) is not None, need.name
+        run["trace_parameters"][need.name] = None
+        (dest / "run.json").write_text(json.dumps(run))
+    return dest
+
+
+def test_without_any_one_need_it_is_skipped_naming_it(observable, study, tmp_path):
+    assert observable.needs, f"{observable.key} declares no needs: what does it read?"
+    for i, need in enumerate(observable.needs):
+        doc, columns, html, md = analyse_and_report(
+            _without(study["dir"], need, tmp_path / f"without-{i}"))
+        assert observable.key not in doc, need
+        reason = doc["skipped"].get(observable.key, "")
+        assert need.label in reason, (need, reason)
+        assert not [c for c in columns if c.startswith(observable.key + "_")]
+        # the report says why, under the observable's title
+        assert observable.title in md and f"{observable.absent}: {reason}." in md
+
+
+def test_a_trace_of_its_needs_alone_gives_its_section_or_a_reason(observable, study):
+    """No column or parameter read that ``needs`` does not declare: on ``time``,
+    ``spring_force`` and the needs, the observable computes or says what is missing."""
+    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.trace import Trace, TraceParameters
+
+    full = study["run"].trace
+    cols = {c: full.columns[c] for c in ("time", "spring_force")}
+    params = {}
+    for need in observable.needs:
+        if need.kind == "column":
+            cols[need.name] = full.columns[need.name]
+        else:
+            params[need.name] = getattr(full.parameters, need.name)
+    doc, _ = analyze(Trace(cols, TraceParameters(**params), study["dir"] / "trace.csv"),
+                     structure=False)
+    assert observable.key in doc or doc["skipped"].get(observable.key)
+
+
+# ---------------------------------------------------------------------------- the report
+def test_rows_and_notes_are_strings(observable, study):
+    section = study["doc"][observable.key]
+    rows = observable.rows(section)
+    assert rows and all(len(r) == 2 and all(isinstance(c, str) and c for c in r) for r in rows)
+    assert len(observable.table_header) == 2 and all(isinstance(h, str) for h in observable.table_header)
+    assert all(isinstance(p, str) for p in observable.notes(section))
+
+
+def test_its_figure_is_a_png_and_the_report_shows_it(observable, study):
+    png = observable.figure(study["run"])
+    assert png is None or (isinstance(png, bytes) and png.startswith(PNG) and len(png) > 2000)
+    html, md = study["html"], study["md"]
+    assert f">{escape(observable.title)}</h2>" in html and f"## {observable.title}" in md
+    for label, value in observable.rows(study["doc"][observable.key]):
+        assert f"| {label} | {value} |" in md
+    assert not re.search(rf"\| (figure|table|notes): {observable.key.replace('_', ' ')} \|", md), \
+        "the report recorded a failure of the observable"
+    if png is not None:
+        assert images(html).get(observable.key, b"").startswith(PNG)
+        assert f"![{observable.key}](report-{observable.key}.png)" in md
+        assert f"*{observable.caption}*" in md
+
+
+def test_one_file_is_enough(slip_temperature, study):
+    """The observable of this file: computed, in the CSV and in the report, with no other change."""
+    doc = study["doc"]
+    assert doc[HERE]["mean"]["mean"] == pytest.approx(0.7)       # the synthetic film is at 0.7
+    assert doc[HERE]["mean"]["units"] == "ε/k_B"
+    assert doc[HERE]["mean"]["n"] == doc["slips"]["count"] - doc["slips"]["summary_skips_first"]
+    assert "slip_temperature_mean" in study["columns"]
+    assert "## Film temperature during the slips" in study["md"]
+    assert HERE in images(study["html"])
