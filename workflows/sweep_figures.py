@@ -4,10 +4,11 @@ Part of :mod:`filmfriction.workflows.sweep`.
 """
 from __future__ import annotations
 
-import io
 
 import numpy as np
 
+
+from filmfriction.analysis.util import png_bytes, pyplot
 
 from .sweep_aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, _eta_points,
                               _group_key, _majority)
@@ -22,20 +23,8 @@ REGIME_COLOUR = {STICK_SLIP: "tab:red", SMOOTH: "tab:blue", IRREGULAR: "tab:oran
                  STUCK: "0.6"}
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _png(fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    _plt().close(fig)
-    return buf.getvalue()
+_plt = pyplot
+_png = png_bytes
 
 
 def _err(x):
