@@ -4,9 +4,7 @@ Part of :mod:`filmfriction.workflows.sweep`.
 """
 from __future__ import annotations
 
-
 import numpy as np
-
 
 from filmfriction.analysis.util import png_bytes, pyplot
 
