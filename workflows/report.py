@@ -132,9 +132,14 @@ def energy_bars(run) -> list[tuple[str, float, float]]:
         d = e.get(name) or {}
         return (d.get("mean") if d.get("mean") is not None else math.nan,
                 d.get("stderr") if d.get("stderr") is not None else math.nan)
-    bars = [("spring released (slip)",) + get("spring_released_exact"),
-            ("film / viscous (slip)",) + get("film_dissipation"),
+    bars = [("released: spring (slip)",) + get("spring_released_exact"),
+            ("released: drive work (slip)",) + get("drive_work_slip"),
+            ("released: stuck film's elastic (slip)",) + get("film_elastic_released"),
+            ("film heat (slip)",) + get("film_heat"),
+            ("  thermostat's measure of it (slip)",) + get("thermostat_heat_slip"),
+            ("mount dashpot (slip)",) + get("mount_dissipation_slip"),
             ("ringing after s",) + get("ringing_energy"),
+            ("dilation work P·A·Δz (slip)",) + get("dilation_work"),
             ("thermostat (cycle)",) + get("thermostat_heat_cycle"),
             ("mount dashpot (cycle)", _mount_heat_per_cycle(run), math.nan),
             ("ledger residual (cycle)",) + get("ledger_residual_cycle")]
@@ -143,16 +148,24 @@ def energy_bars(run) -> list[tuple[str, float, float]]:
 
 def fig_energy(bars) -> bytes:
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(8, 3.2))
+    fig, ax = plt.subplots(figsize=(8.5, 0.34 * len(bars) + 1.0))
     labels = [b[0] for b in bars]
     vals = np.array([b[1] for b in bars], float)
     errs = np.array([b[2] for b in bars], float)
-    colors = ["tab:blue", "tab:red", "tab:orange", "tab:purple", "tab:brown", "0.5"]
-    ax.barh(labels, np.nan_to_num(vals), xerr=np.where(np.isfinite(errs), errs, 0.0),
-            color=colors[:len(bars)], capsize=3)
+    e0 = np.where(np.isfinite(errs), errs, 0.0)
+    colors = {"released": "tab:blue", "film": "tab:red", "  the": "tab:pink", "ringing": "tab:orange",
+              "mount": "tab:brown", "dilation": "tab:gray", "thermostat": "tab:purple",
+              "ledger": "0.5"}
+    colour = [next((c for k, c in colors.items() if lab.startswith(k)), "0.5") for lab in labels]
+    ax.barh(labels, np.nan_to_num(vals), xerr=e0, color=colour, capsize=3)
+    span = float(np.nanmax(np.abs(np.nan_to_num(vals)) + e0)) if len(vals) else 1.0
     for i, v in enumerate(vals):
-        ax.text(0 if not np.isfinite(v) else v, i, "  n/a" if not np.isfinite(v) else f"  {v:.3g}",
-                va="center", fontsize=8)
+        # the number goes beyond the end of the error bar, never over it
+        end = 0.0 if not np.isfinite(v) else (v + e0[i] if v >= 0 else v - e0[i])
+        ax.text(end + (0.01 if v >= 0 or not np.isfinite(v) else -0.01) * span, i,
+                "n/a" if not np.isfinite(v) else f"{v:.3g}", va="center", fontsize=8,
+                ha="left" if (not np.isfinite(v) or v >= 0) else "right")
+    ax.set_xlim(min(0.0, float(np.nanmin(np.nan_to_num(vals) - e0))) - 0.12 * span, 1.15 * span)
     ax.invert_yaxis()
     ax.axvline(0, color="k", lw=0.6)
     ax.set_xlabel("energy per slip / per cycle [ε] (mean ± stderr over analysed cycles)")
@@ -409,14 +422,23 @@ def _energy_section(run, failures) -> Section:
     bars = energy_bars(run)
     png = _attempt(failures, "figure: energy", fig_energy, bars)
     if png:
-        sec.add(Figure("energy", png, "Where the spring's energy goes: per slip (y → s) the spring "
-                                      "energy released and the film's dissipation; the ringing left at "
-                                      "s; per cycle (y → next y) the thermostat's and the mount "
+        sec.add(Figure("energy", png, "Where the spring's energy goes. Per slip (its window, from "
+                                      "just before y to just after s): what is released (spring, "
+                                      "drive, the stuck film's elastic energy) and where it goes "
+                                      "(film heat, which the thermostat measures independently; "
+                                      "the mount dashpot; the ringing left at s; the dilation). "
+                                      "Per cycle (y → next y): the thermostat's and the mount "
                                       "dashpot's heat and the ledger residual."))
     led = e.get("ledger", {})
     vf = e.get("viscous_fraction") or {}
     text = (f"Film dissipation method: {e.get('film_dissipation_method', '?')}. Viscous fraction "
-            f"film/(film + ringing) = {_pm(vf)}.")
+            f"film heat/(film heat + ringing) = {_pm(vf)}.")
+    bal = e.get("balance_residual") or {}
+    if bal.get("mean") is not None:
+        text += (f" Per-slip balance (released − accounted)/released = {_pm(bal)} "
+                 f"(ringing: {e.get('ringing_method', '?')}).")
+    if e.get("film_stiffness"):
+        text += f" Stuck film's shear stiffness k_f = {_pm(e['film_stiffness'])} (from the stick ramps)."
     if led:
         text += (f" Whole-run ledger: input work {_fmt(led['input_work']['mean'])} ε, thermostat heat "
                  f"{_fmt(led['thermostat_heat']['mean'])} ε, mount heat {_fmt(led['mount_heat']['mean'])} ε, "
