@@ -26,6 +26,10 @@ DOP853 with a right-hand side on plain Python floats, the displacement counted
 from the slip's start, and the re-stick located by Newton's method on the RK
 step map (see its docstring).
 
+Laws with a state (and stiff ones) run on LSODA whose step cap follows the
+local damping ratio (:class:`_LocalCapLSODA`): a creeping hold of a light block
+no longer crawls at a sixteenth of the natural period.
+
 Smooth laws (rate-and-state, films without a yield force) are one ODE; their
 ``slip``/``stick`` events mark the maxima/minima of the spring force.  A
 massless block (M = 0) is integrated quasi-statically: the slip velocity
@@ -36,7 +40,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import LSODA, solve_ivp
 from scipy.optimize import brentq
 
 from ._checks import SimulationLimitError
@@ -46,6 +50,37 @@ from .trajectory import Problem
 __all__ = ["run_ode"]
 
 MAX_STEPS = 20_000_000
+
+
+class _LocalCapLSODA(LSODA):
+    """LSODA whose largest step follows the local damping of the slip.
+
+    The step cap (a sixteenth of the natural period) only has to resolve an
+    oscillation, and a slip damped by its own friction (rate-and-state near
+    rest: dF/dv = a N / v) does not oscillate: it relaxes over (d + dF/dv)/K.
+    A fixed cap there forces LSODA through ~10^6 tiny steps of a creeping hold
+    (a light, stiff block) even after it has switched to BDF.  Before each step
+    the cap becomes ``cap(t, y)`` -- the period/16 scaled by the local damping
+    ratio -- and is handed to the integrator as a changed optional input
+    (ISTATE = 3, the documented way to change HMAX mid-run).  Should scipy's
+    internals differ, the constructor's fixed cap stays (the old behaviour).
+    """
+
+    def __init__(self, fun, t0, y0, t_bound, *, cap=None, **kwargs):
+        super().__init__(fun, t0, y0, t_bound, **kwargs)
+        self._cap = cap
+
+    def _step_impl(self):
+        try:
+            integ = self._lsoda_solver._integrator
+            old = float(integ.rwork[5])
+            new = float(self._cap(self.t, self.y))
+            if integ.call_args[3] == 2 and not 0.7 * old <= new <= 1.4 * old:
+                integ.rwork[5] = new
+                integ.call_args[3] = 3          # ISTATE = 3: optional inputs changed
+        except (AttributeError, IndexError, TypeError):
+            pass
+        return super()._step_impl()
 
 
 def _stick_break(law, state, N, held, rate, remaining):
@@ -190,8 +225,12 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             stop.terminal, stop.direction = True, -sig
             events = [stop]
         y0 = np.concatenate(([x, v, 0.0, 0.0, 0.0], state))
-        sol = solve_ivp(rhs, (0.0, remaining), y0, method=method, rtol=rtol, atol=atol,
-                        max_step=max_step, events=events, dense_output=not has_stick)
+        solver, extra = method, {}
+        if method == "LSODA":
+            solver = _LocalCapLSODA
+            extra = {"cap": _local_cap(friction, u, d, M, K, p.period, max_step)}
+        sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
+                        max_step=max_step, events=events, dense_output=not has_stick, **extra)
         rec.nfev += sol.nfev
         ts, ys = sol.t, sol.y
         if not has_stick:
@@ -212,6 +251,28 @@ def run_ode(p: Problem, rtol: float = 1e-10):
         mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
         rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
     return rec.finish()
+
+
+def _local_cap(friction, u, d, M, K, period, floor):
+    """Step cap period/16 x the local damping ratio (d + dF/ds)/(2 sqrt(K M)), >= ``floor``.
+
+    dF/ds is a central difference of the friction at the current slip speed and
+    state; friction that weakens with speed (dF/ds < 0) gets the floor.
+    """
+    two_root_km = 2.0 * math.sqrt(K * M)
+    base = period / 16.0
+
+    def cap(tau, y):
+        s = float(y[1]) - u
+        st = y[5:]
+        h = max(1e-6 * abs(s), 1e-300)
+        try:
+            drag = (float(friction(s + h, st)) - float(friction(s - h, st))) / (2.0 * h)
+        except (ValueError, OverflowError, ZeroDivisionError):
+            return floor
+        zeta = (d + drag) / two_root_km
+        return max(floor, base * zeta) if math.isfinite(zeta) else floor
+    return cap
 
 
 def _slip_dop853(law, N, M, K, d, u, va, f0, v0, sigma, t_end, rtol, atol, max_step):

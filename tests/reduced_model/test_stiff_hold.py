@@ -1,0 +1,27 @@
+"""A creeping hold of a light, stiff block with rate-and-state: no stall, same end state."""
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from filmfriction.reduced_model import SpringBlock, laws
+
+
+def test_creeping_hold_light_block_no_stall():
+    # M = 1e-6, K = 1e5: period/16 = 1.2e-5, so 1 s used to take ~10^6 LSODA steps (30+ s)
+    law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-5, v0=1e-6)
+    M, K, ext, v_init = 1e-6, 1e5, 0.6 / 1e5 * 0.98, 1e-7
+    psi0 = float(law.steady_state(1e-6)[0])
+    block = SpringBlock(mass=M, stiffness=K, drive_velocity=0.0, drive="fixed", law=law)
+    r = block.simulate(1.0, initial_extension=ext, initial_velocity=v_init, initial_state=[psi0])
+    assert r.success
+    assert r.nfev < 20_000                    # the step cap follows the local damping
+
+    # independent reference: Radau on (x, v, psi) with no step cap
+    def rhs(t, y):
+        f = K * (ext - y[0]) - float(law.friction(y[1], y[2:], 1.0))
+        return [y[1], f / M, float(law.state_rate(abs(y[1]), y[2:])[0])]
+    ref = solve_ivp(rhs, (0.0, 1.0), [0.0, v_init, psi0], method="Radau", rtol=1e-11,
+                    atol=[1e-20, 1e-18, 1e-12])
+    assert np.isclose(r.x[-1], ref.y[0, -1], rtol=1e-7, atol=0)
+    assert np.isclose(r.v[-1], ref.y[1, -1], rtol=1e-6, atol=0)
+    assert np.isclose(r.state[0, -1], ref.y[2, -1], rtol=0, atol=1e-9)
+    assert r.energy.closure < 1e-8
