@@ -75,6 +75,26 @@ def _freeze_time(osc: DampedOscillator, e0: float, ed0: float, level: float, sig
         t0, e, ed = t0 + tau, e_next, target
 
 
+def _tile_cycles(rec, cycle, sigma, t, x, xa, T):
+    """At a yield: if the run since the previous yield was one slip and one stick the same
+    way, the rest of the run repeats it exactly, so tile it (all but the last cycle).
+
+    Every yield of a law without a state starts from the same relative state (at rest on
+    the surface, spring force at the static threshold), so the cycle from one yield to the
+    next is the solution for as long as the drive stays as it is.  Returns the updated
+    (t, x, xa) and the new template mark.
+    """
+    if cycle is not None and cycle[1] == sigma:
+        mark = cycle[0]
+        dt, dx, dxa, kinds = rec.period_since(mark)
+        if kinds == ["stick", "slip"] and dt > 0.0:
+            copies = int((T - t) / dt) - 1      # the generic loop finishes the last cycle
+            if copies >= 1:
+                st, sx, sxa = rec.repeat(mark, copies)
+                t, x, xa = t + st, x + sx, xa + sxa
+    return t, x, xa, (rec.mark(), sigma)
+
+
 def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
                     freeze_velocity: float = 0.0, shear_stiffness: float = math.inf):
     """Integrate a Coulomb + viscous block exactly; returns a SimulationResult.
@@ -116,6 +136,7 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
     elif v != u:
         sigma = math.copysign(1.0, v - u)
 
+    cycle = None    # (recorder mark, sigma) at the last yield: the template of a periodic run
     while t < T:
         remaining = T - t
         if mode == "stick":
@@ -140,6 +161,7 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
             sigma = math.copysign(1.0, rate)
             mode = "slip"
             rec.event("slip", t, K * (xa - x))
+            t, x, xa, cycle = _tile_cycles(rec, cycle, sigma, t, x, xa, T)
             continue
 
         f_kin = 0.0 if smooth else sigma * kinetic

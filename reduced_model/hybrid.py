@@ -44,7 +44,7 @@ from scipy.integrate import LSODA, solve_ivp
 from scipy.optimize import brentq
 
 from ._checks import SimulationLimitError
-from .coulomb import settle, stick_break_time
+from .coulomb import _tile_cycles, settle, stick_break_time
 from .trajectory import Problem
 
 __all__ = ["run_ode"]
@@ -150,6 +150,7 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     t, x, v, xa, state = 0.0, p.x0, p.v0, p.xa0, np.array(p.state0, dtype=float)
 
     sigma, mode = 1.0, "slip"
+    cycle = None    # (recorder mark, sigma) at the last yield: template of a periodic run
     if has_stick and v == u:
         mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
     elif v != u:
@@ -176,6 +177,9 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             sigma = math.copysign(1.0, held + rate * tau)
             mode = "slip"
             rec.event("slip", t, K * (xa - x))
+            if not state.size:
+                # stateless: every slip starts from the same relative state, the run is periodic
+                t, x, xa, cycle = _tile_cycles(rec, cycle, sigma, t, x, xa, T)
             continue
 
         if has_stick and method == "DOP853":

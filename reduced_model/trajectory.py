@@ -67,6 +67,57 @@ class Recorder:
                         np.asarray(damper, dtype=float).reshape(-1)[-1]]
         self.n += t.size - 1
 
+    # -- periodic runs: one cycle recorded, the rest tiled -----------------------
+    def mark(self):
+        """Where the recorder stands now (segments, events, totals, samples, end sample)."""
+        return (len(self._t), len(self.events), self.totals.copy(), self.n,
+                float(self._t[-1][-1]), float(self._x[-1][-1]), float(self._xa[-1][-1]))
+
+    def period_since(self, mark):
+        """(duration, displacement, spring-end displacement, event kinds) since ``mark``."""
+        n_seg, n_ev, _, _, t0, x0, xa0 = mark
+        return (float(self._t[-1][-1]) - t0, float(self._x[-1][-1]) - x0,
+                float(self._xa[-1][-1]) - xa0, [e.kind for e in self.events[n_ev:]])
+
+    def repeat(self, mark, copies: int):
+        """Append ``copies`` more copies of everything recorded since ``mark``.
+
+        For a periodic solution: every quantity of the cycle is shifted by what
+        it gained over the cycle (time by the period, positions by the slip of
+        the cycle, cumulative energies by the cycle's totals); velocities and the
+        state repeat as they are.  One NumPy broadcast per array, no per-sample
+        or per-cycle Python.  Returns the (t, x, xa) shift of all copies."""
+        n_seg, n_ev, totals0, n0, t0, x0, xa0 = mark
+        dt, dx, dxa, _ = self.period_since(mark)
+        if copies < 1:
+            return 0.0, 0.0, 0.0
+        m = self.n - n0                         # samples per cycle
+        if len(self.events) + copies * (len(self.events) - n_ev) > self.max_events:
+            raise SimulationLimitError(
+                f"more than max_events = {self.max_events} stick/slip events by t = "
+                f"{t0 + (copies + 1) * dt:.6g}: shorten the duration or raise max_events (each "
+                "event costs memory and time).")
+        k = np.arange(1, copies + 1, dtype=float)[:, None]
+        d_energy = self.totals - totals0
+
+        def cycle(store):
+            return np.concatenate(store[n_seg:], axis=-1)
+
+        self._t.append((cycle(self._t) + k * dt).ravel())
+        self._x.append((cycle(self._x) + k * dx).ravel())
+        self._xa.append((cycle(self._xa) + k * dxa).ravel())
+        self._v.append(np.tile(cycle(self._v), copies))
+        self._state.append(np.tile(cycle(self._state), (1, copies)))
+        for store, j in ((self._wd, 0), (self._wf, 1), (self._wdamp, 2)):
+            store.append((cycle(store) + k * d_energy[j]).ravel())
+        template = self.events[n_ev:]
+        self.events.extend(Event(time=e.time + c * dt, kind=e.kind, index=e.index + c * m,
+                                 spring_force=e.spring_force)
+                           for c in range(1, copies + 1) for e in template)
+        self.totals = self.totals + copies * d_energy
+        self.n += copies * m
+        return copies * dt, copies * dx, copies * dxa
+
     def insert_events(self, times, kinds):
         """Events at samples already recorded (times must be sample times)."""
         t = np.concatenate(self._t)
