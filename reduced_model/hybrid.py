@@ -61,8 +61,10 @@ class _LocalCapLSODA(LSODA):
     A fixed cap there forces LSODA through ~10^6 tiny steps of a creeping hold
     (a light, stiff block) even after it has switched to BDF.  Before each step
     the cap becomes ``cap(t, y)`` -- the period/16 scaled by the local damping
-    ratio -- and is handed to the integrator as a changed optional input
-    (ISTATE = 3, the documented way to change HMAX mid-run).  Should scipy's
+    ratio where that exceeds :data:`OVERDAMPED` -- and is handed to the
+    integrator as a changed optional input (ISTATE = 3, the documented way to
+    change HMAX mid-run).  scipy's C port of LSODA restarts its history on
+    ISTATE = 3, so the cap changes only when it moves by more than 10x.  Should scipy's
     internals differ, the constructor's fixed cap stays (the old behaviour).
     """
 
@@ -71,11 +73,15 @@ class _LocalCapLSODA(LSODA):
         self._cap = cap
 
     def _step_impl(self):
+        self._count = getattr(self, "_count", 0) + 1
+        if self._count % 4 != 1:                # the cap is a slow variable: look every 4 steps
+            return super()._step_impl()
         try:
             integ = self._lsoda_solver._integrator
             old = float(integ.rwork[5])
             new = float(self._cap(self.t, self.y))
-            if integ.call_args[3] == 2 and not 0.7 * old <= new <= 1.4 * old:
+            # ISTATE = 3 restarts LSODA's history (scipy's C port): change the cap rarely
+            if integ.call_args[3] == 2 and not 0.1 * old <= new <= 10.0 * old:
                 integ.rwork[5] = new
                 integ.call_args[3] = 3          # ISTATE = 3: optional inputs changed
         except (AttributeError, IndexError, TypeError):
@@ -257,8 +263,14 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     return rec.finish()
 
 
+#: local damping ratio above which the step cap is lifted (far from any oscillation)
+OVERDAMPED = 1000.0
+
+
 def _local_cap(friction, u, d, M, K, period, floor):
-    """Step cap period/16 x the local damping ratio (d + dF/ds)/(2 sqrt(K M)), >= ``floor``.
+    """Step cap period/16 x the local damping ratio (d + dF/ds)/(2 sqrt(K M)) where that
+    ratio exceeds OVERDAMPED, else ``floor`` (the fixed cap: runs that never get that
+    overdamped integrate exactly as before).
 
     dF/ds is a central difference of the friction at the current slip speed and
     state; friction that weakens with speed (dF/ds < 0) gets the floor.
@@ -275,7 +287,9 @@ def _local_cap(friction, u, d, M, K, period, floor):
         except (ValueError, OverflowError, ZeroDivisionError):
             return floor
         zeta = (d + drag) / two_root_km
-        return max(floor, base * zeta) if math.isfinite(zeta) else floor
+        if not math.isfinite(zeta) or zeta < OVERDAMPED:
+            return floor
+        return max(floor, base * zeta)
     return cap
 
 
