@@ -141,15 +141,16 @@ class SimulationResult:
     def slip_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """Index arrays (yield, stick) of complete slips: each yield with the
         first re-stick after it; an unfinished last slip is left out."""
-        yields, sticks, pending = [], [], None
-        for e in self.events:
-            if e.kind == "slip":
-                pending = e.index if pending is None else pending
-            elif e.kind == "stick" and pending is not None:
-                yields.append(pending)
-                sticks.append(e.index)
-                pending = None
-        return np.array(yields, dtype=int), np.array(sticks, dtype=int)
+        kinds = np.array([e.kind for e in self.events], dtype=object)
+        index = np.array([e.index for e in self.events], dtype=int)
+        slip_at = np.flatnonzero(kinds == "slip")
+        stick_at = np.flatnonzero(kinds == "stick")
+        # each re-stick pairs with the first yield after the re-stick before it (if any)
+        before = np.concatenate(([-1], stick_at[:-1])) if stick_at.size else stick_at
+        first = np.searchsorted(slip_at, before, side="right")
+        ok = first < slip_at.size
+        ok[ok] = slip_at[first[ok]] < stick_at[ok]
+        return index[slip_at[first[ok]]], index[stick_at[ok]]
 
     def cycles(self):
         """Per-cycle table (static force, backward force, slip distance, durations, period).

@@ -29,7 +29,7 @@ class Recorder:
         self._wd, self._wf, self._wdamp = [np.zeros(1)], [np.zeros(1)], [np.zeros(1)]
         self.totals = np.zeros(3)
         self.n = 1
-        self.events: list[Event] = []
+        self.events: list[tuple] = []      # (time, kind, sample index); Events built in finish
         self.nfev = 0
         self._short_run = 0
 
@@ -77,7 +77,7 @@ class Recorder:
         """(duration, displacement, spring-end displacement, event kinds) since ``mark``."""
         n_seg, n_ev, _, _, t0, x0, xa0 = mark
         return (float(self._t[-1][-1]) - t0, float(self._x[-1][-1]) - x0,
-                float(self._xa[-1][-1]) - xa0, [e.kind for e in self.events[n_ev:]])
+                float(self._xa[-1][-1]) - xa0, [e[1] for e in self.events[n_ev:]])
 
     def repeat(self, mark, copies: int):
         """Append ``copies`` more copies of everything recorded since ``mark``.
@@ -111,9 +111,11 @@ class Recorder:
         for store, j in ((self._wd, 0), (self._wf, 1), (self._wdamp, 2)):
             store.append((cycle(store) + k * d_energy[j]).ravel())
         template = self.events[n_ev:]
-        self.events.extend(Event(time=e.time + c * dt, kind=e.kind, index=e.index + c * m,
-                                 spring_force=e.spring_force)
-                           for c in range(1, copies + 1) for e in template)
+        if template:
+            c = np.arange(1, copies + 1)[:, None]
+            times = (np.array([e[0] for e in template]) + c * dt).ravel().tolist()
+            index = (np.array([e[2] for e in template]) + c * m).ravel().tolist()
+            self.events.extend(zip(times, [e[1] for e in template] * copies, index))
         self.totals = self.totals + copies * d_energy
         self.n += copies * m
         return copies * dt, copies * dx, copies * dxa
@@ -124,17 +126,17 @@ class Recorder:
         for time, kind in zip(times, kinds):
             i = int(np.searchsorted(t, time))
             i = min(max(i, 0), t.size - 1)
-            self._add(Event(time=float(t[i]), kind=kind, index=i, spring_force=np.nan))
+            self._add((float(t[i]), kind, i))
 
     def event(self, kind: str, time: float, spring_force: float):
         """Record an event at the last sample (which must be at ``time``)."""
-        self._add(Event(time=float(time), kind=kind, index=self.n - 1, spring_force=float(spring_force)))
+        self._add((float(time), kind, self.n - 1))
 
-    def _add(self, ev: Event):
+    def _add(self, ev: tuple):
         self.events.append(ev)
         if len(self.events) > self.max_events:
             raise SimulationLimitError(
-                f"more than max_events = {self.max_events} stick/slip events by t = {ev.time:.6g}: "
+                f"more than max_events = {self.max_events} stick/slip events by t = {ev[0]:.6g}: "
                 "shorten the duration or raise max_events (each event costs memory and time).")
 
     def finish(self, status=0, message=None, extras=None) -> SimulationResult:
@@ -145,10 +147,10 @@ class Recorder:
         state = np.concatenate(self._state, axis=1)
         wd, wf, wdamp = (np.concatenate(s) for s in (self._wd, self._wf, self._wdamp))
         ledger = ledger_from_series(t, x, v, xa, self.stiffness, self.mass, wd, wf, wdamp)
-        events = []
-        for e in self.events:
-            f = self.stiffness * (xa[e.index] - x[e.index])
-            events.append(Event(time=e.time, kind=e.kind, index=e.index, spring_force=float(f)))
+        idx = np.array([e[2] for e in self.events], dtype=int)
+        forces = (self.stiffness * (xa[idx] - x[idx])).tolist()
+        events = [Event(time=e[0], kind=e[1], index=e[2], spring_force=f)
+                  for e, f in zip(self.events, forces)]
         kwargs = {} if message is None else {"message": message}
         return SimulationResult(t=t, x=x, v=v, drive_position=xa, state=state, drive_work=wd,
                                 friction_dissipation=wf, damper_dissipation=wdamp,

@@ -49,3 +49,27 @@ def test_tiling_respects_max_events():
     block = SpringBlock(1.0, 1.0, 0.1, law=laws.Coulomb(1.0, 0.5))
     with pytest.raises(SimulationLimitError, match="max_events"):
         block.simulate(5000.0, max_events=50)
+
+
+def test_slip_pairs_vectorised_matches_the_rule():
+    from types import SimpleNamespace
+
+    from filmfriction.reduced_model.result import Event, SimulationResult
+
+    def rule(events):       # the first yield after the last pairing, with the next re-stick
+        ys, ss, pending = [], [], None
+        for e in events:
+            if e.kind == "slip":
+                pending = e.index if pending is None else pending
+            elif e.kind == "stick" and pending is not None:
+                ys.append(pending)
+                ss.append(e.index)
+                pending = None
+        return ys, ss
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        kinds = rng.choice(["slip", "stick", "reversal"], size=rng.integers(0, 12))
+        events = [Event(time=float(i), kind=str(k), index=i, spring_force=0.0) for i, k in enumerate(kinds)]
+        y, s = SimulationResult.slip_pairs(SimpleNamespace(events=events))
+        assert (y.tolist(), s.tolist()) == rule(events)
