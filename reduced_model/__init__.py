@@ -20,6 +20,7 @@ if __name__ != "filmfriction.reduced_model":  # one name only: two would give tw
     raise ImportError(f"import filmfriction.reduced_model, not {__name__}")
 from . import laws
 from ._checks import SimulationLimitError
+from .drive import DriveSchedule
 from .klein import KLEIN, KleinExperiment
 from .md_film import MDCalibration
 from .result import EnergyLedger, Event, SimulationResult
@@ -27,6 +28,6 @@ from .sfb import SFBCheck, sfb_check, sfb_table
 from .springblock import SpringBlock
 from .tomlinson import PrandtlTomlinson
 
-__all__ = ["SpringBlock", "laws", "PrandtlTomlinson", "SimulationResult", "Event",
+__all__ = ["SpringBlock", "DriveSchedule", "laws", "PrandtlTomlinson", "SimulationResult", "Event",
            "EnergyLedger", "SimulationLimitError", "sfb_check", "sfb_table", "SFBCheck",
            "MDCalibration", "KleinExperiment", "KLEIN"]

@@ -38,9 +38,10 @@ follows from ``friction(v) = spring force`` (``law.quasi_static_speed``).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
-from scipy.integrate import LSODA, solve_ivp
+from scipy.integrate import LSODA, Radau, solve_ivp
 from scipy.optimize import brentq
 
 from ._checks import SimulationLimitError
@@ -138,7 +139,21 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     has_stick = law.static_force(p.state0, N) is not None
     zeta = (d + law.low_speed_drag()) / (2.0 * math.sqrt(K * M))
     max_step = p.period / 16.0 * max(1.0, zeta)
-    if p.duration / max_step > MAX_STEPS:
+    check_step = max_step
+    if law.state_names or law.stiff:
+        # the cap is lifted where friction overdamps the slip: judge the run at its drive speed
+        s_ref = abs(va - u) or abs(p.v0 - u)
+        h = max(1e-6 * s_ref, 1e-300)
+        try:
+            drag = (float(law.friction(s_ref + h, p.state0, N)) - float(law.friction(s_ref - h, p.state0, N))) / (2 * h)
+        except (ValueError, OverflowError, ZeroDivisionError):
+            drag = 0.0
+        zeta_ref = (d + drag) / (2.0 * math.sqrt(K * M))
+        if math.isfinite(zeta_ref) and zeta_ref >= OVERDAMPED:
+            check_step = max(max_step, p.period / 16.0 * zeta_ref)
+        elif not math.isfinite(zeta_ref):
+            check_step = math.inf
+    if p.duration / check_step > MAX_STEPS:
         raise SimulationLimitError(
             f"duration = {p.duration:.6g} spans {p.duration / p.period:.3g} natural periods "
             f"(2 pi sqrt(M/K) = {p.period:.3g}); integrating that with a smooth law needs more than "
@@ -239,8 +254,17 @@ def run_ode(p: Problem, rtol: float = 1e-10):
         if method == "LSODA":
             solver = _LocalCapLSODA
             extra = {"cap": _local_cap(friction, u, d, M, K, p.period, max_step)}
-        sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
-                        max_step=max_step, events=events, dense_output=not has_stick, **extra)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
+                            max_step=max_step, events=events, dense_output=not has_stick, **extra)
+        if not (sol.status == -1 and solver is _LocalCapLSODA):   # else Radau takes over below
+            for w in caught:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        if sol.status == -1 and solver is _LocalCapLSODA:
+            rec.nfev += sol.nfev
+            sol = solve_ivp(rhs, (0.0, remaining), y0, method=_LocalCapRadau, rtol=rtol, atol=atol,
+                            max_step=max_step, events=events, dense_output=not has_stick, **extra)
         rec.nfev += sol.nfev
         ts, ys = sol.t, sol.y
         if not has_stick:
@@ -265,6 +289,20 @@ def run_ode(p: Problem, rtol: float = 1e-10):
 
 #: local damping ratio above which the step cap is lifted (far from any oscillation)
 OVERDAMPED = 1000.0
+
+
+class _LocalCapRadau(Radau):
+    """Radau with the same local step cap (a plain attribute here: no restart); the
+    fallback when LSODA fails, e.g. starting a hold deep in creep, where the
+    relaxation rate a N / (M v) reaches 10^12 /s."""
+
+    def __init__(self, fun, t0, y0, t_bound, *, cap=None, **kwargs):
+        super().__init__(fun, t0, y0, t_bound, **kwargs)
+        self._cap, self._floor = cap, self.max_step
+
+    def _step_impl(self):
+        self.max_step = self._cap(self.t, self.y)
+        return super()._step_impl()
 
 
 def _local_cap(friction, u, d, M, K, period, floor):

@@ -123,6 +123,29 @@ class SimulationResult:
         """Times of ``[slip, stick]`` events (like ``solve_ivp``'s ``t_events``)."""
         return [np.array([e.time for e in self.events if e.kind == k]) for k in ("slip", "stick")]
 
+    # -- drive protocols, exact output times, the state -----------------------
+    @property
+    def eval_index(self) -> np.ndarray:
+        """Indices of the samples at ``simulate(t_eval=...)``'s times (``r.x[r.eval_index]``)."""
+        if "eval_index" not in self.extras:
+            raise AttributeError("eval_index: this run had no t_eval; pass t_eval to simulate")
+        return self.extras["eval_index"]
+
+    @property
+    def psi(self) -> np.ndarray:
+        """Rate-and-state log state psi = ln(v0 theta / dc) at every sample."""
+        if "log_state" not in self.state_names:
+            raise AttributeError(f"psi: this law's state is {self.state_names}, not a log state")
+        return self.state[self.state_names.index("log_state")]
+
+    @property
+    def theta(self) -> np.ndarray:
+        """Rate-and-state state theta = (dc / v0) e^psi [time] at every sample."""
+        if "theta" not in self.extras:
+            raise AttributeError(f"theta: this law's state is {self.state_names}; theta is "
+                                 "defined for rate-and-state")
+        return self.extras["theta"]
+
     # -- physics ------------------------------------------------------------
     @property
     def spring_force(self) -> np.ndarray:

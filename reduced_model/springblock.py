@@ -34,6 +34,7 @@ import numpy as np
 
 from ._checks import finite, non_negative, positive
 from .laws import Coulomb, FrictionLaw
+from .result import Event
 from .trajectory import Problem
 
 __all__ = ["SpringBlock"]
@@ -129,7 +130,8 @@ class SpringBlock:
         return (friction + self.damping * va) / self.stiffness, (va if self.mass > 0 else 0.0)
 
     # -- running -----------------------------------------------------------------
-    def simulate(self, duration: float, *, initial_extension: float | None = None,
+    def simulate(self, duration: float | None = None, *, drive=None, t_eval=None,
+                 initial_extension: float | None = None,
                  initial_velocity: float | None = None,
                  initial_state=None, samples_per_segment: int = 64, max_events: int = 100_000,
                  method: str = "auto", rtol: float = 1e-10):
@@ -138,7 +140,17 @@ class SpringBlock:
         Parameters
         ----------
         duration : float
-            Length of the run (> 0).
+            Length of the run (> 0); optional with ``drive`` (its length), and must
+            equal it if given.
+        drive : DriveSchedule or list of (duration, velocity), optional
+            A drive protocol: the spring-end velocity piece by piece (velocity
+            steps, holds, slide-hold-slide), in place of ``drive_velocity``, in one
+            run with x, the extension, v and the state continuous across the
+            pieces.  Needs the block's ``drive="spring"``; works with mass = 0.
+        t_eval : array-like, optional
+            Times in [0, duration] at which the result holds an exact sample (the
+            run is integrated to each of them, not interpolated); their indices are
+            ``result.eval_index``.
         initial_extension : float, optional
             Spring extension at t = 0 (spring force K * extension).
         initial_velocity : float, optional
@@ -163,6 +175,13 @@ class SpringBlock:
         -------
         SimulationResult
         """
+        if drive is not None or t_eval is not None:
+            return self._simulate_pieces(duration, drive, t_eval, initial_extension,
+                                         initial_velocity, initial_state,
+                                         dict(samples_per_segment=samples_per_segment,
+                                              max_events=max_events, method=method, rtol=rtol))
+        if duration is None:
+            raise ValueError("duration = None: give the length of the run (or a drive schedule)")
         T = positive("duration", duration, "length of the run")
         law = self.law
         V = self.drive_velocity
@@ -210,4 +229,95 @@ class SpringBlock:
             return run_closed_form(problem, *closed, freeze_velocity=freeze,
                                    shear_stiffness=shear)
         from .hybrid import run_ode
-        return run_ode(problem, rtol=rtol)
+        result = run_ode(problem, rtol=rtol)
+        theta = getattr(law, "theta", None)
+        if theta is not None and result.state.size:
+            result.extras["theta"] = theta(result.state)
+        return result
+
+    # -- drive protocols and exact output times ---------------------------------
+    def _simulate_pieces(self, duration, drive, t_eval, ext, v0, state0, options):
+        """Run a drive schedule (and/or stop at ``t_eval``) as consecutive pieces."""
+        from dataclasses import replace
+
+        from .drive import DriveSchedule
+        from .result import SimulationResult, ledger_from_series
+
+        if drive is None:
+            T = positive("duration", duration, "length of the run")
+            schedule = DriveSchedule((T,), (self.drive_velocity,))
+        else:
+            if self.drive != "spring":
+                raise ValueError(f"drive schedule with drive = {self.drive!r}: a schedule sets the "
+                                 "spring-end velocity; use drive='spring'")
+            schedule = DriveSchedule.coerce(drive)
+            T = schedule.duration
+            if duration is not None and not math.isclose(float(duration), T, rel_tol=1e-12):
+                raise ValueError(f"duration = {duration!r}: the drive schedule lasts {T!r}; "
+                                 "give one or the other")
+        cuts = list(schedule.boundaries)
+        if t_eval is not None:
+            te = np.atleast_1d(np.asarray(t_eval, dtype=float))
+            if te.ndim != 1 or not np.all(np.isfinite(te)) or np.any(te < 0) or np.any(te > T):
+                raise ValueError(f"t_eval: must be finite times within [0, {T!r}]")
+            if np.any(np.diff(te) <= 0):
+                raise ValueError("t_eval: times must be strictly increasing")
+            cuts = sorted(set(cuts) | set(te.tolist()))
+        cuts = np.array(cuts)
+        cuts = cuts[np.concatenate(([True], np.diff(cuts) > 1e-12 * T))]
+        cuts[-1] = T
+        parts = []
+        x_off, t_off, energy = 0.0, 0.0, np.zeros(3)
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            velocity = float(schedule.velocity(0.5 * (a + b)))
+            block = replace(self, drive_velocity=velocity) if self.drive == "spring" else self
+            kwargs = dict(options)
+            if parts:
+                last = parts[-1]
+                kwargs.update(initial_extension=float(last.drive_position[-1] - last.x[-1]),
+                              initial_velocity=0.0 if self.mass == 0.0 else float(last.v[-1]),
+                              initial_state=last.state[:, -1] if last.state.size else None)
+            else:
+                kwargs.update(initial_extension=ext, initial_velocity=v0, initial_state=state0)
+            r = block.simulate(b - a, **kwargs)
+            parts.append(r)
+            if not r.success:
+                break
+        # stitch: time, positions and cumulative energies continue; the repeated first
+        # sample of each later piece is dropped (an event there maps to the previous end)
+        ts, xs, vs, xas, sts, wds, wfs, wdms, events = [], [], [], [], [], [], [], [], []
+        n, nfev = 0, 0
+        for k, (a, r) in enumerate(zip(cuts, parts)):
+            lo = 0 if k == 0 else 1
+            base = n - lo
+            ts.append(r.t[lo:] + a)
+            xs.append(r.x[lo:] + x_off)
+            xas.append(r.drive_position[lo:] + x_off)
+            vs.append(r.v[lo:])
+            sts.append(r.state[:, lo:])
+            wds.append(r.drive_work[lo:] + energy[0])
+            wfs.append(r.friction_dissipation[lo:] + energy[1])
+            wdms.append(r.damper_dissipation[lo:] + energy[2])
+            events.extend(Event(time=e.time + a, kind=e.kind, index=e.index + base,
+                                spring_force=e.spring_force) for e in r.events)
+            n += r.t.size - lo
+            nfev += r.nfev
+            x_off += r.x[-1]
+            energy += (r.drive_work[-1], r.friction_dissipation[-1], r.damper_dissipation[-1])
+        t, x, v, xa = (np.concatenate(z) for z in (ts, xs, vs, xas))
+        state = np.concatenate(sts, axis=1)
+        wd, wf, wdm = (np.concatenate(z) for z in (wds, wfs, wdms))
+        last = parts[-1]
+        ledger = ledger_from_series(t, x, v, xa, self.stiffness, self.mass, wd, wf, wdm)
+        extras = {"drive_schedule": schedule}
+        theta = getattr(self.law, "theta", None)
+        if theta is not None and state.size:
+            extras["theta"] = theta(state)
+        if t_eval is not None:
+            extras["eval_index"] = np.searchsorted(t, te - 1e-13 * T).clip(0, t.size - 1)
+        return SimulationResult(t=t, x=x, v=v, drive_position=xa, state=state, drive_work=wd,
+                                friction_dissipation=wf, damper_dissipation=wdm,
+                                events=tuple(events), energy=ledger, stiffness=self.stiffness,
+                                mass=self.mass, state_names=last.state_names,
+                                status=last.status, message=last.message, nfev=nfev,
+                                extras=extras)

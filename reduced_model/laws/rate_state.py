@@ -93,6 +93,10 @@ class RateState(FrictionLaw):
             return np.array([0.0])
         return np.array([-(speed / self.dc) * (math.log(speed / self.v0) + psi)])
 
+    def theta(self, state):
+        """The state variable theta = (dc / v0) exp(psi) [time] of a (n_state, ...) state array."""
+        return (self.dc / self.v0) * np.exp(np.asarray(state, dtype=float)[0])
+
     def state_relaxation_rate(self, speed):
         return speed / self.dc
 
