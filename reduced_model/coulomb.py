@@ -88,7 +88,9 @@ def _tile_cycles(rec, cycle, sigma, t, x, xa, T):
         mark = cycle[0]
         dt, dx, dxa, kinds = rec.period_since(mark)
         if kinds == ["stick", "slip"] and dt > 0.0:
-            copies = int((T - t) / dt) - 1      # the generic loop finishes the last cycle
+            copies = int((T - t) / dt)
+            if t + copies * dt > T - 1e-9 * dt:
+                copies -= 1                     # the generic loop runs to T itself
             if copies >= 1:
                 st, sx, sxa = rec.repeat(mark, copies)
                 t, x, xa = t + st, x + sx, xa + sxa

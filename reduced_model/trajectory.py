@@ -149,8 +149,8 @@ class Recorder:
         ledger = ledger_from_series(t, x, v, xa, self.stiffness, self.mass, wd, wf, wdamp)
         idx = np.array([e[2] for e in self.events], dtype=int)
         forces = (self.stiffness * (xa[idx] - x[idx])).tolist()
-        events = [Event(time=e[0], kind=e[1], index=e[2], spring_force=f)
-                  for e, f in zip(self.events, forces)]
+        events = Event.many([e[0] for e in self.events], [e[1] for e in self.events],
+                            idx.tolist(), forces)
         kwargs = {} if message is None else {"message": message}
         return SimulationResult(t=t, x=x, v=v, drive_position=xa, state=state, drive_work=wd,
                                 friction_dissipation=wf, damper_dissipation=wdamp,
