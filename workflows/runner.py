@@ -73,6 +73,10 @@ def versions() -> dict:
 
 def new_run_dir(scene_name: str, out: Path | None) -> Path:
     """Create a fresh run directory; never reuse an existing one."""
+    from .scene import SAFE_NAME
+
+    if not SAFE_NAME.fullmatch(scene_name):
+        raise SceneError(f"scene name {scene_name!r} is not a safe directory name")
     if out is None:
         stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
         base = Path("runs") / f"{scene_name}-{stamp}"
