@@ -110,6 +110,15 @@ def run(args: argparse.Namespace) -> int:
     except RunFailed as exc:
         print(f"filmfriction run: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt as exc:
+        run_dir = getattr(exc, "run_dir", None)
+        if run_dir is None:
+            raise
+        from .runner import resume_command
+
+        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); trace.csv written; resume "
+              f"with {resume_command(run_dir)}", file=sys.stderr)
+        return 130
     print(f"run directory: {run_dir}")
     if args.md_only:
         return 0

@@ -55,6 +55,70 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
+class RunLock:
+    """An exclusive ``flock`` on ``RUN_DIR/.lock`` for as long as a run or a
+    resume drives the directory; the file holds the holder's pid.
+
+    A second run or ``--resume`` of the same directory is refused
+    (:class:`SceneError`, naming the pid).  The lock goes with the process:
+    a killed runner leaves no stale lock.
+    """
+
+    def __init__(self, run_dir: Path):
+        self.path = Path(run_dir) / ".lock"
+        self.fd: int | None = None
+
+    def acquire(self) -> "RunLock":
+        import fcntl
+
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 64).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            raise SceneError(f"run directory {self.path.parent} is in use by process {holder} "
+                             "(a run or a resume is driving it); wait for it to finish, or "
+                             "stop that process first") from None
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self.fd = fd
+        return self
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, handled like Ctrl-C (SIGINT)."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated(signal.Signals(signum).name)
+
+
+class _TerminationAsInterrupt:
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only)."""
+
+    SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+    def __enter__(self):
+        import threading
+
+        self.saved = {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in self.SIGNALS:
+                self.saved[sig] = signal.signal(sig, _raise_terminated)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self.saved.items():
+            signal.signal(sig, handler)
+        return False
+
+
 def write_json(path: Path, data: dict) -> None:
     write_atomic(path, json.dumps(data, indent=2, default=json_default) + "\n")
 
@@ -338,6 +402,14 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     ``["srun"]`` for a sweep point inside a Slurm allocation).
     """
     run_dir = new_run_dir(scene.name, out)
+    lock = RunLock(run_dir).acquire()
+    try:
+        return _execute(scene, run_dir, nprocs, progress, launcher)
+    finally:
+        lock.release()
+
+
+def _execute(scene, run_dir, nprocs, progress, launcher):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
@@ -352,13 +424,21 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
 
+def resume_command(run_dir: Path) -> str:
+    return f"filmfriction run --resume {_shell_line([str(run_dir)])}"
+
+
 def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     try:
-        outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
-                             label=scene.name)
-    except KeyboardInterrupt:
-        _finish(run_dir, record, scene, None, "interrupted by the user (resume with "
-                f"filmfriction run --resume {run_dir})")
+        with _TerminationAsInterrupt():
+            outcome = run_engine(cmd, run_dir, total, progress=progress,
+                                 start_step=start_step, label=scene.name)
+    except KeyboardInterrupt as exc:
+        why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
+        record["resume_command"] = resume_command(run_dir)
+        _finish(run_dir, record, scene, None, f"interrupted {why}; resume with "
+                f"{record['resume_command']}", status="interrupted")
+        exc.run_dir = run_dir
         raise
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
@@ -366,7 +446,7 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     return _finish(run_dir, record, scene, outcome, outcome.error)
 
 
-def _finish(run_dir, record, scene, outcome, error):
+def _finish(run_dir, record, scene, outcome, error, status=None):
     dat = read_trace_dat(run_dir / "trace.dat")
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
@@ -395,9 +475,11 @@ def _finish(run_dir, record, scene, outcome, error):
         # the last figure is the slide, the one that matters for cost
         record["atom_steps_per_second"] = perf[-1]
     record["finished"] = seg["finished"]
-    record["status"] = "failed" if error else "completed"
+    record["status"] = status or ("failed" if error else "completed")
     record["error"] = error
     write_json(run_dir / "run.json", record)
+    if status == "interrupted":
+        return run_dir
     if error:
         raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
     _prune_restarts(run_dir)
@@ -421,15 +503,32 @@ def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
 
 
 def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
-    """Continue an interrupted or failed run from its newest restart file."""
+    """Continue an interrupted or failed run from its newest restart file.
+
+    ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
+    The directory is locked for the whole resume: a second one is refused.
+    """
+    run_dir = Path(run_dir)
+    if not (run_dir / "run.json").exists():
+        raise SceneError(f"{run_dir} is not a run directory (no run.json)")
+    lock = RunLock(run_dir).acquire()
+    try:
+        return _resume(run_dir, nprocs, progress)
+    finally:
+        lock.release()
+
+
+def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     from . import scene as scene_mod
 
-    run_dir = Path(run_dir)
     record_path = run_dir / "run.json"
-    if not record_path.exists():
-        raise SceneError(f"{run_dir} is not a run directory (no run.json)")
-    record = json.loads(record_path.read_text())
-    if record.get("status") == "completed":
+    try:
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise SceneError(f"{record_path}: not a readable run record ({exc})") from None
+    if not isinstance(record, dict) or not isinstance(record.get("scene"), dict):
+        raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
+    if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
     restarts = _restart_files(run_dir)
     if not restarts:
@@ -445,32 +544,46 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
     dat = read_trace_dat(run_dir / "trace.dat")
     keep = dat[dat[:, 0] < step] if len(dat) else dat
     at = dat[dat[:, 0] == step] if len(dat) else dat
-    # offsets at the restart step: from the row printed there, else the last kept row
-    ref = at[0] if len(at) else (keep[-1] if len(keep) else None)
-    if ref is None:
+    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    # the ledger's running sums at the restart step: from the row printed there
+    # (remembered in run.json, so a resume cut off before LAMMPS prints that row
+    # again, then resumed, starts from the same sums), else the last kept row
+    offsets = record.setdefault("resume_offsets", {})
+    if len(at):
+        offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
+    if str(step) in offsets:
+        sums = offsets[str(step)]
+    elif len(keep):
+        sums = {n: float(keep[-1][col[n]]) for n in LEDGER_SUMS}
+    else:
         raise SceneError(f"{run_dir}/trace.dat has no rows up to the restart step {step}")
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
     origin = _slide_origin(run_dir)
-    _rewrite_trace_dat(run_dir / "trace.dat", keep)
-    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    nprocs = nprocs or int(record.get("np", 2))
+    # the record first (the sums at the restart step), then the trimmed trace
+    record["status"] = "running"
+    record["resumed_from"] = restart.name
+    record["np"] = nprocs
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
-    variables["drive_work0"] = repr(float(ref[col["drive_work"]]))
-    variables["heat0"] = repr(float(ref[col["thermostat_heat"]]))
-    variables["mount_heat0"] = repr(float(ref[col["mount_heat"]]))
+    variables["drive_work0"] = repr(sums["drive_work"])
+    variables["heat0"] = repr(sums["thermostat_heat"])
+    variables["mount_heat0"] = repr(sums["mount_heat"])
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    nprocs = nprocs or int(record.get("np", 2))
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
                              log=Path(f"lammps.resume{step}.log"))
-    record["status"] = "running"
-    record["resumed_from"] = restart.name
     record.setdefault("commands", [record["command"]]).append(cmd)
     write_json(record_path, record)
+    _rewrite_trace_dat(run_dir / "trace.dat", keep)
     return _drive(scene, run_dir, record, cmd, total,
                   scene.parameters["equilibrate_steps"] + step, progress)
+
+
+# the running sums of the ledger that a resumed LAMMPS continues from
+LEDGER_SUMS = ("drive_work", "thermostat_heat", "mount_heat")
 
 
 def _slide_origin(run_dir: Path) -> tuple[str, str]:
