@@ -120,9 +120,21 @@ def run(args: argparse.Namespace) -> int:
               f"with {resume_command(run_dir)}", file=sys.stderr)
         return 130
     print(f"run directory: {run_dir}")
+    _print_warnings(run_dir)
     if args.md_only:
         return 0
     return post_process(run_dir)
+
+
+def _print_warnings(run_dir: Path) -> None:
+    import json
+
+    record = json.loads((Path(run_dir) / "run.json").read_text())
+    for line in record.get("warnings") or []:
+        print(f"filmfriction run: warning: {line}", file=sys.stderr)
+    if record.get("warnings"):
+        print(f"filmfriction run: {record['status']} ({len(record['warnings'])} physics "
+              "check(s) broken; see run.json 'warnings')", file=sys.stderr)
 
 
 def post_process(run_dir: Path) -> int:

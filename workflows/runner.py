@@ -331,17 +331,96 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 
 
 def lost_atoms_hint(scene: Scene) -> str:
-    """Why atoms leave the box, for the engine's bare "Lost atoms" message."""
-    from .scene import derived_quantities
+    """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
+    likely causes found in the actual parameters, most likely first."""
+    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, derived_quantities
 
     p = scene.parameters
-    limit = derived_quantities(p)["timestep_limit"]
+    d = derived_quantities(p)
+    causes = []
+    limit = d["timestep_limit"]
     if p["timestep"] > limit:
-        return (f" (the integration blew up: timestep {p['timestep']:g} tau is above the "
-                f"stability limit {limit:.3g} tau)")
-    return (" (atoms left the box: the integration blew up, or the film pushed the top wall "
-            f"off -- normal_pressure {p['normal_pressure']:g} too low for temperature "
-            f"{p['temperature']:g}?)")
+        causes.append(f"timestep {p['timestep']:g} tau is above the stability limit "
+                      f"{limit:.3g} tau")
+    elif p["timestep"] > 0.7 * limit:
+        causes.append(f"timestep {p['timestep']:g} tau is close to the stability limit "
+                      f"{limit:.3g} tau")
+    mismatch = p["film_spacing"] / p["wall_spacing"] - 1.0
+    strain = max(abs(d["film_strain_x"]), abs(d["film_strain_y"]))
+    if p["film_spacing"] < 1.0 or abs(mismatch) > 0.1 or strain > 0.05:
+        causes.append(f"film_spacing {p['film_spacing']:g} sigma against wall_spacing "
+                      f"{p['wall_spacing']:g} sigma (mismatch {100 * mismatch:+.0f} %, film "
+                      f"strained {100 * strain:.0f} %): overlapping atoms start with huge "
+                      f"forces")
+    if p["temperature"] > 1.3:
+        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is above the LJ "
+                      f"critical temperature 1.3: the film boils and pushes the wall off")
+    elif p["wall_model"] == "flexible" and p["temperature"] > 0.8 * FLEXIBLE_WALL_MAX_TEMPERATURE:
+        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is near the flexible "
+                      f"walls' limit {FLEXIBLE_WALL_MAX_TEMPERATURE:g}")
+    if p["normal_pressure"] < 0.5 * max(p["temperature"], 0.1):
+        causes.append(f"normal_pressure {p['normal_pressure']:g} is low for temperature "
+                      f"{p['temperature']:g}: the film can push the top wall off")
+    if p["drive_velocity"] > 1.0:
+        causes.append(f"drive_velocity {p['drive_velocity']:g} sigma/tau is fast: the film "
+                      f"heats faster than the thermostat cools it")
+    if not causes:
+        return (" (atoms left the box: none of timestep, spacing, temperature, pressure or "
+                "velocity looks extreme; see lammps.screen)")
+    return " (atoms left the box; likely cause: " + "; ".join(causes) + ")"
+
+
+# Physics sanity of a finished run: a run outside one of these is
+# "completed_with_warnings" (it still counts, but read it with care).
+# Validated runs: the thermostat holds the film within ~10 % of its set point,
+# the gap moves by a few % (dilation at slips), the ledger closes below 1 %.
+TEMPERATURE_TOLERANCE = 0.3     # |<T_film> - T| / T over the slide's second half
+GAP_DRIFT_TOLERANCE = 0.15      # |gap(end) - gap(start)| / gap(start), 10 % windows
+WALL_SPEED_TOLERANCE = 0.2      # |<v_wall> - V| / V in steady sliding (never stuck)
+LEDGER_WARNING = 0.02           # residual / turnover (a run fails at LEDGER_LIMIT)
+
+
+def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
+    """The physics checks of a run that completed: each broken one as a line
+    naming the check and the values (empty: all passed)."""
+    if len(dat) < 10:
+        return []
+    p = scene.parameters
+    col = {c: dat[:, i] for i, c in enumerate(DAT_COLUMNS)}
+    n = len(dat)
+    half = slice(n // 2, None)
+    out = []
+    T = float(np.mean(col["film_temperature"][half]))
+    tol = TEMPERATURE_TOLERANCE * (1.5 if p["thermostat_placement"] == "walls" else 1.0)
+    ref = max(p["temperature"], 0.05)
+    if abs(T - p["temperature"]) > tol * ref:
+        out.append(f"film temperature: mean {T:.3g} epsilon/k_B over the slide's second half "
+                   f"against the set point {p['temperature']:g} (tolerance "
+                   f"{100 * tol:.0f} %): the thermostat does not hold the film (drive_velocity "
+                   f"{p['drive_velocity']:g}, thermostat_damping {p['thermostat_damping']:g})")
+    w = max(1, n // 10)
+    g0, g1 = float(np.mean(col["gap"][:w])), float(np.mean(col["gap"][-w:]))
+    if g0 > 0 and abs(g1 - g0) > GAP_DRIFT_TOLERANCE * g0:
+        out.append(f"gap drift: the gap went from {g0:.3g} to {g1:.3g} sigma over the slide "
+                   f"({100 * (g1 / g0 - 1):+.0f} %, tolerance {100 * GAP_DRIFT_TOLERANCE:.0f} "
+                   f"%): the film is expanding or squeezed out")
+    V = p["drive_velocity"]
+    v = col["wall_velocity"][half]
+    if V > 0 and np.min(v) > 0.2 * V:       # steady sliding: the wall never sticks
+        t, x = col["time"][half], col["wall_position"][half]
+        mean_v = float((x[-1] - x[0]) / (t[-1] - t[0])) if t[-1] > t[0] else float(np.mean(v))
+        if abs(mean_v - V) > WALL_SPEED_TOLERANCE * V:
+            out.append(f"wall speed: {mean_v:.3g} sigma/tau in steady sliding against the drive "
+                       f"V = {V:g} (tolerance {100 * WALL_SPEED_TOLERANCE:.0f} %): not yet "
+                       f"steady, or the wall slips past the drive")
+    led = energy.ledger({c: col[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)})
+    residual, turnover = float(led["residual"][-1]), led["turnover"]
+    if turnover > 0 and abs(residual) > LEDGER_WARNING * turnover:
+        out.append(f"energy ledger: residual {residual:.3g} epsilon is "
+                   f"{100 * abs(residual) / turnover:.1f} % of the turnover {turnover:.3g} "
+                   f"epsilon (warning above {100 * LEDGER_WARNING:.0f} %, failure above "
+                   f"{100 * LEDGER_LIMIT:.0f} %)")
+    return out
 
 
 def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
@@ -475,7 +554,10 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
         # the last figure is the slide, the one that matters for cost
         record["atom_steps_per_second"] = perf[-1]
     record["finished"] = seg["finished"]
-    record["status"] = status or ("failed" if error else "completed")
+    warnings = sanity_warnings(dat, scene) if not error and status is None else []
+    record["warnings"] = warnings
+    record["status"] = status or ("failed" if error else
+                                  "completed_with_warnings" if warnings else "completed")
     record["error"] = error
     write_json(run_dir / "run.json", record)
     if status == "interrupted":

@@ -158,3 +158,16 @@ def test_ledger_carried_across_a_cut_off_resume(tmp_path, md, monkeypatch):
     for name in runner.LEDGER_SUMS:
         assert again[col(name)] == pytest.approx(at_restart[col(name)], rel=1e-9, abs=1e-9), name
     assert md.ledger_closure(md.trace(out)) < 0.02
+
+
+def test_a_run_that_blows_up_within_the_ledger_is_completed_with_warnings(tmp_path, md):
+    # the case: at V = 5 the film runs hot and the gap grows, the ledger
+    # still closes; the run completes, with the broken checks named
+    scene = md.scene("stick-slip", drive_velocity=5.0, timestep=0.002, equilibrate_steps=1000,
+                     slide_steps=4000, trace_every=20, restart_every=0)
+    md.execute(scene, tmp_path / "run")
+    record = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert record["status"] == "completed_with_warnings"
+    checks = [w.split(":")[0] for w in record["warnings"]]
+    assert "film temperature" in checks and "gap drift" in checks, record["warnings"]
+    assert "set point 0.7" in record["warnings"][checks.index("film temperature")]
