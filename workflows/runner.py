@@ -278,8 +278,13 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
 
 
 # ---------------------------------------------------------------- the trace
-def read_trace_dat(path: Path) -> np.ndarray:
-    """Rows of ``trace.dat``; a final line cut off by a crash is dropped."""
+def read_trace_dat(path: Path, raw: bool = False) -> np.ndarray:
+    """Rows of ``trace.dat``; a final line cut off by a crash is dropped.
+
+    A segment's first row repeats the previous segment's last step (the script
+    prints at each segment's start): the later row is kept, the one a resumed
+    job prints; ``raw`` keeps every row as printed.
+    """
     rows = []
     if not path.exists():
         return np.empty((0, len(DAT_COLUMNS)))
@@ -293,7 +298,11 @@ def read_trace_dat(path: Path) -> np.ndarray:
             rows.append([float(x) for x in parts])
         except ValueError:
             continue
-    return np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
+    table = np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
+    if raw or len(table) < 2:
+        return table
+    later = np.append(table[1:, 0] != table[:-1, 0], True)   # last of each run of a step
+    return table[later]
 
 
 def write_trace_csv(dat: np.ndarray, path: Path) -> None:
@@ -623,8 +632,10 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
         models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
         expected_cost=record["scene"]["expected_cost"],
         parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
-    dat = read_trace_dat(run_dir / "trace.dat")
-    keep = dat[dat[:, 0] < step] if len(dat) else dat
+    dat = read_trace_dat(run_dir / "trace.dat", raw=True)
+    keep = read_trace_dat(run_dir / "trace.dat")
+    keep = keep[keep[:, 0] < step] if len(keep) else keep
+    # the first row printed at the restart step: the sums the script restarts from
     at = dat[dat[:, 0] == step] if len(dat) else dat
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: from the row printed there
