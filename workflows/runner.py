@@ -531,7 +531,20 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
-    return _finish(run_dir, record, scene, outcome, outcome.error)
+    try:
+        return _finish(run_dir, record, scene, outcome, outcome.error)
+    except OSError as exc:
+        # a full disk (or another write error): say so, keep the restart files
+        restarts = [p.name for _, p in _usable_restarts(run_dir)]
+        message = (f"cannot write {exc.filename or run_dir}: {exc.strerror or exc}; the "
+                   f"restart files are kept ({restarts[-1] if restarts else 'none'} the newest "
+                   f"usable): free space, then {resume_command(run_dir)}")
+        record.update(status="failed", error=message)
+        try:
+            write_json(run_dir / "run.json", record)
+        except OSError:
+            pass
+        raise RunFailed(f"run failed: {message}", run_dir) from None
 
 
 def _finish(run_dir, record, scene, outcome, error, status=None):
@@ -584,6 +597,15 @@ def _prune_restarts(run_dir: Path) -> None:
         path.unlink(missing_ok=True)
 
 
+def _usable_restarts(run_dir: Path) -> list[tuple[int, Path]]:
+    """Restart files that were written whole: every restart of a run has the same
+    size (same atoms), so a shorter one was cut off (a full disk, a kill)."""
+    files = _restart_files(run_dir)
+    sizes = [p.stat().st_size for _, p in files]
+    full = max(sizes, default=0)
+    return [(step, p) for (step, p), size in zip(files, sizes) if size == full and size > 0]
+
+
 def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
     found = []
     for p in run_dir.glob("restart.*"):
@@ -621,11 +643,10 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
     if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
-    restarts = _restart_files(run_dir)
+    restarts = _usable_restarts(run_dir)
     if not restarts:
-        raise SceneError(f"{run_dir} has no restart file to resume from (restart_every = "
+        raise SceneError(f"{run_dir} has no usable restart file to resume from (restart_every = "
                          f"{record['scene']['parameters'].get('restart_every')}); start a new run")
-    step, restart = restarts[-1]
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],
@@ -633,23 +654,25 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
         expected_cost=record["scene"]["expected_cost"],
         parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
     dat = read_trace_dat(run_dir / "trace.dat", raw=True)
+    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    # the ledger's running sums at the restart step: the first row printed there
+    # (remembered in run.json, so a resume cut off before LAMMPS prints that row
+    # again, then resumed, starts from the same sums).  The newest restart whose
+    # sums are known: a trace cut short (a full disk) may lack the newest's row.
+    offsets = record.setdefault("resume_offsets", {})
+    for step, restart in reversed(restarts):
+        at = dat[dat[:, 0] == step] if len(dat) else dat
+        if len(at):
+            offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
+        if str(step) in offsets:
+            sums = offsets[str(step)]
+            break
+    else:
+        raise SceneError(f"{run_dir}/trace.dat has no row at any restart step "
+                         f"({', '.join(p.name for _, p in restarts)}): cannot carry the energy "
+                         "ledger exactly; start a new run")
     keep = read_trace_dat(run_dir / "trace.dat")
     keep = keep[keep[:, 0] < step] if len(keep) else keep
-    # the first row printed at the restart step: the sums the script restarts from
-    at = dat[dat[:, 0] == step] if len(dat) else dat
-    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
-    # the ledger's running sums at the restart step: from the row printed there
-    # (remembered in run.json, so a resume cut off before LAMMPS prints that row
-    # again, then resumed, starts from the same sums), else the last kept row
-    offsets = record.setdefault("resume_offsets", {})
-    if len(at):
-        offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
-    if str(step) in offsets:
-        sums = offsets[str(step)]
-    elif len(keep):
-        sums = {n: float(keep[-1][col[n]]) for n in LEDGER_SUMS}
-    else:
-        raise SceneError(f"{run_dir}/trace.dat has no rows up to the restart step {step}")
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
     origin = _slide_origin(run_dir)

@@ -199,3 +199,48 @@ def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command):
     runner.resume(out, progress=False)
     assert json.loads((out / "run.json").read_text())["np"] == 1
     assert (out / "trace.csv").read_bytes() == (whole / "trace.csv").read_bytes()
+
+
+@pytest.fixture
+def small_tmpfs(tmp_path):
+    """A 400 kB tmpfs (root only); skipped with the reason where it cannot be made."""
+    mnt = tmp_path / "tiny"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=400k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a small tmpfs here ({r.stderr.strip() or r.returncode}): "
+                    "the full-disk test needs root")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+def test_full_disk_is_one_line_and_resumable(small_tmpfs, md, filmfriction_command):
+    out = small_tmpfs / "run"
+    settings = {**SMALL, "equilibrate_steps": 500, "slide_steps": 20000}
+    proc = _start(filmfriction_command, out, md, **settings)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 1, err
+    assert "No space left on device" in err and "Traceback" not in err
+    assert len([ln for ln in err.splitlines() if ln.strip()]) <= 2, err
+    record = json.loads((out / "run.json").read_text())
+    assert record["status"] in ("running", "failed")   # run.json itself may not fit
+    # room again: the resume picks the newest whole restart file and finishes
+    subprocess.run(["mount", "-o", "remount,size=20m", str(small_tmpfs)], check=True)
+    # the disk filled while LAMMPS wrote a restart file (seen: a 0-byte restart.12000);
+    # make sure the newest one is cut off, whatever this run's timing was
+    restarts = sorted(out.glob("restart.*"), key=lambda p: int(p.suffix[1:]))
+    assert restarts, "no restart file before the disk filled"
+    newest = int(restarts[-1].suffix[1:])
+    if restarts[-1].stat().st_size == restarts[0].stat().st_size:
+        cut = out / f"restart.{newest + SMALL['restart_every']}"
+        cut.write_bytes(restarts[0].read_bytes()[:1000])
+    r = subprocess.run([filmfriction_command, "run", "--resume", str(out), "--md-only",
+                        "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    d = md.trace(out)
+    assert d["step"][-1] == settings["slide_steps"]
+    assert np.allclose(np.diff(d["step"]), SMALL["trace_every"])
+    assert md.ledger_closure(d) < 0.02
