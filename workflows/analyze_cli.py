@@ -26,6 +26,10 @@ def _count(text: str) -> int:
     return v
 
 
+# Largest magnitude accepted in a trace: the analysis squares and sums values
+# (variances, energies); beyond this they overflow to inf and the verdict is noise.
+MAX_MAGNITUDE = 1e100
+
 # Fewest trace rows the analysis classifies: below this a trace cannot show
 # one stick and one slip, and a "smooth" verdict would be a guess.
 MIN_ROWS = 10
@@ -83,6 +87,13 @@ def run(args: argparse.Namespace) -> int:
             raise UserError(f"{where}: column {name} has {int(bad.sum())} non-finite (NaN or "
                             f"infinite) values (first at data row {first + 2}); every value must be a "
                             f"finite number (drop the column to skip what needs it)")
+    for name, column in trace.columns.items():
+        big = np.abs(np.asarray(column, dtype=float)) > MAX_MAGNITUDE
+        if big.any():
+            first = int(np.flatnonzero(big)[0])
+            raise UserError(f"{where}: column {name} has {int(big.sum())} values beyond "
+                            f"±{MAX_MAGNITUDE:g} (first {float(column[first]):g} at data row "
+                            f"{first + 2}): arithmetic on them overflows; rescale the trace")
     if rows < MIN_ROWS:
         raise UserError(f"{where}: {rows} data rows: too short to classify (unresolved); "
                         f"need at least {MIN_ROWS}")

@@ -63,6 +63,12 @@ def _overflow(tmp: Path) -> Path:
     return p
 
 
+def _huge(tmp: Path) -> Path:
+    t = np.arange(400) * 0.5
+    force = (10 * np.sin(t) + t % 20) * 1e306     # finite, but its square is not
+    return _csv(tmp / "huge.csv", "time,spring_force", zip(t, force))
+
+
 def _toml(tmp: Path, name: str, text: str) -> Path:
     (tmp / name).write_text(text)
     return tmp / name
@@ -87,6 +93,7 @@ CASES = {
                                          _latin1(t, "c.json", '{"a": "caf\xe9"}')],
                               "not UTF-8", 2),
     "trace that overflows": (lambda t: ["analyze", _overflow(t)], "non-finite", 2),
+    "trace whose arithmetic overflows": (lambda t: ["analyze", _huge(t)], "beyond ±1e+100", 2),
     "run.json not an object (analyze)": (lambda t: ["analyze", _list_run(t)],
                                          "JSON object", 2),
     "run.json not an object (calibrate)": (lambda t: ["calibrate", _list_run(t)],
@@ -215,3 +222,40 @@ def test_umask_is_not_the_check(tmp_path):
     assert not (tmp_path / "new").exists() and os.listdir(tmp_path) == []
     with pytest.raises(UserError, match="cannot write in /proc"):
         check_writable("/proc/x", "--out")
+
+
+@pytest.fixture
+def read_only_dir(tmp_path):
+    """A read-only tmpfs (root only); skipped with the reason where it cannot be made."""
+    import subprocess
+
+    mnt = tmp_path / "ro"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a read-only tmpfs here ({r.stderr.strip() or r.returncode})")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+@pytest.mark.parametrize("command", [
+    lambda ro, t: ["run", "--md-only", "--out", ro / "r"],
+    lambda ro, t: ["analyze", _trace(t), "--output", ro / "a.json"],
+    lambda ro, t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", ro / "s"],
+    lambda ro, t: ["map", "velocity-stiffness", "--out", ro / "m"],
+], ids=["run", "analyze", "sweep", "map"])
+def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, capsys):
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    monkeypatch.chdir(inputs)
+    args = command(read_only_dir, inputs)
+    before = _snapshot(tmp_path)
+    rc, out, err = _cli(capsys, *args)
+    assert rc == 2 and "Read-only file system" in err and "Traceback" not in err, err
+    # refused by the check before any compute, which names the option
+    flag = next(a for a in args if str(a).startswith("--o"))
+    assert f"error: {flag} {read_only_dir}" in err, err
+    assert _snapshot(tmp_path) == before
