@@ -16,6 +16,25 @@ def _positive(text: str) -> float:
     return v
 
 
+def _count(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{v}: must be 0 or more (slips left out)")
+    return v
+
+
+# Largest magnitude accepted in a trace: the analysis squares and sums values
+# (variances, energies); beyond this they overflow to inf and the verdict is noise.
+MAX_MAGNITUDE = 1e100
+
+# Fewest trace rows the analysis classifies: below this a trace cannot show
+# one stick and one slip, and a "smooth" verdict would be a guess.
+MIN_ROWS = 10
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "analyze", help="stick-slip events, energy partition, viscosity, structure",
@@ -32,7 +51,7 @@ def register(subparsers) -> None:
     p.add_argument("--drive-velocity", type=_positive, help="spring-end velocity V")
     p.add_argument("--units", choices=("lj", "si"), default=None,
                    help="unit system of the trace (default: run.json's, else lj)")
-    p.add_argument("--skip", type=int, default=None,
+    p.add_argument("--skip", type=_count, default=None,
                    help="slips left out of the summaries (default: 1 when >= 3 slips)")
     p.add_argument("--no-structure", action="store_true",
                    help="skip the trajectory analyses")
@@ -42,20 +61,55 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from filmfriction.workflows.cli import UserError
+    import numpy as np
+
+    from filmfriction.workflows.cli import UserError, check_run_json, check_writable
 
     from filmfriction.analysis.report import analyze, to_json, write_outputs
     from filmfriction.analysis.trace import read_trace
 
+    if args.path.is_dir():
+        check_run_json(args.path)
+    if args.output is not None:
+        check_writable(args.output, "--output")
     try:
         trace = read_trace(args.path, spring_constant=args.spring_constant,
                            mass=args.mass, area=args.area, thickness=args.thickness,
                            drive_velocity=args.drive_velocity, units=args.units)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    where = trace.path
+    rows = len(trace.columns["time"])
+    for name, column in trace.columns.items():
+        bad = ~np.isfinite(np.asarray(column, dtype=float))
+        if bad.any():
+            first = int(np.flatnonzero(bad)[0])
+            raise UserError(f"{where}: column {name} has {int(bad.sum())} non-finite (NaN or "
+                            f"infinite) values (first at data row {first + 2}); every value must be a "
+                            f"finite number (drop the column to skip what needs it)")
+    for name, column in trace.columns.items():
+        big = np.abs(np.asarray(column, dtype=float)) > MAX_MAGNITUDE
+        if big.any():
+            first = int(np.flatnonzero(big)[0])
+            raise UserError(f"{where}: column {name} has {int(big.sum())} values beyond "
+                            f"±{MAX_MAGNITUDE:g} (first {float(column[first]):g} at data row "
+                            f"{first + 2}): arithmetic on them overflows; rescale the trace")
+    if rows < MIN_ROWS:
+        raise UserError(f"{where}: {rows} data rows: too short to classify (unresolved); "
+                        f"need at least {MIN_ROWS}")
+    out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
+    check_writable(out, "output")
+    try:
         doc, per_cycle = analyze(trace, skip=args.skip,
                                  structure=not args.no_structure)
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
+    slips = doc["slips"]["count"]
+    if args.skip is not None and args.skip > 0 and args.skip >= slips:
+        raise UserError(f"--skip {args.skip}: the trace has {slips} slips; give a value in "
+                        f"[0, {slips})" if slips else
+                        f"--skip {args.skip}: the trace has no slips; give --skip 0")
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
     json_path, csv_path = write_outputs(doc, per_cycle, out)
     if args.json:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))

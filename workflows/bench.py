@@ -58,7 +58,15 @@ def bulk_cells(n_atoms: int) -> tuple[int, int, int]:
 
 
 def main(args: argparse.Namespace) -> int:
-    overrides = dict(parse_assignment(t) for t in args.overrides)
+    from .cli import UserError
+    from .run_cli import check_ranks, overrides as parse_overrides
+
+    if args.steps < 1:
+        raise UserError(f"--steps {args.steps}: need at least 1 timed step")
+    if args.repeat < 1:
+        raise UserError(f"--repeat {args.repeat}: need at least 1 repetition")
+    check_ranks(args.np)
+    overrides = parse_overrides(args.overrides)
     overrides.update(equilibrate_steps=0, slide_steps=args.steps, restart_every=0,
                      trace_every=max(100, args.steps // 100))
     scene = load(args.scene, overrides)

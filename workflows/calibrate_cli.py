@@ -71,7 +71,7 @@ def format_calibration(cal) -> str:
 def run(args) -> int:
     """Entry point; returns the exit code."""
     from filmfriction.analysis import calibrate, write_calibration
-    from filmfriction.workflows.cli import UserError
+    from filmfriction.workflows.cli import UserError, check_run_json
 
     from filmfriction.workflows.report import _split_sweeps
 
@@ -81,6 +81,7 @@ def run(args) -> int:
         if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
             raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
                             "(aggregate.json)")
+        check_run_json(d)
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
     run_dirs, _ = _split_sweeps(list(args.run_dirs))
     try:

@@ -33,6 +33,44 @@ class UserError(Exception):
     """A problem with the user's input: printed without a traceback, exit code 2."""
 
 
+# Exit codes: 0 done, 1 a run or computation failed, 2 bad input, 130 interrupted.
+EXIT_FAILED = 1
+EXIT_BAD_INPUT = 2
+
+
+def _one_line(exc: BaseException) -> tuple[str, int]:
+    """The message and exit code for an exception that reached the command line.
+
+    Bad input (UserError, a scene's SceneError, a file that cannot be read or
+    written, a file that is not UTF-8) is exit 2; anything else is a failed
+    run, exit 1.  The message names the input and the value.
+    """
+    from .scene import SceneError
+
+    if isinstance(exc, (UserError, SceneError)):
+        return str(exc), EXIT_BAD_INPUT
+    if isinstance(exc, UnicodeDecodeError):
+        return (f"a file is not UTF-8 text ({exc.reason} at byte {exc.start}); give a "
+                f"UTF-8 file", EXIT_BAD_INPUT)
+    if isinstance(exc, OSError):
+        import errno
+
+        what = exc.strerror or str(exc)
+        where = f"{exc.filename}: " if exc.filename else ""
+        if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+            return (f"{where}{what}: the disk is full; free space and resume the run "
+                    "(--resume DIR) or run again", EXIT_FAILED)
+        return f"{where}{what}", EXIT_BAD_INPUT
+    try:
+        from .runner import RunFailed
+    except ImportError:  # pragma: no cover
+        RunFailed = ()
+    if RunFailed and isinstance(exc, RunFailed):
+        return str(exc), EXIT_FAILED
+    return (f"{type(exc).__name__}: {exc} (an internal error; run with --debug for the "
+            "traceback and report it)", EXIT_FAILED)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="filmfriction",
@@ -41,6 +79,8 @@ def build_parser() -> argparse.ArgumentParser:
     from filmfriction import __version__
 
     parser.add_argument("--version", action="version", version=f"filmfriction {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="show a Python traceback on errors (they are one line otherwise)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     registered = set()
     for name, module_name in COMMANDS.items():
@@ -69,17 +109,73 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except UserError as exc:
-        print(f"filmfriction {args.command}: error: {exc}", file=sys.stderr)
-        return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 -- the one error path of the CLI
+        if args.debug:
+            import traceback
+
+            traceback.print_exc()
+        message, code = _one_line(exc)
+        print(f"filmfriction {args.command}: error: {message}", file=sys.stderr)
+        return code
 
 
-if __name__ == "__main__":
-    # run through the package module, so that sub-commands and this entry
-    # point share one UserError class (not a second copy in __main__)
-    from filmfriction.workflows.cli import main as _main
+def check_writable(path, flag: str, *, directory: bool = False) -> None:
+    """Refuse (UserError) an output path that cannot be written, before any compute.
 
-    sys.exit(_main())
+    ``directory``: the path is a directory to create or write into; otherwise a
+    file (an existing directory there is refused).  Nothing is created.
+    """
+    import os
+    from pathlib import Path
+
+    path = Path(path)
+    if not directory and path.is_dir():
+        raise UserError(f"{flag} {path}: is a directory; give a file name")
+    if directory and path.exists() and not path.is_dir():
+        raise UserError(f"{flag} {path}: is a file; give a directory")
+    # the nearest existing ancestor must be a writable directory
+    probe = path if directory and path.exists() else path.parent
+    probe = probe if str(probe) else Path(".")
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise UserError(f"{flag} {path}: {probe} is a file, not a directory")
+    # a real probe (os.access says yes to root, and knows nothing of /proc):
+    # create and remove one hidden file
+    import tempfile
+
+    try:
+        fd, name = tempfile.mkstemp(prefix=".ff-probe-", dir=probe)
+    except OSError as exc:
+        raise UserError(f"{flag} {path}: cannot write in {probe}: "
+                        f"{exc.strerror or exc}") from None
+    os.close(fd)
+    os.unlink(name)
+
+
+def check_run_json(run_dir, flag: str = "") -> dict | None:
+    """``RUN_DIR/run.json`` as a dict (None when absent); UserError when it is not
+    UTF-8, not JSON, or not a JSON object."""
+    import json
+    from pathlib import Path
+
+    path = Path(run_dir) / "run.json"
+    if not path.is_file():
+        return None
+    where = f"{flag} {path}" if flag else str(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise UserError(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise UserError(f"{where}: not valid JSON: line {exc.lineno} column {exc.colno}: "
+                        f"{exc.msg}") from None
+    if not isinstance(data, dict):
+        raise UserError(f"{where}: a run record is a JSON object, this is a "
+                        f"{type(data).__name__}")
+    return data

@@ -45,6 +45,9 @@ def run(args) -> int:
         raise _user_error(f"--resolution {n}: allowed range is [2, 1000] grid points per axis")
     if args.processes < 1:
         raise _user_error(f"--processes {args.processes}: allowed range is [1, inf)")
+    from filmfriction.workflows.cli import check_writable
+
+    check_writable(out, "--out", directory=True)
     out.mkdir(parents=True, exist_ok=True)
 
     import numpy as np

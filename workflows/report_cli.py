@@ -39,15 +39,18 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from filmfriction.workflows.cli import UserError
+    from filmfriction.workflows.cli import UserError, check_run_json, check_writable
     from filmfriction.workflows.report import build_report
 
     for d in args.run_dirs:
         if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
             raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
                             "(aggregate.json)")
+        check_run_json(d)
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
+    out = args.out if args.out is not None else args.run_dirs[0] / "report.html"
+    check_writable(out, "--out")
     try:
         path = build_report(args.run_dirs, out=args.out, log=print)
     except ValueError as exc:

@@ -19,7 +19,9 @@ def register(subparsers) -> None:
                         "'filmfriction scenes')")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter (LJ units), e.g. --set drive_velocity=0.05")
-    p.add_argument("--np", type=int, default=2, help="MPI ranks (default 2)")
+    p.add_argument("--np", type=int, default=None,
+                   help="MPI ranks (default 2; with --resume, the ranks the run was started "
+                        "with)")
     p.add_argument("--out", type=Path, default=None,
                    help="run directory to create (default runs/<scene>-<time>)")
     p.add_argument("--resume", type=Path, default=None, metavar="DIR",
@@ -39,13 +41,36 @@ def register(subparsers) -> None:
 
 
 def _overrides(args) -> dict:
-    from .scene import parse_assignment
+    return overrides(args.overrides)
 
-    values = {}
-    for text in args.overrides:
+
+def overrides(texts) -> dict:
+    """``--set KEY=VALUE`` texts as a dict; a key given twice is refused."""
+    from .scene import SceneError, parse_assignment
+
+    values: dict = {}
+    for text in texts:
         key, value = parse_assignment(text)
+        if key in values:
+            raise SceneError(f"--set {key} given twice ({values[key]!r} and {value!r}): "
+                             "give each key once")
         values[key] = value
     return values
+
+
+def check_ranks(nprocs: int | None, flag: str = "--np") -> None:
+    """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
+    oversubscribe, or fail after the setup)."""
+    import os
+
+    from .cli import UserError
+
+    if nprocs is None:
+        return
+    cpus = os.cpu_count() or 1
+    if not 1 <= nprocs <= cpus:
+        raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
+                        f"(the CPUs of this machine)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -53,8 +78,14 @@ def run(args: argparse.Namespace) -> int:
     from .runner import RunFailed, execute, resume
     from .scene import SceneError, load
 
-    if args.np < 1:
-        raise UserError(f"--np {args.np}: need at least 1 MPI rank")
+    check_ranks(args.np)
+    if args.resume and (args.overrides or args.fidelity or args.out):
+        raise UserError("--resume continues a run as it was started: --set, --fidelity and "
+                        "--out are not accepted with it")
+    if args.out is not None:
+        from .cli import check_writable
+
+        check_writable(args.out, "--out", directory=True)
     try:
         if args.resume:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet)
@@ -72,16 +103,38 @@ def run(args: argparse.Namespace) -> int:
                                     f"--fidelity {args.fidelity}")
                 user = {**extra, **user}
             scene = load(args.scene, user)
-            run_dir = execute(scene, out=args.out, nprocs=args.np, progress=not args.quiet)
+            run_dir = execute(scene, out=args.out, nprocs=args.np or 2,
+                              progress=not args.quiet)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except RunFailed as exc:
         print(f"filmfriction run: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt as exc:
+        run_dir = getattr(exc, "run_dir", None)
+        if run_dir is None:
+            raise
+        from .runner import resume_command
+
+        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); trace.csv written; resume "
+              f"with {resume_command(run_dir)}", file=sys.stderr)
+        return 130
     print(f"run directory: {run_dir}")
+    _print_warnings(run_dir)
     if args.md_only:
         return 0
     return post_process(run_dir)
+
+
+def _print_warnings(run_dir: Path) -> None:
+    import json
+
+    record = json.loads((Path(run_dir) / "run.json").read_text())
+    for line in record.get("warnings") or []:
+        print(f"filmfriction run: warning: {line}", file=sys.stderr)
+    if record.get("warnings"):
+        print(f"filmfriction run: {record['status']} ({len(record['warnings'])} physics "
+              "check(s) broken; see run.json 'warnings')", file=sys.stderr)
 
 
 def post_process(run_dir: Path) -> int:

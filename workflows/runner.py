@@ -55,6 +55,70 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
+class RunLock:
+    """An exclusive ``flock`` on ``RUN_DIR/.lock`` for as long as a run or a
+    resume drives the directory; the file holds the holder's pid.
+
+    A second run or ``--resume`` of the same directory is refused
+    (:class:`SceneError`, naming the pid).  The lock goes with the process:
+    a killed runner leaves no stale lock.
+    """
+
+    def __init__(self, run_dir: Path):
+        self.path = Path(run_dir) / ".lock"
+        self.fd: int | None = None
+
+    def acquire(self) -> "RunLock":
+        import fcntl
+
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 64).decode(errors="replace").strip() or "?"
+            os.close(fd)
+            raise SceneError(f"run directory {self.path.parent} is in use by process {holder} "
+                             "(a run or a resume is driving it); wait for it to finish, or "
+                             "stop that process first") from None
+        os.ftruncate(fd, 0)
+        os.write(fd, f"{os.getpid()}\n".encode())
+        self.fd = fd
+        return self
+
+    def release(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP, handled like Ctrl-C (SIGINT)."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated(signal.Signals(signum).name)
+
+
+class _TerminationAsInterrupt:
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only)."""
+
+    SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+    def __enter__(self):
+        import threading
+
+        self.saved = {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in self.SIGNALS:
+                self.saved[sig] = signal.signal(sig, _raise_terminated)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self.saved.items():
+            signal.signal(sig, handler)
+        return False
+
+
 def write_json(path: Path, data: dict) -> None:
     write_atomic(path, json.dumps(data, indent=2, default=json_default) + "\n")
 
@@ -73,6 +137,10 @@ def versions() -> dict:
 
 def new_run_dir(scene_name: str, out: Path | None) -> Path:
     """Create a fresh run directory; never reuse an existing one."""
+    from .scene import SAFE_NAME
+
+    if not SAFE_NAME.fullmatch(scene_name):
+        raise SceneError(f"scene name {scene_name!r} is not a safe directory name")
     if out is None:
         stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
         base = Path("runs") / f"{scene_name}-{stamp}"
@@ -210,8 +278,13 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
 
 
 # ---------------------------------------------------------------- the trace
-def read_trace_dat(path: Path) -> np.ndarray:
-    """Rows of ``trace.dat``; a final line cut off by a crash is dropped."""
+def read_trace_dat(path: Path, raw: bool = False) -> np.ndarray:
+    """Rows of ``trace.dat``; a final line cut off by a crash is dropped.
+
+    A segment's first row repeats the previous segment's last step (the script
+    prints at each segment's start): the later row is kept, the one a resumed
+    job prints; ``raw`` keeps every row as printed.
+    """
     rows = []
     if not path.exists():
         return np.empty((0, len(DAT_COLUMNS)))
@@ -225,7 +298,11 @@ def read_trace_dat(path: Path) -> np.ndarray:
             rows.append([float(x) for x in parts])
         except ValueError:
             continue
-    return np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
+    table = np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
+    if raw or len(table) < 2:
+        return table
+    later = np.append(table[1:, 0] != table[:-1, 0], True)   # last of each run of a step
+    return table[later]
 
 
 def write_trace_csv(dat: np.ndarray, path: Path) -> None:
@@ -263,17 +340,96 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 
 
 def lost_atoms_hint(scene: Scene) -> str:
-    """Why atoms leave the box, for the engine's bare "Lost atoms" message."""
-    from .scene import derived_quantities
+    """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
+    likely causes found in the actual parameters, most likely first."""
+    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, derived_quantities
 
     p = scene.parameters
-    limit = derived_quantities(p)["timestep_limit"]
+    d = derived_quantities(p)
+    causes = []
+    limit = d["timestep_limit"]
     if p["timestep"] > limit:
-        return (f" (the integration blew up: timestep {p['timestep']:g} tau is above the "
-                f"stability limit {limit:.3g} tau)")
-    return (" (atoms left the box: the integration blew up, or the film pushed the top wall "
-            f"off -- normal_pressure {p['normal_pressure']:g} too low for temperature "
-            f"{p['temperature']:g}?)")
+        causes.append(f"timestep {p['timestep']:g} tau is above the stability limit "
+                      f"{limit:.3g} tau")
+    elif p["timestep"] > 0.7 * limit:
+        causes.append(f"timestep {p['timestep']:g} tau is close to the stability limit "
+                      f"{limit:.3g} tau")
+    mismatch = p["film_spacing"] / p["wall_spacing"] - 1.0
+    strain = max(abs(d["film_strain_x"]), abs(d["film_strain_y"]))
+    if p["film_spacing"] < 1.0 or abs(mismatch) > 0.1 or strain > 0.05:
+        causes.append(f"film_spacing {p['film_spacing']:g} sigma against wall_spacing "
+                      f"{p['wall_spacing']:g} sigma (mismatch {100 * mismatch:+.0f} %, film "
+                      f"strained {100 * strain:.0f} %): overlapping atoms start with huge "
+                      f"forces")
+    if p["temperature"] > 1.3:
+        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is above the LJ "
+                      f"critical temperature 1.3: the film boils and pushes the wall off")
+    elif p["wall_model"] == "flexible" and p["temperature"] > 0.8 * FLEXIBLE_WALL_MAX_TEMPERATURE:
+        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is near the flexible "
+                      f"walls' limit {FLEXIBLE_WALL_MAX_TEMPERATURE:g}")
+    if p["normal_pressure"] < 0.5 * max(p["temperature"], 0.1):
+        causes.append(f"normal_pressure {p['normal_pressure']:g} is low for temperature "
+                      f"{p['temperature']:g}: the film can push the top wall off")
+    if p["drive_velocity"] > 1.0:
+        causes.append(f"drive_velocity {p['drive_velocity']:g} sigma/tau is fast: the film "
+                      f"heats faster than the thermostat cools it")
+    if not causes:
+        return (" (atoms left the box: none of timestep, spacing, temperature, pressure or "
+                "velocity looks extreme; see lammps.screen)")
+    return " (atoms left the box; likely cause: " + "; ".join(causes) + ")"
+
+
+# Physics sanity of a finished run: a run outside one of these is
+# "completed_with_warnings" (it still counts, but read it with care).
+# Validated runs: the thermostat holds the film within ~10 % of its set point,
+# the gap moves by a few % (dilation at slips), the ledger closes below 1 %.
+TEMPERATURE_TOLERANCE = 0.3     # |<T_film> - T| / T over the slide's second half
+GAP_DRIFT_TOLERANCE = 0.15      # |gap(end) - gap(start)| / gap(start), 10 % windows
+WALL_SPEED_TOLERANCE = 0.2      # |<v_wall> - V| / V in steady sliding (never stuck)
+LEDGER_WARNING = 0.02           # residual / turnover (a run fails at LEDGER_LIMIT)
+
+
+def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
+    """The physics checks of a run that completed: each broken one as a line
+    naming the check and the values (empty: all passed)."""
+    if len(dat) < 10:
+        return []
+    p = scene.parameters
+    col = {c: dat[:, i] for i, c in enumerate(DAT_COLUMNS)}
+    n = len(dat)
+    half = slice(n // 2, None)
+    out = []
+    T = float(np.mean(col["film_temperature"][half]))
+    tol = TEMPERATURE_TOLERANCE * (1.5 if p["thermostat_placement"] == "walls" else 1.0)
+    ref = max(p["temperature"], 0.05)
+    if abs(T - p["temperature"]) > tol * ref:
+        out.append(f"film temperature: mean {T:.3g} epsilon/k_B over the slide's second half "
+                   f"against the set point {p['temperature']:g} (tolerance "
+                   f"{100 * tol:.0f} %): the thermostat does not hold the film (drive_velocity "
+                   f"{p['drive_velocity']:g}, thermostat_damping {p['thermostat_damping']:g})")
+    w = max(1, n // 10)
+    g0, g1 = float(np.mean(col["gap"][:w])), float(np.mean(col["gap"][-w:]))
+    if g0 > 0 and abs(g1 - g0) > GAP_DRIFT_TOLERANCE * g0:
+        out.append(f"gap drift: the gap went from {g0:.3g} to {g1:.3g} sigma over the slide "
+                   f"({100 * (g1 / g0 - 1):+.0f} %, tolerance {100 * GAP_DRIFT_TOLERANCE:.0f} "
+                   f"%): the film is expanding or squeezed out")
+    V = p["drive_velocity"]
+    v = col["wall_velocity"][half]
+    if V > 0 and np.min(v) > 0.2 * V:       # steady sliding: the wall never sticks
+        t, x = col["time"][half], col["wall_position"][half]
+        mean_v = float((x[-1] - x[0]) / (t[-1] - t[0])) if t[-1] > t[0] else float(np.mean(v))
+        if abs(mean_v - V) > WALL_SPEED_TOLERANCE * V:
+            out.append(f"wall speed: {mean_v:.3g} sigma/tau in steady sliding against the drive "
+                       f"V = {V:g} (tolerance {100 * WALL_SPEED_TOLERANCE:.0f} %): not yet "
+                       f"steady, or the wall slips past the drive")
+    led = energy.ledger({c: col[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)})
+    residual, turnover = float(led["residual"][-1]), led["turnover"]
+    if turnover > 0 and abs(residual) > LEDGER_WARNING * turnover:
+        out.append(f"energy ledger: residual {residual:.3g} epsilon is "
+                   f"{100 * abs(residual) / turnover:.1f} % of the turnover {turnover:.3g} "
+                   f"epsilon (warning above {100 * LEDGER_WARNING:.0f} %, failure above "
+                   f"{100 * LEDGER_LIMIT:.0f} %)")
+    return out
 
 
 def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
@@ -334,6 +490,14 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     ``["srun"]`` for a sweep point inside a Slurm allocation).
     """
     run_dir = new_run_dir(scene.name, out)
+    lock = RunLock(run_dir).acquire()
+    try:
+        return _execute(scene, run_dir, nprocs, progress, launcher)
+    finally:
+        lock.release()
+
+
+def _execute(scene, run_dir, nprocs, progress, launcher):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
@@ -348,21 +512,42 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
 
+def resume_command(run_dir: Path) -> str:
+    return f"filmfriction run --resume {_shell_line([str(run_dir)])}"
+
+
 def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     try:
-        outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
-                             label=scene.name)
-    except KeyboardInterrupt:
-        _finish(run_dir, record, scene, None, "interrupted by the user (resume with "
-                f"filmfriction run --resume {run_dir})")
+        with _TerminationAsInterrupt():
+            outcome = run_engine(cmd, run_dir, total, progress=progress,
+                                 start_step=start_step, label=scene.name)
+    except KeyboardInterrupt as exc:
+        why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
+        record["resume_command"] = resume_command(run_dir)
+        _finish(run_dir, record, scene, None, f"interrupted {why}; resume with "
+                f"{record['resume_command']}", status="interrupted")
+        exc.run_dir = run_dir
         raise
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
-    return _finish(run_dir, record, scene, outcome, outcome.error)
+    try:
+        return _finish(run_dir, record, scene, outcome, outcome.error)
+    except OSError as exc:
+        # a full disk (or another write error): say so, keep the restart files
+        restarts = [p.name for _, p in _usable_restarts(run_dir)]
+        message = (f"cannot write {exc.filename or run_dir}: {exc.strerror or exc}; the "
+                   f"restart files are kept ({restarts[-1] if restarts else 'none'} the newest "
+                   f"usable): free space, then {resume_command(run_dir)}")
+        record.update(status="failed", error=message)
+        try:
+            write_json(run_dir / "run.json", record)
+        except OSError:
+            pass
+        raise RunFailed(f"run failed: {message}", run_dir) from None
 
 
-def _finish(run_dir, record, scene, outcome, error):
+def _finish(run_dir, record, scene, outcome, error, status=None):
     dat = read_trace_dat(run_dir / "trace.dat")
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
@@ -391,9 +576,14 @@ def _finish(run_dir, record, scene, outcome, error):
         # the last figure is the slide, the one that matters for cost
         record["atom_steps_per_second"] = perf[-1]
     record["finished"] = seg["finished"]
-    record["status"] = "failed" if error else "completed"
+    warnings = sanity_warnings(dat, scene) if not error and status is None else []
+    record["warnings"] = warnings
+    record["status"] = status or ("failed" if error else
+                                  "completed_with_warnings" if warnings else "completed")
     record["error"] = error
     write_json(run_dir / "run.json", record)
+    if status == "interrupted":
+        return run_dir
     if error:
         raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
     _prune_restarts(run_dir)
@@ -407,6 +597,15 @@ def _prune_restarts(run_dir: Path) -> None:
         path.unlink(missing_ok=True)
 
 
+def _usable_restarts(run_dir: Path) -> list[tuple[int, Path]]:
+    """Restart files that were written whole: every restart of a run has the same
+    size (same atoms), so a shorter one was cut off (a full disk, a kill)."""
+    files = _restart_files(run_dir)
+    sizes = [p.stat().st_size for _, p in files]
+    full = max(sizes, default=0)
+    return [(step, p) for (step, p), size in zip(files, sizes) if size == full and size > 0]
+
+
 def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
     found = []
     for p in run_dir.glob("restart.*"):
@@ -417,56 +616,90 @@ def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
 
 
 def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
-    """Continue an interrupted or failed run from its newest restart file."""
+    """Continue an interrupted or failed run from its newest restart file.
+
+    ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
+    The directory is locked for the whole resume: a second one is refused.
+    """
+    run_dir = Path(run_dir)
+    if not (run_dir / "run.json").exists():
+        raise SceneError(f"{run_dir} is not a run directory (no run.json)")
+    lock = RunLock(run_dir).acquire()
+    try:
+        return _resume(run_dir, nprocs, progress)
+    finally:
+        lock.release()
+
+
+def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     from . import scene as scene_mod
 
-    run_dir = Path(run_dir)
     record_path = run_dir / "run.json"
-    if not record_path.exists():
-        raise SceneError(f"{run_dir} is not a run directory (no run.json)")
-    record = json.loads(record_path.read_text())
-    if record.get("status") == "completed":
+    try:
+        record = json.loads(record_path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise SceneError(f"{record_path}: not a readable run record ({exc})") from None
+    if not isinstance(record, dict) or not isinstance(record.get("scene"), dict):
+        raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
+    if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
-    restarts = _restart_files(run_dir)
+    restarts = _usable_restarts(run_dir)
     if not restarts:
-        raise SceneError(f"{run_dir} has no restart file to resume from (restart_every = "
+        raise SceneError(f"{run_dir} has no usable restart file to resume from (restart_every = "
                          f"{record['scene']['parameters'].get('restart_every')}); start a new run")
-    step, restart = restarts[-1]
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],
         models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
         expected_cost=record["scene"]["expected_cost"],
         parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
-    dat = read_trace_dat(run_dir / "trace.dat")
-    keep = dat[dat[:, 0] < step] if len(dat) else dat
-    at = dat[dat[:, 0] == step] if len(dat) else dat
-    # offsets at the restart step: from the row printed there, else the last kept row
-    ref = at[0] if len(at) else (keep[-1] if len(keep) else None)
-    if ref is None:
-        raise SceneError(f"{run_dir}/trace.dat has no rows up to the restart step {step}")
+    dat = read_trace_dat(run_dir / "trace.dat", raw=True)
+    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    # the ledger's running sums at the restart step: the first row printed there
+    # (remembered in run.json, so a resume cut off before LAMMPS prints that row
+    # again, then resumed, starts from the same sums).  The newest restart whose
+    # sums are known: a trace cut short (a full disk) may lack the newest's row.
+    offsets = record.setdefault("resume_offsets", {})
+    for step, restart in reversed(restarts):
+        at = dat[dat[:, 0] == step] if len(dat) else dat
+        if len(at):
+            offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
+        if str(step) in offsets:
+            sums = offsets[str(step)]
+            break
+    else:
+        raise SceneError(f"{run_dir}/trace.dat has no row at any restart step "
+                         f"({', '.join(p.name for _, p in restarts)}): cannot carry the energy "
+                         "ledger exactly; start a new run")
+    keep = read_trace_dat(run_dir / "trace.dat")
+    keep = keep[keep[:, 0] < step] if len(keep) else keep
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
     origin = _slide_origin(run_dir)
-    _rewrite_trace_dat(run_dir / "trace.dat", keep)
-    col = {c: i for i, c in enumerate(DAT_COLUMNS)}
+    nprocs = nprocs or int(record.get("np", 2))
+    # the record first (the sums at the restart step), then the trimmed trace
+    record["status"] = "running"
+    record["resumed_from"] = restart.name
+    record["np"] = nprocs
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
-    variables["drive_work0"] = repr(float(ref[col["drive_work"]]))
-    variables["heat0"] = repr(float(ref[col["thermostat_heat"]]))
-    variables["mount_heat0"] = repr(float(ref[col["mount_heat"]]))
+    variables["drive_work0"] = repr(sums["drive_work"])
+    variables["heat0"] = repr(sums["thermostat_heat"])
+    variables["mount_heat0"] = repr(sums["mount_heat"])
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    nprocs = nprocs or int(record.get("np", 2))
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
                              log=Path(f"lammps.resume{step}.log"))
-    record["status"] = "running"
-    record["resumed_from"] = restart.name
     record.setdefault("commands", [record["command"]]).append(cmd)
     write_json(record_path, record)
+    _rewrite_trace_dat(run_dir / "trace.dat", keep)
     return _drive(scene, run_dir, record, cmd, total,
                   scene.parameters["equilibrate_steps"] + step, progress)
+
+
+# the running sums of the ledger that a resumed LAMMPS continues from
+LEDGER_SUMS = ("drive_work", "thermostat_heat", "mount_heat")
 
 
 def _slide_origin(run_dir: Path) -> tuple[str, str]:

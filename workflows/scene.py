@@ -30,6 +30,10 @@ from typing import Any
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 
 
+# A scene name: it names the run directory, so no path separators, no "..".
+SAFE_NAME = __import__("re").compile(r"[A-Za-z0-9_][A-Za-z0-9._-]{0,63}")
+
+
 class SceneError(ValueError):
     """A scene or a parameter value is not acceptable; the message says why."""
 
@@ -65,7 +69,8 @@ class Parameter:
         if self.kind is int:
             if isinstance(value, float):
                 if not value.is_integer():
-                    raise SceneError(f"{self.name} = {value!r}: must be a whole number")
+                    raise SceneError(f"{self.name} = {value!r}: must be a whole number in "
+                                     f"[{self.low}, {self.high}] ({self.help})")
                 value = int(value)
         else:
             value = float(value)
@@ -137,10 +142,12 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
       choices=("film", "walls", "both")),
     P("mount_damping", float, "1/tau", 0.3, 0.0, 100.0,
       "mount dashpot: -gamma*M*(vx - V) in parallel with the spring, -gamma*M*vz along z"),
-    P("seed", int, "-", 4928459, 1, 2**31 - 1, "random seed (velocities, thermostat)"),
+    # the script derives seed+1 .. seed+4 for the flexible walls: all stay a 32-bit int
+    P("seed", int, "-", 4928459, 1, 2**31 - 5, "random seed (velocities, thermostat)"),
     P("equilibrate_steps", int, "steps", 10000, 0, 10**9,
       "loaded and thermostatted, spring off"),
-    P("slide_steps", int, "steps", 100000, 1, 10**10, "spring drive on"),
+    # LAMMPS's run command takes at most 2^31 - 1 steps
+    P("slide_steps", int, "steps", 100000, 1, 2**31 - 1, "spring drive on"),
     P("trace_every", int, "steps", 50, 1, 10**7, "interval of trace.csv rows"),
     P("restart_every", int, "steps", 20000, 0, 10**9,
       "restart-file interval for --resume (0 = none)"),
@@ -351,12 +358,13 @@ def parse_assignment(text: str) -> tuple[str, float | int]:
     key, value = split_parameter(text, "--set", "KEY=VALUE")
     if PARAMETERS[key].choices:
         return key, PARAMETERS[key].check(value.strip())
-    kind = PARAMETERS[key].kind
+    spec = PARAMETERS[key]
     try:
-        number = int(value) if kind is int else float(value)
+        number = int(value) if spec.kind is int else float(value)
     except ValueError:
-        raise SceneError(
-            f"--set {key}={value!r}: not a {kind.__name__} ({PARAMETERS[key].unit})") from None
+        what = (f"a whole number in [{spec.low}, {spec.high}]" if spec.kind is int
+                else f"a number in [{spec.low}, {spec.high}] {spec.unit}")
+        raise SceneError(f"--set {key}={value.strip()!r}: not {what} ({spec.help})") from None
     return key, number
 
 
@@ -379,9 +387,14 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
             raise SceneError(f"no scene {name_or_path!r}; known scenes: "
                              f"{', '.join(scenes)} (or give a path to a .toml file)")
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}); "
+                         "a scene is a UTF-8 TOML file") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
     allowed = {"name", "description", "models", "observables", "expected_cost", "parameters"}
     unknown = set(data) - allowed
     if unknown:
@@ -399,7 +412,12 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
         resolved = resolve(params, overrides)
     except SceneError as exc:
         raise SceneError(f"scene {data.get('name', path.stem)!r}: {exc}") from None
-    return Scene(name=str(data.get("name", path.stem)),
+    name = data.get("name", path.stem)
+    if not isinstance(name, str) or not SAFE_NAME.fullmatch(name):
+        raise SceneError(f"{path}: name = {name!r}: a scene name is 1-64 characters from "
+                         "letters, digits, '.', '_', '-', not starting with '.' or '-' "
+                         "(it names the run directory)")
+    return Scene(name=name,
                  description=str(data.get("description", "")),
                  models=str(data.get("models", "")),
                  observables=tuple(observables),

@@ -77,9 +77,12 @@ def _calibration(path: Path | None):
     from filmfriction.reduced_model import MDCalibration
     from filmfriction.workflows.cli import UserError
     try:
-        data = json.loads(Path(path).read_text())
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise UserError(f"calibration file {path} does not exist") from None
+    except UnicodeDecodeError as exc:
+        raise UserError(f"calibration file {path}: not UTF-8 text ({exc.reason} at byte "
+                        f"{exc.start})") from None
     except (OSError, json.JSONDecodeError) as exc:
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
     if isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction.calibration/"):
@@ -127,6 +130,10 @@ def run(args) -> int:
 
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
+    if args.out is not None:
+        from filmfriction.workflows.cli import check_writable
+
+        check_writable(args.out, "--out")
     units = _units(args)
     calibration = _calibration(args.calibration)
     contact = None

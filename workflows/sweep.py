@@ -149,6 +149,9 @@ def main_sweep(args: argparse.Namespace) -> int:
     profile = profile_path(args.profile) if args.profile else None
     check_installed(profile)
     out = args.out if args.out is not None else default_out(plan)
+    from .cli import check_writable
+
+    check_writable(out, "--out", directory=True)
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)

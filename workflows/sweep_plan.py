@@ -19,6 +19,16 @@ PLAN_SCHEMA = "filmfriction.sweep/1"
 POINT_SCHEMA = "filmfriction.sweep-point/1"
 SEPARATOR = "__"          # between key=value pairs in a point name
 SIGNIFICANT = 6           # grid values are rounded to this many digits (name == value)
+# Most points a sweep plans unless FILMFRICTION_MAX_POINTS says otherwise:
+# counted before any value is built (a typo of N must not allocate GiBs).
+MAX_POINTS = 10000
+
+
+def max_points() -> int:
+    try:
+        return int(os.environ.get("FILMFRICTION_MAX_POINTS", MAX_POINTS))
+    except ValueError:
+        return MAX_POINTS
 
 
 def _user_error(message: str) -> Exception:
@@ -120,6 +130,9 @@ def parse_grid(text: str) -> GridAxis:
             raise SceneError(f"--grid {text!r}: N {parts[2]!r} is not a whole number") from None
         if n < 1:
             raise SceneError(f"--grid {text!r}: N = {n}: need at least 1 value")
+        if n > max_points():
+            raise SceneError(f"--grid {text!r}: N = {n} values is above the cap of "
+                             f"{max_points()} points (set FILMFRICTION_MAX_POINTS to raise it)")
         log = len(parts) == 4 and parts[3] == "log"
         if log and (start <= 0 or stop <= 0):
             raise SceneError(f"--grid {text!r}: a log range needs START > 0 and STOP > 0")
@@ -131,6 +144,12 @@ def parse_grid(text: str) -> GridAxis:
         raw = [number(s.strip(), "value") for s in body.split(",") if s.strip()]
         if not raw:
             raise SceneError(f"--grid {text!r}: no values")
+    if kind is int and ":" not in body:
+        spec = PARAMETERS[key]
+        odd = [x for x in raw if not float(x).is_integer()]
+        if odd:
+            raise SceneError(f"--grid {text!r}: {key} takes whole numbers in "
+                             f"[{spec.low}, {spec.high}]; {odd[0]:g} is not one")
     if kind is int:
         values = tuple(int(round(x)) for x in raw)
     else:
@@ -232,11 +251,18 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
     if dup:
         raise SceneError(f"--grid given twice for {', '.join(dup)}: give each key once "
                          "(use KEY=V1,V2,... for an irregular set)")
+    total = math.prod(len(a.values) for a in axes)
+    if total > max_points():
+        raise SceneError(f"--grid: {' x '.join(str(len(a.values)) for a in axes)} = {total} "
+                         f"points is above the cap of {max_points()} (set "
+                         "FILMFRICTION_MAX_POINTS to raise it)")
     fixed: dict = {}
     for text in sets or []:
         k, v = parse_assignment(text)
         if k in keys:
             raise SceneError(f"--set {text!r}: {k} is already swept by --grid")
+        if k in fixed:
+            raise SceneError(f"--set {k} given twice: give each key once")
         fixed[k] = v
     base = load(scene, fixed)       # the scene itself and the fixed values, checked once
     points, params = [], {}
@@ -254,6 +280,17 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
         calibration = Path(calibration).resolve()
         if not calibration.is_file():
             raise SceneError(f"--calibration {calibration}: no such file")
+        try:
+            data = json.loads(calibration.read_text(encoding="utf-8"))
+        except UnicodeDecodeError as exc:
+            raise SceneError(f"--calibration {calibration}: not UTF-8 text ({exc.reason} at "
+                             f"byte {exc.start})") from None
+        except json.JSONDecodeError as exc:
+            raise SceneError(f"--calibration {calibration}: not valid JSON: line "
+                             f"{exc.lineno} column {exc.colno}: {exc.msg}") from None
+        if not isinstance(data, dict):
+            raise SceneError(f"--calibration {calibration}: a calibration is a JSON object "
+                             f"(calibration.json), this is a {type(data).__name__}")
     return SweepPlan(scene=base.name, scene_source=str(Path(base.source).resolve()),
                      grid=tuple(axes), fixed=fixed, np=np_, points=tuple(points),
                      parameters=params,

@@ -694,6 +694,11 @@ def main(args: argparse.Namespace) -> int:
     out = args.out or Path("runs") / f"tradeoff-{datetime.now():%Y%m%d-%H%M%S}"
     if out.exists():
         raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
+    from .cli import check_writable
+    from .run_cli import check_ranks
+
+    check_ranks(args.np)
+    check_writable(out, "--out", directory=True)
     stream = sys.stderr if args.json else sys.stdout
     # flushed: the progress lines must show while the study runs, even in a log file
 

@@ -392,6 +392,11 @@ def main(args: argparse.Namespace) -> int:
     if args.out is not None and Path(args.out).exists():
         _fail(f"--out {args.out}: already exists; a run never overwrites another, "
               "choose a new directory")
+    from .cli import check_writable
+    from .run_cli import check_ranks
+
+    check_ranks(args.np)
+    check_writable(args.out if args.out is not None else Path("runs"), "--out", directory=True)
     try:
         run_dir = new_run_dir(f"viscosity-T{settings.temperature:g}-rho{settings.density:g}",
                               args.out)

@@ -281,7 +281,7 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path, cli, s
     assert len(agg.points) == 4 and len(agg.run_dirs) == 4
     for run_dir in agg.run_dirs:
         record = json.loads((run_dir / "run.json").read_text())
-        assert record["status"] == "completed"
+        assert record["status"] in ("completed", "completed_with_warnings")
         assert record["scene"]["parameters"]["slide_steps"] == 3000
         assert "-n 1" in (run_dir / "command.txt").read_text()
         analysis = json.loads((run_dir / "analysis.json").read_text())
@@ -349,7 +349,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
             f"the interrupted point {name} was put in place as if it had completed"
     kept = {p: (p.stat().st_ino, p.stat().st_mtime_ns) for p in done}
     for p in done:
-        assert json.loads(p.read_text())["status"] == "completed"
+        assert json.loads(p.read_text())["status"] in ("completed", "completed_with_warnings")
     time.sleep(0.5)
     assert processes_in(out) == [], "an engine was left running"
     assert not list(out.glob("points/.*")), "the interrupted run's directory is cleaned up"

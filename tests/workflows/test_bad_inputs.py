@@ -1,0 +1,261 @@
+"""Bad input, table-driven: every case ends in one line naming the input, exit
+code 2, no traceback, and nothing written (the working directory, where
+``runs/`` and ``sweeps/`` would go, and every input directory are unchanged).
+
+Each case builds its inputs under ``tmp`` and returns the command line; none
+reaches LAMMPS (the checks come first), so the table runs without an engine.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+
+def _csv(path: Path, header: str, rows) -> Path:
+    path.write_text(header + "\n" + "".join(",".join(repr(float(v)) for v in r) + "\n"
+                                            for r in rows))
+    return path
+
+
+def _trace(tmp: Path, n: int = 400, wall=None, name: str = "trace.csv") -> Path:
+    t = np.arange(n) * 0.5
+    force = 10 * np.sin(t) + t % 20
+    x = np.cumsum(np.abs(force)) * 0.01
+    wall = x if wall is None else wall
+    return _csv(tmp / name, "time,spring_force,drive_position,wall_position",
+                zip(t, force, x, wall))
+
+
+def _latin1(tmp: Path, name: str, text: str) -> Path:
+    (tmp / name).write_bytes(text.encode("latin-1"))
+    return tmp / name
+
+
+def _afile(tmp: Path) -> Path:
+    (tmp / "afile").write_text("x")
+    return tmp / "afile"
+
+
+def _list_run(tmp: Path) -> Path:
+    d = tmp / "run-list"
+    d.mkdir()
+    _trace(d)
+    (d / "run.json").write_text("[1, 2]")
+    return d
+
+
+def _nan_wall(tmp: Path) -> Path:
+    wall = np.arange(400) * 0.1
+    wall[::3] = np.nan
+    return _trace(tmp, wall=wall, name="nanwall.csv")
+
+
+def _overflow(tmp: Path) -> Path:
+    p = _trace(tmp, name="overflow.csv")
+    lines = p.read_text().splitlines()
+    parts = lines[5].split(",")
+    parts[3] = "1e400"                      # overflows a double: inf
+    lines[5] = ",".join(parts)
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def _huge(tmp: Path) -> Path:
+    t = np.arange(400) * 0.5
+    force = (10 * np.sin(t) + t % 20) * 1e306     # finite, but its square is not
+    return _csv(tmp / "huge.csv", "time,spring_force", zip(t, force))
+
+
+def _toml(tmp: Path, name: str, text: str) -> Path:
+    (tmp / name).write_text(text)
+    return tmp / name
+
+
+# id: (command line from tmp, message fragment, exit code)
+CASES = {
+    # -- ended in a traceback
+    "run --out under a file": (lambda t: ["run", "--md-only", "--out", _afile(t) / "r"],
+                               "is a file, not a directory", 2),
+    "run --out in /proc": (lambda t: ["run", "--md-only", "--out", "/proc/ff-run"],
+                           "cannot write in /proc", 2),
+    "analyze --output a directory": (lambda t: ["analyze", _trace(t), "--output", t],
+                                     "is a directory", 2),
+    "analyze --output under a file": (lambda t: ["analyze", _trace(t), "--output",
+                                                 _afile(t) / "a.json"], "is a file", 2),
+    "sweep --out in /proc": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run",
+                                        "--out", "/proc/ff-sweep"], "cannot write in /proc", 2),
+    "scene not UTF-8": (lambda t: ["run", _latin1(t, "s.toml", 'name = "caf\xe9"\n'),
+                                   "--out", t / "r"], "not UTF-8", 2),
+    "calibration not UTF-8": (lambda t: ["sfb", "--calibration",
+                                         _latin1(t, "c.json", '{"a": "caf\xe9"}')],
+                              "not UTF-8", 2),
+    "trace that overflows": (lambda t: ["analyze", _overflow(t)], "non-finite", 2),
+    "trace whose arithmetic overflows": (lambda t: ["analyze", _huge(t)], "beyond ±1e+100", 2),
+    "run.json not an object (analyze)": (lambda t: ["analyze", _list_run(t)],
+                                         "JSON object", 2),
+    "run.json not an object (calibrate)": (lambda t: ["calibrate", _list_run(t)],
+                                           "JSON object", 2),
+    "run.json not an object (report)": (lambda t: ["report", _list_run(t)], "JSON object", 2),
+    "bench --steps 0": (lambda t: ["bench", "--steps", "0"], "--steps 0", 2),
+    "bench --repeat 0": (lambda t: ["bench", "--repeat", "0"], "--repeat 0", 2),
+    # -- were accepted
+    "2-row trace": (lambda t: ["analyze", _csv(t / "two.csv", "time,spring_force",
+                                               [(0, 1), (1, 2)])], "too short to classify", 2),
+    "NaN in wall_position": (lambda t: ["analyze", _nan_wall(t)], "column wall_position", 2),
+    "--skip negative": (lambda t: ["analyze", _trace(t), "--skip", "-1"], "--skip", 2),
+    "--skip beyond the slips": (lambda t: ["analyze", _trace(t), "--skip", "100000"],
+                                "--skip 100000", 2),
+    "--grid int rounded": (lambda t: ["sweep", "stick-slip", "--grid", "film_layers=1.4,2.6",
+                                      "--dry-run", "--out", t / "s"], "whole numbers", 2),
+    "--grid too large": (lambda t: ["sweep", "stick-slip", "--grid",
+                                    "drive_velocity=0.01:1:100000000000", "--dry-run",
+                                    "--out", t / "s"], "above the cap", 2),
+    "--grid product too large": (lambda t: ["sweep", "stick-slip", "--grid",
+                                            "drive_velocity=0.01:1:200", "--grid",
+                                            "spring_constant=10:100:200", "--dry-run",
+                                            "--out", t / "s"], "above the cap", 2),
+    "--np 1000": (lambda t: ["run", "--np", "1000", "--out", t / "r"], "--np 1000", 2),
+    "--np 0": (lambda t: ["run", "--np", "0", "--out", t / "r"], "--np 0", 2),
+    "bench --np 1000": (lambda t: ["bench", "--np", "1000"], "--np 1000", 2),
+    "slide_steps beyond LAMMPS": (lambda t: ["run", "--set", "slide_steps=3000000000",
+                                             "--out", t / "r"], "2147483647", 2),
+    "scene name as a path": (lambda t: ["run", _toml(t, "n.toml", 'name = "../../escape"\n'),
+                                        "--md-only"], "scene name", 2),
+    "scene name absolute": (lambda t: ["run", _toml(t, "n.toml", 'name = "/tmp/x"\n'),
+                                       "--md-only"], "scene name", 2),
+    "--calibration not JSON": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                          "--dry-run", "--out", t / "s", "--calibration",
+                                          _toml(t, "c.json", "not json")], "not valid JSON", 2),
+    "--set integer as 2.5": (lambda t: ["run", "--set", "film_layers=2.5", "--out", t / "r"],
+                             "whole number in [1, 8]", 2),
+    "TOML integer as 2.5": (lambda t: ["run", _toml(t, "f.toml",
+                                                    "[parameters]\nfilm_layers = 2.5\n"),
+                                       "--out", t / "r"], "whole number in [1, 8]", 2),
+    "--set key twice": (lambda t: ["run", "--set", "seed=1", "--set", "seed=2",
+                                   "--out", t / "r"], "given twice", 2),
+    "sweep --set key twice": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                         "--set", "cells_x=8", "--set", "cells_x=9",
+                                         "--dry-run", "--out", t / "s"], "given twice", 2),
+    "--resume with --set": (lambda t: ["run", "--resume", t, "--set", "seed=1"],
+                            "not accepted with it", 2),
+}
+
+
+def _snapshot(root: Path) -> dict:
+    """Every path under root; files with their size and time (a directory's own
+    time changes when the writability probe creates and removes its file)."""
+    return {str(p.relative_to(root)): (p.stat().st_size, p.stat().st_mtime_ns)
+            if p.is_file() else "dir" for p in root.rglob("*")}
+
+
+def _cli(capsys, *args):
+    """``filmfriction ARGS`` in process; argparse's own refusals exit via SystemExit."""
+    from filmfriction.workflows.cli import main
+
+    capsys.readouterr()
+    try:
+        code = main([str(a) for a in args])
+    except SystemExit as exc:
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input(case, tmp_path, monkeypatch, capsys):
+    build, fragment, code = CASES[case]
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    work = tmp_path / "work"            # the working directory: runs/, sweeps/ go here
+    work.mkdir()
+    monkeypatch.chdir(work)
+    args = build(inputs)
+    before = _snapshot(tmp_path)
+    rc, out, err = _cli(capsys, *args)
+    assert rc == code, (rc, err)
+    assert fragment in err, err
+    assert "Traceback" not in err + out
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert lines[-1].startswith("filmfriction ") and "error" in lines[-1], err
+    assert _snapshot(tmp_path) == before, "something was written"
+
+
+def test_debug_shows_the_traceback(tmp_path, run_cli):
+    (tmp_path / "run-list").mkdir()
+    _trace(tmp_path / "run-list")
+    (tmp_path / "run-list" / "run.json").write_text("[1]")
+    r = run_cli("--debug", "calibrate", tmp_path / "run-list")
+    assert r.code == 2 and "Traceback" in r.err and "JSON object" in r.err
+
+
+def test_internal_error_is_one_line_exit_1(monkeypatch, run_cli):
+    from filmfriction.workflows import run_cli as run_cli_mod
+
+    def boom(args):
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.setattr(run_cli_mod, "list_scenes", boom)
+    # the parser holds the function: patch it through the registered default
+    from filmfriction.workflows import cli
+
+    parser = cli.build_parser
+    monkeypatch.setattr(cli, "build_parser", lambda: _patched(parser(), boom))
+    r = run_cli("scenes")
+    assert r.code == 1 and "ZeroDivisionError: boom" in r.err and "--debug" in r.err
+    assert "Traceback" not in r.err
+
+
+def _patched(parser, func):
+    for action in parser._subparsers._group_actions:
+        action.choices["scenes"].set_defaults(func=func)
+    return parser
+
+
+def test_umask_is_not_the_check(tmp_path):
+    """check_writable probes with a real file (root passes os.access everywhere)."""
+    from filmfriction.workflows.cli import UserError, check_writable
+
+    check_writable(tmp_path / "new" / "x.json", "--out")
+    assert not (tmp_path / "new").exists() and os.listdir(tmp_path) == []
+    with pytest.raises(UserError, match="cannot write in /proc"):
+        check_writable("/proc/x", "--out")
+
+
+@pytest.fixture
+def read_only_dir(tmp_path):
+    """A read-only tmpfs (root only); skipped with the reason where it cannot be made."""
+    import subprocess
+
+    mnt = tmp_path / "ro"
+    mnt.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(mnt)],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        pytest.skip(f"cannot mount a read-only tmpfs here ({r.stderr.strip() or r.returncode})")
+    try:
+        yield mnt
+    finally:
+        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+
+
+@pytest.mark.parametrize("command", [
+    lambda ro, t: ["run", "--md-only", "--out", ro / "r"],
+    lambda ro, t: ["analyze", _trace(t), "--output", ro / "a.json"],
+    lambda ro, t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", ro / "s"],
+    lambda ro, t: ["map", "velocity-stiffness", "--out", ro / "m"],
+], ids=["run", "analyze", "sweep", "map"])
+def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, capsys):
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    monkeypatch.chdir(inputs)
+    args = command(read_only_dir, inputs)
+    before = _snapshot(tmp_path)
+    rc, out, err = _cli(capsys, *args)
+    assert rc == 2 and "Read-only file system" in err and "Traceback" not in err, err
+    # refused by the check before any compute, which names the option
+    flag = next(a for a in args if str(a).startswith("--o"))
+    assert f"error: {flag} {read_only_dir}" in err, err
+    assert _snapshot(tmp_path) == before
