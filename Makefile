@@ -12,8 +12,15 @@ $(STAMP): pyproject.toml constraints.txt
 	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[test,sweep]'
 	touch $(STAMP)
 
+# The main job: the default study, then a preview of the Klein-similar scene (about 1.5 min
+# on 2 cores), and one report that compares the two with Klein's experiment.  Each make run
+# gets its own folder under runs/ (a run directory is never overwritten).
+STUDY := runs/study-$(shell date +%Y%m%d-%H%M%S)
+
 run: $(STAMP)
-	$(BIN)/filmfriction run
+	$(BIN)/filmfriction run --out $(STUDY)/stick-slip
+	$(BIN)/filmfriction run sfb-similar --fidelity preview --out $(STUDY)/sfb-similar-preview
+	$(BIN)/filmfriction report $(STUDY)/stick-slip $(STUDY)/sfb-similar-preview --out $(STUDY)/report.html
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
