@@ -20,7 +20,7 @@ STUDY := runs/study-$(shell date +%Y%m%d-%H%M%S)
 run: $(STAMP)
 	$(BIN)/filmfriction run --out $(STUDY)/stick-slip
 	$(BIN)/filmfriction run sfb-similar --fidelity preview --out $(STUDY)/sfb-similar-preview
-	$(BIN)/filmfriction report $(STUDY)/stick-slip $(STUDY)/sfb-similar-preview --out $(STUDY)/report.html
+	$(BIN)/filmfriction report $(STUDY)/stick-slip --compare $(STUDY)/sfb-similar-preview --out $(STUDY)/report.html
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -250,9 +250,9 @@ def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) 
             unc = (lo, hi)
             if lo <= 0 or hi / lo > 10:   # every number here is positive by nature
                 note += "; the model's interval reaches zero or spans more than a decade: no ratio"
-        for n in (m.note, k.note):
+        for who, n in (("this run", m.note), ("Klein", k.note)):
             if n:
-                note += f"; {n}"
+                note += f"; {who}: {n}"
         row = table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)
         if "no ratio" in note or (math.isfinite(m.value) and m.value <= 0):
             if "no ratio" not in note:

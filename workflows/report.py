@@ -634,7 +634,7 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     return sec
 
 
-def _similarity_section(check, run_dirs, failures) -> Section:
+def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
     """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given."""
     from filmfriction.analysis.contact import contact_from_run
     from filmfriction.reduced_model.similarity import klein_contact, similarity_numbers
@@ -653,6 +653,23 @@ def _similarity_section(check, run_dirs, failures) -> Section:
     else:
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
+    for d in compare:
+        try:
+            other = [r for r in json.loads((d / "sfb.json").read_text())["rows"]
+                     if r["source"] == "similarity"]
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            failures.setdefault(f"similarity rows of {d.name}", str(exc))
+            continue
+        if other and rows:
+            mine = {r["name"]: r for r in other}
+            sec.p(f"Beside it, `{d.name}` (its own `sfb.json`):")
+            sec.add(Table(("number", "Klein", "this run", d.name, f"{d.name}'s range"),
+                          tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+                                 _fmt(mine.get(r["name"], {}).get("model"), 3),
+                                 "–" if not mine.get(r["name"], {}).get("uncertainty") else
+                                 f"{_fmt(mine[r['name']]['uncertainty'][0], 2)} … "
+                                 f"{_fmt(mine[r['name']]['uncertainty'][1], 2)}")
+                                for r in rows)))
 
     def point(label, contact):
         n = similarity_numbers(contact)
@@ -871,7 +888,7 @@ def _sweep_section(sweeps) -> Section:
     return sec
 
 
-def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
+def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> Path:
     """Write ``report.html`` and ``report.md`` for one or several runs.
 
     The report renders what is in the main run's directory: ``analysis.json``
@@ -893,6 +910,9 @@ def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
         a failed ``calibration`` or ``sfb`` step is reported as failed, not read).
     log : callable, optional
         Called with one line per input that is missing and the command that makes it.
+    compare : list of path-like
+        Other analysed runs set beside the main one in the similarity section (their
+        ``sfb.json`` similarity rows and their points on the λ–ζ map).
 
     Returns
     -------
@@ -935,7 +955,8 @@ def build_report(run_dirs, out=None, *, failures=None, log=None) -> Path:
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
                 _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
-                _similarity_section(inputs.sfb, run_dirs, failures),
+                _similarity_section(inputs.sfb, list(run_dirs) + [Path(c) for c in compare],
+                                    failures, compare=[Path(c) for c in compare]),
                 _cost_section(run)]
     if sweeps:
         sections.insert(3 + len(observed), _sweep_section(sweeps))

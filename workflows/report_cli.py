@@ -32,6 +32,10 @@ def register(subparsers) -> None:
                    help="run directories (the first is the main run, whose calibration.json and "
                         "sfb.json are rendered) or finished sweep directories (a sweep section "
                         "and their runs)")
+    p.add_argument("--compare", nargs="+", type=Path, default=[], metavar="RUN_DIR",
+                   help="other analysed runs set beside the main run in the similarity section "
+                        "(their sfb.json similarity rows and their points on the lambda-zeta map); "
+                        "not part of the calibration")
     p.add_argument("--out", type=Path, default=None, metavar="FILE",
                    help="HTML file to write (default RUN_DIR/report.html; the .md goes next to it)")
     p.set_defaults(func=run)
@@ -42,6 +46,10 @@ def run(args) -> int:
     from filmfriction.workflows.cli import UserError, check_run_json, check_writable
     from filmfriction.workflows.report import build_report
 
+    for d in args.compare:
+        if not (d / "analysis.json").is_file() or not (d / "run.json").is_file():
+            raise UserError(f"--compare {d}: not an analysed run directory (analysis.json and "
+                            "run.json; 'filmfriction analyze RUN_DIR' writes the first)")
     for d in args.run_dirs:
         if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
             raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
@@ -52,7 +60,7 @@ def run(args) -> int:
     out = args.out if args.out is not None else args.run_dirs[0] / "report.html"
     check_writable(out, "--out")
     try:
-        path = build_report(args.run_dirs, out=args.out, log=print)
+        path = build_report(args.run_dirs, out=args.out, log=print, compare=args.compare)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     print(f"report: {path}")

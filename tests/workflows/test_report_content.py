@@ -42,3 +42,20 @@ def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
     sec = report._film_section(SimpleNamespace(run_dir=tmp_path, analysis={}), {})
     assert sec.title == "The film: density profile and picture"
     assert any("`film-structure` scene" in b for b in sec.blocks if isinstance(b, str))
+
+
+def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path, report_study,
+                                                       run_cli):
+    # a second study, compared: its similarity rows and its point appear; it is not calibrated
+    from filmfriction.analysis.synthetic import run_directory
+
+    other = run_directory(tmp_path / "other", layers=4)
+    report_study(other)
+    out = tmp_path / "cmp.html"
+    r = run_cli("report", synthetic_study.path, "--compare", other, "--out", out)
+    assert r.code == 0, r.err
+    md = out.with_suffix(".md").read_text()
+    assert "Beside it, `other`" in md
+    assert "lambda_zeta" in md and "calibrate" not in r.out
+    bad = run_cli("report", synthetic_study.path, "--compare", tmp_path / "nope")
+    assert bad.code == 2 and "--compare" in bad.err
