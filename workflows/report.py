@@ -396,6 +396,10 @@ def _scene_section(run) -> Section:
 
 def _trace_section(run, failures) -> Section:
     sec = Section("Stick-slip trace")
+    warnings = (run.trace.run or {}).get("warnings") or []
+    if warnings:
+        sec.p("**The run completed with warnings** (physics checks): " + "; ".join(map(str, warnings))
+              + ". Read the numbers below with them in mind.")
     doc = run.analysis
     s = doc.get("slips", {})
     sec.p(f"Regime: **{doc.get('regime', '?')}** ({doc.get('regime_criterion', '')}). "
@@ -739,6 +743,8 @@ def _cost_section(run) -> Section:
             ("versions", ", ".join(f"{k} {v}" for k, v in (rj.get("versions") or {}).items())),
             ("started / finished", f"{rj.get('started')} / {rj.get('finished')}"),
             ("run directory", str(run.run_dir))]
+    for w in rj.get("warnings") or []:
+        rows.insert(1, ("warning", str(w)))
     sec.add(Table(("item", "value"), tuple(rows)))
     cmd = rj.get("command")
     if cmd:
@@ -771,7 +777,11 @@ window.addEventListener('load', function () {
 
 
 def _inline_md(text: str) -> str:
-    return text
+    """Markdown text with its tags escaped outside code spans (a viewer would render them)."""
+    import re
+    parts = re.split(r"(`[^`]*`)", str(text))
+    return "".join(p if p.startswith("`") and p.endswith("`") and len(p) > 1
+                   else p.replace("<", "&lt;").replace(">", "&gt;") for p in parts)
 
 
 def _inline_html(text: str) -> str:
@@ -809,26 +819,26 @@ def _render_html(title: str, intro: list, sections: list) -> str:
 
 
 def _md_cell(c: str) -> str:
-    return str(c).replace("|", "\\|").replace("\n", " ")
+    return _inline_md(str(c)).replace("|", "\\|").replace("\n", " ")
 
 
 def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str, dict]:
-    lines, files = [f"# {title}", ""], {}
-    lines += [p + "\n" for p in intro]
+    lines, files = [f"# {_inline_md(title)}", ""], {}
+    lines += [_inline_md(p) + "\n" for p in intro]
     for sec in sections:
-        lines += [f"## {sec.title}", ""]
+        lines += [f"## {_inline_md(sec.title)}", ""]
         for b in sec.blocks:
             if isinstance(b, Figure):
                 fname = f"{stem}-{b.name}.png"
                 files[fname] = b.png
-                lines += [f"![{b.name}]({fname})", "", f"*{b.caption}*", ""]
+                lines += [f"![{b.name}]({fname})", "", f"*{_inline_md(b.caption)}*", ""]
             elif isinstance(b, Table):
                 lines.append("| " + " | ".join(_md_cell(h) for h in b.header) + " |")
                 lines.append("|" + "---|" * len(b.header))
                 lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in b.rows]
                 lines.append("")
             else:
-                lines += [b, ""]
+                lines += [_inline_md(b), ""]
     return "\n".join(lines) + "\n", files
 
 

@@ -59,3 +59,25 @@ def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path,
     assert "lambda_zeta" in md and "calibrate" not in r.out
     bad = run_cli("report", synthetic_study.path, "--compare", tmp_path / "nope")
     assert bad.code == 2 and "--compare" in bad.err
+
+
+def test_markdown_escapes_html_outside_code():
+    from filmfriction.workflows.report import _inline_md, _md_cell
+
+    assert _inline_md("a <script>x</script> & `<b>`") == "a &lt;script&gt;x&lt;/script&gt; & `<b>`"
+    assert _md_cell("<i>|") == "&lt;i&gt;\\|"
+
+
+def test_a_run_with_warnings_says_so(synthetic_study, tmp_path, report_study):
+    import json as _json
+    import shutil
+
+    from filmfriction.workflows.report import build_report
+
+    run = tmp_path / "warned"
+    shutil.copytree(synthetic_study.path, run)
+    rj = _json.loads((run / "run.json").read_text())
+    rj["status"], rj["warnings"] = "completed_with_warnings", ["film temperature 1.06 vs 0.7"]
+    (run / "run.json").write_text(_json.dumps(rj))
+    md = build_report(run).with_suffix(".md").read_text()
+    assert "completed with warnings" in md and "film temperature 1.06 vs 0.7" in md
