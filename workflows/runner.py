@@ -36,6 +36,7 @@ from filmfriction.analysis import energy
 from filmfriction.analysis.util import json_default, write_atomic
 from filmfriction.md_inputs import contract
 from . import engine
+from .locks import DirectoryLock
 from .scene import Scene, SceneError
 
 SCRIPT = "film_slide.lmp"
@@ -55,40 +56,14 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
-class RunLock:
-    """An exclusive ``flock`` on ``RUN_DIR/.lock`` for as long as a run or a
-    resume drives the directory; the file holds the holder's pid.
-
-    A second run or ``--resume`` of the same directory is refused
-    (:class:`SceneError`, naming the pid).  The lock goes with the process:
-    a killed runner leaves no stale lock.
-    """
-
-    def __init__(self, run_dir: Path):
-        self.path = Path(run_dir) / ".lock"
-        self.fd: int | None = None
-
-    def acquire(self) -> "RunLock":
-        import fcntl
-
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.read(fd, 64).decode(errors="replace").strip() or "?"
-            os.close(fd)
-            raise SceneError(f"run directory {self.path.parent} is in use by process {holder} "
-                             "(a run or a resume is driving it); wait for it to finish, or "
-                             "stop that process first") from None
-        os.ftruncate(fd, 0)
-        os.write(fd, f"{os.getpid()}\n".encode())
-        self.fd = fd
-        return self
-
-    def release(self) -> None:
-        if self.fd is not None:
-            os.close(self.fd)
-            self.fd = None
+def RunLock(run_dir: Path) -> DirectoryLock:
+    """The lock on ``RUN_DIR/.lock`` for as long as a run or a resume drives the directory:
+    a second run or ``--resume`` of the same directory is refused (:class:`SceneError`,
+    naming the holder's pid)."""
+    run_dir = Path(run_dir)
+    return DirectoryLock(run_dir / ".lock", lambda holder: SceneError(
+        f"run directory {run_dir} is in use ({holder}: a run or a resume is driving it); "
+        "wait for it to finish, or stop that process first"))
 
 
 class Terminated(KeyboardInterrupt):

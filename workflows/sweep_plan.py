@@ -4,7 +4,6 @@ Part of :mod:`filmfriction.workflows.sweep` (which documents the sweep directory
 """
 from __future__ import annotations
 
-import fcntl
 import json
 import math
 import os
@@ -14,6 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.util import json_default, write_atomic
+
+from .locks import DirectoryLock
 
 PLAN_SCHEMA = "filmfriction.sweep/1"
 POINT_SCHEMA = "filmfriction.sweep-point/1"
@@ -327,44 +328,12 @@ def write_plan(plan: SweepPlan, out: Path) -> list[str]:
     return changed
 
 
-class SweepLock:
-    """Exclusive ``flock`` on ``<sweep>/.sweep.lock``: one sweep per directory.
-
-    The kernel releases it when every holder exits, however it exits, so a
-    killed sweep never leaves a stale lock.  The file descriptor is passed to
-    the Snakemake child, so the lock lasts as long as either process does.
-    """
-
-    def __init__(self, directory: Path):
-        self.path = Path(directory) / ".sweep.lock"
-        self.fd: int | None = None
-
-    def acquire(self) -> "SweepLock":
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 200, 0).decode(errors="replace").strip() or "?"
-            os.close(fd)
-            raise _user_error(
-                f"another sweep is running in {self.path.parent} ({holder}); wait for it, "
-                "or give this sweep its own --out") from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"pid {os.getpid()} on {os.uname().nodename}\n".encode(), 0)
-        os.set_inheritable(fd, True)
-        self.fd = fd
-        return self
-
-    def release(self) -> None:
-        if self.fd is not None:
-            os.close(self.fd)
-            self.fd = None
-
-    def __enter__(self):
-        return self.acquire()
-
-    def __exit__(self, *exc):
-        self.release()
+def SweepLock(directory: Path) -> DirectoryLock:
+    """The lock on ``<sweep>/.sweep.lock``: one sweep per directory.  Its descriptor is
+    passed to the Snakemake child, so the lock lasts as long as either process does."""
+    directory = Path(directory)
+    return DirectoryLock(directory / ".sweep.lock", lambda holder: _user_error(
+        f"another sweep is running in {directory} ({holder}); wait for it, "
+        "or give this sweep its own --out"), inheritable=True)
 
 
