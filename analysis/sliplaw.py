@@ -36,7 +36,7 @@ A reduced-model trace with known F_k and B (a Coulomb + viscous block) gives the
 >>> from filmfriction.reduced_model import SpringBlock, laws
 >>> r = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.01, damping=0.5,
 ...                 law=laws.Coulomb(static=1.0, kinetic=0.4)).simulate(600.0)
->>> fit = fit_slip_law(r.t, r.spring_force, r.v, r.cycles(), mass=1.0, drive_velocity=0.01)
+>>> fit = fit_film_force(r.t, r.spring_force, r.v, r.cycles(), mass=1.0, drive_velocity=0.01)
 >>> round(fit.kinetic_force, 3), round(fit.damping, 3), fit.verdict
 (0.4, 0.5, 'mixed')
 """
@@ -49,7 +49,7 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CycleTable
 
-__all__ = ["SlipLawFit", "film_force", "fit_slip_law", "VISCOUS_SHARE", "RESOLVED_SIGMAS"]
+__all__ = ["FilmForceFit", "film_force", "fit_film_force", "VISCOUS_SHARE", "RESOLVED_SIGMAS"]
 
 #: Viscous share s = B·v̄/(F_k + B·v̄) at or above which a slip is ``viscous`` (and at or
 #: below 1 − VISCOUS_SHARE, ``kinetic``).
@@ -59,7 +59,7 @@ RESOLVED_SIGMAS = 2.0
 
 
 @dataclass(frozen=True)
-class SlipLawFit:
+class FilmForceFit:
     """F_film = F_k + B·v fitted over the slips (see the module text).
 
     Attributes
@@ -101,18 +101,6 @@ class SlipLawFit:
     samples: int
     residual_rms: float
     r_squared: float = float("nan")
-
-    def as_dict(self) -> dict:
-        """JSON-ready values (arrays as lists)."""
-        return {"kinetic_force": self.kinetic_force,
-                "kinetic_force_stderr": self.kinetic_force_stderr,
-                "damping": self.damping, "damping_stderr": self.damping_stderr,
-                "mean_slip_velocity": self.mean_slip_velocity,
-                "viscous_share": self.viscous_share, "verdict": self.verdict,
-                "reason": self.reason, "samples": self.samples,
-                "residual_rms": self.residual_rms, "r_squared": self.r_squared,
-                "per_slip_kinetic_force": self.per_slip_kinetic_force.tolist(),
-                "per_slip_damping": self.per_slip_damping.tolist()}
 
 
 def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity: float = 0.0,
@@ -188,9 +176,9 @@ def _verdict(fk, se_fk, b, se_b, vbar):
     return "mixed", share, f"both terms resolved: {nums}"
 
 
-def fit_slip_law(time, spring_force, wall_velocity, table: CycleTable, *, mass: float,
+def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass: float,
                  drive_velocity: float = 0.0, mount_damping: float = 0.0,
-                 min_velocity_fraction: float = 0.2) -> SlipLawFit:
+                 min_velocity_fraction: float = 0.2) -> FilmForceFit:
     """Fit F_film = F_k + B·v over each slip of ``table`` and over all of them.
 
     Parameters
@@ -207,7 +195,7 @@ def fit_slip_law(time, spring_force, wall_velocity, table: CycleTable, *, mass: 
 
     Returns
     -------
-    SlipLawFit
+    FilmForceFit
         The pooled F_k and B are the means of the per-slip fits, with the
         standard error of their scatter (2 or more slips, floored at the pooled
         least-squares errors); with one slip, that slip's fit and its errors.
@@ -235,7 +223,7 @@ def fit_slip_law(time, spring_force, wall_velocity, table: CycleTable, *, mass: 
     ok = np.isfinite(fks) & np.isfinite(bs)
     nan = math.nan
     if not ok.any():
-        return SlipLawFit(nan, nan, nan, nan, nan, nan, "none",
+        return FilmForceFit(nan, nan, nan, nan, nan, nan, "none",
                           "no slip with 4 or more samples above the velocity floor",
                           fks, bs, 0, nan)
     vall, fall = np.concatenate(vs), np.concatenate(fs)
@@ -253,5 +241,5 @@ def fit_slip_law(time, spring_force, wall_velocity, table: CycleTable, *, mass: 
     r2 = 1.0 - rms ** 2 / var if var > 0 else math.nan
     verdict, share, reason = _verdict(fk, se_fk, b, se_b, vbar)
     reason += f"; the line explains {r2:.0%} of the film force's variance"
-    return SlipLawFit(fk, se_fk, b, se_b, vbar, share, verdict, reason, fks, bs,
+    return FilmForceFit(fk, se_fk, b, se_b, vbar, share, verdict, reason, fks, bs,
                       int(vall.size), rms, r2)

@@ -638,9 +638,33 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     return sec
 
 
+def _similarity_rows(run_dir: Path) -> list[dict]:
+    """The ``similarity`` rows of ``run_dir/sfb.json`` (what the study wrote)."""
+    doc = json.loads((Path(run_dir) / "sfb.json").read_text())
+    rows = doc["rows"] if isinstance(doc, dict) else doc
+    return [r for r in rows if r["source"] == "similarity"]
+
+
+def _lambda_zeta_point(label: str, rows: list[dict]) -> tuple:
+    """(label, ζ, ζ error, λ, λ error) of a run from its similarity rows: ζ = film + mount
+    (an unresolved, non-positive film drag counts as 0), errors the rows' half-ranges."""
+    by = {r["name"]: r for r in rows}
+
+    def value(name):
+        v = by.get(name, {}).get("model")
+        return math.nan if v is None else float(v)
+
+    def half_range(name):
+        u = by.get(name, {}).get("uncertainty")
+        return math.nan if not u else 0.5 * (u[1] - u[0])
+    zf = value("film_damping_ratio")
+    zeta = (zf if math.isfinite(zf) and zf > 0 else 0.0) + value("mount_damping_ratio")
+    return (label, zeta, half_range("film_damping_ratio"), value("lambda"), half_range("lambda"))
+
+
 def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
-    """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given."""
-    from filmfriction.analysis.contact import contact_from_run
+    """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given: the rows
+    each run's ``sfb.json`` holds (Klein's point from his printed parameters)."""
     from filmfriction.reduced_model.similarity import klein_contact, similarity_numbers
 
     sec = Section("Similarity with the SFB experiment: dimensionless numbers")
@@ -657,15 +681,15 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
     else:
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
-    for d in compare:
+    others = {}
+    for d in list(run_dirs[1:]) + [Path(c) for c in compare]:
         try:
-            other = [r for r in json.loads((d / "sfb.json").read_text())["rows"]
-                     if r["source"] == "similarity"]
+            others[Path(d)] = _similarity_rows(d)
         except (OSError, ValueError, KeyError, TypeError) as exc:
-            failures.setdefault(f"similarity rows of {d.name}", str(exc))
-            continue
-        if other and rows:
-            mine = {r["name"]: r for r in other}
+            failures.setdefault(f"similarity rows of {Path(d).name}", str(exc))
+    for d in compare:
+        mine = {r["name"]: r for r in others.get(Path(d), [])}
+        if mine and rows:
             sec.p(f"Beside it, `{d.name}` (its own `sfb.json`):")
             sec.add(Table(("number", "Klein", "this run", d.name, f"{d.name}'s range"),
                           tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
@@ -675,19 +699,18 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
                                  f"{_fmt(mine[r['name']]['uncertainty'][1], 2)}")
                                 for r in rows)))
 
-    def point(label, contact):
-        n = similarity_numbers(contact)
-        zf, zm, lam = n["film_damping_ratio"], n["mount_damping_ratio"], n["lambda"]
-        zeta = (zf.value if math.isfinite(zf.value) and zf.value > 0 else 0.0) + zm.value
-        return (label, zeta, zf.stderr if math.isfinite(zf.stderr) else math.nan,
-                lam.value, lam.stderr)
-    points = [point("Klein (SFB, OMCTS)", klein_contact())]
-    for d in run_dirs:
+    def scene_of(d):
         try:
-            scene = json.loads((Path(d) / "run.json").read_text()).get("scene", {}).get("name", "")
-            points.append(point(f"{scene or Path(d).name} (MD)", contact_from_run(d)))
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            failures.setdefault(f"λ–ζ point of {Path(d).name}", str(exc))
+            return json.loads((Path(d) / "run.json").read_text()).get("scene", {}).get("name", "")
+        except (OSError, ValueError, AttributeError):
+            return ""
+    n = similarity_numbers(klein_contact())
+    zk = n["film_damping_ratio"].value + n["mount_damping_ratio"].value
+    points = [("Klein (SFB, OMCTS)", zk, n["film_damping_ratio"].stderr, n["lambda"].value,
+               n["lambda"].stderr)]
+    for d, rs in [(Path(run_dirs[0]), rows)] + list(others.items()):
+        if rs:
+            points.append(_lambda_zeta_point(f"{scene_of(d) or d.name} (MD)", rs))
     png = _attempt(failures, "figure: lambda-zeta", fig_lambda_zeta, points)
     if png:
         sec.add(Figure("lambda_zeta", png,
@@ -965,8 +988,8 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
                 _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
-                _similarity_section(inputs.sfb, list(run_dirs) + [Path(c) for c in compare],
-                                    failures, compare=[Path(c) for c in compare]),
+                _similarity_section(inputs.sfb, run_dirs, failures,
+                                    compare=[Path(c) for c in compare]),
                 _cost_section(run)]
     if sweeps:
         sections.insert(3 + len(observed), _sweep_section(sweeps))

@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-from ..sliplaw import film_force, fit_slip_law
+from ..sliplaw import film_force, fit_film_force
+from ..trace import unit
 from .base import (Context, MissingInput, Observable, column, format_estimate, format_value,
                    parameter, png_bytes, pyplot)
 
@@ -39,9 +40,9 @@ class SlipLaw(Observable):
         if len(ctx.table) == 0:
             raise MissingInput("slips", "the slip-law fit")
         v_drive, _ = trace.drive_velocity()
-        fit = fit_slip_law(trace.time, trace.spring_force, trace.columns["wall_velocity"],
-                           ctx.table, mass=p.mass, drive_velocity=v_drive or 0.0,
-                           mount_damping=p.mount_damping or 0.0)
+        fit = fit_film_force(trace.time, trace.spring_force, trace.columns["wall_velocity"],
+                             ctx.table, mass=p.mass, drive_velocity=v_drive or 0.0,
+                             mount_damping=p.mount_damping or 0.0)
         out = {"kinetic_force": ctx.value(fit.kinetic_force, fit.kinetic_force_stderr, "force"),
                "damping": ctx.value(fit.damping, fit.damping_stderr, "damping"),
                "mean_slip_velocity": ctx.value(fit.mean_slip_velocity, None, "velocity"),
@@ -87,8 +88,10 @@ class SlipLaw(Observable):
         law = run.analysis.get(self.key) or {}
         plt = pyplot()
         t, f, v = tr.time, tr.spring_force, tr.columns["wall_velocity"]
-        ff = film_force(t, f, v, mass=p.mass, drive_velocity=p.drive_velocity or 0.0,
+        v_drive, _ = tr.drive_velocity()   # the same V as the fit's (compute)
+        ff = film_force(t, f, v, mass=p.mass, drive_velocity=v_drive or 0.0,
                         mount_damping=p.mount_damping or 0.0)
+        lab = lambda q: unit(tr.units, q)  # noqa: E731
         yi = np.asarray(run.cycles.get("yield_index", []), int)[run.skip:]
         si = np.asarray(run.cycles.get("stick_index", []), int)[run.skip:]
         fig, ax = plt.subplots(figsize=(6.4, 4.0))
@@ -104,9 +107,10 @@ class SlipLaw(Observable):
         if fk is not None and b is not None and vmax > 0:
             vv = np.linspace(0.0, vmax, 50)
             ax.plot(vv, fk + b * vv, "k--", lw=1.5,
-                    label=f"fit F_k + B·v: F_k = {fk:.3g} ε/σ, B = {b:.3g} m/τ")
+                    label=f"fit F_k + B·v: F_k = {fk:.3g} {lab('force')}, "
+                          f"B = {b:.3g} {lab('damping')}")
         ax.axhline(0, color="0.6", lw=0.5)
-        ax.set_xlabel("wall velocity during the slip v [σ/τ]")
-        ax.set_ylabel("film force F_spring − M·a − γM(v − V) [ε/σ]")
+        ax.set_xlabel(f"wall velocity during the slip v [{lab('velocity')}]")
+        ax.set_ylabel(f"film force F_spring − M·a − γM(v − V) [{lab('force')}]")
         ax.legend(loc="best", fontsize=8)
         return png_bytes(fig)
