@@ -34,6 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from filmfriction.reduced_model.sfb_rows import spans_decade
+
 __all__ = ["RateLaw", "Extrapolation", "eyring_fit", "power_fit", "choose_rate_law"]
 
 
@@ -52,11 +54,7 @@ class Extrapolation:
 
     @property
     def spans_decade(self) -> bool:
-        if not (math.isfinite(self.low) and math.isfinite(self.high)):
-            return True
-        if self.low <= 0 or self.value <= 0:
-            return True
-        return self.high / self.low > 10.0
+        return self.value <= 0 or spans_decade(self.low, self.high)
 
     def as_dict(self) -> dict:
         return {"rate": self.rate, "value": self.value, "low": self.low, "high": self.high,

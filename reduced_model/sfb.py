@@ -79,8 +79,6 @@ Example
 """
 from __future__ import annotations
 
-from __future__ import annotations
-
 import math
 from dataclasses import asdict, dataclass, replace
 
@@ -92,7 +90,7 @@ from .klein import (BRAUN_TOSATTI_NOTE, KLEIN, KleinExperiment, SlipGeometry,
 from .laws import NewtonianFilm
 from .md_film import MDCalibration
 from .sfb_md import md_rows
-from .sfb_rows import ROW_KEYS, SOURCES, find_row, table_row as _row
+from .sfb_rows import ROW_KEYS, SOURCES, find_row, table_row as _row, without_unfixed_ratio
 from .slip import run_slip, time_to_fraction
 from .springblock import SpringBlock
 from .units import OMCTS, LJUnits
@@ -177,20 +175,6 @@ ASSUMPTIONS = (
     "Uncertainty intervals of sfb-parameters rows: B = A eta/D at +/-1 sigma from Klein's errors "
     "(eta +/-4 Pa s, A +/-10 %, D +/-0.3 nm -> +/-20 %); the x0 ambiguity is not included.",
 )
-
-
-def _decade_rule(row: dict) -> dict:
-    """An absolute row whose interval reaches zero or spans more than a decade has no ratio."""
-    unc = row.get("uncertainty")
-    if unc is None or row.get("model") is None:
-        return row
-    lo, hi = unc
-    if lo <= 0 or hi / lo > 10:
-        row = dict(row, ratio=None)
-        row["note"] = (row["note"] + "; " if row["note"] else "") + (
-            "the interval reaches zero or spans more than a decade: an extrapolation that does "
-            "not fix the value, so no ratio")
-    return row
 
 
 def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperiment = KLEIN,
@@ -312,7 +296,7 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
     if calibration is not None:
         calibration = MDCalibration.coerce(calibration)
         extra_rows, md_run, md_notes = md_rows(calibration, units, ex, geo, liquid)
-        rows += [_decade_rule(r) for r in extra_rows]
+        rows += [without_unfixed_ratio(r) for r in extra_rows]
         slips["md"] = md_run
         notes += md_notes
     if contact is not None:

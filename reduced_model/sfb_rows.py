@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["ROW_KEYS", "SOURCES", "table_row", "find_row"]
+__all__ = ["ROW_KEYS", "SOURCES", "table_row", "find_row", "spans_decade", "without_unfixed_ratio"]
 
 #: Keys of every table row (``note`` and ``uncertainty`` are extras to the issue's six).
 ROW_KEYS = ("name", "klein", "model", "ratio", "units", "source", "uncertainty", "note")
@@ -46,3 +46,29 @@ def find_row(rows, name: str, source: str = "sfb-parameters") -> dict:
         if r["name"] == name and r["source"] == source:
             return r
     raise KeyError(f"no row {name!r} with source {source!r}")
+
+
+def spans_decade(low: float, high: float) -> bool:
+    """Whether the interval [low, high] of a positive quantity fails to fix it: not
+    finite, reaching zero, or wider than a factor of 10.
+
+    >>> spans_decade(1.0, 5.0), spans_decade(0.5, 6.0), spans_decade(-1.0, 2.0)
+    (False, True, True)
+    """
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return True
+    return low <= 0 or high / low > 10
+
+
+def without_unfixed_ratio(row: dict) -> dict:
+    """The row without a ratio when its model value is not positive or its interval
+    :func:`spans_decade`, its note saying why; else the row as it is."""
+    unc, model = row.get("uncertainty"), row.get("model")
+    why = None
+    if model is not None and model <= 0:
+        why = "the model's value is not positive: no ratio"
+    elif unc is not None and model is not None and spans_decade(*unc):
+        why = "the model's interval reaches zero or spans more than a decade: no ratio"
+    if why is None:
+        return row
+    return dict(row, ratio=None, note=(row["note"] + "; " if row["note"] else "") + why)

@@ -44,7 +44,7 @@ from dataclasses import dataclass, fields, replace
 
 from .klein import KLEIN, KleinExperiment, klein_slip_geometry
 from .maps import critical_lambda
-from .sfb_rows import table_row
+from .sfb_rows import table_row, without_unfixed_ratio
 from .units import OMCTS, LJUnits
 
 __all__ = ["SlidingContact", "Number", "similarity_numbers", "NUMBERS", "klein_contact",
@@ -246,17 +246,11 @@ def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) 
         unc = None
         note = _ROW_NOTES[name]
         if math.isfinite(m.stderr) and math.isfinite(m.value):
-            lo, hi = m.value - m.stderr, m.value + m.stderr
-            unc = (lo, hi)
-            if lo <= 0 or hi / lo > 10:   # every number here is positive by nature
-                note += "; the model's interval reaches zero or spans more than a decade: no ratio"
+            unc = (m.value - m.stderr, m.value + m.stderr)
         for who, n in (("this run", m.note), ("Klein", k.note)):
             if n:
                 note += f"; {who}: {n}"
-        row = table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)
-        if "no ratio" in note or (math.isfinite(m.value) and m.value <= 0):
-            if "no ratio" not in note:
-                note += "; the model's value is not positive: no ratio"
-            row["ratio"] = None
-        rows.append(row)
+        # every number here is positive by nature
+        rows.append(without_unfixed_ratio(
+            table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)))
     return rows

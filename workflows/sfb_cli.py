@@ -145,10 +145,10 @@ def run(args) -> int:
                                 f"{args.run}' on a run directory first)")
         try:
             contact = contact_from_run(args.run)
-        except (ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
-            raise UserError(f"--run {args.run}: {exc}") from None
-        except json.JSONDecodeError as exc:
+        except json.JSONDecodeError as exc:   # before ValueError, its base class
             raise UserError(f"--run {args.run}: not valid JSON ({exc})") from None
+        except (ValueError, KeyError, TypeError) as exc:
+            raise UserError(f"--run {args.run}: {exc}") from None
     try:
         check = sfb_check(calibration=calibration, units=units, contact=contact)
     except ValueError as exc:
