@@ -154,3 +154,31 @@ def png_bytes(fig) -> bytes:
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     return buf.getvalue()
+
+
+def read_json_object(path, where: str | None = None, *, what: str = "a JSON object") -> dict:
+    """The JSON object in the file ``path``; ``ValueError`` naming ``where`` (default the
+    path) and the reason when the file is not UTF-8, not JSON, or not an object.
+    (``OSError`` for a file that cannot be read passes through.)
+
+    >>> import tempfile, pathlib
+    >>> p = pathlib.Path(tempfile.mkdtemp()) / "x.json"
+    >>> _ = p.write_text("[1]")
+    >>> read_json_object(p, "x.json")
+    Traceback (most recent call last):
+    ...
+    ValueError: x.json: must be a JSON object, this is a list
+    """
+    import json
+
+    where = where or str(path)
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{where}: not valid JSON: line {exc.lineno} column {exc.colno}: "
+                         f"{exc.msg}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{where}: must be {what}, this is a {type(data).__name__}")
+    return data

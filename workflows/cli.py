@@ -161,21 +161,15 @@ def check_writable(path, flag: str, *, directory: bool = False) -> None:
 def check_run_json(run_dir, flag: str = "") -> dict | None:
     """``RUN_DIR/run.json`` as a dict (None when absent); UserError when it is not
     UTF-8, not JSON, or not a JSON object."""
-    import json
     from pathlib import Path
 
     path = Path(run_dir) / "run.json"
     if not path.is_file():
         return None
+    from filmfriction.analysis.util import read_json_object
+
     where = f"{flag} {path}" if flag else str(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise UserError(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    except json.JSONDecodeError as exc:
-        raise UserError(f"{where}: not valid JSON: line {exc.lineno} column {exc.colno}: "
-                        f"{exc.msg}") from None
-    if not isinstance(data, dict):
-        raise UserError(f"{where}: a run record is a JSON object, this is a "
-                        f"{type(data).__name__}")
-    return data
+        return read_json_object(path, where, what="a JSON object (a run record)")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None

@@ -76,15 +76,16 @@ def _calibration(path: Path | None):
         return None
     from filmfriction.reduced_model import MDCalibration
     from filmfriction.workflows.cli import UserError
+    from filmfriction.analysis.util import read_json_object
+
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        data = read_json_object(path, f"cannot read calibration file {path}")
     except FileNotFoundError:
         raise UserError(f"calibration file {path} does not exist") from None
-    except UnicodeDecodeError as exc:
-        raise UserError(f"calibration file {path}: not UTF-8 text ({exc.reason} at byte "
-                        f"{exc.start})") from None
-    except (OSError, json.JSONDecodeError) as exc:
+    except OSError as exc:
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
     if isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction.calibration/"):
         # a calibration.json: its md_calibration is what the SFB check takes
         if data.get("md_calibration") is None:

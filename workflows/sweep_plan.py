@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import json_default, write_atomic
+from filmfriction.analysis.util import json_default, read_json_object, write_atomic
 
 from .locks import DirectoryLock
 
@@ -282,16 +282,10 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
         if not calibration.is_file():
             raise SceneError(f"--calibration {calibration}: no such file")
         try:
-            data = json.loads(calibration.read_text(encoding="utf-8"))
-        except UnicodeDecodeError as exc:
-            raise SceneError(f"--calibration {calibration}: not UTF-8 text ({exc.reason} at "
-                             f"byte {exc.start})") from None
-        except json.JSONDecodeError as exc:
-            raise SceneError(f"--calibration {calibration}: not valid JSON: line "
-                             f"{exc.lineno} column {exc.colno}: {exc.msg}") from None
-        if not isinstance(data, dict):
-            raise SceneError(f"--calibration {calibration}: a calibration is a JSON object "
-                             f"(calibration.json), this is a {type(data).__name__}")
+            read_json_object(calibration, f"--calibration {calibration}",
+                             what="a JSON object (calibration.json)")
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
     return SweepPlan(scene=base.name, scene_source=str(Path(base.source).resolve()),
                      grid=tuple(axes), fixed=fixed, np=np_, points=tuple(points),
                      parameters=params,
