@@ -16,11 +16,12 @@ and the run's own parameters (``run.json``'s ``trace_parameters`` and scene) int
 """
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 from filmfriction.reduced_model.similarity import SlidingContact
+
+from .util import read_json_object
 
 __all__ = ["contact_from_analysis", "contact_from_run"]
 
@@ -89,6 +90,5 @@ def contact_from_analysis(analysis: dict, run: dict) -> SlidingContact:
 def contact_from_run(run_dir) -> SlidingContact:
     """:func:`contact_from_analysis` of ``run_dir/analysis.json`` and ``run_dir/run.json``."""
     run_dir = Path(run_dir)
-    analysis = json.loads((run_dir / "analysis.json").read_text(encoding="utf-8"))
-    run = json.loads((run_dir / "run.json").read_text(encoding="utf-8"))
-    return contact_from_analysis(analysis, run)
+    return contact_from_analysis(read_json_object(run_dir / "analysis.json"),
+                                 read_json_object(run_dir / "run.json"))

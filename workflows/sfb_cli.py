@@ -146,8 +146,6 @@ def run(args) -> int:
                                 f"{args.run}' on a run directory first)")
         try:
             contact = contact_from_run(args.run)
-        except json.JSONDecodeError as exc:   # before ValueError, its base class
-            raise UserError(f"--run {args.run}: not valid JSON ({exc})") from None
         except (ValueError, KeyError, TypeError) as exc:
             raise UserError(f"--run {args.run}: {exc}") from None
     try:
