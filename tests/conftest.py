@@ -260,3 +260,28 @@ def synthetic_run(tmp_path) -> Path:
     from filmfriction.analysis.synthetic import run_directory
 
     return run_directory(tmp_path / "synthetic-run", layers=3)
+
+
+@pytest.fixture
+def tmpfs(tmp_path):
+    """``tmpfs(name, options, why)``: a tmpfs mounted at ``tmp_path/name`` with the mount
+    ``options`` (e.g. ``"ro,size=64k"``), unmounted after the test; the test is skipped,
+    saying ``why``, where it cannot be made (mounting needs root)."""
+    import subprocess
+
+    mounted = []
+
+    def make(name: str, options: str, why: str) -> Path:
+        mnt = tmp_path / name
+        mnt.mkdir()
+        r = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(mnt)],
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            pytest.skip(f"cannot mount a tmpfs here ({r.stderr.strip() or r.returncode}): {why}")
+        mounted.append(mnt)
+        return mnt
+    try:
+        yield make
+    finally:
+        for mnt in mounted:
+            subprocess.run(["umount", "-l", str(mnt)], capture_output=True)

@@ -225,20 +225,9 @@ def test_umask_is_not_the_check(tmp_path):
 
 
 @pytest.fixture
-def read_only_dir(tmp_path):
+def read_only_dir(tmpfs):
     """A read-only tmpfs (root only); skipped with the reason where it cannot be made."""
-    import subprocess
-
-    mnt = tmp_path / "ro"
-    mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(mnt)],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        pytest.skip(f"cannot mount a read-only tmpfs here ({r.stderr.strip() or r.returncode})")
-    try:
-        yield mnt
-    finally:
-        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+    return tmpfs("ro", "ro,size=64k", "the read-only file-system test needs root")
 
 
 @pytest.mark.parametrize("command", [

@@ -202,19 +202,9 @@ def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command):
 
 
 @pytest.fixture
-def small_tmpfs(tmp_path):
+def small_tmpfs(tmpfs):
     """A 400 kB tmpfs (root only); skipped with the reason where it cannot be made."""
-    mnt = tmp_path / "tiny"
-    mnt.mkdir()
-    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=400k", "tmpfs", str(mnt)],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        pytest.skip(f"cannot mount a small tmpfs here ({r.stderr.strip() or r.returncode}): "
-                    "the full-disk test needs root")
-    try:
-        yield mnt
-    finally:
-        subprocess.run(["umount", "-l", str(mnt)], capture_output=True)
+    return tmpfs("tiny", "size=400k", "the full-disk test needs root")
 
 
 def test_full_disk_is_one_line_and_resumable(small_tmpfs, md, filmfriction_command):
