@@ -23,13 +23,14 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from filmfriction.reduced_model.cycles import CYCLE_COLUMNS, CycleTable, cycle_table, stats
+from filmfriction.reduced_model.cycles import CycleTable, cycle_table, stats
 
-__all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTable", "SlipEvents", "StickStiffness", "stick_stiffness", "cycle_table", "detect_slips",
+__all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTable", "SlipEvents",
+           "StickStiffness", "stick_stiffness", "cycle_table", "detect_slips",
            "noise_level", "classify_regime", "ramp_forces", "REGIME_CV_MAX"]
 
 class Regime(enum.StrEnum):

@@ -267,7 +267,7 @@ class SpringBlock:
         cuts = cuts[np.concatenate(([True], np.diff(cuts) > 1e-12 * T))]
         cuts[-1] = T
         parts = []
-        x_off, t_off, energy = 0.0, 0.0, np.zeros(3)
+        x_off, energy = 0.0, np.zeros(3)
         for a, b in zip(cuts[:-1], cuts[1:]):
             velocity = float(schedule.velocity(0.5 * (a + b)))
             block = replace(self, drive_velocity=velocity) if self.drive == "spring" else self

@@ -17,7 +17,7 @@ from pathlib import Path
 from filmfriction import md_inputs
 from . import engine
 from .runner import atom_steps_per_second, loop_atoms
-from .scene import load, parse_assignment
+from .scene import load
 
 
 
