@@ -56,7 +56,7 @@ def reference_events(law, rtol, method="Radau"):
     """Event-driven stick/slip with solve_ivp in every phase; returns event times."""
     N = 1.0
     Fs = law.static_force((), N)
-    t, x, v, events = 0.0, 0.0, 0.0, []
+    t, x, events = 0.0, 0.0, []
     mode = "stick"
     while t < T:
         if mode == "stick":

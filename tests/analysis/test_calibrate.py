@@ -12,7 +12,6 @@ import pytest
 
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.analysis import calibration as cal_mod
-from filmfriction.workflows import cli
 
 # a heavy wall on a stiff spring, like the MD scene (LJ units)
 M, K, V, D_MOUNT = 500.0, 100.0, 0.02, 50.0

@@ -105,7 +105,7 @@ def _write_correlate(path, blocks, delays, values, with_start=True, truncated=Fa
             lines.append(f"{i + 1} {d} {n + 10 - i} " + " ".join(f"{v:.12g}" for v in values[b, i]))
     if truncated:
         lines.append(f"{blocks[-1] * 2} {n}")
-        lines.append(f"1 0 100 1 1 1")
+        lines.append("1 0 100 1 1 1")
     path.write_text("\n".join(lines) + "\n")
 
 
