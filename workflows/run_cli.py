@@ -58,9 +58,10 @@ def overrides(texts) -> dict:
     return values
 
 
-def check_ranks(nprocs: int | None, flag: str = "--np") -> None:
+def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
     """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
-    oversubscribe, or fail after the setup)."""
+    oversubscribe, or fail after the setup).  ``more``: where more ranks are
+    accepted, appended to the message."""
     import os
 
     from .cli import UserError
@@ -70,7 +71,7 @@ def check_ranks(nprocs: int | None, flag: str = "--np") -> None:
     cpus = os.cpu_count() or 1
     if not 1 <= nprocs <= cpus:
         raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
-                        f"(the CPUs of this machine)")
+                        f"(the CPUs of this machine){more}")
 
 
 def run(args: argparse.Namespace) -> int:
