@@ -115,10 +115,11 @@ def run(args: argparse.Namespace) -> int:
         run_dir = getattr(exc, "run_dir", None)
         if run_dir is None:
             raise
-        from .runner import resume_command
-
-        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); trace.csv written; resume "
-              f"with {resume_command(run_dir)}", file=sys.stderr)
+        command = getattr(exc, "resume_command", None)
+        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); "
+              + (f"resume with {command}" if command else
+                 f"nothing to resume yet (no restart file): start the run again; {run_dir}/"
+                 "run.json records the interruption"), file=sys.stderr)
         return 130
     print(f"run directory: {run_dir}")
     _print_warnings(run_dir)

@@ -35,7 +35,7 @@ from filmfriction import md_inputs
 from filmfriction.analysis import energy
 from filmfriction.analysis.util import json_default, write_atomic
 from filmfriction.md_inputs import contract
-from . import engine
+from . import engine, restarts
 from .locks import DirectoryLock
 from .scene import Scene, SceneError
 
@@ -71,11 +71,19 @@ class Terminated(KeyboardInterrupt):
 
 
 def _raise_terminated(signum, frame):
+    # the first signal only: a second one while the runner stops LAMMPS and records
+    # the interruption is ignored (the context restores the handlers at its end)
+    for sig in _TerminationAsInterrupt.SIGNALS:
+        signal.signal(sig, signal.SIG_IGN)
     raise Terminated(signal.Signals(signum).name)
 
 
 class _TerminationAsInterrupt:
-    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only)."""
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only).
+
+    Active for the whole of a run or a resume, from the run directory's creation
+    on: a signal during the set-up ends the same way as one while LAMMPS runs.
+    """
 
     SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
@@ -188,8 +196,12 @@ class EngineOutcome:
 
 
 def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
-               start_step: int = 0, label: str = "") -> EngineOutcome:
-    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors."""
+               start_step: int = 0, label: str = "", on_step=None) -> EngineOutcome:
+    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors.
+
+    ``on_step(step)`` is called with LAMMPS's step at every thermo line of the
+    slide (or of a resumed slide); an exception it raises stops LAMMPS.
+    """
     from tqdm import tqdm
 
     t0 = time.perf_counter()
@@ -230,13 +242,16 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
                     outcome.total_atoms = atoms
                     continue
                 m = _THERMO_LINE.match(line)
+                if m and on_step is not None and stage_name in ("slide", "resume"):
+                    on_step(int(m.group(1)))
                 if m and stage_name in ("equilibrate", "slide", "resume"):
                     step = int(m.group(1)) + (stage_offset if stage_name == "slide" else 0)
                     if step > done:
                         bar.update(min(step, total_steps) - done)
                         done = min(step, total_steps)
             proc.wait()
-        except KeyboardInterrupt:
+        except BaseException:
+            # Ctrl-C, SIGTERM, or on_step refusing the run: LAMMPS stops too
             os.killpg(proc.pid, signal.SIGTERM)
             proc.wait()
             bar.close()
@@ -464,15 +479,21 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
     ``["srun"]`` for a sweep point inside a Slurm allocation).
     """
-    run_dir = new_run_dir(scene.name, out)
-    lock = RunLock(run_dir).acquire()
-    try:
-        return _execute(scene, run_dir, nprocs, progress, launcher)
-    finally:
-        lock.release()
+    with _TerminationAsInterrupt():
+        run_dir = new_run_dir(scene.name, out)
+        state = {"record": None}
+        try:
+            lock = RunLock(run_dir).acquire()
+            try:
+                return _execute(scene, run_dir, nprocs, progress, launcher, state)
+            finally:
+                lock.release()
+        except KeyboardInterrupt as exc:
+            _interrupted(run_dir, state["record"], scene, exc)
+            raise
 
 
-def _execute(scene, run_dir, nprocs, progress, launcher):
+def _execute(scene, run_dir, nprocs, progress, launcher, state):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
@@ -480,9 +501,9 @@ def _execute(scene, run_dir, nprocs, progress, launcher):
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"),
                              launcher=launcher)
+    state["record"] = record = _record(scene, run_dir, cmd, nprocs)
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
-    record = _record(scene, run_dir, cmd, nprocs)
     write_json(run_dir / "run.json", record)
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
@@ -491,17 +512,45 @@ def resume_command(run_dir: Path) -> str:
     return f"filmfriction run --resume {_shell_line([str(run_dir)])}"
 
 
-def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+def _interrupted(run_dir: Path, record: dict | None, scene: Scene, exc: KeyboardInterrupt):
+    """Record an interruption (Ctrl-C, SIGTERM, SIGHUP) at any stage of a run or a resume:
+    ``run.json`` says ``interrupted``, with the resume command when a usable restart
+    exists, and never stays ``running``.  Sets ``exc.run_dir`` and ``exc.resume_command``
+    (None: nothing to resume) for the command line.  Once recorded, does nothing."""
+    if getattr(exc, "run_dir", None) is not None:
+        return
+    exc.run_dir, exc.resume_command = run_dir, None
+    why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
+    if record is None:          # before the record was built: the least that says what ran
+        record = {"schema": "filmfriction.run/1", "scene": scene.as_dict(), "segments": [],
+                  "started": datetime.now(timezone.utc).isoformat()}
+    started = (run_dir / "lammps.screen").exists()
+    if restarts.usable(run_dir):
+        exc.resume_command = record["resume_command"] = resume_command(run_dir)
+        message = f"interrupted {why}; resume with {exc.resume_command}"
+    else:
+        record.pop("resume_command", None)
+        stage = "before LAMMPS started" if not started else "before the first restart file"
+        message = (f"interrupted {why} {stage}: nothing to resume (no usable restart file); "
+                   "start the run again")
     try:
-        with _TerminationAsInterrupt():
-            outcome = run_engine(cmd, run_dir, total, progress=progress,
-                                 start_step=start_step, label=scene.name)
+        if started:
+            _finish(run_dir, record, scene, None, message, status="interrupted")
+        else:
+            record.update(status="interrupted", error=message, warnings=[],
+                          finished=datetime.now(timezone.utc).isoformat())
+            write_json(run_dir / "run.json", record)
+    except OSError:
+        pass                    # a full disk: the interruption is still reported
+
+
+def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+    ledger = restarts.RestartLedger(run_dir)
+    try:
+        outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
+                             label=scene.name, on_step=ledger.record_below)
     except KeyboardInterrupt as exc:
-        why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
-        record["resume_command"] = resume_command(run_dir)
-        _finish(run_dir, record, scene, None, f"interrupted {why}; resume with "
-                f"{record['resume_command']}", status="interrupted")
-        exc.run_dir = run_dir
+        _interrupted(run_dir, record, scene, exc)
         raise
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
@@ -510,9 +559,9 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
         return _finish(run_dir, record, scene, outcome, outcome.error)
     except OSError as exc:
         # a full disk (or another write error): say so, keep the restart files
-        restarts = [p.name for _, p in _usable_restarts(run_dir)]
+        good = [p.name for _, p in restarts.usable(run_dir)]
         message = (f"cannot write {exc.filename or run_dir}: {exc.strerror or exc}; the "
-                   f"restart files are kept ({restarts[-1] if restarts else 'none'} the newest "
+                   f"restart files are kept ({good[-1] if good else 'none'} the newest "
                    f"usable): free space, then {resume_command(run_dir)}")
         record.update(status="failed", error=message)
         try:
@@ -524,6 +573,14 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
 
 def _finish(run_dir, record, scene, outcome, error, status=None):
     dat = read_trace_dat(run_dir / "trace.dat")
+    # LAMMPS has stopped: a clean exit closed every restart file, otherwise the
+    # trace's last row vouches for the restarts before it
+    clean = outcome is not None and outcome.returncode == 0
+    try:
+        restarts.RestartLedger(run_dir).record_below(
+            None if clean else int(dat[-1, 0]) if len(dat) else 0)
+    except OSError:
+        pass                    # a full disk: resume then checks the markers only
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
         error = trace_problem(dat, scene)
@@ -561,33 +618,8 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
         return run_dir
     if error:
         raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
-    _prune_restarts(run_dir)
+    restarts.prune(run_dir)
     return run_dir
-
-
-def _prune_restarts(run_dir: Path) -> None:
-    """Keep only the newest restart file: the one --resume would use."""
-    files = _restart_files(run_dir)
-    for _, path in files[:-1]:
-        path.unlink(missing_ok=True)
-
-
-def _usable_restarts(run_dir: Path) -> list[tuple[int, Path]]:
-    """Restart files that were written whole: every restart of a run has the same
-    size (same atoms), so a shorter one was cut off (a full disk, a kill)."""
-    files = _restart_files(run_dir)
-    sizes = [p.stat().st_size for _, p in files]
-    full = max(sizes, default=0)
-    return [(step, p) for (step, p), size in zip(files, sizes) if size == full and size > 0]
-
-
-def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
-    found = []
-    for p in run_dir.glob("restart.*"):
-        suffix = p.name.split(".", 1)[1]
-        if suffix.isdigit():
-            found.append((int(suffix), p))
-    return sorted(found)
 
 
 def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
@@ -599,14 +631,23 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
     run_dir = Path(run_dir)
     if not (run_dir / "run.json").exists():
         raise SceneError(f"{run_dir} is not a run directory (no run.json)")
-    lock = RunLock(run_dir).acquire()
-    try:
-        return _resume(run_dir, nprocs, progress)
-    finally:
-        lock.release()
+    with _TerminationAsInterrupt():
+        lock = RunLock(run_dir).acquire()
+        state = {"record": None, "scene": None}
+        try:
+            return _resume(run_dir, nprocs, progress, state)
+        except KeyboardInterrupt as exc:
+            if state["record"] is not None:      # run.json was (being) set to running
+                _interrupted(run_dir, state["record"], state["scene"], exc)
+            elif getattr(exc, "run_dir", None) is None:   # run.json untouched: as it was
+                exc.run_dir = run_dir
+                exc.resume_command = resume_command(run_dir) if restarts.usable(run_dir) else None
+            raise
+        finally:
+            lock.release()
 
 
-def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
+def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict) -> Path:
     from . import scene as scene_mod
 
     record_path = run_dir / "run.json"
@@ -618,10 +659,14 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
     if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
-    restarts = _usable_restarts(run_dir)
-    if not restarts:
+    good, bad = restarts.check(run_dir)
+    if bad:
+        record["unusable_restarts"] = bad
+    if not good:
+        why = "".join(f"; {name}: {reason}" for name, reason in bad.items())
         raise SceneError(f"{run_dir} has no usable restart file to resume from (restart_every = "
-                         f"{record['scene']['parameters'].get('restart_every')}); start a new run")
+                         f"{record['scene']['parameters'].get('restart_every')}{why}); "
+                         "start a new run")
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],
@@ -635,7 +680,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     # again, then resumed, starts from the same sums).  The newest restart whose
     # sums are known: a trace cut short (a full disk) may lack the newest's row.
     offsets = record.setdefault("resume_offsets", {})
-    for step, restart in reversed(restarts):
+    for step, restart in reversed(good):
         at = dat[dat[:, 0] == step] if len(dat) else dat
         if len(at):
             offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
@@ -644,7 +689,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
             break
     else:
         raise SceneError(f"{run_dir}/trace.dat has no row at any restart step "
-                         f"({', '.join(p.name for _, p in restarts)}): cannot carry the energy "
+                         f"({', '.join(p.name for _, p in good)}): cannot carry the energy "
                          "ledger exactly; start a new run")
     keep = read_trace_dat(run_dir / "trace.dat")
     keep = keep[keep[:, 0] < step] if len(keep) else keep
@@ -667,6 +712,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
                              log=Path(f"lammps.resume{step}.log"))
     record.setdefault("commands", [record["command"]]).append(cmd)
+    state["record"], state["scene"] = record, scene
     write_json(record_path, record)
     _rewrite_trace_dat(run_dir / "trace.dat", keep)
     return _drive(scene, run_dir, record, cmd, total,
