@@ -9,11 +9,20 @@ DEFAULT_SCENE = "stick-slip"
 
 
 def register(subparsers) -> None:
+    import textwrap
+
     p = subparsers.add_parser(
         "run", help="run a scene in LAMMPS (default: the stick-slip study end to end)",
-        description="Run a scene in LAMMPS on N MPI ranks, then analyse the run. "
-                    "Values are checked before LAMMPS starts; a run never overwrites "
-                    "an existing directory.")
+        description=textwrap.fill(
+            "Run a scene in LAMMPS on N MPI ranks, then analyse the run, calibrate the "
+            "reduced model, compare with the SFB experiment and write the report. Values "
+            "are checked before LAMMPS starts; a run never overwrites an existing "
+            "directory; Ctrl-C, SIGTERM or SIGHUP leave it resumable (--resume).", 79),
+        epilog="scene parameters (--set KEY=VALUE, LJ units; a range's '(' excludes its "
+               "bound;\nthe default applies when the scene does not set the parameter; "
+               "'filmfriction\nscenes --parameters' says what each one is):\n\n"
+               + parameter_table(),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
                    help=f"scene name or TOML file (default: {DEFAULT_SCENE}; see "
                         "'filmfriction scenes')")
@@ -41,8 +50,45 @@ def register(subparsers) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
-    s = subparsers.add_parser("scenes", help="list the scenes with what they model and cost")
+    s = subparsers.add_parser(
+        "scenes", help="list the scenes with what they model and cost",
+        description="List the shipped scenes: what each one models, its main parameters, "
+                    "its observables and its cost. A scene is a TOML file; give its name or "
+                    "the path of your own to 'filmfriction run'.")
+    s.add_argument("--parameters", action="store_true",
+                   help="list every scene parameter instead: unit, default, allowed range "
+                        "and meaning")
     s.set_defaults(func=list_scenes)
+
+
+def _number(value) -> str:
+    return str(value) if isinstance(value, int) else f"{value:g}"
+
+
+def parameter_table(meaning: bool = False) -> str:
+    """Every scene parameter, one per line: name, unit, default, allowed range
+    (and, with ``meaning``, what it is)."""
+    import textwrap
+
+    from .scene import PARAMETERS
+
+    rows = [("parameter", "unit", "default", "range")]
+    for spec in PARAMETERS.values():
+        if spec.choices:
+            allowed = " | ".join(spec.choices)
+        else:
+            allowed = (f"{'(' if spec.low_open else '['}{_number(spec.low)}, "
+                       f"{_number(spec.high)}]")
+        rows.append((spec.name, spec.unit, _number(spec.default) if not spec.choices
+                     else spec.default, allowed))
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    lines = []
+    for i, row in enumerate(rows):
+        lines.append("  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip())
+        if meaning and i > 0:
+            lines.append(textwrap.fill(list(PARAMETERS.values())[i - 1].help, 79,
+                                       initial_indent="    ", subsequent_indent="    "))
+    return "\n".join(lines)
 
 
 def _overrides(args) -> dict:
@@ -155,6 +201,9 @@ def post_process(run_dir: Path) -> int:
 def list_scenes(args: argparse.Namespace) -> int:
     from .scene import available, load
 
+    if args.parameters:
+        print(parameter_table(meaning=True))
+        return 0
     for name, path in available().items():
         scene = load(str(path))
         p = scene.parameters
