@@ -174,14 +174,16 @@ def check_head(text: str, *, timestep: float, trace_every: int, drive_velocity: 
         parts = line.split()
         where = f"trace.dat row {i}"
         if len(parts) != len(TRACE):
-            return f"{where} has {len(parts)} values, expected {len(TRACE)} ({' '.join(DAT_COLUMNS)})"
+            return (f"{where} has {len(parts)} values, expected {len(TRACE)} "
+                    f"({' '.join(DAT_COLUMNS)})")
         try:
             row = dict(zip(DAT_COLUMNS, (float(x) for x in parts)))
         except ValueError:
             return f"{where} is not all numbers: {line[:120]!r}"
         step, where = row["step"], f"{where} (step {row['step']:g})"
         if previous is not None and step - previous != trace_every:
-            return f"{where}: steps advance by {step - previous:g}, expected trace_every = {trace_every}"
+            return (f"{where}: steps advance by {step - previous:g}, expected trace_every = "
+                    f"{trace_every}")
         previous = step
         checks = (("time", step * timestep, "step x timestep", "tau"),
                   ("drive_position", drive_velocity * row["time"], "V x time", "sigma"),
