@@ -73,7 +73,7 @@ def engine_env(base: dict | None = None, lmp: Path | None = None) -> dict:
     env = dict(os.environ if base is None else base)
     libdir = str(mpi_library_dir())
     parts = [p for p in env.get("LD_LIBRARY_PATH", "").split(":") if p]
-    if libdir not in parts and (lmp is None or Path(lmp) == lmp_binary()):
+    if libdir not in parts and (lmp is None or Path(lmp).resolve() == lmp_binary().resolve()):
         env["LD_LIBRARY_PATH"] = ":".join([libdir, *parts])
     # One OpenMP thread per MPI rank: the ranks already use every core.
     env.setdefault("OMP_NUM_THREADS", "1")

@@ -71,7 +71,7 @@ class LammpsBuild:
 
     @property
     def is_wheel(self) -> bool:
-        return self.path == engine.lmp_binary()
+        return self.path.resolve() == engine.lmp_binary().resolve()
 
     def as_dict(self) -> dict:
         return {"path": str(self.path), "source": self.source, "version": self.version,

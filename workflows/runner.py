@@ -345,7 +345,7 @@ def contract_problem(run_dir: Path, scene: Scene, rows: int = 4) -> tuple[str | 
     return problem, max(0, len(complete) - 1)
 
 
-def _contract_message(run_dir: Path, problem: str) -> str:
+def _contract_message(problem: str) -> str:
     return (f"the LAMMPS script's trace breaks the trace contract (md_inputs/contract.py: "
             f"columns and LJ units): {problem}")
 
@@ -615,7 +615,7 @@ def _watch(run_dir: Path, scene: Scene):
         if not checked:
             problem, rows = contract_problem(run_dir, scene)
             if problem:
-                raise ContractBroken(_contract_message(run_dir, problem))
+                raise ContractBroken(_contract_message(problem))
             checked = rows >= 4
     return on_step
 
@@ -663,7 +663,7 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
         problem = contract_problem(run_dir, scene)[0] if scene.script else None
-        error = _contract_message(run_dir, problem) if problem else trace_problem(dat, scene)
+        error = _contract_message(problem) if problem else trace_problem(dat, scene)
         # fix print writes on multiples of trace_every: the last row is the last
         # such multiple, which is below slide_steps when trace_every does not divide it
         every = scene.parameters["trace_every"]
