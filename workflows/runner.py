@@ -531,8 +531,8 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     for the packages the scene needs before the run directory is created.
     """
     script = Path(scene.script) if scene.script else md_inputs.script(SCRIPT)
-    build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script)
     with _TerminationAsInterrupt():
+        build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script)
         run_dir = new_run_dir(scene.name, out)
         state = {"record": None}
         try:
