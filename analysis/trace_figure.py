@@ -14,7 +14,7 @@ Example
 >>> tr = Trace({"time": t, "spring_force": 1e-5 * (t % 0.25)}, TraceParameters(units="si"), None)
 >>> fig = trace_figure(tr, [49, 99], [50, 100])
 >>> [ax.get_ylabel() for ax in fig.axes], fig.axes[-1].get_xlabel()
-(['spring force [µN]'], 'time [ms]')
+(['spring force [µN]'], 'time [s]')
 """
 from __future__ import annotations
 
