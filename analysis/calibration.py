@@ -364,8 +364,10 @@ def calibrate(run_dirs) -> Calibration:
         failures["md_calibration"] = str(exc)
     dependence = None
     if distinct >= 3:
+        from filmfriction.reduced_model.units import SI_IDENTITY
         try:
-            dependence = rate_dependence(points)
+            # an SI trace's rates are SI already: the identity mapping carries them
+            dependence = rate_dependence(points, SI_IDENTITY if units == {"si"} else None)
         except ValueError as exc:
             failures["rate_dependence"] = str(exc)
     return Calibration(runs=runs, rate_law=law, rate_points=points, md_calibration=md,
