@@ -39,7 +39,8 @@ from .klein import KleinExperiment
 from .sfb import SFBCheck, sfb_check
 from .units import OMCTS, LJUnits
 
-__all__ = ["SFBSetup", "MeasuredSlip", "setup_experiment", "sfb_check_setup", "SETUP_KEYS"]
+__all__ = ["SFBSetup", "MeasuredSlip", "setup_experiment", "sfb_check_setup", "SETUP_KEYS",
+           "load_setup"]
 
 #: The set-up's quantities: name -> (SI unit, meaning).
 SETUP_KEYS = {
@@ -157,6 +158,32 @@ class SFBSetup:
             out[key] = {"value": getattr(self, key),
                         "error": getattr(self, key + "_err", 0.0), "units": units_}
         return out
+
+
+def load_setup(path) -> SFBSetup:
+    """The :class:`SFBSetup` in the TOML file ``path`` (named after the file unless it
+    says ``name``).
+
+    Raises
+    ------
+    ValueError
+        A file that is missing, not UTF-8 TOML, or not a valid set-up; the message
+        names the file.
+    """
+    import tomllib
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
+    try:
+        return SFBSetup.from_dict(data, name=path.stem)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
 
 
 @dataclass(frozen=True)

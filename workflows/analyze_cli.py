@@ -58,6 +58,10 @@ def register(subparsers) -> None:
                         "drive_position, wall_position, wall_velocity, gap, ...); repeat per "
                         "column, e.g. --column time=t_s --column spring_force=F_N")
     p.add_argument("--json", action="store_true", help="also print the document")
+    p.add_argument("--setup", type=Path, default=None, metavar="FILE.toml",
+                   help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
+                        "constant, mass, contact area, film thickness and drive velocity, "
+                        "unless given below; implies --units si")
     p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
     p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
     p.add_argument("--area", type=_positive, help="contact area A")
@@ -89,6 +93,21 @@ def run(args: argparse.Namespace) -> int:
         check_run_json(args.path)
     if args.output is not None:
         check_writable(args.output, "--output")
+    if args.setup is not None:
+        from filmfriction.reduced_model.sfb_setup import load_setup
+
+        try:
+            setup = load_setup(args.setup)
+        except ValueError as exc:
+            raise UserError(f"--setup {exc}") from None
+        if args.units == "lj":
+            raise UserError(f"--units lj with --setup {args.setup}: a set-up is in SI units")
+        args.units = "si"
+        for flag, value in (("spring_constant", setup.spring_constant), ("mass", setup.mass),
+                            ("area", setup.contact_area), ("thickness", setup.film_thickness),
+                            ("drive_velocity", setup.drive_velocity)):
+            if getattr(args, flag) is None:
+                setattr(args, flag, value)
     columns = {}
     for name, column in args.column:
         if name in columns and columns[name] != column:

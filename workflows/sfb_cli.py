@@ -119,22 +119,14 @@ def _setup(args):
     if args.setup is None or args.measured is None:
         raise UserError("--setup FILE.toml and --measured DIR go together: the set-up of your "
                         "SFB and the analysed trace whose slip it measured")
-    import tomllib
-
     from filmfriction.analysis.measured import measured_slip
     from filmfriction.analysis.util import read_json_object
-    from filmfriction.reduced_model.sfb_setup import SFBSetup
+    from filmfriction.reduced_model.sfb_setup import load_setup
 
     try:
-        data = tomllib.loads(args.setup.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise UserError(f"--setup {args.setup}: no such file") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise UserError(f"--setup {args.setup}: cannot read it as TOML: {exc}") from None
-    try:
-        setup = SFBSetup.from_dict(data, name=args.setup.stem)
+        setup = load_setup(args.setup)
     except ValueError as exc:
-        raise UserError(f"--setup {args.setup}: {exc}") from None
+        raise UserError(f"--setup {exc}") from None
     doc_path = args.measured / "analysis.json" if args.measured.is_dir() else args.measured
     if not doc_path.is_file():
         raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
