@@ -108,6 +108,9 @@ def test_sfb_runs_on_the_users_setup_and_slip(chain):
     assert doc["units"]["name"] == "SI (identity)"      # an SI calibration is not re-mapped
     assert "measured" in printed["sfb"].splitlines()[2]
     assert not any(c in "".join(r["units"] for r in doc["rows"]) for c in LJ_LABELS)
+    # the calibrated rows speak SI too: no LJ mapping in their notes
+    calibrated = [r["note"] for r in doc["rows"] if r["source"] == "md-calibrated"]
+    assert calibrated and not any("eps/sigma" in n or "/tau" in n for n in calibrated)
 
 
 def test_report_is_written(chain):
