@@ -20,10 +20,11 @@ entry of :data:`UNITS` that labels it) and ``run.json``, and optionally
 ``profiles/density.profile``, ``profiles/velocity.profile`` (``fix
 ave/chunk``) and ``trajectory.dcd`` + ``topology.data``.
 
-Speed: a text trace is parsed by NumPy's C reader (~0.15 s per 10⁶ rows of
-three columns); a binary copy beside it (``trace.npy``, :func:`write_binary_copy`,
-written by the runner and by ``filmfriction analyze`` for long traces) is read
-instead when it is at least as new as the text (~0.02 s).
+Speed: a text trace is parsed by NumPy's C reader (~0.2 s per 10⁶ rows of three
+columns); a binary copy beside it (``trace.npy``, :func:`write_binary_copy`, written
+by ``filmfriction analyze`` for traces of :data:`BINARY_MIN_ROWS` rows or more) is
+read instead while it is at least as new as the text (~0.01 s; see
+``benchmarks/bench_analysis.py``).
 
 The unit system is only reported, never converted: ``lj`` or ``si``.
 """
