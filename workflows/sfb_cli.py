@@ -1,6 +1,7 @@
 """``filmfriction sfb``: the reduced model against Klein's SFB numbers.
 
     filmfriction sfb [--json] [--calibration FILE.json] [--run RUN_DIR] [--out sfb.json] [--sigma-nm S] [--epsilon-K E]
+    filmfriction sfb --setup MY_SFB.toml --measured DIR [--calibration DIR/calibration.json] [--out sfb.json]
 
 Prints the comparison table (name, Klein, model, ratio, units, source) and
 the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
@@ -11,7 +12,12 @@ rows; ``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to
 carry it to SI.  ``--run`` adds the ``similarity`` rows: the dimensionless
 numbers of an analysed MD run beside Klein's.  ``--out`` also writes the check as the study does
 (``sfb.json`` + ``sfb_slips.csv``), for ``filmfriction report`` to read.
-The check itself is :func:`filmfriction.reduced_model.sfb_check`.
+``--setup`` / ``--measured`` run the check on one's own SFB set-up (a TOML file,
+:func:`filmfriction.reduced_model.sfb_setup.load_setup`) and the slip of an analysed
+SI trace (:func:`filmfriction.analysis.measured.measured_slip`); an SI calibration
+(a measured trace's ``calibration.json``) is taken without any LJ mapping.
+The check itself is :func:`filmfriction.reduced_model.sfb_check`
+(:func:`filmfriction.reduced_model.sfb_setup.sfb_check_setup` with a set-up).
 """
 from __future__ import annotations
 
