@@ -157,7 +157,6 @@ def run(args: argparse.Namespace) -> int:
         doc["source"]["delimiter"] = layout.delimiter
         doc["source"]["columns"] = dict(layout.columns)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
-    figure = None
     if not args.no_figure:
         from filmfriction.analysis.trace_figure import write_trace_figure
 
@@ -177,7 +176,8 @@ def run(args: argparse.Namespace) -> int:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))
     else:
         s = doc["slips"]
-        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path} and {csv_path.name}",
+        names = [csv_path.name] + ([doc["figure"]] if "figure" in doc else [])
+        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path}, {', '.join(names)}",
               file=sys.stdout)
         for key, why in doc["skipped"].items():
             print(f"  skipped {key}: {why}", file=sys.stdout)
