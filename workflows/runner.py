@@ -422,7 +422,7 @@ def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
 
 
 # ---------------------------------------------------------------- the run
-def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
+def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: int = 1) -> dict:
     d = scene.derived()
     p = scene.parameters
     return {
@@ -449,6 +449,7 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
         },
         "trace_units": TRACE_UNITS,
         "command": cmd, "np": nprocs, "cwd": str(run_dir.resolve()),
+        "layout": {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads},
         "seeds": {"seed": p["seed"]},
         "versions": versions(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
@@ -458,31 +459,36 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
 
 
 def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
-            progress: bool = True, launcher: list[str] | None = None) -> Path:
+            progress: bool = True, launcher: list[str] | None = None,
+            threads: int = 1) -> Path:
     """Run ``scene`` in a new directory and return it; raise RunFailed on failure.
 
-    ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
-    ``["srun"]`` for a sweep point inside a Slurm allocation).
+    ``nprocs`` MPI ranks of ``threads`` OpenMP threads each (``threads`` > 1
+    uses the OPENMP styles).  On the scenes' boxes, ranks alone measure fastest
+    (``filmfriction bench --omp`` compares the two layouts), so ``run --np N``
+    uses N ranks of one thread.  ``launcher`` starts the MPI ranks instead of
+    the venv's ``mpiexec`` (e.g. ``["srun"]`` for a sweep point inside a Slurm
+    allocation).
     """
     run_dir = new_run_dir(scene.name, out)
     lock = RunLock(run_dir).acquire()
     try:
-        return _execute(scene, run_dir, nprocs, progress, launcher)
+        return _execute(scene, run_dir, nprocs, progress, launcher, threads)
     finally:
         lock.release()
 
 
-def _execute(scene, run_dir, nprocs, progress, launcher):
+def _execute(scene, run_dir, nprocs, progress, launcher, threads=1):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"),
-                             launcher=launcher)
+                             launcher=launcher, threads=threads)
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
-    record = _record(scene, run_dir, cmd, nprocs)
+    record = _record(scene, run_dir, cmd, nprocs, threads)
     write_json(run_dir / "run.json", record)
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
@@ -656,6 +662,8 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     record["status"] = "running"
     record["resumed_from"] = restart.name
     record["np"] = nprocs
+    threads = int((record.get("layout") or {}).get("omp_threads", 1))
+    record["layout"] = {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads}
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
@@ -665,7 +673,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
-                             log=Path(f"lammps.resume{step}.log"))
+                             log=Path(f"lammps.resume{step}.log"), threads=threads)
     record.setdefault("commands", [record["command"]]).append(cmd)
     write_json(record_path, record)
     _rewrite_trace_dat(run_dir / "trace.dat", keep)
