@@ -13,10 +13,13 @@ step that failed is reported as failed, with its reason, and the rest of the
 report is still written.
 
 The document is built once as a list of sections of blocks (paragraph,
-figure, table) and rendered twice, so the two files cannot disagree.  Each
-observable of the analysis (:mod:`filmfriction.analysis.observables`) gets a
-section from one function, :func:`_observable_section`: its title, its figure
-with its caption, its table and its notes, or why it is not there.
+figure, table) and rendered twice, so the two files cannot disagree.  Every
+section of the analysis is an observable
+(:mod:`filmfriction.analysis.observables`: the slips, the energy, the sliding
+state, the viscosity, the structure, the slip law ...) and gets its section
+from one function, :func:`_observable_section`, in the observables' order: its
+title, its lead paragraphs, its figures with their captions, its table and its
+notes, or why it is not there.
 """
 from __future__ import annotations
 

@@ -6,21 +6,28 @@ report, declared in one file of this package:
 * what it needs -- :attr:`Observable.needs`, trace columns (:func:`column`) and
   parameters (:func:`parameter`).  When one is absent the analysis does not call
   it: ``skipped[key]`` says which is missing and what for (``missing
-  wall_velocity (needed for ...)``, ``missing --mass (needed for ...)``), the
-  way the built-in sections do;
+  wall_velocity (needed for ...)``, ``missing --mass (needed for ...)``);
 * what it computes -- :meth:`Observable.compute` gets a :class:`Context` (the
-  trace, the analysed slips, the unit labels ...) and returns its section of
-  ``analysis.json`` and its per-slip columns for ``analysis_cycles.csv``.  A
-  need that only the run can reveal (no slips at all) is a
-  :class:`~filmfriction.analysis.trace.MissingInput` raised from ``compute``:
-  the analysis records it in ``skipped`` too;
+  trace, the slips, the regime, the unit labels, the sections computed before
+  it ...) and returns its section of ``analysis.json`` and its per-slip columns
+  for ``analysis_cycles.csv``.  A need that only the run can reveal (no slips
+  at all) is a :class:`~filmfriction.analysis.trace.MissingInput` raised from
+  ``compute``: the analysis records it in ``skipped`` too; a part of the
+  section that cannot be computed is recorded with :meth:`Context.skip_part`;
+* where it comes -- :attr:`~Observable.order` (the slips 10, the energy 20,
+  the sliding state 30, the viscosity 40, the structure 50, others 100 by
+  default), which slips its per-slip columns cover
+  (:attr:`~Observable.per_slip`) and what their names begin with
+  (:attr:`~Observable.column_prefix`);
 * what it adds to the report -- :attr:`~Observable.title`,
+  :meth:`~Observable.lead` (paragraphs first), :meth:`~Observable.figure`, PNG
+  bytes drawn from the run directory
+  (:class:`~filmfriction.analysis.rundata.RunData`), shown with
+  :attr:`~Observable.caption` (or :meth:`~Observable.figures` for several),
   :meth:`~Observable.rows` (label, value) for a table with
-  :attr:`~Observable.table_header`, :meth:`~Observable.notes` (paragraphs
-  after it), and :meth:`~Observable.figure`, PNG bytes drawn from the run
-  directory (:class:`~filmfriction.analysis.rundata.RunData`), shown with
-  :attr:`~Observable.caption`.  The report (``workflows/report.py``) renders
-  every registered observable with one function; nothing here knows the report.
+  :attr:`~Observable.table_header`, and :meth:`~Observable.notes` (paragraphs
+  after it).  The report (``workflows/report.py``) renders every registered
+  observable with one function; nothing here knows the report.
 
 Registry
 --------
@@ -29,9 +36,10 @@ Every subclass of :class:`Observable` registers itself under its ``key`` in
 friction laws of :mod:`filmfriction.reduced_model.laws` do.  A subclass that is
 not an observable of its own (a helper base, a broken variant in a test) opts
 out with ``class X(Observable, register=False)``.  A key is the observable's
-``analysis.json`` section, so it must be unique and may not be a built-in
-section's (:data:`BUILT_IN`); its per-slip columns are written as
-``<key>_<name>``.
+``analysis.json`` section, so it must be unique and may not be a key of
+the document itself (:data:`BUILT_IN`: the schema, the source, the
+regime, the detection ...); its per-slip columns are written as
+``<key>_<name>`` unless it names a :attr:`~Observable.column_prefix`.
 
 Example
 -------
@@ -71,7 +79,8 @@ __all__ = ["Observable", "Context", "Need", "column", "parameter", "REGISTRY", "
 #: key -> observable class, for every registered :class:`Observable` subclass
 REGISTRY: dict[str, type[Observable]] = {}
 
-#: The ``analysis.json`` keys that the analysis writes itself (no observable may take one).
+#: The ``analysis.json`` keys that the analysis writes itself, around the
+#: observables' sections (no observable may take one).
 BUILT_IN = frozenset({"schema", "units", "source", "regime", "regime_criterion", "regime_note",
                       "detection", "skipped", "cycles_csv"})
 
@@ -337,7 +346,7 @@ def _register(cls) -> None:
         raise TypeError(f"observable {where}: key {key!r} must be lower case letters, digits "
                         "and '_' (it names its analysis.json section)")
     if key in BUILT_IN:
-        raise TypeError(f"observable {where}: key {key!r} is a built-in section of analysis.json")
+        raise TypeError(f"observable {where}: key {key!r} is a key analysis.json has of its own")
     if not cls.title:
         raise TypeError(f"observable {where}: no title (the report section's)")
     if not isinstance(cls.needs, (tuple, list)):
