@@ -24,7 +24,6 @@ notes, or why it is not there.
 from __future__ import annotations
 
 import base64
-import html
 import json
 import math
 import os
@@ -550,27 +549,10 @@ def _cost_section(run) -> Section:
 
 
 # ---------------------------------------------------------------------------
-# rendering
+# rendering: Jinja2 templates (workflows/templates/), HTML autoescaped
 # ---------------------------------------------------------------------------
-_CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;max-width:1050px;margin:2em auto;padding:0 1em;
-color:#222;line-height:1.45}
-h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.8em}
-table{border-collapse:collapse;margin:.8em 0;font-size:.86em}
-td,th{border:1px solid #ccc;padding:.25em .5em;vertical-align:top;text-align:left}
-th{background:#f3f3f3}figure{margin:1em 0}figure img{max-width:100%}
-figcaption{font-size:.88em;color:#555}code{background:#f4f4f4;padding:0 .2em}
-.fail{color:#a00}
-"""
-
-_SCRIPT = """
-window.addEventListener('load', function () {
-  var imgs = document.images, ok = 0;
-  for (var i = 0; i < imgs.length; i++) { if (imgs[i].complete && imgs[i].naturalWidth > 0) ok++; }
-  document.body.setAttribute('data-images-total', imgs.length);
-  document.body.setAttribute('data-images-loaded', ok);
-});
-"""
+#: how a paragraph that says something is missing or failed begins (shown in red)
+_FAILURE_OPENINGS = ("Not computed", "Calibration failed", "The SFB check failed", "No `")
 
 
 def _inline_md(text: str) -> str:
@@ -581,62 +563,47 @@ def _inline_md(text: str) -> str:
                    else p.replace("<", "&lt;").replace(">", "&gt;") for p in parts)
 
 
-def _inline_html(text: str) -> str:
+def _inline_html(text) -> str:
+    """HTML of a paragraph: the text escaped, then its ``**bold**`` and ```code``` marked up."""
     import re
-    out = html.escape(text)
+
+    from markupsafe import Markup, escape
+    out = str(escape(str(text)))
     out = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", out)
     out = re.sub(r"`(.+?)`", r"<code>\1</code>", out)
-    return out
-
-
-def _render_html(title: str, intro: list, sections: list) -> str:
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}"
-             f"</title><style>{_CSS}</style></head><body><h1>{html.escape(title)}</h1>"]
-    parts += [f"<p>{_inline_html(p)}</p>" for p in intro]
-    parts.append("<nav><ol>" + "".join(f"<li><a href='#s{i}'>{html.escape(s.title)}</a></li>"
-                                      for i, s in enumerate(sections)) + "</ol></nav>")
-    for i, sec in enumerate(sections):
-        parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}</h2>")
-        for b in sec.blocks:
-            if isinstance(b, Figure):
-                data = base64.b64encode(b.png).decode("ascii")
-                parts.append(f"<figure><img alt='{html.escape(b.name)}' src='data:image/png;base64,{data}'>"
-                             f"<figcaption>{_inline_html(b.caption)}</figcaption></figure>")
-            elif isinstance(b, Table):
-                head = "".join(f"<th>{html.escape(str(h))}</th>" for h in b.header)
-                body = "".join("<tr>" + "".join(f"<td>{_inline_html(str(c))}</td>" for c in row) + "</tr>"
-                               for row in b.rows)
-                parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
-            else:
-                cls = " class='fail'" if b.startswith(("Not computed", "Calibration failed",
-                                                       "The SFB check failed", "No `")) else ""
-                parts.append(f"<p{cls}>{_inline_html(b)}</p>")
-    parts.append(f"<script>{_SCRIPT}</script></body></html>")
-    return "\n".join(parts)
+    return Markup(out)
 
 
 def _md_cell(c: str) -> str:
     return _inline_md(str(c)).replace("|", "\\|").replace("\n", " ")
 
 
+def _templates(*, html: bool):
+    """The report's Jinja2 environment: the package's templates, HTML autoescaped."""
+    from jinja2 import Environment, PackageLoader, StrictUndefined
+
+    env = Environment(loader=PackageLoader("filmfriction.workflows", "templates"),
+                      autoescape=html, undefined=StrictUndefined, trim_blocks=True,
+                      lstrip_blocks=True, keep_trailing_newline=True)
+    env.filters.update(inline=_inline_html, md=_inline_md, cell=_md_cell,
+                       base64=lambda data: base64.b64encode(data).decode("ascii"))
+    env.tests.update(figure=lambda b: isinstance(b, Figure), table=lambda b: isinstance(b, Table),
+                     failure=lambda b: isinstance(b, str) and b.startswith(_FAILURE_OPENINGS))
+    return env
+
+
+def _render_html(title: str, intro: list, sections: list) -> str:
+    return _templates(html=True).get_template("report.html.j2").render(
+        title=title, intro=intro, sections=sections)
+
+
 def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str, dict]:
-    lines, files = [f"# {_inline_md(title)}", ""], {}
-    lines += [_inline_md(p) + "\n" for p in intro]
-    for sec in sections:
-        lines += [f"## {_inline_md(sec.title)}", ""]
-        for b in sec.blocks:
-            if isinstance(b, Figure):
-                fname = f"{stem}-{b.name}.png"
-                files[fname] = b.png
-                lines += [f"![{b.name}]({fname})", "", f"*{_inline_md(b.caption)}*", ""]
-            elif isinstance(b, Table):
-                lines.append("| " + " | ".join(_md_cell(h) for h in b.header) + " |")
-                lines.append("|" + "---|" * len(b.header))
-                lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in b.rows]
-                lines.append("")
-            else:
-                lines += [_inline_md(b), ""]
-    return "\n".join(lines) + "\n", files
+    """The Markdown twin and its figure files (name -> PNG bytes)."""
+    text = _templates(html=False).get_template("report.md.j2").render(
+        title=title, intro=intro, sections=sections, stem=stem)
+    files = {f"{stem}-{b.name}.png": b.png for sec in sections for b in sec.blocks
+             if isinstance(b, Figure)}
+    return text, files
 
 
 from filmfriction.analysis.util import write_atomic as _write_atomic  # noqa: E402

@@ -23,11 +23,11 @@ import csv
 import json
 import re
 import shutil
-from html import escape
 from pathlib import Path
 
 import numpy as np
 import pytest
+from markupsafe import escape
 
 from filmfriction.analysis import observables
 from filmfriction.analysis.observables import REGISTRY, Observable
