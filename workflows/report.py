@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.observables import Observable, registered as registered_observables
+from filmfriction.analysis.trace import unit as _unit
 from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.reduced_model.units import OMCTS
@@ -86,6 +87,11 @@ class Section:
         self.blocks.append(block)
 
 
+def _source(units: str) -> str:
+    """What made the trace, as the report names it: an MD run (LJ) or a measurement (SI)."""
+    return "MD" if units == "lj" else "measured"
+
+
 def _fixed(x, decimals: int) -> str:
     """``x`` with fixed decimals; "–" for a value the document has not (null)."""
     return "–" if x is None else f"{x:.{decimals}f}"
@@ -125,7 +131,9 @@ def fig_viscosity(cal: dict) -> bytes:
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     pts = np.array(cal["rate_points"], float).reshape(-1, 3)
     err = np.where(np.isfinite(pts[:, 2]), pts[:, 2], 0.0)
-    ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3, label="MD runs")
+    units = cal.get("units", "lj")
+    ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3,
+                label=f"{_source(units)} runs")
     law = cal.get("rate_law")
     if law is not None:
         # the fitted law as written, drawn over the runs' range (rendering, not fitting)
@@ -134,28 +142,32 @@ def fig_viscosity(cal: dict) -> bytes:
                 label=f"η ∝ γ̇^({law['exponent']:.2f} ± {_fixed(law['exponent_stderr'], 2)})")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("shear rate γ̇ [1/τ]")
-    ax.set_ylabel("η_eff [ετ/σ³]")
+    ax.set_xlabel(f"shear rate γ̇ [{_unit(units, 'shear_rate')}]")
+    ax.set_ylabel(f"η_eff [{_unit(units, 'viscosity')}]")
     ax.legend(fontsize=8)
     return _png(fig)
 
 
 def fig_replay(run, trace: dict, start_time: float) -> bytes:
-    """The MD spring force and the calibrated model's (``trace``: ``t``, ``spring_force``)."""
+    """The run's spring force and the calibrated model's (``trace``: ``t``, ``spring_force``),
+    labelled in the units of the analysis."""
     plt = _plt()
     tr = run.trace
+    units = run.analysis.get("units", tr.units)
     fig, ax = plt.subplots(figsize=(9, 3.2))
-    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label="MD")
+    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label=_source(units))
     ax.plot(trace["t"], trace["spring_force"], lw=1.2, color="tab:red", alpha=0.85,
             label="calibrated model")
     ax.axvline(start_time, color="tab:red", lw=0.6, ls=":")
-    ax.set_xlabel("time [τ]")
-    ax.set_ylabel("spring force [ε/σ]")
+    ax.set_xlabel(f"time [{_unit(units, 'time')}]")
+    ax.set_ylabel(f"spring force [{_unit(units, 'force')}]")
     ax.legend(fontsize=8, loc="upper left")
     return _png(fig)
 
 
-def fig_replay_errors(errors: dict) -> bytes:
+def fig_replay_errors(errors: dict, source: str = "MD") -> bytes:
+    """The model's relative error on the peak force, slip distance and period, with the
+    ``source``'s (MD or measured) own standard error."""
     plt = _plt()
     names = ["peak_force", "slip_distance", "period"]
     vals = [errors[n]["rel_error"] for n in names]
@@ -164,14 +176,15 @@ def fig_replay_errors(errors: dict) -> bytes:
               for n in names]
     fig, ax = plt.subplots(figsize=(5.5, 2.8))
     v = np.array([x if x is not None and math.isfinite(x) else 0.0 for x in vals]) * 100
-    ax.bar(names, v, color=["tab:blue", "tab:orange", "tab:green"])
-    ax.errorbar(names, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k", capsize=4,
-                label="± MD standard error")
+    ticks = [n.replace("_", " ") for n in names]
+    ax.bar(ticks, v, color=["tab:blue", "tab:orange", "tab:green"])
+    ax.errorbar(ticks, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k",
+                capsize=4, label=f"± {source} standard error")
     for i, x in enumerate(vals):
         ax.text(i, v[i], "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
                 ha="center", va="bottom" if v[i] >= 0 else "top", fontsize=9)
     ax.axhline(0, color="k", lw=0.6)
-    ax.set_ylabel("(model − MD) / MD [%]")
+    ax.set_ylabel(f"(model − {source}) / {source} [%]")
     ax.legend(fontsize=7)
     return _png(fig)
 
@@ -213,6 +226,15 @@ def _scene_section(run) -> Section:
     sec = Section("Scene and parameters")
     rj = run.trace.run or {}
     scene = rj.get("scene", {})
+    if not scene:
+        units = run.analysis.get("units", "lj")
+        sec.p(f"No MD scene: a trace read as it is (`{run.trace.path.name}`), in "
+              f"{'SI' if units == 'si' else 'LJ'} units as its analysis records; the parameters "
+              "the analysis used: " + (", ".join(
+                  f"{k} = {_fmt(v)}" for k, v in
+                  ((run.analysis.get("source") or {}).get("parameters") or {}).items()
+                  if v is not None) or "none") + ".")
+        return sec
     sec.p(f"Scene **{scene.get('name', '?')}**: {scene.get('description', '')}")
     if scene.get("models"):
         sec.p(" ".join(scene["models"].split()))
@@ -248,6 +270,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
                               "“Calibrated reduced model”)" if cal is None else
                               main_failures.get("eta_eff") or "no run with η_eff") + ".")
         return sec
+    units = cal.get("units", "lj")
     png = _attempt(failures, "figure: viscosity", fig_viscosity, cal)
     law = cal.get("rate_law")
     if png:
@@ -255,12 +278,15 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
                        + (" with the power-law fit." if law is not None else ".")))
     if law is not None:
         sec.p(f"Power law over {law['n']} runs: η_eff = {_fmt(law['prefactor'], 3)} · γ̇^({law['exponent']:.3f} ± "
-              f"{_fixed(law['exponent_stderr'], 3)}) (LJ units); a thinning exponent n = {-law['exponent']:.3f}.")
+              f"{_fixed(law['exponent_stderr'], 3)}) ({units.upper()} units); a thinning exponent n = {-law['exponent']:.3f}.")
     else:
         g, eta, err = cal["rate_points"][0]
-        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} ετ/σ³ "
-              f"(= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s) at γ̇ = {_fmt(g, 3)} 1/τ "
-              f"(= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s). "
+        in_si = ("" if units == "si" else
+                 f" (= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s)")
+        rate_si = "" if units == "si" else f" (= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s)"
+        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} "
+              f"{_unit(units, 'viscosity')}{in_si} at γ̇ = {_fmt(g, 3)} "
+              f"{_unit(units, 'shear_rate')}{rate_si}. "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
     dep = cal.get("rate_dependence")
     if dep:
@@ -294,7 +320,9 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         sec.p(why_none)
         return sec
     rc = cal["runs"][0]
-    sec.p("Model: the MD wall's mass M, spring K, drive V and mount dashpot d in "
+    units = cal.get("units", "lj")
+    source = _source(units)
+    sec.p(f"Model: the {'MD' if units == 'lj' else 'driven'} wall's mass M, spring K, drive V and mount dashpot d in "
           "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
           "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
           "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
@@ -305,7 +333,7 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         e = rc.get(name)
         if e is not None:
             rows.append((name.replace("_", " "), _pm(e), e["method"]))
-    sec.add(Table(("parameter", "value (LJ)", "how"), tuple(rows)))
+    sec.add(Table(("parameter", f"value ({units.upper()})", "how"), tuple(rows)))
     ageing = rc.get("ageing")
     if ageing is not None:
         stderr = math.nan if ageing["stderr"] is None else ageing["stderr"]
@@ -322,26 +350,29 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         if trace is not None:
             png = _attempt(failures, "figure: replay", fig_replay, run, trace, replay["start_time"])
             if png:
-                sec.add(Figure("replay", png, f"The calibrated model over the MD trace; it starts at "
-                               f"t = {_fmt(replay['start_time'])} τ (dotted line) from the MD's state there."))
+                sec.add(Figure("replay", png, f"The calibrated model over the {source} trace; it "
+                               f"starts at t = {_fmt(replay['start_time'])} {_unit(units, 'time')} "
+                               f"(dotted line) from the {source} trace's state there."))
         else:
             sec.p("No replay trace beside `calibration.json` (`calibration_replay.csv`): the figure of the "
-                  "model over the MD trace is left out; `filmfriction calibrate` writes it.")
+                  f"model over the {source} trace is left out; `filmfriction calibrate` writes it.")
         errs = replay["errors"]
-        png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs)
+        png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs, source)
         if png:
             sec.add(Figure("replay-errors", png, "Relative error of the model's mean peak force, slip "
-                           "distance and period against the MD's; black bars: the MD's own standard error."))
+                           f"distance and period against the {source} trace's; black bars: its own "
+                           "standard error."))
         rows = [(q.replace("_", " "), _fmt(e["md"]), _fmt(e["md_stderr"], 2), _fmt(e["model"]),
                  "–" if e["rel_error"] is None or not math.isfinite(e["rel_error"]) else f"{e['rel_error']:+.1%}")
                 for q, e in errs.items()]
-        sec.add(Table(("quantity", "MD", "MD stderr", "model", "error"), tuple(rows)))
+        sec.add(Table(("quantity", source, f"{source} stderr", "model", "error"), tuple(rows)))
         sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
               "predicting anything; slip distance and period are predictions. The model sticks at the "
-              "first zero of the wall velocity and has no ringing after s, which the MD wall shows.")
+              f"first zero of the wall velocity and has no ringing after s, which the {source} "
+              "wall shows.")
     md = cal.get("md_calibration")
     if md is not None:
-        sec.p(f"Handed to the SFB check (LJ): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
+        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
               f"sliding stress {md['sliding_stress']:.4g} ± {md['sliding_stress_err']:.2g}, re-stick stress "
               f"{_fmt(md['restick_stress'])}, η0 {md['eta_zero']:.4g} ± {md['eta_zero_err']:.2g}, thinning "
               f"exponent {md['thinning_exponent']:.3g} ± {md['thinning_exponent_err']:.2g}.")
@@ -530,6 +561,10 @@ def _sfb_reading(check) -> str:
 def _cost_section(run) -> Section:
     sec = Section("Cost and provenance")
     rj = run.trace.run or {}
+    if not rj:
+        sec.p(f"No `run.json` in `{run.run_dir}`: not a run of `filmfriction run`, so no cost "
+              "or provenance to report.")
+        return sec
     rows = [("status", str(rj.get("status"))),
             ("wall time", f"{_fmt(rj.get('wall_time'))} s"),
             ("atom-steps per second", _fmt(rj.get("atom_steps_per_second"))),
@@ -718,9 +753,12 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
     out = Path(out) if out is not None else run.run_dir / "report.html"
     scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
     title = f"filmfriction report — {scene} ({run.run_dir.name})"
-    intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. MD quantities are in LJ units "
-             "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
-             f"({OMCTS.name})."]
+    units = run.analysis.get("units", "lj")
+    intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. " + (
+        "MD quantities are in LJ units (σ, ε, m, τ) unless marked SI; SI values go through "
+        f"`filmfriction.reduced_model.units` ({OMCTS.name})." if units == "lj" else
+        "The trace's quantities are in SI units (N, m, s, J, Pa·s), as its analysis records; "
+        "nothing is converted.")]
     observed = [_observable_section(obs, run, failures) for obs in registered_observables()]
     sections = [_scene_section(run), *observed,
                 _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
