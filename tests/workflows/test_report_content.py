@@ -85,3 +85,41 @@ def test_a_run_with_warnings_says_so(synthetic_study, tmp_path, report_study):
     (run / "run.json").write_text(_json.dumps(rj))
     md = build_report(run).with_suffix(".md").read_text()
     assert "completed with warnings" in md and "film temperature 1.06 vs 0.7" in md
+
+
+def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, monkeypatch):
+    """A measured trace (SFB scale, SI) through analyze, calibrate and report: every number
+    and axis in SI, nothing called MD or labelled in LJ units."""
+    import re
+
+    from matplotlib.figure import Figure
+
+    from filmfriction.analysis.synthetic import klein_trace, write_csv
+
+    tr = klein_trace(cycles=5, noise=0.005 * 9.7e-6, seed=2)
+    write_csv(tmp_path / "trace.csv", {k: tr[k] for k in ("time", "spring_force", "drive_position",
+                                                         "wall_position", "wall_velocity")})
+    sfb = ["--units", "si", "--spring-constant", "97", "--mass", "1.47e-3", "--area", "4e-10",
+           "--thickness", "3.5e-9", "--drive-velocity", "1e-7"]
+    assert run_cli("analyze", tmp_path / "trace.csv", *sfb).code == 0
+    calibrated = run_cli("calibrate", tmp_path)
+    assert calibrated.code == 0, calibrated.err
+    cal = json.loads((tmp_path / "calibration.json").read_text())
+    assert cal["units"] == "si" and cal["runs"][0]["static_force"]["units"] == "N"
+    labels, savefig = [], Figure.savefig
+
+    def capture(fig, *args, **kwargs):
+        labels.append([(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes])
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", capture)
+    assert run_cli("report", tmp_path).code == 0
+    md = (tmp_path / "report.md").read_text()
+    named = [label for fig in labels for axis in fig for label in axis if label]
+    units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
+    assert {"N", "s", "J", "Pa·s", "1/s"} <= units, units
+    assert not units & {"ε/σ", "τ", "σ", "ε", "ετ/σ³", "1/τ", "σ/τ"}, units
+    for lj in ("ε/σ", "ετ/σ³", " τ ", "LJ", "MD spring force", "the MD trace"):
+        assert lj not in md, lj
+    assert re.search(r"^\| static force \| 9\.7\d*e-06 ± \S+ N \|", md, re.M) and "(SI)" in md
+    assert all(re.search(r"\[[^\]]+\]", label) for label in named), named
