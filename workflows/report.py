@@ -161,7 +161,8 @@ def fig_replay(run, trace: dict, start_time: float) -> bytes:
     ax.axvline(start_time, color="tab:red", lw=0.6, ls=":")
     ax.set_xlabel(f"time [{_unit(units, 'time')}]")
     ax.set_ylabel(f"spring force [{_unit(units, 'force')}]")
-    ax.legend(fontsize=8, loc="upper left")
+    # above the axes, right-aligned: never over the traces (nor the offset text)
+    ax.legend(fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2, frameon=False)
     return _png(fig)
 
 
@@ -180,12 +181,20 @@ def fig_replay_errors(errors: dict, source: str = "MD") -> bytes:
     ax.bar(ticks, v, color=["tab:blue", "tab:orange", "tab:green"])
     ax.errorbar(ticks, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k",
                 capsize=4, label=f"± {source} standard error")
+    bars = np.array(md_rel) * 100
     for i, x in enumerate(vals):
-        ax.text(i, v[i], "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
+        # beyond the bar and the error bar drawn about zero, never over either
+        span = max(float(np.max(np.abs(v))), float(np.max(bars)), 1.0)
+        end = (max(v[i], bars[i]) + 0.03 * span if v[i] >= 0
+               else min(v[i], -bars[i]) - 0.03 * span)
+        ax.text(i, end, "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
                 ha="center", va="bottom" if v[i] >= 0 else "top", fontsize=9)
+    # room for the numbers over (under) the bars
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo - 0.12 * (hi - lo) * (v.min() < 0), hi + 0.12 * (hi - lo))
     ax.axhline(0, color="k", lw=0.6)
     ax.set_ylabel(f"(model − {source}) / {source} [%]")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.0, 1.0), frameon=False)
     return _png(fig)
 
 

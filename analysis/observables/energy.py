@@ -150,6 +150,12 @@ class Energy(Observable):
                 "independently; the mount dashpot; the ringing left at s; the dilation). "
                 "Per cycle (y → next y): the thermostat's and the mount dashpot's heat and the "
                 "ledger residual.")]
+        if all(run.trace.has(c) for c in _energy.LEDGER_COLUMNS):
+            out.append(("ledger", fig_ledger(run),
+                        "The run's energy ledger over time, each term from the start: the work "
+                        "done on the system (drive and load) against the energy stored "
+                        "(potential, kinetic, spring) and the heat the thermostat and the mount "
+                        "dashpot removed; the residual closes the books. Shaded: the slips."))
         return out
 
 
@@ -209,4 +215,44 @@ def fig_energy(bars, energy_unit: str) -> bytes:
     ax.axvline(0, color="k", lw=0.6)
     ax.set_xlabel(f"energy per slip / per cycle [{energy_unit}] (mean ± stderr over analysed "
                   "cycles)")
+    return png_bytes(fig)
+
+
+def fig_ledger(run) -> bytes:
+    """The ledger's terms against time (:func:`filmfriction.analysis.energy.ledger`)."""
+    plt = pyplot()
+    tr = run.trace
+    lab = lambda q: unit(tr.units, q)  # noqa: E731
+    cols = {c: tr.columns[c] for c in _energy.LEDGER_COLUMNS + ("mount_heat",) if tr.has(c)}
+    led = _energy.ledger(cols)
+
+    def since_start(name):
+        x = np.asarray(cols[name], float)
+        return x - x[0]
+    t = tr.time
+    work = since_start("drive_work") + since_start("load_work")
+    stored = (since_start("potential_energy") + since_start("kinetic_energy")
+              + since_start("spring_energy"))
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(9, 5.0), sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 1]})
+    ax.plot(t, work, color="k", lw=1.2, label="work in (drive + load)")
+    ax.plot(t, stored, color="tab:blue", lw=0.9, label="Δ stored (potential + kinetic + spring)")
+    ax.plot(t, since_start("thermostat_heat"), color="tab:purple", lw=0.9,
+            label="thermostat heat")
+    if "mount_heat" in cols:
+        ax.plot(t, since_start("mount_heat"), color="tab:brown", lw=0.9, label="mount dashpot heat")
+    axr.plot(t, led["residual"], color="0.4", lw=0.8, label="residual")
+    axr.axhline(0.0, color="k", lw=0.5)
+    t_slip = t
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    si = np.asarray(run.cycles.get("stick_index", []), int)
+    for a in (ax, axr):
+        for i, (y, s) in enumerate(zip(yi, si)):
+            a.axvspan(t_slip[y], t_slip[s], color="tab:red", alpha=0.12, lw=0,
+                      label="slip (y → s)" if i == 0 else None)
+        a.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    ax.set_ylabel(f"energy since the start [{lab('energy')}]")
+    axr.set_ylabel(f"residual [{lab('energy')}]")
+    axr.set_xlabel(f"time [{lab('time')}]")
+    fig.align_ylabels((ax, axr))
     return png_bytes(fig)

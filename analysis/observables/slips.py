@@ -78,8 +78,9 @@ class Slips(Observable):
     def figures(self, run) -> list[tuple[str, bytes, str]]:
         return [("trace", fig_trace(run),
                  f"The {force_label(run.trace.units)} with the detected yield (y, ▼) "
-                 "and re-stick (s, ▲) points"
-                 + ("; lower panel: film gap." if run.trace.has("gap") else "."))]
+                 "and re-stick (s, ▲) points, the slips shaded"
+                 + ("; lower panel: the gap between the walls' inner planes."
+                    if run.trace.has("gap") else "."))]
 
 
 def fig_trace(run) -> bytes:
@@ -99,9 +100,15 @@ def fig_trace(run) -> bytes:
         ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
         ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
     ax.set_ylabel(f"spring force [{lab('force')}]")
-    ax.legend(loc="upper left", fontsize=8, ncol=3)
     if rows == 2:
-        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue")
+        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue", label="gap")
         axes[1, 0].set_ylabel(f"gap [{lab('length')}]")
+    for a in axes[:, 0]:
+        for i, (y, s) in enumerate(zip(yi, si)):
+            a.axvspan(t[y], t[s], color="tab:red", alpha=0.12, lw=0,
+                      label="slip (y → s)" if i == 0 and a is ax else None)
+    # the legend above the axes, right-aligned: never over the trace (nor the offset text)
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=4, frameon=False)
     axes[-1, 0].set_xlabel(f"time [{lab('time')}]")
+    fig.align_ylabels(axes[:, 0])
     return png_bytes(fig)

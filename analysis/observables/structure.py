@@ -90,8 +90,182 @@ class Structure(Observable):
                 f"{section.get('frames')} frames."]
 
     def figures(self, run) -> list[tuple[str, bytes, str]]:
+        out = []
         png, note = fig_film(run.run_dir)
-        return [] if png is None else [("film", png, note + ".")]
+        if png is not None:
+            out.append(("film", png, note + "."))
+        frames = film_frames(run)
+        if frames is None:
+            return out
+        out.append(("structure-time", fig_structure_time(run, frames),
+                    "The spring force with the detected yield (y, ▼) and re-stick (s, ▲) points, "
+                    "and under it, on the same time axis, the hexatic order |ψ6| of each film "
+                    "layer (one point per trajectory frame) and the gap between the walls' "
+                    "inner planes; shaded: the slips (y → s)."))
+        png, caption = fig_layers_top(run, frames)
+        if png is not None:
+            out.append(("layers-top", png, caption))
+        return out
+
+
+def slip_windows(run) -> list[tuple[float, float]]:
+    """(t at y, t at s) of every detected slip of a run (its ``analysis_cycles.csv``)."""
+    t = run.trace.time
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    si = np.asarray(run.cycles.get("stick_index", []), int)
+    return [(float(t[y]), float(t[s])) for y, s in zip(yi, si)]
+
+
+def film_frames(run) -> dict | None:
+    """The trajectory's frames on the trace's time axis, with the film's layers
+    and their ψ6 per frame (:class:`~filmfriction.analysis.structure.DensityProfile`,
+    :class:`~filmfriction.analysis.structure.HexaticOrder`); None without a
+    trajectory, a ``step`` column or layers."""
+    from filmfriction.md_inputs.contract import FILM_TYPES
+
+    from .. import structure
+
+    tr = run.trace
+    if not ((run.run_dir / TRAJECTORY).exists() and (run.run_dir / TOPOLOGY).exists()
+            and tr.has("step")):
+        return None
+    u = universe(run.run_dir)
+    steps = structure.frame_steps(u)
+    film = u.select_atoms("type " + " ".join(str(int(t)) for t in FILM_TYPES))
+    if steps is None or film.n_atoms == 0:
+        return None
+    layers = structure.DensityProfile(film).run().results.layers
+    if not layers["count"]:
+        return None
+    psi6 = structure.HexaticOrder(film, layers["edges"]).run().results.psi6
+    time = np.interp(steps, tr.columns["step"], tr.time)
+    return {"universe": u, "film": film, "time": time, "psi6": psi6,
+            "edges": np.asarray(layers["edges"], float)}
+
+
+def _shade_slips(ax, windows) -> None:
+    for i, (ty, ts) in enumerate(windows):
+        ax.axvspan(ty, ts, color="tab:red", alpha=0.12, lw=0, label="slip (y → s)" if i == 0 else None)
+
+
+def fig_structure_time(run, frames: dict) -> bytes:
+    """Force, ψ6 per layer and gap against time, aligned, the slips shaded."""
+    plt = pyplot()
+    tr = run.trace
+    lab = lambda q: unit(tr.units, q)  # noqa: E731
+    windows = slip_windows(run)
+    fig, axes = plt.subplots(3, 1, figsize=(10, 6.8), sharex=True,
+                             gridspec_kw={"height_ratios": [2, 1.4, 1]})
+    t, f = tr.time, tr.spring_force
+    ax = axes[0]
+    ax.plot(t, f, lw=0.8, color="0.2", label="spring force")
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    si = np.asarray(run.cycles.get("stick_index", []), int)
+    if yi.size:
+        ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
+        ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
+    ax.set_ylabel(f"spring force [{lab('force')}]")
+    ax = axes[1]
+    psi6 = frames["psi6"]
+    colours = pyplot().get_cmap("viridis")
+    n = psi6.shape[1]
+    for i in range(n):
+        ax.plot(frames["time"], psi6[:, i], ".-", lw=0.7, ms=4,
+                color=colours(i / max(n - 1, 1)), label=f"layer {i + 1}" + (
+                    " (bottom)" if i == 0 else " (top)" if i == n - 1 else ""))
+    ax.set_ylabel("hexatic order |ψ6| [1]")
+    ax.set_ylim(0.0, 1.05)
+    ax = axes[2]
+    if tr.has("gap"):
+        ax.plot(t, tr.columns["gap"], lw=0.7, color="tab:blue", label="gap (trace)")
+    else:
+        from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, TOP_WALL_TYPES
+
+        from .. import structure
+
+        u = frames["universe"]
+        pick = lambda types: u.select_atoms(  # noqa: E731
+            "type " + " ".join(str(int(x)) for x in types))
+        gap = structure.FilmThickness(pick(BOTTOM_WALL_TYPES), pick(TOP_WALL_TYPES)).run()
+        ax.plot(frames["time"], gap.results.gap, ".-", lw=0.7, color="tab:blue",
+                label="gap (trajectory)")
+    ax.set_ylabel(f"gap [{lab('length')}]")
+    ax.set_xlabel(f"time [{lab('time')}]")
+    for ax in axes:
+        _shade_slips(ax, windows)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    fig.align_ylabels(axes)
+    return png_bytes(fig)
+
+
+def _stick_and_slip_frames(run, frames: dict) -> tuple[int | None, int | None]:
+    """A frame deep in a stick (the one between two slips farthest from every slip) and
+    one in a slip (the one nearest the middle of a slip), as indices into ``frames["time"]``."""
+    windows = slip_windows(run)
+    tf = frames["time"]
+    if not windows:
+        return (int(tf.size // 2) if tf.size else None), None
+    inside = np.zeros(tf.size, bool)
+    for ty, ts in windows:
+        inside |= (tf >= ty) & (tf <= ts)
+    mids = np.array([0.5 * (ty + ts) for ty, ts in windows])
+    edges = np.array([x for w in windows for x in w])
+    stick = None
+    # a stick between two slips (not the start-up loading), else any frame out of the slips
+    between = ~inside & (tf >= windows[0][1]) & (tf <= windows[-1][0])
+    candidates = between if between.any() else ~inside
+    if candidates.any():
+        distance = np.min(np.abs(tf[:, None] - edges[None, :]), axis=1)
+        distance[~candidates] = -1.0
+        stick = int(np.argmax(distance))
+    slip = None
+    if inside.any():
+        distance = np.min(np.abs(tf[:, None] - mids[None, :]), axis=1)
+        distance[~inside] = np.inf
+        slip = int(np.argmin(distance))
+    return stick, slip
+
+
+def fig_layers_top(run, frames: dict) -> tuple[bytes | None, str]:
+    """Top views (x, y) of each film layer at a frame in a stick and one in a slip."""
+    stick, slip = _stick_and_slip_frames(run, frames)
+    columns = [(name, i) for name, i in (("stick", stick), ("slip", slip)) if i is not None]
+    if not columns:
+        return None, ""
+    plt = pyplot()
+    lab = unit(run.trace.units, "length")
+    tu = unit(run.trace.units, "time")
+    u, film, edges = frames["universe"], frames["film"], frames["edges"]
+    n = edges.size - 1
+    box = u.dimensions[:2].astype(float)
+    fig, axes = plt.subplots(n, len(columns), figsize=(3.3 * len(columns) + 0.6, 3.0 * n),
+                             squeeze=False, sharex=True, sharey=True)
+    for c, (name, i) in enumerate(columns):
+        u.trajectory[int(i)]
+        pos = film.positions
+        layer = np.searchsorted(edges, pos[:, 2]) - 1
+        xy = np.mod(pos[:, :2], box)
+        for row in range(n):
+            ax = axes[n - 1 - row, c]           # the top layer on top
+            sel = xy[layer == row]
+            ax.scatter(sel[:, 0], sel[:, 1], s=22, color="tab:orange", edgecolor="k", lw=0.3)
+            ax.set_xlim(0, box[0])
+            ax.set_ylim(0, box[1])
+            ax.set_aspect("equal")
+            psi = frames["psi6"][int(i), row]
+            ax.set_title(f"layer {row + 1}, {name} (t = {frames['time'][int(i)]:.4g} {tu}): "
+                         f"|ψ6| = {psi:.2f}", fontsize=8)
+            if row == 0:
+                ax.set_xlabel(f"x [{lab}] (sliding)")
+            if c == 0:
+                ax.set_ylabel(f"y [{lab}]")
+    fig.tight_layout()
+    caption = ("Top views of each film layer (bottom layer at the bottom; atoms assigned to "
+               "layers by height, the periodic box shown) at a trajectory frame deep in a stick"
+               + (" and at one inside a slip" if slip is not None else
+                  "; no trajectory frame falls inside a slip (frames are further apart than "
+                  "the slips last)") + ".")
+    return png_bytes(fig), caption
 
 
 def _layers(values) -> str:
