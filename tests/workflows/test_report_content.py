@@ -35,6 +35,15 @@ def test_every_figure_has_units_on_its_axes(synthetic_study, report_checks):
     report_checks.axes_units(synthetic_study.labels)
 
 
+def test_every_figure_loads_in_headless_chromium(synthetic_study, report_checks):
+    report = synthetic_study.path / "report.html"
+    sizes = report_checks.in_browser(report)
+    assert set(sizes) == set(report_checks.images(report.read_text()))
+    # the figures of the analysis' observables, each from its own file
+    assert {"trace", "energy", "ledger", "eta-per-slip", "film", "structure-time", "layers-top",
+            "slip_law"} <= set(sizes), sorted(sizes)
+
+
 def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
     from filmfriction.analysis.observables.structure import Structure, fig_film
     from filmfriction.workflows import report
