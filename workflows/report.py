@@ -140,8 +140,13 @@ def fig_viscosity(cal: dict) -> bytes:
         g = np.geomspace(pts[:, 0].min() / 2, pts[:, 0].max() * 2, 50)
         ax.plot(g, law["prefactor"] * g ** law["exponent"], "-", color="tab:red",
                 label=f"η ∝ γ̇^({law['exponent']:.2f} ± {_fixed(law['exponent_stderr'], 2)})")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    if len(pts) > 1:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    else:
+        # one run: no law to draw; a log-log plane of one point says nothing more
+        ax.set_title("one shear rate only: a sweep of drive velocities gives η_eff(γ̇)",
+                     fontsize=8, color="0.3")
     ax.set_xlabel(f"shear rate γ̇ [{_unit(units, 'shear_rate')}]")
     ax.set_ylabel(f"η_eff [{_unit(units, 'viscosity')}]")
     ax.legend(fontsize=8)

@@ -323,7 +323,7 @@ def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
         ax2.set_xlabel("x [σ] (sliding direction)")
         ax2.set_ylabel("z [σ]")
         ax2.set_title(f"side view, last frame ({len(u.trajectory)} frames)", fontsize=9)
-        ax2.legend(fontsize=7, loc="upper right")
+        ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
         note.append("side view: atoms of the last trajectory frame, coloured by type")
     return png_bytes(fig), "; ".join(note)
 
