@@ -74,7 +74,7 @@ from ..util import finite_or_none, format_estimate, format_value, png_bytes, pyp
 
 __all__ = ["Observable", "Context", "Need", "column", "parameter", "REGISTRY", "registered",
            "BUILT_IN", "entry", "value", "MissingInput",
-           "format_estimate", "format_value", "png_bytes", "pyplot"]
+           "format_estimate", "format_value", "png_bytes", "pyplot", "shade_slips"]
 
 #: key -> observable class, for every registered :class:`Observable` subclass
 REGISTRY: dict[str, type[Observable]] = {}
@@ -337,6 +337,17 @@ class Observable:
         defines this instead."""
         png = self.figure(run)
         return [] if png is None else [(self.key, png, self.caption)]
+
+
+def shade_slips(ax, run, *, label: bool = True) -> None:
+    """Shade every detected slip (y → s) of ``run`` (a ``RunData``) on a time axis ``ax``;
+    ``label``: name the shading in the legend."""
+    t = run.trace.time
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    si = np.asarray(run.cycles.get("stick_index", []), int)
+    for i, (y, s) in enumerate(zip(yi, si)):
+        ax.axvspan(t[y], t[s], color="tab:red", alpha=0.12, lw=0,
+                   label="slip (y → s)" if label and i == 0 else None)
 
 
 def _register(cls) -> None:

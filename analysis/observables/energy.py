@@ -18,7 +18,7 @@ from .. import stickslip
 from ..trace import MissingInput, unit
 from ..util import finite_or_none
 from .base import (Context, Observable, entry, format_estimate, format_value, png_bytes,
-                   pyplot)
+                   pyplot, shade_slips)
 
 __all__ = ["Energy", "ENERGY_QUANTITIES"]
 
@@ -243,13 +243,8 @@ def fig_ledger(run) -> bytes:
         ax.plot(t, since_start("mount_heat"), color="tab:brown", lw=0.9, label="mount dashpot heat")
     axr.plot(t, led["residual"], color="0.4", lw=0.8, label="residual")
     axr.axhline(0.0, color="k", lw=0.5)
-    t_slip = t
-    yi = np.asarray(run.cycles.get("yield_index", []), int)
-    si = np.asarray(run.cycles.get("stick_index", []), int)
     for a in (ax, axr):
-        for i, (y, s) in enumerate(zip(yi, si)):
-            a.axvspan(t_slip[y], t_slip[s], color="tab:red", alpha=0.12, lw=0,
-                      label="slip (y → s)" if i == 0 else None)
+        shade_slips(a, run)
         a.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax.set_ylabel(f"energy since the start [{lab('energy')}]")
     axr.set_ylabel(f"residual [{lab('energy')}]")

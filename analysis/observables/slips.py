@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..trace import MissingInput, unit
-from .base import Context, Observable, entry, format_estimate, png_bytes, pyplot
+from .base import (Context, Observable, entry, format_estimate, png_bytes, pyplot,
+                   shade_slips)
 
 __all__ = ["Slips", "SLIP_QUANTITIES"]
 
@@ -104,9 +105,7 @@ def fig_trace(run) -> bytes:
         axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue", label="gap")
         axes[1, 0].set_ylabel(f"gap [{lab('length')}]")
     for a in axes[:, 0]:
-        for i, (y, s) in enumerate(zip(yi, si)):
-            a.axvspan(t[y], t[s], color="tab:red", alpha=0.12, lw=0,
-                      label="slip (y → s)" if i == 0 and a is ax else None)
+        shade_slips(a, run, label=a is ax)
     # the legend above the axes, right-aligned: never over the trace (nor the offset text)
     ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=4, frameon=False)
     axes[-1, 0].set_xlabel(f"time [{lab('time')}]")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..trace import unit
-from .base import Context, Observable, format_value, png_bytes, pyplot
+from .base import Context, Observable, format_value, png_bytes, pyplot, shade_slips
 
 __all__ = ["Structure", "universe", "fig_film"]
 
@@ -143,17 +143,11 @@ def film_frames(run) -> dict | None:
             "edges": np.asarray(layers["edges"], float)}
 
 
-def _shade_slips(ax, windows) -> None:
-    for i, (ty, ts) in enumerate(windows):
-        ax.axvspan(ty, ts, color="tab:red", alpha=0.12, lw=0, label="slip (y → s)" if i == 0 else None)
-
-
 def fig_structure_time(run, frames: dict) -> bytes:
     """Force, ψ6 per layer and gap against time, aligned, the slips shaded."""
     plt = pyplot()
     tr = run.trace
     lab = lambda q: unit(tr.units, q)  # noqa: E731
-    windows = slip_windows(run)
     fig, axes = plt.subplots(3, 1, figsize=(10, 6.8), sharex=True,
                              gridspec_kw={"height_ratios": [2, 1.4, 1]})
     t, f = tr.time, tr.spring_force
@@ -192,7 +186,7 @@ def fig_structure_time(run, frames: dict) -> bytes:
     ax.set_ylabel(f"gap [{lab('length')}]")
     ax.set_xlabel(f"time [{lab('time')}]")
     for ax in axes:
-        _shade_slips(ax, windows)
+        shade_slips(ax, run)
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     fig.align_ylabels(axes)
     return png_bytes(fig)
