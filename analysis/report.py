@@ -120,8 +120,12 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                f"slip need at least {MIN_ROWS})")
         doc.update(regime=Regime.UNRESOLVED, regime_criterion=REGIME_CRITERION, regime_note=why)
         skipped["detection"] = why
+        none = stickslip.cycle_table(trace.time, trace.spring_force, [], [])
+        ctx = Context(trace=trace, all_slips=none, skip=0, events=None, regime=Regime.UNRESOLVED,
+                      regime_note=why, trajectory_analyses=structure)
         for obs in observables.registered():
-            skipped[obs.key] = why
+            if obs.applies(ctx):
+                skipped[obs.key] = why
         doc["skipped"] = skipped
         return doc, {}
     ctx = context(trace, skip=skip, structure=structure)

@@ -157,12 +157,13 @@ def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, run_
         assert doc["regime_note"].startswith("fewer than 2 slips, but")
 
 
-#: traces too short to classify: rows, the columns and flags given
+#: traces too short to classify: rows, the flags given, a run directory (else a CSV file)
 SHORT = {
-    "1 row": (1, []),
-    "2 rows": (2, []),
+    "1 row": (1, [], False),
+    "2 rows": (2, [], False),
     "9 rows, every parameter": (9, ["--spring-constant", "100", "--mass", "5", "--area", "50",
-                                    "--thickness", "3", "--drive-velocity", "0.02"]),
+                                    "--thickness", "3", "--drive-velocity", "0.02"], False),
+    "9 rows in a run directory": (9, [], True),
 }
 
 
@@ -171,21 +172,22 @@ def test_a_trace_too_short_to_classify_is_unresolved_with_its_reason(tmp_path, r
     from filmfriction.analysis.observables import registered
     from filmfriction.analysis.report import MIN_ROWS
 
-    rows, flags = SHORT[case]
+    rows, flags, run_dir = SHORT[case]
     assert rows < MIN_ROWS
     t = np.arange(rows) * 0.5
-    p = tmp_path / "short.csv"
+    p = tmp_path / ("trace.csv" if run_dir else "short.csv")
     write_csv(p, {"time": t, "spring_force": 1.0 + 0.1 * t, "wall_position": 0.02 * t,
                   "wall_velocity": np.full(rows, 0.02)})
-    r = run_cli("analyze", p, "--json", *flags)
+    r = run_cli("analyze", tmp_path if run_dir else p, "--json", *flags)
     assert r.code == 0, r.err
     doc = r.json()
     assert json.loads((tmp_path / "analysis.json").read_text()) == doc
     assert doc["regime"] == "unresolved"
     assert f"{rows} data row{'' if rows == 1 else 's'}: too short to classify" \
         in doc["regime_note"]
-    # every section is listed as skipped with that reason, none is written
-    keys = [o.key for o in registered()] + ["detection"]
+    # every section is listed as skipped with that reason, none is written (but the
+    # structure of a CSV trace: it has no run directory, so no trajectory, no place at all)
+    keys = [o.key for o in registered() if run_dir or o.key != "structure"] + ["detection"]
     assert sorted(doc["skipped"]) == sorted(keys)
     assert all(why == doc["regime_note"] for why in doc["skipped"].values())
     assert not set(keys) & set(doc)
