@@ -53,6 +53,21 @@ class RunData:
         return float(tr.parameters.require("thickness", "eta_eff = B D / A"))
 
 
+def _as_analysed(trace, doc: dict):
+    """The trace with the unit system and the parameters its analysis used
+    (``analysis.json``'s ``units`` and ``source.parameters``: a measured trace
+    analysed with ``--units si --spring-constant ...`` is read as such again)."""
+    from filmfriction.analysis.trace import read_trace
+
+    used = {k: v for k, v in ((doc.get("source") or {}).get("parameters") or {}).items()
+            if v is not None}
+    if doc.get("units") in ("lj", "si"):
+        used["units"] = doc["units"]
+    if all(getattr(trace.parameters, k, None) == v for k, v in used.items()):
+        return trace
+    return read_trace(trace.run_dir or trace.path, **used)
+
+
 def load_run(run_dir, *, analyse: bool = True) -> RunData:
     """Read a run directory; run the analysis (and write it) if ``analysis.json`` is missing.
 
@@ -85,6 +100,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
         except json.JSONDecodeError as exc:
             raise ValueError(f"{apath}: not valid JSON: {exc}") from None
         cycles = read_cycles_csv(cpath)
+        trace = _as_analysed(trace, doc)
     elif not analyse:
         missing = " and ".join(p.name for p in (apath, cpath) if not p.exists())
         raise ValueError(f"{run_dir}: no {missing}; make it with `filmfriction analyze {run_dir}`")

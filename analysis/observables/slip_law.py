@@ -24,7 +24,7 @@ class SlipLaw(Observable):
     """F_film = F_k + B·v fitted over the analysed slips, and its verdict."""
 
     key = "slip_law"
-    title = "Klein's slip equation on the MD slips: viscous or kinetic?"
+    title = "Klein's slip equation on the slips: viscous or kinetic?"
     needs = (column("wall_velocity", "the film force during the slip"),
              parameter("mass", "the film force F_spring − M·a"))
     table_header = ("slip law (mean ± stderr over slips)", "value")

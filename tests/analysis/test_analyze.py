@@ -157,6 +157,56 @@ def test_fewer_than_two_slips_is_smooth_only_when_the_wall_slides(tmp_path, run_
         assert doc["regime_note"].startswith("fewer than 2 slips, but")
 
 
+#: traces too short to classify: rows, the flags given, a run directory (else a CSV file)
+SHORT = {
+    "1 row": (1, [], False),
+    "2 rows": (2, [], False),
+    "9 rows, every parameter": (9, ["--spring-constant", "100", "--mass", "5", "--area", "50",
+                                    "--thickness", "3", "--drive-velocity", "0.02"], False),
+    "9 rows in a run directory": (9, [], True),
+}
+
+
+@pytest.mark.parametrize("case", list(SHORT))
+def test_a_trace_too_short_to_classify_is_unresolved_with_its_reason(tmp_path, run_cli, case):
+    from filmfriction.analysis.observables import registered
+    from filmfriction.analysis.report import MIN_ROWS
+
+    rows, flags, run_dir = SHORT[case]
+    assert rows < MIN_ROWS
+    t = np.arange(rows) * 0.5
+    p = tmp_path / ("trace.csv" if run_dir else "short.csv")
+    write_csv(p, {"time": t, "spring_force": 1.0 + 0.1 * t, "wall_position": 0.02 * t,
+                  "wall_velocity": np.full(rows, 0.02)})
+    r = run_cli("analyze", tmp_path if run_dir else p, "--json", *flags)
+    assert r.code == 0, r.err
+    doc = r.json()
+    assert json.loads((tmp_path / "analysis.json").read_text()) == doc
+    assert doc["regime"] == "unresolved"
+    assert f"{rows} data row{'' if rows == 1 else 's'}: too short to classify" \
+        in doc["regime_note"]
+    # every section is listed as skipped with that reason, none is written (but the
+    # structure of a CSV trace: it has no run directory, so no trajectory, no place at all)
+    keys = [o.key for o in registered() if run_dir or o.key != "structure"] + ["detection"]
+    assert sorted(doc["skipped"]) == sorted(keys)
+    assert all(why == doc["regime_note"] for why in doc["skipped"].values())
+    assert not set(keys) & set(doc)
+    # the per-slip CSV: no slips, no columns
+    assert (tmp_path / doc["cycles_csv"]).read_text().strip() == ""
+
+
+def test_a_short_trace_is_analysed_from_ten_rows(tmp_path, run_cli):
+    from filmfriction.analysis.report import MIN_ROWS
+
+    t = np.arange(MIN_ROWS) * 0.5
+    p = tmp_path / "ten.csv"
+    write_csv(p, {"time": t, "spring_force": np.ones(MIN_ROWS)})
+    r = run_cli("analyze", p, "--json")
+    assert r.code == 0, r.err
+    doc = r.json()
+    assert "too short" not in doc.get("regime_note", "") and doc["slips"]["count"] == 0
+
+
 def test_thickness_is_layers_times_spacing_for_a_run(synthetic_run, run_cli):
     # a run records its film layers: D = gap n/(n+1) (Klein's D = n layers x spacing)
     import json as _json

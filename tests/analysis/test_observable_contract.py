@@ -1,18 +1,20 @@
 """The contract every observable keeps (``filmfriction.analysis.observables``).
 
-Each registered observable, and one defined in this file (the mean film
-temperature of each slip: what a user would drop into
+Each registered observable (the built-in sections -- slips, energy, sliding,
+viscosity, structure -- are observables too), and one defined in this file (the
+mean film temperature of each slip: what a user would drop into
 ``analysis/observables/`` as a file of its own), on a synthetic run directory
-(:func:`filmfriction.analysis.synthetic.run_directory`):
+with a trajectory (:func:`filmfriction.analysis.synthetic.run_directory`):
 
 * its section is JSON data and lands in ``analysis.json``, its per-slip columns
-  (``<key>_<name>``, one value per slip) in ``analysis_cycles.csv``;
+  (``<key>_<name>`` unless it names them otherwise, one value per slip) in
+  ``analysis_cycles.csv``; sections and columns come in the observables' order;
 * with any one of its ``needs`` taken from the run, it is skipped with a reason
   naming that need, and the analysis and the report still go through;
 * on a trace of nothing but ``time``, ``spring_force`` and its needs it gives
   its section or a reason, never an error (no need left undeclared);
 * ``rows()`` gives (label, value) strings, ``figure()`` PNG bytes or None, and
-  the report shows its title, table and figure.
+  the report shows its title, table and figures.
 """
 from __future__ import annotations
 
@@ -21,11 +23,11 @@ import csv
 import json
 import re
 import shutil
-from html import escape
 from pathlib import Path
 
 import numpy as np
 import pytest
+from markupsafe import escape
 
 from filmfriction.analysis import observables
 from filmfriction.analysis.observables import REGISTRY, Observable
@@ -90,6 +92,16 @@ def observable(request, slip_temperature) -> Observable:
     return REGISTRY[request.param]()
 
 
+def _needs(key: str) -> tuple:
+    """The needs of the observable ``key`` (that of this file: its one column)."""
+    return (REGISTRY[key].needs if key in REGISTRY else
+            (observables.column("film_temperature", "the film's temperature during each slip"),))
+
+
+#: (key, index of one of its needs) for every need of every observable
+NEEDS = [(key, i) for key in KEYS for i in range(len(_needs(key)))]
+
+
 def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
     """``analyze`` (written out) and ``build_report`` on ``run_dir``: the document,
     the per-slip CSV's columns, report.html and report.md."""
@@ -113,7 +125,7 @@ def study(tmp_path_factory, slip_temperature):
     from filmfriction.analysis.rundata import load_run
     from filmfriction.analysis.synthetic import run_directory
 
-    run_dir = run_directory(tmp_path_factory.mktemp("observables") / "run", trajectory=False)
+    run_dir = run_directory(tmp_path_factory.mktemp("observables") / "run")
     doc, columns, html, md = analyse_and_report(run_dir)
     return dict(dir=run_dir, doc=doc, columns=columns, html=html, md=md,
                 run=load_run(run_dir, analyse=False))
@@ -147,6 +159,10 @@ def test_the_class_statement_registers_and_refuses_a_taken_key(slip_temperature)
             type("Untitled", (Observable,), {"key": "untitled"})
         with pytest.raises(TypeError, match="needs"):
             type("Bare", (Observable,), {"key": "bare", "title": "t", "needs": "mass"})
+        with pytest.raises(TypeError, match="order"):
+            type("Late", (Observable,), {"key": "late", "title": "t", "order": "last"})
+        with pytest.raises(TypeError, match="per_slip"):
+            type("Each", (Observable,), {"key": "each", "title": "t", "per_slip": "every"})
         type("Helper", (Observable,), {"key": "helper", "title": "t"}, register=False)
         assert REGISTRY == before
     finally:                        # whatever a failure registered goes again
@@ -163,13 +179,30 @@ def test_its_section_is_json_and_lands_in_analysis_json(observable, study):
     section = doc[key]
     assert isinstance(section, dict) and section
     assert json.loads(json.dumps(section, allow_nan=False)) == section
-    # its per-slip columns: <key>_<name>, one value a slip (the start-up slips empty)
-    mine = [c for c in study["columns"] if c.startswith(key + "_")]
-    n = doc["slips"]["count"]
-    for name in mine:
-        cells = study["columns"][name]
+    # its per-slip columns, one value a slip (the start-up slips empty unless it covers all)
+    from filmfriction.analysis.report import context, run_observable
+
+    _, columns = run_observable(observable, context(study["run"].trace))
+    n, skip = doc["slips"]["count"], doc["slips"]["summary_skips_first"]
+    for name in columns:
+        cells = study["columns"][observable.column_name(name)]
         assert len(cells) == n, name
-        assert all(c == "" for c in cells[:doc["slips"]["summary_skips_first"]]), name
+        if observable.per_slip == "analysed":
+            assert all(c == "" for c in cells[:skip]), name
+            cells = cells[skip:]
+        assert cells == ["" if not np.isfinite(float(v)) else repr(v) for v in columns[name]], name
+
+
+def test_sections_and_columns_come_in_the_observables_order(study):
+    doc, order = study["doc"], [o.key for o in observables.registered()]
+    assert order[:5] == ["slips", "energy", "sliding", "viscosity", "structure"]
+    written = [k for k in doc if k in REGISTRY]
+    assert written == [k for k in order if k in doc]
+    # the CSV: the slips' own columns first, the slip law's after the viscosity's
+    header = list(study["columns"])
+    assert header[:2] == ["yield_index", "stick_index"]
+    assert header.index("energy_film_heat") < header.index("eta_eff") \
+        < header.index("slip_law_damping")
 
 
 def _without(run_dir: Path, need, dest: Path) -> Path:
@@ -192,17 +225,18 @@ def _without(run_dir: Path, need, dest: Path) -> Path:
     return dest
 
 
-def test_without_any_one_need_it_is_skipped_naming_it(observable, study, tmp_path):
-    assert observable.needs, f"{observable.key} declares no needs: what does it read?"
-    for i, need in enumerate(observable.needs):
-        doc, columns, html, md = analyse_and_report(
-            _without(study["dir"], need, tmp_path / f"without-{i}"))
-        assert observable.key not in doc, need
-        reason = doc["skipped"].get(observable.key, "")
-        assert need.label in reason, (need, reason)
-        assert not [c for c in columns if c.startswith(observable.key + "_")]
-        # the report says why, under the observable's title
-        assert observable.title in md and f"{observable.absent}: {reason}." in md
+@pytest.mark.parametrize("key, i", NEEDS, ids=[f"{k}-{i}" for k, i in NEEDS])
+def test_without_any_one_need_it_is_skipped_naming_it(key, i, slip_temperature, study,
+                                                      tmp_path):
+    observable = REGISTRY[key]()
+    need = observable.needs[i]
+    doc, columns, html, md = analyse_and_report(_without(study["dir"], need, tmp_path / "run"))
+    assert observable.key not in doc, need
+    reason = doc["skipped"].get(observable.key, "")
+    assert need.label in reason, (need, reason)
+    assert not [c for c in columns if c.startswith(observable.column_name(""))]
+    # the report says why, under the observable's title
+    assert observable.title in md and f"{observable.absent}: {reason}." in md
 
 
 def test_a_trace_of_its_needs_alone_gives_its_section_or_a_reason(observable, study):
@@ -219,8 +253,9 @@ def test_a_trace_of_its_needs_alone_gives_its_section_or_a_reason(observable, st
             cols[need.name] = full.columns[need.name]
         else:
             params[need.name] = getattr(full.parameters, need.name)
-    doc, _ = analyze(Trace(cols, TraceParameters(**params), study["dir"] / "trace.csv"),
-                     structure=False)
+    # the run directory's files (trajectory, profiles) stay: they are no column or parameter
+    doc, _ = analyze(Trace(cols, TraceParameters(**params), study["dir"] / "trace.csv",
+                           run_dir=study["dir"]))
     assert observable.key in doc or doc["skipped"].get(observable.key)
 
 
@@ -233,19 +268,18 @@ def test_rows_and_notes_are_strings(observable, study):
     assert all(isinstance(p, str) for p in observable.notes(section))
 
 
-def test_its_figure_is_a_png_and_the_report_shows_it(observable, study):
-    png = observable.figure(study["run"])
-    assert png is None or (isinstance(png, bytes) and png.startswith(PNG) and len(png) > 2000)
+def test_its_figures_are_pngs_and_the_report_shows_them(observable, study):
+    figures = observable.figures(study["run"])
     html, md = study["html"], study["md"]
     assert f">{escape(observable.title)}</h2>" in html and f"## {observable.title}" in md
     for label, value in observable.rows(study["doc"][observable.key]):
         assert f"| {label} | {value} |" in md
-    assert not re.search(rf"\| (figure|table|notes): {observable.key.replace('_', ' ')} \|", md), \
-        "the report recorded a failure of the observable"
-    if png is not None:
-        assert images(html).get(observable.key, b"").startswith(PNG)
-        assert f"![{observable.key}](report-{observable.key}.png)" in md
-        assert f"*{observable.caption}*" in md
+    assert not re.search(rf"\| (lead|figure|table|notes): {observable.key.replace('_', ' ')} \|",
+                         md), "the report recorded a failure of the observable"
+    for name, png, caption in figures:
+        assert isinstance(png, bytes) and png.startswith(PNG) and len(png) > 2000, name
+        assert images(html).get(name, b"").startswith(PNG), name
+        assert f"![{name}](report-{name}.png)" in md and f"*{caption}*" in md
 
 
 def test_one_file_is_enough(slip_temperature, study):

@@ -3,7 +3,8 @@
 ``report_study(run_dir)`` runs the study (analysis, calibration, SFB check,
 report) on a run directory and returns the axis labels of every figure it drew;
 ``report_checks`` holds the checks that the report tests apply to the synthetic
-run (test_report_content.py) and to the real one (test_report.py).
+run (test_report_content.py) and to the real one (test_report.py), among them the
+headless-Chromium check that every figure loads at a non-trivial size.
 """
 from __future__ import annotations
 
@@ -130,12 +131,67 @@ def check_axes_units(labels: list) -> None:
     assert AXIS_UNITS <= units, units
 
 
+CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                  "--disable-background-networking", "--disable-component-update", "--disable-sync")
+#: the least size (width, height in pixels) a figure of the report may have in the browser
+MIN_FIGURE = (300, 150)
+
+
+def chromium() -> str | None:
+    """A Chromium binary on PATH, or None."""
+    import shutil
+
+    for name in ("chromium", "chromium-browser", "google-chrome", "chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def check_in_browser(report: Path) -> dict[str, tuple[int, int]]:
+    """Open ``report`` in headless Chromium: every figure loads, with a size of at
+    least :data:`MIN_FIGURE`; returns name -> (width, height) as the browser decoded it.
+    Skips the test when no Chromium is installed."""
+    import os
+    import subprocess
+    import tempfile
+
+    browser = chromium()
+    if browser is None:
+        pytest.skip("no chromium binary on PATH (install with: apt-get install -y chromium)")
+    with tempfile.TemporaryDirectory() as profile:
+        cmd = [browser, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=10000",
+               "--dump-dom", Path(report).resolve().as_uri()]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120,
+                              env={**os.environ, "HOME": profile})
+    body = re.search(r"<body[^>]*>", proc.stdout)
+    assert body, f"no DOM from chromium (rc {proc.returncode}): {proc.stderr[-2000:]}"
+    total = re.search(r'data-images-total="(\d+)"', body.group(0))
+    loaded = re.search(r'data-images-loaded="(\d+)"', body.group(0))
+    assert total and loaded, body.group(0)
+    imgs = re.findall(r"<img [^>]*>", proc.stdout)
+    assert int(total.group(1)) == len(imgs) >= 2
+    assert int(loaded.group(1)) == int(total.group(1)), "some figures did not load"
+    sizes = {}
+    for tag in imgs:
+        name = re.search(r'alt="([^"]*)"', tag).group(1)
+        natural = re.search(r'data-natural-size="(\d+)x(\d+)"', tag)
+        shown = re.search(r'data-shown-size="(\d+)x(\d+)"', tag)
+        assert natural and shown, tag[:200]
+        w, h = int(natural.group(1)), int(natural.group(2))
+        assert w >= MIN_FIGURE[0] and h >= MIN_FIGURE[1], (name, w, h)
+        assert int(shown.group(1)) > 0 and int(shown.group(2)) > 0, (name, shown.group(0))
+        sizes[name] = (w, h)
+    return sizes
+
+
 @pytest.fixture(scope="session")
 def report_checks():
     """The report checks: ``outputs(run_dir)``, ``content(run_dir, out=None)``,
-    ``axes_units(labels)``, ``images(html)``."""
+    ``axes_units(labels)``, ``images(html)``, ``in_browser(report_html)``."""
     return SimpleNamespace(outputs=check_outputs, content=check_content,
-                           axes_units=check_axes_units, images=images, sections=SECTIONS, png=PNG)
+                           axes_units=check_axes_units, images=images, sections=SECTIONS, png=PNG,
+                           in_browser=check_in_browser)
 
 
 @pytest.fixture

@@ -102,8 +102,6 @@ CASES = {
     "bench --steps 0": (lambda t: ["bench", "--steps", "0"], "--steps 0", 2),
     "bench --repeat 0": (lambda t: ["bench", "--repeat", "0"], "--repeat 0", 2),
     # -- were accepted
-    "2-row trace": (lambda t: ["analyze", _csv(t / "two.csv", "time,spring_force",
-                                               [(0, 1), (1, 2)])], "too short to classify", 2),
     "NaN in wall_position": (lambda t: ["analyze", _nan_wall(t)], "column wall_position", 2),
     "--skip negative": (lambda t: ["analyze", _trace(t), "--skip", "-1"], "--skip", 2),
     "--skip beyond the slips": (lambda t: ["analyze", _trace(t), "--skip", "100000"],

@@ -35,13 +35,26 @@ def test_every_figure_has_units_on_its_axes(synthetic_study, report_checks):
     report_checks.axes_units(synthetic_study.labels)
 
 
+def test_every_figure_loads_in_headless_chromium(synthetic_study, report_checks):
+    report = synthetic_study.path / "report.html"
+    sizes = report_checks.in_browser(report)
+    assert set(sizes) == set(report_checks.images(report.read_text()))
+    # the figures of the analysis' observables, each from its own file
+    assert {"trace", "energy", "ledger", "eta-per-slip", "film", "structure-time", "layers-top",
+            "slip_law"} <= set(sizes), sorted(sizes)
+
+
 def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
+    from filmfriction.analysis.observables.structure import Structure, fig_film
     from filmfriction.workflows import report
 
-    assert report.fig_film(tmp_path) == (None, "")
-    sec = report._film_section(SimpleNamespace(run_dir=tmp_path, analysis={}), {})
+    assert fig_film(tmp_path) == (None, "")
+    run = SimpleNamespace(run_dir=tmp_path, analysis={"skipped": {
+        "structure": "no trajectory.dcd + topology.data in the run directory"}})
+    sec = report._observable_section(Structure(), run, {})
     assert sec.title == "The film: density profile and picture"
-    assert any("`film-structure` scene" in b for b in sec.blocks if isinstance(b, str))
+    text = [b for b in sec.blocks if isinstance(b, str)]
+    assert any("`film-structure` scene" in b and "no trajectory.dcd" in b for b in text), text
 
 
 def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path, report_study,
@@ -81,3 +94,41 @@ def test_a_run_with_warnings_says_so(synthetic_study, tmp_path, report_study):
     (run / "run.json").write_text(_json.dumps(rj))
     md = build_report(run).with_suffix(".md").read_text()
     assert "completed with warnings" in md and "film temperature 1.06 vs 0.7" in md
+
+
+def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, monkeypatch):
+    """A measured trace (SFB scale, SI) through analyze, calibrate and report: every number
+    and axis in SI, nothing called MD or labelled in LJ units."""
+    import re
+
+    from matplotlib.figure import Figure
+
+    from filmfriction.analysis.synthetic import klein_trace, write_csv
+
+    tr = klein_trace(cycles=5, noise=0.005 * 9.7e-6, seed=2)
+    write_csv(tmp_path / "trace.csv", {k: tr[k] for k in ("time", "spring_force", "drive_position",
+                                                         "wall_position", "wall_velocity")})
+    sfb = ["--units", "si", "--spring-constant", "97", "--mass", "1.47e-3", "--area", "4e-10",
+           "--thickness", "3.5e-9", "--drive-velocity", "1e-7"]
+    assert run_cli("analyze", tmp_path / "trace.csv", *sfb).code == 0
+    calibrated = run_cli("calibrate", tmp_path)
+    assert calibrated.code == 0, calibrated.err
+    cal = json.loads((tmp_path / "calibration.json").read_text())
+    assert cal["units"] == "si" and cal["runs"][0]["static_force"]["units"] == "N"
+    labels, savefig = [], Figure.savefig
+
+    def capture(fig, *args, **kwargs):
+        labels.append([(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes])
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", capture)
+    assert run_cli("report", tmp_path).code == 0
+    md = (tmp_path / "report.md").read_text()
+    named = [label for fig in labels for axis in fig for label in axis if label]
+    units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
+    assert {"N", "s", "J", "Pa·s", "1/s"} <= units, units
+    assert not units & {"ε/σ", "τ", "σ", "ε", "ετ/σ³", "1/τ", "σ/τ"}, units
+    for lj in ("ε/σ", "ετ/σ³", " τ ", "LJ", "MD spring force", "the MD trace"):
+        assert lj not in md, lj
+    assert re.search(r"^\| static force \| 9\.7\d*e-06 ± \S+ N \|", md, re.M) and "(SI)" in md
+    assert all(re.search(r"\[[^\]]+\]", label) for label in named), named

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filmfriction.analysis.report import sliding_section
+from filmfriction.analysis.observables.sliding import sliding_section
 from filmfriction.analysis.trace import read_trace
 from filmfriction.workflows import sweep
 from filmfriction.workflows.scene import SceneError
