@@ -118,9 +118,6 @@ def test_report_is_written(chain):
     assert (d / "report.html").stat().st_size > 10_000 and "report:" in printed["report"]
 
 
-@pytest.mark.xfail(strict=True, reason="workflows/report.py labels every trace in LJ units "
-                                       "(its figures' axes and its tables); a measured SI trace "
-                                       "needs SI labels there")
 def test_report_labels_a_measured_trace_in_si(chain):
     d, _ = chain
     text = (d / "report.md").read_text()
