@@ -364,8 +364,10 @@ def calibrate(run_dirs) -> Calibration:
         failures["md_calibration"] = str(exc)
     dependence = None
     if distinct >= 3:
+        from filmfriction.reduced_model.units import SI_IDENTITY
         try:
-            dependence = rate_dependence(points)
+            # an SI trace's rates are SI already: the identity mapping carries them
+            dependence = rate_dependence(points, SI_IDENTITY if units == {"si"} else None)
         except ValueError as exc:
             failures["rate_dependence"] = str(exc)
     return Calibration(runs=runs, rate_law=law, rate_points=points, md_calibration=md,
@@ -376,7 +378,8 @@ def calibrate(run_dirs) -> Calibration:
 def rate_dependence(points, units=None) -> dict:
     """The sliding stress's rate law across runs, carried to Klein's slip rate.
 
-    ``points`` are (γ̇, η_eff, stderr) in LJ units; the stress is τ = η_eff·γ̇ (error
+    ``points`` are (γ̇, η_eff, stderr) in LJ units (SI with ``units`` =
+    :data:`~filmfriction.reduced_model.units.SI_IDENTITY`, a measured trace's); the stress is τ = η_eff·γ̇ (error
     stderr·γ̇).  Both an Eyring-like τ0 + τ1 ln(γ̇/γ̇_ref) and a power law c γ̇^n are
     fitted (:mod:`.ratelaw`); the one with the smaller residual in stress is chosen
     and both are evaluated at the mean shear rate of Klein's slip, Δx0/(τ_s D)
@@ -384,11 +387,12 @@ def rate_dependence(points, units=None) -> dict:
     interval and whether that interval spans more than a decade.
     """
     from filmfriction.reduced_model.klein import KLEIN, klein_slip_geometry
-    from filmfriction.reduced_model.units import OMCTS
+    from filmfriction.reduced_model.units import OMCTS, SI_IDENTITY
 
     from .ratelaw import choose_rate_law, eyring_fit, power_fit
 
     units = units or OMCTS
+    stress_units = "Pa, a measured trace's" if units == SI_IDENTITY else "LJ stress units"
     rate = np.array([p[0] for p in points], float)
     stress = np.array([p[1] * p[0] for p in points], float)
     err = np.array([p[2] * p[0] for p in points], float)
@@ -396,7 +400,7 @@ def rate_dependence(points, units=None) -> dict:
     geo = klein_slip_geometry(KLEIN)
     sfb_rate_si = geo.slip_distance / (KLEIN.slip_time * KLEIN.film_thickness)
     sfb_rate = float(units.from_si(sfb_rate_si, "shear_rate"))
-    out = {"stress": "eta_eff * shear_rate (LJ stress units)", "weighted": err is not None,
+    out = {"stress": f"eta_eff * shear_rate ({stress_units})", "weighted": err is not None,
            "sfb_shear_rate": sfb_rate, "sfb_shear_rate_si": sfb_rate_si,
            "decades_extrapolated": float(np.log10(rate.min() / sfb_rate))}
     fits = {"eyring": eyring_fit(rate, stress, err)}

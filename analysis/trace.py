@@ -1,18 +1,30 @@
-"""Read a stick-slip trace: a run directory or a plain CSV file.
+"""Read a stick-slip trace: a run directory, a plain trace file, or an analysed one.
 
-A plain CSV has a header line naming its columns (``time`` and
+A plain trace file has a header line naming its columns (``time`` and
 ``spring_force`` required; ``drive_position``, ``wall_position``,
-``wall_velocity``, ``gap`` and the MD ledger columns optional).  Lines
-starting with ``#`` before the header are ignored.  The parameters a trace
-needs (spring constant, wall mass, contact area, film thickness, drive
-velocity) and the unit system come from the command line or, for a run
-directory, from ``run.json``'s ``trace_parameters`` (the command line wins).
+``wall_velocity``, ``gap`` and the MD ledger columns optional), separated by
+commas, tabs, semicolons or whitespace (detected from the header,
+:func:`detect_delimiter`).  A file with its own column names is read through a
+mapping, analysis name → the file's name (:func:`map_columns`; ``filmfriction
+analyze --column time=t_s``).  Lines starting with ``#`` before the header are
+ignored.  The parameters a trace needs (spring constant, wall mass, contact
+area, film thickness, drive velocity) and the unit system come from the
+command line or, for a run directory, from ``run.json``'s ``trace_parameters``
+(the command line wins).  A directory holding the ``analysis.json`` of a plain
+trace file (and no ``trace.csv``) reads that file again with the mapping,
+units and parameters the analysis recorded.
 
 A run directory holds ``trace.csv`` (the columns of the MD script's contract,
 :data:`filmfriction.md_inputs.contract.TRACE`, whose ``quantity`` names the
 entry of :data:`UNITS` that labels it) and ``run.json``, and optionally
 ``profiles/density.profile``, ``profiles/velocity.profile`` (``fix
 ave/chunk``) and ``trajectory.dcd`` + ``topology.data``.
+
+Speed: a text trace is parsed by NumPy's C reader (~0.2 s per 10⁶ rows of three
+columns); a binary copy beside it (``trace.npy``, :func:`write_binary_copy`, written
+by ``filmfriction analyze`` for traces of :data:`BINARY_MIN_ROWS` rows or more) is
+read instead while it is at least as new as the text (~0.01 s; see
+``benchmarks/bench_analysis.py``).
 
 The unit system is only reported, never converted: ``lj`` or ``si``.
 """
@@ -25,10 +37,18 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["MissingInput", "TraceParameters", "Trace", "read_trace",
-           "read_csv_trace", "UNITS", "unit"]
+__all__ = ["MissingInput", "TraceParameters", "TraceLayout", "Trace", "read_trace",
+           "read_csv_trace", "map_columns", "detect_delimiter", "trace_column_names",
+           "write_binary_copy", "binary_copy_path", "BINARY_MIN_ROWS", "UNITS", "unit"]
 
 REQUIRED_COLUMNS = ("time", "spring_force")
+
+
+def trace_column_names() -> tuple[str, ...]:
+    """The column names the analysis reads (the targets of a column mapping): the MD
+    trace contract's, :data:`filmfriction.md_inputs.contract.TRACE_COLUMNS`."""
+    from filmfriction.md_inputs.contract import TRACE_COLUMNS
+    return TRACE_COLUMNS
 PARAMETERS = ("spring_constant", "mass", "area", "thickness", "drive_velocity",
               "mount_damping")
 
@@ -110,6 +130,25 @@ class TraceParameters:
         return TraceParameters(**values)
 
 
+@dataclass(frozen=True)
+class TraceLayout:
+    """How a trace file was read.
+
+    Attributes
+    ----------
+    delimiter : str
+        ``"comma"``, ``"tab"``, ``"semicolon"`` or ``"whitespace"``.
+    columns : dict
+        Analysis name → the file's column name, for the columns renamed.
+    binary : bool
+        Read from the binary copy beside the text (:func:`write_binary_copy`).
+    """
+
+    delimiter: str = "comma"
+    columns: dict = field(default_factory=dict)
+    binary: bool = False
+
+
 @dataclass(frozen=True, eq=False)
 class Trace:
     """A time series with named columns plus its parameters.
@@ -127,6 +166,8 @@ class Trace:
         ``run.json`` content (empty for a plain CSV).
     notes : tuple of str
         Remarks made while reading (e.g. a dropped truncated last line).
+    layout : TraceLayout or None
+        How the file was read: delimiter, column mapping, binary copy.
     """
 
     columns: dict
@@ -135,6 +176,7 @@ class Trace:
     run_dir: Path | None = None
     run: dict = field(default_factory=dict)
     notes: tuple = ()
+    layout: "TraceLayout | None" = None
 
     @property
     def time(self) -> np.ndarray:
@@ -212,74 +254,248 @@ class Trace:
         return p if p.exists() else None
 
 
-def _read_table(path: Path) -> tuple[list[str], np.ndarray, list[str]]:
-    notes = []
-    with path.open("rb") as fh:
-        raw = fh.read()
-    text_head = raw[:65536].decode("utf-8", errors="replace").splitlines()
+def detect_delimiter(header: str, first_row: str | None = None) -> str | None:
+    """The delimiter of a trace's header line: ``","``, ``"\\t"`` or ``";"``, the first
+    of these that the header holds (and the first data row, when given, splits into as
+    many fields with), else ``None``: runs of whitespace.
+
+    >>> detect_delimiter("t_s\\tF_N"), detect_delimiter("time;force"), detect_delimiter("a  b")
+    ('\\t', ';', None)
+    """
+    for sep in (",", "\t", ";"):
+        if sep in header and (first_row is None
+                              or len(first_row.split(sep)) == len(header.split(sep))):
+            return sep
+    return None
+
+
+def _split(line: str, sep: str | None) -> list[str]:
+    """A header line's names: split at ``sep``, blanks and quotes stripped."""
+    return [h.strip().strip('"').strip("'").strip() for h in
+            (line.split(sep) if sep is not None else line.split())]
+
+
+def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
+    """Index of the header line (after blank and ``#`` lines), its text, the delimiter."""
+    head = raw[:65536].decode("utf-8", errors="replace").splitlines()
     start = 0
-    while start < len(text_head) and (not text_head[start].strip()
-                                      or text_head[start].lstrip().startswith("#")):
+    while start < len(head) and (not head[start].strip() or head[start].lstrip().startswith("#")):
         start += 1
-    if start == len(text_head):
+    if start == len(head):
         raise ValueError(f"{path}: empty file (no header line)")
-    header = text_head[start]
-    names = [h.strip() for h in header.split(",")]
+    first_row = head[start + 1] if start + 1 < len(head) else None
+    return start, head[start], detect_delimiter(head[start], first_row)
+
+
+def _read_table(path: Path) -> tuple[list[str], np.ndarray, list[str], str | None]:
+    """The header's names, the data rows (2-D), remarks, and the delimiter of a text trace."""
+    notes = []
+    raw = path.read_bytes()
+    start, header, sep = _header(raw, path)
+    names = _split(header, sep)
     if any(not n for n in names) or len(set(names)) != len(names):
-        raise ValueError(f"{path}: bad header {header!r} "
-                         "(need unique comma-separated column names)")
+        raise ValueError(f"{path}: bad header {header!r} (need unique column names separated "
+                         "by commas, tabs, semicolons or spaces)")
     body = raw.rstrip(b"\n\r\t ")
     n_lines = body.count(b"\n") + 1 if body else 0
     n_rows = n_lines - start - 1
     if n_rows > 0 and not raw.endswith(b"\n"):
         last = body[body.rfind(b"\n") + 1:].decode("utf-8", errors="replace")
-        if last.count(",") != len(names) - 1 or last.rstrip().endswith(","):
+        fields = last.split(sep) if sep is not None else last.split()
+        if len(fields) != len(names) or not fields[-1].strip():
             n_rows -= 1
             notes.append(f"dropped truncated last line {n_lines}")
     if n_rows <= 0:
         raise ValueError(f"{path}: no data rows after the header")
+    source = path
+    if sep == ";":
+        # a semicolon-separated table may write decimal commas (1,5;2,25)
+        rows = raw.split(b"\n", start + 1)[-1]
+        if b"," in rows:
+            import io
+            source = io.StringIO(rows.decode("utf-8").replace(",", "."))
+            start = -1
+            notes.append("decimal commas read as decimal points")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=start + 1, max_rows=n_rows,
+        data = np.loadtxt(source, delimiter=sep, skiprows=start + 1, max_rows=n_rows,
                           ndmin=2, dtype=float, comments=None)
     except ValueError as exc:
-        raise ValueError(f"{path}: cannot parse data rows: {exc}") from None
+        raise ValueError(f"{path}: cannot parse data rows "
+                         f"({_DELIMITER_NAMES[sep]}-separated): {exc}") from None
     if data.shape[1] != len(names):
-        raise ValueError(f"{path}: header has {len(names)} columns, "
-                         f"rows have {data.shape[1]}")
-    return names, data, notes
+        raise ValueError(f"{path}: header has {len(names)} columns ({_DELIMITER_NAMES[sep]}-"
+                         f"separated), rows have {data.shape[1]}")
+    return names, data, notes, sep
 
 
-def read_csv_trace(path, parameters: TraceParameters | None = None) -> Trace:
-    """Read a plain CSV trace.
+_DELIMITER_NAMES = {",": "comma", "\t": "tab", ";": "semicolon", None: "whitespace"}
+
+#: A text trace of at least this many rows gets a binary copy beside it when
+#: ``filmfriction analyze`` reads it (:func:`write_binary_copy`).
+BINARY_MIN_ROWS = 100_000
+
+
+def binary_copy_path(path) -> Path:
+    """Where the binary copy of the text trace ``path`` lives: ``trace.csv`` → ``trace.npy``."""
+    return Path(path).with_suffix(".npy")
+
+
+def write_binary_copy(trace: "Trace") -> Path:
+    """Write the binary copy of ``trace``'s text file beside it (atomically): a NumPy
+    structured array whose fields are the file's columns, named as in its header.
+
+    :func:`read_csv_trace` reads it instead of the text when it is at least as new
+    as the text and has the header's names; text edited later is read again.
+    """
+    import io
+
+    from .util import write_atomic
+
+    layout = trace.layout or TraceLayout()
+    names = [layout.columns.get(name, name) for name in trace.columns]
+    table = np.empty(len(trace), dtype=[(name, "<f8") for name in names])
+    for name, values in zip(names, trace.columns.values()):
+        table[name] = values
+    buf = io.BytesIO()
+    np.save(buf, table, allow_pickle=False)
+    return write_atomic(binary_copy_path(trace.path), buf.getvalue())
+
+
+def _read_binary_copy(path: Path, names: list[str]) -> dict | None:
+    """The columns of ``path``'s binary copy, or None when there is none, it is older
+    than the text, or its fields are not the header's ``names``."""
+    copy = binary_copy_path(path)
+    if copy == path:
+        return None
+    try:
+        if copy.stat().st_mtime_ns < path.stat().st_mtime_ns:
+            return None
+        table = np.load(copy, allow_pickle=False)
+    except (OSError, ValueError):
+        return None
+    if table.ndim != 1 or table.dtype.names is None or list(table.dtype.names) != names:
+        return None
+    return {name: np.ascontiguousarray(table[name], dtype=float) for name in names}
+
+
+def map_columns(names, mapping: dict | None, where="") -> dict:
+    """Check a column mapping (analysis name → the file's column name) against a header.
+
+    Returns
+    -------
+    dict
+        The file's column name → the name the analysis gives it (identity for
+        columns not mapped).
 
     Raises
     ------
     ValueError
-        Unreadable file, missing ``time``/``spring_force``, non-increasing time.
+        A target that the analysis does not know, a source column not in the
+        header (both list what exists), or two sources for one name.
+
+    Examples
+    --------
+    >>> map_columns(["t_s", "F_N"], {"time": "t_s", "spring_force": "F_N"})
+    {'t_s': 'time', 'F_N': 'spring_force'}
+    >>> map_columns(["t_s"], {"tme": "t_s"})
+    Traceback (most recent call last):
+    ...
+    ValueError: --column tme=t_s: unknown name 'tme'; the analysis reads time, step, drive_position, spring_force, wall_position, wall_velocity, wall_z, gap, film_temperature, drive_work, load_work, thermostat_heat, potential_energy, kinetic_energy, spring_energy, mount_heat
+    """
+    known = trace_column_names()
+    where = f"{where}: " if where else ""
+    renames = {n: n for n in names}
+    for target, src in (mapping or {}).items():
+        if target not in known:
+            raise ValueError(f"--column {target}={src}: unknown name {target!r}; the analysis "
+                             f"reads {', '.join(known)}")
+        if src not in names:
+            raise ValueError(f"{where}--column {target}={src}: no column {src!r} in the header "
+                             f"(columns: {', '.join(names)})")
+        renames[src] = target
+    targets = list(renames.values())
+    for target in set(targets):
+        if targets.count(target) > 1:
+            srcs = [s for s, t in renames.items() if t == target]
+            raise ValueError(f"{where}columns {', '.join(srcs)} would all be called {target!r}; "
+                             f"map one of them with --column {target}=NAME and rename the others")
+    return renames
+
+
+def read_csv_trace(path, parameters: TraceParameters | None = None,
+                   columns: dict | None = None) -> Trace:
+    """Read a plain trace file (comma-, tab-, semicolon- or whitespace-separated).
+
+    Parameters
+    ----------
+    path : path-like
+    parameters : TraceParameters, optional
+    columns : dict, optional
+        Analysis name → the file's column name, e.g. ``{"time": "t_s",
+        "spring_force": "F_N"}`` (:func:`map_columns`).
+
+    Raises
+    ------
+    ValueError
+        Unreadable file, a bad mapping, missing ``time``/``spring_force``,
+        non-increasing time.
     """
     path = Path(path)
-    names, data, notes = _read_table(path)
+    raw_head = path.open("rb").read(65536)
+    start, header, sep = _header(raw_head, path)
+    renames = map_columns(_split(header, sep), columns, str(path))
+    cols = _read_binary_copy(path, list(renames))
+    notes, from_binary = [], cols is not None
+    if cols is None:
+        names, data, notes, sep = _read_table(path)
+        cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
+    cols = {renames[n]: v for n, v in cols.items()}
     for req in REQUIRED_COLUMNS:
-        if req not in names:
-            raise ValueError(f"{path}: required column '{req}' missing "
-                             f"(header: {', '.join(names)})")
-    cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
+        if req not in cols:
+            raise ValueError(f"{path}: required column '{req}' missing (header: "
+                             f"{', '.join(renames)}); name it with --column {req}=NAME")
     t = cols["time"]
     if not np.all(np.isfinite(t)):
         raise ValueError(f"{path}: column 'time' has non-finite values")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         i = int(np.flatnonzero(np.diff(t) <= 0)[0])
         raise ValueError(f"{path}: time not increasing at data row {i + 2}")
-    return Trace(cols, parameters or TraceParameters(), path, notes=tuple(notes))
+    mapped = {renames[s]: s for s in renames if renames[s] != s}
+    return Trace(cols, parameters or TraceParameters(), path, notes=tuple(notes),
+                 layout=TraceLayout(_DELIMITER_NAMES[sep], mapped, from_binary))
 
 
-def read_trace(path, **overrides) -> Trace:
-    """Read a run directory or a CSV trace.
+def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
+    """The plain trace file an ``analysis.json`` in ``directory`` was made from, and
+    that document, when the directory holds no ``trace.csv`` (a measured trace)."""
+    doc_path = directory / "analysis.json"
+    if not doc_path.is_file():
+        return None
+    from .util import read_json_object
+
+    doc = read_json_object(doc_path)
+    source = doc.get("source") or {}
+    if source.get("run_dir") or not source.get("path"):
+        return None
+    given = Path(source["path"])
+    for candidate in (directory / given.name, given):
+        if candidate.is_file():
+            return candidate, doc
+    raise ValueError(f"{doc_path}: the trace it was made from, {given}, is not there "
+                     f"(nor in {directory})")
+
+
+def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
+    """Read a run directory, a plain trace file, or the directory of an analysed trace.
 
     Parameters
     ----------
     path : path-like
-        A run directory (with ``trace.csv`` and ``run.json``) or a CSV file.
+        A run directory (with ``trace.csv`` and ``run.json``), a trace file, or a
+        directory with the ``analysis.json`` of a trace file (``filmfriction analyze``
+        records the file, its column mapping, units and parameters there).
+    columns : dict, optional
+        Analysis name → the file's column name (:func:`map_columns`).
     **overrides
         ``spring_constant``, ``mass``, ``area``, ``thickness``,
         ``drive_velocity``, ``units``; ``None`` values are ignored.
@@ -292,7 +508,18 @@ def read_trace(path, **overrides) -> Trace:
     if path.is_dir():
         csv_path = path / "trace.csv"
         if not csv_path.exists():
-            raise ValueError(f"{path}: run directory without trace.csv")
+            analysed = _analysed_trace_file(path)
+            if analysed is None:
+                raise ValueError(f"{path}: run directory without trace.csv (and no "
+                                 "analysis.json of a trace file)")
+            file, doc = analysed
+            source = doc["source"]
+            base = {k: v for k, v in (source.get("parameters") or {}).items() if k in PARAMETERS}
+            base["units"] = doc.get("units", "lj")
+            params = TraceParameters(**base).updated(**overrides)
+            mapping = dict(source.get("columns") or {})
+            mapping.update(columns or {})
+            return read_csv_trace(file, params, mapping)
         run = {}
         if (path / "run.json").exists():
             try:
@@ -303,8 +530,8 @@ def read_trace(path, **overrides) -> Trace:
         base = {k: given.get(k) for k in PARAMETERS}
         base["units"] = given.get("units", "lj")
         params = TraceParameters(**base).updated(**overrides)
-        tr = read_csv_trace(csv_path, params)
-        return Trace(tr.columns, params, csv_path, path, run, tr.notes)
+        tr = read_csv_trace(csv_path, params, columns)
+        return Trace(tr.columns, params, csv_path, path, run, tr.notes, tr.layout)
     if not path.exists():
         raise ValueError(f"{path}: no such file or directory")
-    return read_csv_trace(path, TraceParameters().updated(**overrides))
+    return read_csv_trace(path, TraceParameters().updated(**overrides), columns)

@@ -15,6 +15,8 @@ JSON-safe numbers, numbers as report text, figures as PNG bytes.
   ``analysis.json`` entry ``{"mean", "stderr", "units"}``, as the report writes it.
 * :func:`pyplot`, :func:`png_bytes` -- matplotlib without a display, and a
   figure as PNG bytes (the figure closed).
+* :func:`json_schema` -- the JSON Schema of an output (``analysis``, ``sfb``),
+  shipped in ``analysis/schemas/``.
 """
 from __future__ import annotations
 
@@ -27,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["write_atomic", "finite_or_none", "json_safe", "json_default",
-           "format_value", "format_estimate", "pyplot", "png_bytes"]
+           "format_value", "format_estimate", "pyplot", "png_bytes", "read_json_object",
+           "json_schema"]
 
 
 def _umask() -> int:
@@ -182,3 +185,20 @@ def read_json_object(path, where: str | None = None, *, what: str = "a JSON obje
     if not isinstance(data, dict):
         raise ValueError(f"{where}: must be {what}, this is a {type(data).__name__}")
     return data
+
+
+def json_schema(name: str) -> dict:
+    """The JSON Schema (draft 2020-12) of the output ``name``: ``"analysis"``
+    (``analysis.json``) or ``"sfb"`` (``sfb.json``), from ``analysis/schemas/``.
+
+    >>> json_schema("analysis")["properties"]["schema"]
+    {'const': 'filmfriction.analysis/1'}
+    """
+    import json
+
+    path = Path(__file__).parent / "schemas" / f"{name}.schema.json"
+    if not path.is_file():
+        known = sorted(p.name.removesuffix(".schema.json")
+                       for p in path.parent.glob("*.schema.json"))
+        raise ValueError(f"no schema {name!r}; the schemas are {', '.join(known)}")
+    return json.loads(path.read_text(encoding="utf-8"))

@@ -30,7 +30,7 @@ from enum import IntEnum
 
 __all__ = ["DATA_FILE", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
            "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
-           "column", "fix_print_text", "fix_print_title"]
+           "column", "fix_print_text", "fix_print_title", "check_head"]
 
 
 #: The script's ``data_file`` default: the runner writes the geometry there.
@@ -146,3 +146,61 @@ def fix_print_text() -> str:
 def fix_print_title() -> str:
     """The ``title`` of the script's ``fix print`` (the header of ``trace.dat``)."""
     return "# " + " ".join(DAT_COLUMNS)
+
+
+def check_head(text: str, *, timestep: float, trace_every: int, drive_velocity: float,
+               spring_constant: float, temperature: float, rows: int = 4) -> str | None:
+    """What breaks this contract in the first ``rows`` rows of a ``trace.dat`` (None: nothing).
+
+    For a script other than ``film_slide.lmp``: the header names the columns in
+    order; each row has them all, as numbers; the step advances by
+    ``trace_every``; and the units are LJ: time = step x timestep (tau), the
+    spring end moves at V (drive_position = V x time, sigma), spring_force =
+    K (drive_position - wall_position) (epsilon/sigma), and the film's
+    temperature is within a factor 5 of the thermostat's (epsilon/k_B).  Fewer
+    rows than ``rows`` are checked as far as they go.
+
+    Examples
+    --------
+    >>> head = fix_print_title() + "\\n0 0 0 0 0 0 7 3 0.7 0 0 0 -1 1 0 0\\n"
+    >>> good = dict(timestep=0.005, trace_every=50, drive_velocity=0.02,
+    ...             spring_constant=100.0, temperature=0.7)
+    >>> check_head(head + "50 0.25 0.005 0.5 0 0 7 3 0.7 0 0 0 -1 1 0 0", **good) is None
+    True
+    >>> print(check_head(head + "50 250 5 5000 0 0 7 3 300 0 0 0 -1 1 0 0", **good))
+    trace.dat row 2 (step 50): time = 250, expected step x timestep = 0.25 tau (LJ units)
+    """
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    if not lines or lines[0].split() != fix_print_title().split():
+        found = lines[0][:120] if lines else "nothing"
+        return (f"trace.dat header is {found!r}, expected {fix_print_title()!r} (the "
+                f"columns of md_inputs/contract.py, in order)")
+    previous = None
+    for i, line in enumerate(lines[1:rows + 1], start=1):
+        parts = line.split()
+        where = f"trace.dat row {i}"
+        if len(parts) != len(TRACE):
+            return (f"{where} has {len(parts)} values, expected {len(TRACE)} "
+                    f"({' '.join(DAT_COLUMNS)})")
+        try:
+            row = dict(zip(DAT_COLUMNS, (float(x) for x in parts)))
+        except ValueError:
+            return f"{where} is not all numbers: {line[:120]!r}"
+        step, where = row["step"], f"{where} (step {row['step']:g})"
+        if previous is not None and step - previous != trace_every:
+            return (f"{where}: steps advance by {step - previous:g}, expected trace_every = "
+                    f"{trace_every}")
+        previous = step
+        checks = (("time", step * timestep, "step x timestep", "tau"),
+                  ("drive_position", drive_velocity * row["time"], "V x time", "sigma"),
+                  ("spring_force", spring_constant * (row["drive_position"] - row["wall_position"]),
+                   "K (drive_position - wall_position)", "epsilon/sigma"))
+        for name, expected, rule, unit in checks:
+            if abs(row[name] - expected) > 1e-5 * max(1.0, abs(expected)):
+                return (f"{where}: {name} = {row[name]:g}, expected {rule} = {expected:g} "
+                        f"{unit} (LJ units)")
+        T = row["film_temperature"]
+        if temperature > 0 and not temperature / 5 <= T <= 5 * temperature:
+            return (f"{where}: film_temperature = {T:g}, expected near the thermostat's "
+                    f"{temperature:g} epsilon/k_B (LJ units)")
+    return None

@@ -28,7 +28,7 @@ from .klein import KleinExperiment, SlipGeometry
 from .md_film import MDCalibration, film_law, slip_drag
 from .sfb_rows import table_row as _row
 from .slip import SlipRun, run_slip
-from .units import LJUnits
+from .units import SI_IDENTITY, LJUnits
 
 __all__ = ["md_rows", "md_quantities"]
 
@@ -158,16 +158,22 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
     decades = None
     if cal.shear_rate_range is not None:
         decades = math.log10(cal.shear_rate_range[0] / rate_lj)
-    extrap = (f"MD law evaluated at Klein's mean slip rate dx0/(tau_s D) = {rate:.3g} 1/s = "
-              f"{rate_lj:.3g} /tau" + (f", {decades:.1f} decades below the lowest MD rate"
-                                       if decades is not None else ""))
+    # a measured trace's calibration is SI already (units = SI_IDENTITY): said in SI words
+    si = units == SI_IDENTITY
+    md, rate_unit = ("calibrated", "1/s") if si else ("MD", "/tau")
+    extrap = (f"{md} law evaluated at Klein's mean slip rate dx0/(tau_s D) = {rate:.3g} 1/s"
+              + ("" if si else f" = {rate_lj:.3g} /tau")
+              + (f", {decades:.1f} decades below the lowest {md} rate"
+                 if decades is not None else ""))
+    stress_text = (f"calibrated yield stress {cal.yield_stress:g} Pa" if si else
+                   f"MD yield stress {cal.yield_stress:g} eps/sigma^3 x {units.stress:.3g} Pa")
     klein_restick = geo.restick_force(K) / A
     rows = [
         _row("yield_stress", geo.x0 * K / A, q["yield_stress"], "Pa", src,
-             f"MD yield stress {cal.yield_stress:g} eps/sigma^3 x {units.stress:.3g} Pa; Klein: K x0/A with "
+             f"{stress_text}; Klein: K x0/A with "
              "x0 from dE_f (not printed in the paper)", interval("yield_stress")),
         _row("static_force", geo.x0 * K, q["static_force"], "N", src,
-             f"MD yield stress x Klein's contact area {A:.2g} m2 vs Klein's K x0", interval("static_force")),
+             f"{md} yield stress x Klein's contact area {A:.2g} m2 vs Klein's K x0", interval("static_force")),
     ]
     if q["restick_stress"] is not None:
         rows.append(_row("restick_stress", klein_restick, q["restick_stress"], "Pa", src,
@@ -178,7 +184,7 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
                      interval("sliding_stress")))
     rows.append(_row("eta_eff", ex.eta_eff, q["eta_eff"], "Pa s", src,
                      extrap + f"; Carreau eta0 = {cal.eta_zero:g}, n = {cal.thinning_exponent:g}, "
-                     f"onset {cal.onset_rate:g} /tau", interval("eta_eff")))
+                     f"onset {cal.onset_rate:g} {rate_unit}", interval("eta_eff")))
     if cal.shear_rate_range is not None and cal.thinning_exponent > 0:
         g_lo = cal.shear_rate_range[0]
         eta_pl = units.to_si(cal.eta(g_lo) * (rate_lj / g_lo) ** (-cal.thinning_exponent), "viscosity")
@@ -193,7 +199,9 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
             ("viscous_fraction", ex.viscous_fraction, "1", "viscous / (viscous + kinetic energy at s)"),
             ("temperature_rise", ex.temperature_rise, "K", "viscous energy / (rho c_p A D)")):
         rows.append(_row(key, klein, q[key], unit, src, note, interval(key)))
-    notes = [f"md-calibrated: units {units.name} (sigma = {units.sigma * 1e9:.3g} nm, eps/kB = "
-             f"{units.temperature:.0f} K, tau = {units.tau * 1e12:.2f} ps); stresses x Klein's area; "
+    mapping = ("a measured trace's calibration, SI already (no LJ mapping)" if si else
+               f"units {units.name} (sigma = {units.sigma * 1e9:.3g} nm, eps/kB = "
+               f"{units.temperature:.0f} K, tau = {units.tau * 1e12:.2f} ps)")
+    notes = [f"md-calibrated: {mapping}; stresses x Klein's area; "
              f"{extrap}." + (f" Calibration source: {cal.source}" if cal.source else "")]
     return rows, run, notes

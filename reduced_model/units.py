@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import constants
 
-__all__ = ["LJUnits", "OMCTS", "QUANTITIES", "to_si", "from_si",
+__all__ = ["LJUnits", "OMCTS", "SI_IDENTITY", "QUANTITIES", "to_si", "from_si",
            "OMCTS_SIGMA_NM", "OMCTS_EPSILON_OVER_KB", "OMCTS_MOLAR_MASS_G",
            "OMCTS_T_TRIPLE", "LJ_T_TRIPLE_REDUCED"]
 
@@ -296,6 +296,13 @@ def _scaled(value, factor: float):
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value) * factor
     return np.asarray(value, dtype=float) * factor
+
+
+#: The identity mapping (σ = 1 m, ε = 1 J, m = 1 kg, so τ = 1 s): numbers that are
+#: already SI, such as a measured trace's calibration, pass through unchanged
+#: (temperatures excepted: ε/k_B is not a temperature scale here).
+SI_IDENTITY = LJUnits(sigma=1.0, epsilon=1.0, mass=1.0, name="SI (identity)",
+                      source="a measured trace: its numbers are already SI")
 
 
 #: The project's default unit system: one LJ particle = one OMCTS molecule.

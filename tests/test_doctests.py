@@ -21,7 +21,7 @@ import filmfriction
 NEEDS_LAMMPS: dict[str, str] = {}
 
 #: Modules whose every example is marked +SKIP (they read a real run directory).
-SKIPPED_ONLY = {"filmfriction.analysis.structure", "filmfriction.analysis.trace"}
+SKIPPED_ONLY = {"filmfriction.analysis.structure"}
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 

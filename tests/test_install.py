@@ -42,7 +42,8 @@ def test_wheel_ships_scripts_and_scenes(tmp_path):
     for needed in ("md_inputs/film_slide.lmp", "md_inputs/bulk_lj.lmp",
                    "workflows/scenes/stick-slip.toml", "workflows/scenes/smooth-sliding.toml",
                    "workflows/cli.py", "analysis/stickslip.py", "reduced_model/units.py",
-                   "reduced_model/laws/__init__.py", "reduced_model/laws/coulomb.py", "__init__.py"):
+                   "reduced_model/laws/__init__.py", "reduced_model/laws/coulomb.py", "__init__.py",
+                   "analysis/schemas/analysis.schema.json", "analysis/schemas/sfb.schema.json"):
         assert f"filmfriction/{needed}" in names, needed
     # one import name: nothing of ours at the top level of the wheel but filmfriction
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}

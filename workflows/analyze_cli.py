@@ -35,15 +35,33 @@ MAX_MAGNITUDE = 1e100
 MIN_ROWS = 10
 
 
+def _mapping(text: str) -> tuple[str, str]:
+    name, sep, column = text.partition("=")
+    if not sep or not name.strip() or not column.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: give NAME=COLUMN, e.g. time=t_s")
+    return name.strip(), column.strip()
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "analyze", help="stick-slip events, energy partition, viscosity, structure",
-        description="Analyse a run directory (trace.csv + run.json) or a CSV trace "
-                    "(header with time, spring_force; optional drive_position, "
-                    "wall_position, wall_velocity, gap). Writes analysis.json and "
-                    "analysis_cycles.csv next to the trace.")
-    p.add_argument("path", type=Path, help="run directory or CSV trace")
+        description="Analyse a run directory (trace.csv + run.json) or a trace file "
+                    "(a header line, then rows separated by commas, tabs, semicolons or "
+                    "spaces; columns time, spring_force, optional drive_position, "
+                    "wall_position, wall_velocity, gap, or the file's own names mapped with "
+                    "--column). Writes analysis.json, analysis_cycles.csv and "
+                    "analysis_trace.png (the trace with its slips) next to the trace.")
+    p.add_argument("path", type=Path, help="run directory, trace file, or the directory of an "
+                                           "analysed trace file (its analysis.json)")
+    p.add_argument("--column", type=_mapping, action="append", default=[], metavar="NAME=COLUMN",
+                   help="read the file's column COLUMN as NAME (time, spring_force, "
+                        "drive_position, wall_position, wall_velocity, gap, ...); repeat per "
+                        "column, e.g. --column time=t_s --column spring_force=F_N")
     p.add_argument("--json", action="store_true", help="also print the document")
+    p.add_argument("--setup", type=Path, default=None, metavar="FILE.toml",
+                   help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
+                        "constant, mass, contact area, film thickness and drive velocity, "
+                        "unless given below; implies --units si")
     p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
     p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
     p.add_argument("--area", type=_positive, help="contact area A")
@@ -57,6 +75,8 @@ def register(subparsers) -> None:
                    help="skip the trajectory analyses")
     p.add_argument("--output", type=Path, default=None,
                    help="where to write analysis.json (default: next to the trace)")
+    p.add_argument("--no-figure", action="store_true",
+                   help="do not draw analysis_trace.png")
     p.set_defaults(func=run)
 
 
@@ -66,14 +86,36 @@ def run(args: argparse.Namespace) -> int:
     from filmfriction.workflows.cli import UserError, check_run_json, check_writable
 
     from filmfriction.analysis.report import analyze, to_json, write_outputs
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
+                                             write_binary_copy)
 
     if args.path.is_dir():
         check_run_json(args.path)
     if args.output is not None:
         check_writable(args.output, "--output")
+    if args.setup is not None:
+        from filmfriction.reduced_model.sfb_setup import load_setup
+
+        try:
+            setup = load_setup(args.setup)
+        except ValueError as exc:
+            raise UserError(f"--setup {exc}") from None
+        if args.units == "lj":
+            raise UserError(f"--units lj with --setup {args.setup}: a set-up is in SI units")
+        args.units = "si"
+        for flag, value in (("spring_constant", setup.spring_constant), ("mass", setup.mass),
+                            ("area", setup.contact_area), ("thickness", setup.film_thickness),
+                            ("drive_velocity", setup.drive_velocity)):
+            if getattr(args, flag) is None:
+                setattr(args, flag, value)
+    columns = {}
+    for name, column in args.column:
+        if name in columns and columns[name] != column:
+            raise UserError(f"--column {name}={column}: {name} is already read from "
+                            f"{columns[name]!r}; give each name once")
+        columns[name] = column
     try:
-        trace = read_trace(args.path, spring_constant=args.spring_constant,
+        trace = read_trace(args.path, columns=columns, spring_constant=args.spring_constant,
                            mass=args.mass, area=args.area, thickness=args.thickness,
                            drive_velocity=args.drive_velocity, units=args.units)
     except ValueError as exc:
@@ -109,13 +151,33 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--skip {args.skip}: the trace has {slips} slips; give a value in "
                         f"[0, {slips})" if slips else
                         f"--skip {args.skip}: the trace has no slips; give --skip 0")
+    layout = trace.layout
+    if trace.run_dir is None and layout is not None:
+        # how the file was read: `calibrate`, `report` and `analyze DIR` read it again so
+        doc["source"]["delimiter"] = layout.delimiter
+        doc["source"]["columns"] = dict(layout.columns)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
+    if not args.no_figure:
+        from filmfriction.analysis.trace_figure import write_trace_figure
+
+        figure = Path(out).with_name(Path(out).stem + "_trace.png")
+        write_trace_figure(trace, per_cycle.get("yield_index", []),
+                           per_cycle.get("stick_index", []), figure)
+        doc["figure"] = figure.name
     json_path, csv_path = write_outputs(doc, per_cycle, out)
+    if (layout is not None and not layout.binary and not trace.notes
+            and len(trace) >= BINARY_MIN_ROWS):
+        # long text traces: later reads (calibrate, report, analyze again) take the copy
+        try:
+            write_binary_copy(trace)
+        except OSError:
+            pass
     if args.json:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))
     else:
         s = doc["slips"]
-        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path} and {csv_path.name}",
+        names = [csv_path.name] + ([doc["figure"]] if "figure" in doc else [])
+        print(f"{doc['regime']}: {s['count']} slips; wrote {json_path}, {', '.join(names)}",
               file=sys.stdout)
         for key, why in doc["skipped"].items():
             print(f"  skipped {key}: {why}", file=sys.stdout)

@@ -1,7 +1,8 @@
 """``filmfriction calibrate RUN_DIR... [--json]``: fit the reduced model to MD runs.
 
 Writes ``calibration.json`` (and the replay's trace, ``calibration_replay.csv``)
-into the first run directory and prints the fitted parameters (LJ units, ± one
+into the first run directory and prints the fitted parameters (in the runs' units:
+LJ for MD runs, SI for a measured trace analysed with ``--units si``; ± one
 standard error), the replay's errors and the MD calibration handed to the SFB
 check; ``--json`` prints the document.  The calibration itself is
 :func:`filmfriction.analysis.calibrate`.
@@ -23,8 +24,9 @@ def register(subparsers) -> None:
                     "MD mount dashpot) on one or several run directories, replay the MD trace with "
                     "it, and write calibration.json into the first run directory.")
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
-                   help="run directories (trace.csv + run.json) or finished sweeps "
-                        "(aggregate.json); several runs give the shear-rate law")
+                   help="run directories (trace.csv + run.json), finished sweeps "
+                        "(aggregate.json) or directories of analysed trace files "
+                        "(analysis.json); several runs give the shear-rate law")
     p.add_argument("--json", action="store_true", help="print calibration.json")
     p.set_defaults(func=run)
 
@@ -37,7 +39,11 @@ def _fmt(e) -> str:
 
 
 def format_calibration(cal) -> str:
-    """Human-readable summary of a :class:`filmfriction.analysis.calibration.Calibration`."""
+    """Human-readable summary of a :class:`filmfriction.analysis.calibration.Calibration`:
+    an MD run's (LJ units) or a measured trace's (SI units, "trace" for "MD")."""
+    from filmfriction.analysis.trace import unit
+
+    source = "MD" if cal.units == "lj" else "trace"
     out = []
     for r in cal.runs:
         out.append(f"{r.run.run_dir}: {r.regime}, {r.run.n_slips} slips")
@@ -49,7 +55,7 @@ def format_calibration(cal) -> str:
                 if q == "backward_force":
                     continue
                 rel = e["rel_error"]
-                out.append(f"  replay {q:12s} MD {e['md']:.4g}, model {e['model']:.4g}, error "
+                out.append(f"  replay {q:12s} {source} {e['md']:.4g}, model {e['model']:.4g}, error "
                            + ("-" if rel is None or not math.isfinite(rel) else f"{rel:+.1%}"))
         for k, v in r.failures.items():
             out.append(f"  not computed: {k}: {v}")
@@ -59,9 +65,11 @@ def format_calibration(cal) -> str:
                    f"{law.exponent_stderr:.2g}) over {law.n} runs")
     md = cal.md_calibration
     if md is not None:
-        out.append(f"MD calibration (LJ): yield stress {md.yield_stress:.4g} ± {md.yield_stress_err:.2g}, "
-                   f"sliding stress {md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g}, eta0 "
-                   f"{md.eta_zero:.4g} ± {md.eta_zero_err:.2g}, n = {md.thinning_exponent:.3g}")
+        stress, visc = unit(cal.units, "stress"), unit(cal.units, "viscosity")
+        out.append(f"{source} film calibration ({cal.units.upper()} units): yield stress "
+                   f"{md.yield_stress:.4g} ± {md.yield_stress_err:.2g} {stress}, sliding stress "
+                   f"{md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g} {stress}, eta0 "
+                   f"{md.eta_zero:.4g} ± {md.eta_zero_err:.2g} {visc}, n = {md.thinning_exponent:.3g}")
     for k, v in cal.failures.items():
         out.append(f"not computed: {k}: {v}")
     out += [f"note: {n}" for n in cal.notes]
@@ -78,9 +86,11 @@ def run(args) -> int:
     for d in args.run_dirs:
         if not d.is_dir():
             raise UserError(f"{d}: not a directory")
-        if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
-            raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
-                            "(aggregate.json)")
+        if not any((d / name).exists() for name in ("trace.csv", "aggregate.json",
+                                                     "analysis.json")):
+            raise UserError(f"{d}: neither a run directory (trace.csv), a finished sweep "
+                            "(aggregate.json) nor an analysed trace file (analysis.json; "
+                            "'filmfriction analyze TRACE_FILE' writes it)")
         check_run_json(d)
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
     run_dirs, _ = _split_sweeps(list(args.run_dirs))

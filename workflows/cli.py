@@ -95,6 +95,12 @@ def build_parser() -> argparse.ArgumentParser:
             raise
         module.register(sub)
         registered.add(module_name)
+    # a sub-command's --help opens with what it does: its one-line help when it
+    # gives no longer description
+    helps = {action.dest: action.help for action in sub._choices_actions}
+    for name, command in sub.choices.items():
+        if not command.description and helps.get(name):
+            command.description = helps[name][0].upper() + helps[name][1:] + "."
     return parser
 
 

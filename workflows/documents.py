@@ -34,13 +34,14 @@ SFB_TRACES_SUFFIX = "_slips.csv"
 TRACE_SPAN = 2.0
 
 
-def write_sfb(check, path) -> Path:
+def write_sfb(check, path, extra: dict | None = None) -> Path:
     """Write an SFB check (:class:`filmfriction.reduced_model.SFBCheck`) as ``sfb.json``.
 
     The document is ``check.as_dict()`` plus ``traces``, the name of the CSV
     (``slip,time,x``, SI) with every slip's trace from the yield point y to
     twice its slip time (the whole run when s was not reached), written
-    beside it.
+    beside it.  ``extra`` adds top-level entries (the user's ``setup`` and
+    ``measured`` slip of ``filmfriction sfb --setup``).
 
     Returns
     -------
@@ -59,6 +60,7 @@ def write_sfb(check, path) -> Path:
     write_atomic(traces, "".join(lines))
     doc = check.as_dict()
     doc["traces"] = traces.name
+    doc.update(extra or {})
     return write_atomic(path, to_json(doc) + "\n")
 
 

@@ -64,12 +64,16 @@ def mpiexec() -> Path:
         f"no mpiexec next to {sys.executable}; the mpich wheel provides it")
 
 
-def engine_env(base: dict | None = None) -> dict:
-    """Environment for an ``lmp`` child: libmpi on the loader path, one thread per rank."""
+def engine_env(base: dict | None = None, lmp: Path | None = None) -> dict:
+    """Environment for an ``lmp`` child: libmpi on the loader path, one thread per rank.
+
+    ``lmp``: a site build (``--lmp``) keeps the loader path it was given (its own
+    MPI); only the wheel's ``lmp`` needs the ``mpich`` wheel's library.
+    """
     env = dict(os.environ if base is None else base)
     libdir = str(mpi_library_dir())
     parts = [p for p in env.get("LD_LIBRARY_PATH", "").split(":") if p]
-    if libdir not in parts:
+    if libdir not in parts and (lmp is None or Path(lmp).resolve() == lmp_binary().resolve()):
         env["LD_LIBRARY_PATH"] = ":".join([libdir, *parts])
     # One OpenMP thread per MPI rank: the ranks already use every core.
     env.setdefault("OMP_NUM_THREADS", "1")
@@ -77,16 +81,25 @@ def engine_env(base: dict | None = None) -> dict:
 
 
 def lmp_command(nprocs: int, script: Path, variables: dict[str, str] | None = None,
-                log: Path | None = None, launcher: list[str] | None = None) -> list[str]:
-    """Command line that runs ``script`` on ``nprocs`` MPI ranks.
+                log: Path | None = None, launcher: list[str] | None = None,
+                lmp: Path | None = None, threads: int = 1) -> list[str]:
+    """Command line that runs ``script`` on ``nprocs`` MPI ranks of ``threads`` threads.
 
     ``launcher`` replaces the venv's ``mpiexec`` (e.g. ``["srun"]`` inside a
-    Slurm allocation); it takes the same ``-n N``.
+    Slurm allocation); it takes the same ``-n N``.  ``lmp`` replaces the
+    wheel's executable (a site build, ``--lmp``).  ``threads`` > 1 runs the
+    OPENMP package's styles (``-sf omp -pk omp threads``); the thread count is
+    on the command line, so the one-thread default of :func:`engine_env` does
+    not limit it.
     """
     if not isinstance(nprocs, int) or nprocs < 1:
         raise ValueError(f"np = {nprocs!r}: need an integer >= 1 MPI ranks")
+    if not isinstance(threads, int) or threads < 1:
+        raise ValueError(f"threads = {threads!r}: need an integer >= 1 OpenMP threads per rank")
     start = list(launcher) if launcher else [str(mpiexec())]
-    cmd = [*start, "-n", str(nprocs), str(lmp_binary()), "-in", str(script), "-nocite"]
+    cmd = [*start, "-n", str(nprocs), str(lmp or lmp_binary()), "-in", str(script), "-nocite"]
+    if threads > 1:
+        cmd += ["-sf", "omp", "-pk", "omp", str(threads)]
     cmd += ["-log", str(log) if log else "none"]
     for key, value in (variables or {}).items():
         cmd += ["-var", key, value]

@@ -19,8 +19,14 @@ KINDS = ("lambda-zeta", "velocity-stiffness")
 
 def register(subparsers) -> argparse.ArgumentParser:
     """Add the ``map`` sub-command to the filmfriction dispatcher."""
-    p = subparsers.add_parser("map", help="regime maps of the reduced spring-block model (CSV + PNG)",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = subparsers.add_parser(
+        "map", help="regime maps of the reduced spring-block model (CSV + PNG)",
+        description="Regime maps of the reduced spring-block model, written as <kind>.csv and "
+                    "<kind>.png. lambda-zeta: the Coulomb block over Nakano-Maegawa's plane "
+                    "(100 x 100 by default) with the exact stick-slip boundary and the "
+                    "asymptotes lambda^2 = 4 pi zeta and zeta = 1. velocity-stiffness: the "
+                    "contact-age block over (V, K) (12 x 12 by default, each cell a full "
+                    "simulation, about 20 s) with Persson's critical-velocity estimate.")
     p.add_argument("kind", choices=KINDS, help="which plane to map")
     p.add_argument("--out", default=".", help="output directory (created if missing; default: .)")
     p.add_argument("--resolution", type=int, default=None,

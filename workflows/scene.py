@@ -12,11 +12,18 @@ A scene is a TOML file (see ``workflows/scenes/``)::
     drive_velocity = 0.02
     ...
 
+Two optional keys bring one's own LAMMPS script: ``script = "my_slide.lmp"``
+(a path, relative to the TOML file) runs instead of ``film_slide.lmp`` with the
+same ``-var`` variables, and must write ``trace.dat`` as
+``md_inputs/contract.py`` says (checked on its first rows); ``lammps_packages
+= ["RIGID", ...]`` lists the LAMMPS packages it needs (default: those of the
+shipped script).
+
 Every value that reaches LAMMPS passes through :func:`resolve`: it must be a
 known name, of the declared type, finite and inside the declared range, and is
 formatted here as a plain number.  Nothing a user writes is ever pasted into
 an input script as text, so a scene cannot smuggle LAMMPS commands (``shell``)
-into a run.
+into a run.  (A scene's own ``script`` is a file its author wrote, run as it is.)
 """
 from __future__ import annotations
 
@@ -191,6 +198,8 @@ class Scene:
     expected_cost: str
     parameters: dict[str, float | int] = field(hash=False)
     source: str = ""
+    script: str = ""              # the scene's own LAMMPS script ("": film_slide.lmp)
+    lammps_packages: tuple[str, ...] = ("RIGID",)   # what the script needs of LAMMPS
 
     @property
     def writes_trajectory(self) -> bool:
@@ -231,7 +240,8 @@ class Scene:
     def as_dict(self) -> dict:
         return {"name": self.name, "description": self.description, "models": self.models,
                 "observables": list(self.observables), "expected_cost": self.expected_cost,
-                "parameters": dict(self.parameters), "source": self.source}
+                "parameters": dict(self.parameters), "source": self.source,
+                "script": self.script, "lammps_packages": list(self.lammps_packages)}
 
 
 def geometry(p: dict) -> ConfinedFilm:
@@ -406,7 +416,8 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
                          "a scene is a UTF-8 TOML file") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    allowed = {"name", "description", "models", "observables", "expected_cost", "parameters"}
+    allowed = {"name", "description", "models", "observables", "expected_cost", "parameters",
+               "script", "lammps_packages"}
     unknown = set(data) - allowed
     if unknown:
         raise SceneError(f"{path}: unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}")
@@ -433,4 +444,31 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
                  models=str(data.get("models", "")),
                  observables=tuple(observables),
                  expected_cost=str(data.get("expected_cost", "")),
-                 parameters=resolved, source=str(path))
+                 parameters=resolved, source=str(path),
+                 script=_own_script(path, data.get("script")),
+                 lammps_packages=_packages(path, data.get("lammps_packages", ["RIGID"])))
+
+
+def _own_script(path: Path, script) -> str:
+    """The absolute path of a scene's own LAMMPS script ("" for none)."""
+    if script is None:
+        return ""
+    if not isinstance(script, str) or not script.strip():
+        raise SceneError(f"{path}: script = {script!r}: give the path of a LAMMPS input "
+                         "script (relative to the scene file)")
+    full = (path.parent / script).resolve()
+    if not full.is_file():
+        raise SceneError(f"{path}: script = {script!r}: no such file ({full})")
+    return str(full)
+
+
+def _packages(path: Path, packages) -> tuple[str, ...]:
+    """LAMMPS package names as ``lmp -h`` lists them (e.g. RIGID, EXTRA-DUMP)."""
+    import re
+
+    if (not isinstance(packages, list)
+            or not all(isinstance(p, str) and re.fullmatch(r"[A-Z0-9][A-Z0-9-]*", p)
+                       for p in packages)):
+        raise SceneError(f"{path}: lammps_packages = {packages!r}: give a list of LAMMPS "
+                         "package names in capitals, e.g. [\"RIGID\", \"EXTRA-DUMP\"]")
+    return tuple(packages)

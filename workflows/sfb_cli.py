@@ -1,6 +1,7 @@
 """``filmfriction sfb``: the reduced model against Klein's SFB numbers.
 
     filmfriction sfb [--json] [--calibration FILE.json] [--run RUN_DIR] [--out sfb.json] [--sigma-nm S] [--epsilon-K E]
+    filmfriction sfb --setup MY_SFB.toml --measured DIR [--calibration DIR/calibration.json] [--out sfb.json]
 
 Prints the comparison table (name, Klein, model, ratio, units, source) and
 the assumptions behind it; ``--json`` prints the rows as a JSON list instead.
@@ -11,10 +12,16 @@ rows; ``--sigma-nm`` / ``--epsilon-K`` override the OMCTS unit mapping used to
 carry it to SI.  ``--run`` adds the ``similarity`` rows: the dimensionless
 numbers of an analysed MD run beside Klein's.  ``--out`` also writes the check as the study does
 (``sfb.json`` + ``sfb_slips.csv``), for ``filmfriction report`` to read.
-The check itself is :func:`filmfriction.reduced_model.sfb_check`.
+``--setup`` / ``--measured`` run the check on one's own SFB set-up (a TOML file,
+:func:`filmfriction.reduced_model.sfb_setup.load_setup`) and the slip of an analysed
+SI trace (:func:`filmfriction.analysis.measured.measured_slip`); an SI calibration
+(a measured trace's ``calibration.json``) is taken without any LJ mapping.
+The check itself is :func:`filmfriction.reduced_model.sfb_check`
+(:func:`filmfriction.reduced_model.sfb_setup.sfb_check_setup` with a set-up).
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -31,6 +38,14 @@ def register(subparsers) -> None:
         description="Klein's SFB parameters (PRL 98, 056101) in the reduced model, each "
                     "quantity beside Klein's number with the ratio; optional MD-calibrated rows.")
     p.add_argument("--json", action="store_true", help="print the table as a JSON list")
+    p.add_argument("--setup", metavar="FILE.toml", type=Path, default=None,
+                   help="your own SFB set-up in SI units (spring_constant, mass, contact_area or "
+                        "contact_radius, film_thickness, load, drive_velocity; each a number or "
+                        "{value = ..., error = ...}); with --measured, the check runs on it "
+                        "instead of Klein's, errors propagated (see docs/measured-traces.md)")
+    p.add_argument("--measured", metavar="DIR", type=Path, default=None,
+                   help="with --setup: the analysed SI trace (a directory with its analysis.json, "
+                        "or the analysis.json) whose slip takes the place of Klein's numbers")
     p.add_argument("--calibration", metavar="FILE.json", type=Path,
                    help="MD calibration to add md-calibrated rows: MDCalibration fields (LJ units) "
                         "or a calibration.json from 'filmfriction calibrate'")
@@ -72,8 +87,9 @@ def _units(args) -> LJUnits:
 
 
 def _calibration(path: Path | None):
+    """The calibration file's MDCalibration and whether it is in SI (a measured trace's)."""
     if path is None:
-        return None
+        return None, False
     from filmfriction.reduced_model import MDCalibration
     from filmfriction.workflows.cli import UserError
     from filmfriction.analysis.util import read_json_object
@@ -91,11 +107,49 @@ def _calibration(path: Path | None):
         if data.get("md_calibration") is None:
             why = (data.get("failures") or {}).get("md_calibration", "no md_calibration in it")
             raise UserError(f"calibration file {path}: no MD calibration for the SFB check ({why})")
+        si = data.get("units") == "si"
         data = data["md_calibration"]
+    else:
+        si = False
     try:
-        return MDCalibration.from_dict(data)
+        return MDCalibration.from_dict(data), si
     except (ValueError, TypeError) as exc:
         raise UserError(f"calibration file {path}: {exc}") from None
+
+
+def _setup(args):
+    """The set-up (--setup) and the measured slip (--measured), or (None, None)."""
+    if args.setup is None and args.measured is None:
+        return None, None
+    from filmfriction.workflows.cli import UserError
+    if args.setup is None or args.measured is None:
+        raise UserError("--setup FILE.toml and --measured DIR go together: the set-up of your "
+                        "SFB and the analysed trace whose slip it measured")
+    from filmfriction.analysis.measured import measured_slip
+    from filmfriction.analysis.util import read_json_object
+    from filmfriction.reduced_model.sfb_setup import load_setup
+
+    try:
+        setup = load_setup(args.setup)
+    except ValueError as exc:
+        raise UserError(f"--setup {exc}") from None
+    doc_path = args.measured / "analysis.json" if args.measured.is_dir() else args.measured
+    if not doc_path.is_file():
+        raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
+                        "analyze TRACE_FILE --units si ...' first)")
+    try:
+        doc = read_json_object(doc_path, f"--measured {doc_path}")
+        slip = measured_slip(doc, f"--measured {doc_path}")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    # the analysis and the set-up must describe the same instrument
+    used = (doc.get("source") or {}).get("parameters") or {}
+    for key, value in (("spring_constant", setup.spring_constant), ("mass", setup.mass),
+                       ("area", setup.contact_area), ("thickness", setup.film_thickness)):
+        if used.get(key) is not None and abs(used[key] - value) > 1e-6 * abs(value):
+            raise UserError(f"--setup {args.setup}: {key} {value:g} differs from the {used[key]:g} "
+                            f"the analysis {doc_path} used; analyse with the set-up's values")
+    return setup, slip
 
 
 def _fmt(value) -> str:
@@ -104,9 +158,10 @@ def _fmt(value) -> str:
     return f"{value:.3g}"
 
 
-def format_table(rows, notes=()) -> str:
-    """The rows as an aligned text table, then the notes as a numbered list."""
-    header = ("quantity", "Klein", "model", "ratio", "model range", "units", "source")
+def format_table(rows, notes=(), measured: str = "Klein") -> str:
+    """The rows as an aligned text table (``measured`` heads the column of the
+    experiment's numbers), then the notes as a numbered list."""
+    header = ("quantity", measured, "model", "ratio", "model range", "units", "source")
     body = []
     for r in rows:
         unc = r.get("uncertainty")
@@ -136,7 +191,16 @@ def run(args) -> int:
 
         check_writable(args.out, "--out")
     units = _units(args)
-    calibration = _calibration(args.calibration)
+    setup, slip = _setup(args)
+    calibration, si = _calibration(args.calibration)
+    if si:
+        # a measured trace's calibration is SI already: no LJ mapping to apply
+        if args.sigma_nm is not None or args.epsilon_K is not None or args.time_unit != "mass":
+            raise UserError(f"--calibration {args.calibration}: an SI calibration (a measured "
+                            "trace's); --sigma-nm, --epsilon-K and --time-unit map LJ units and "
+                            "do not apply")
+        from filmfriction.reduced_model.units import SI_IDENTITY
+        units = SI_IDENTITY
     contact = None
     if args.run is not None:
         from filmfriction.analysis.contact import contact_from_run
@@ -149,24 +213,36 @@ def run(args) -> int:
         except (ValueError, KeyError, TypeError) as exc:
             raise UserError(f"--run {args.run}: {exc}") from None
     try:
-        check = sfb_check(calibration=calibration, units=units, contact=contact)
+        if setup is not None:
+            from filmfriction.reduced_model.sfb_setup import sfb_check_setup
+            if contact is not None:
+                raise UserError("--run (an MD run's similarity with Klein's contact) does not "
+                                "apply with --setup")
+            check = sfb_check_setup(setup, slip, calibration=calibration, units=units)
+        else:
+            check = sfb_check(calibration=calibration, units=units, contact=contact)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     path = None
     if args.out is not None:
         from filmfriction.workflows.documents import write_sfb
-        path = write_sfb(check, args.out)
+        extra = None if setup is None else {"setup": setup.as_dict(),
+                                            "measured": dataclasses.asdict(slip)}
+        path = write_sfb(check, args.out, extra)
     if args.json:
         print(json.dumps(check.rows, indent=2, allow_nan=False))
         if path is not None:
             print(f"sfb check: {path}", file=sys.stderr)
         return 0
-    print("SFB check: Klein, PRL 98, 056101 (2007), OMCTS, n = 4 layers "
-          f"(K = {check.experiment.spring_constant:g} N/m, M = {check.experiment.mass * 1e3:g} g, "
-          f"A = {check.experiment.contact_area:.2g} m2, D = {check.experiment.film_thickness * 1e9:g} nm, "
-          f"eta_eff = {check.experiment.eta_eff:g} Pa s)")
+    ex = check.experiment
+    what = ("Klein, PRL 98, 056101 (2007), OMCTS, n = 4 layers" if setup is None else
+            f"{setup.name}, the slip measured in {slip.source}")
+    print(f"SFB check: {what} "
+          f"(K = {ex.spring_constant:g} N/m, M = {ex.mass * 1e3:g} g, "
+          f"A = {ex.contact_area:.2g} m2, D = {ex.film_thickness * 1e9:g} nm, "
+          f"eta_eff = {ex.eta_eff:.3g} Pa s)")
     print()
-    print(format_table(check.rows, check.notes))
+    print(format_table(check.rows, check.notes, measured="Klein" if setup is None else "measured"))
     notes_by_row = [(r["name"], r["source"], r["note"]) for r in check.rows if r["note"]]
     print()
     print("Row notes:")

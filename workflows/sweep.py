@@ -102,7 +102,9 @@ def register(subparsers) -> None:
                         "with :log), or KEY=V1,V2,...; repeat for a full product")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="fixed override for every point, e.g. --set slide_steps=20000")
-    p.add_argument("--np", type=int, default=2, help="MPI ranks per point (default 2)")
+    p.add_argument("--np", type=int, default=2,
+                   help="MPI ranks per point (default 2): at most the CPUs of this machine, "
+                        "any number with a Slurm profile (--profile slurm)")
     p.add_argument("--cores", type=int, default=2,
                    help="cores Snakemake may use at once on this machine (default 2)")
     p.add_argument("--out", type=Path, default=None,
@@ -122,16 +124,22 @@ def default_out(plan: SweepPlan) -> Path:
     return Path("sweeps") / f"{plan.scene}-{'-'.join(a.key for a in plan.grid)}"
 
 
+def uses_slurm(profile: Path | None) -> bool:
+    """True when the Snakemake profile sends the jobs to Slurm (``executor: slurm``)."""
+    import re
+
+    return profile is not None and bool(
+        re.search(r"^executor:\s*slurm\b", (profile / "config.yaml").read_text(), re.M))
+
+
 def check_installed(profile: Path | None) -> None:
     """Snakemake (and the Slurm executor plugin for a Slurm profile) must be importable."""
     import importlib.util
-    import re
 
     if importlib.util.find_spec("snakemake") is None:
         raise _user_error("Snakemake is not installed: pip install -e '.[sweep]'")
     if profile is not None:
-        text = (profile / "config.yaml").read_text()
-        if (re.search(r"^executor:\s*slurm\b", text, re.M)
+        if (uses_slurm(profile)
                 and importlib.util.find_spec("snakemake_executor_plugin_slurm") is None):
             raise _user_error(f"profile {profile} uses the Slurm executor, which is not "
                               "installed: pip install snakemake-executor-plugin-slurm")
@@ -142,11 +150,17 @@ def main_sweep(args: argparse.Namespace) -> int:
 
     if args.cores < 1:
         raise _user_error(f"--cores {args.cores}: need at least 1")
+    profile = profile_path(args.profile) if args.profile else None
+    if not uses_slurm(profile):
+        # the points run here: no more ranks than CPUs; on Slurm each point gets its own
+        # allocation of --np tasks
+        from .run_cli import check_ranks
+
+        check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
     try:
         plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
     except SceneError as exc:
         raise _user_error(str(exc)) from None
-    profile = profile_path(args.profile) if args.profile else None
     check_installed(profile)
     out = args.out if args.out is not None else default_out(plan)
     from .cli import check_writable

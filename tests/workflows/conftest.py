@@ -136,3 +136,38 @@ def report_checks():
     ``axes_units(labels)``, ``images(html)``."""
     return SimpleNamespace(outputs=check_outputs, content=check_content,
                            axes_units=check_axes_units, images=images, sections=SECTIONS, png=PNG)
+
+
+@pytest.fixture
+def interrupted_run():
+    """``interrupted_run(run_dir)``: a run directory as an interrupted run leaves it,
+    without LAMMPS: restarts at 2000 and 4000 (made of LAMMPS's markers around
+    arbitrary bytes, each recorded as if LAMMPS had finished it), trace rows every
+    200 steps up to 4400, the slide origin; returns ``run_dir``."""
+    def make(run_dir: Path) -> Path:
+        import numpy as np
+
+        from filmfriction.md_inputs.contract import DAT_COLUMNS
+        from filmfriction.workflows import restarts
+        from filmfriction.workflows.scene import load
+
+        scene = load("stick-slip", {"slide_steps": 8000, "restart_every": 2000,
+                                    "equilibrate_steps": 100, "trace_every": 200})
+        run_dir.mkdir()
+        for step in (2000, 4000):
+            (run_dir / f"restart.{step}").write_bytes(
+                restarts.MAGIC + bytes(range(256)) * 8 + restarts.MAGIC)
+        restarts.RestartLedger(run_dir).record_below(4400)
+        steps = np.arange(0, 4401, 200)
+        rows = np.column_stack([steps] + [steps * 0.001 + i for i in range(1, len(DAT_COLUMNS))])
+        (run_dir / "trace.dat").write_text(
+            "# " + " ".join(DAT_COLUMNS) + "\n"
+            + "".join(" ".join(f"{v:.10g}" for v in r) + "\n" for r in rows))
+        (run_dir / "slide_origin.txt").write_text("0.0 0.0\n")
+        (run_dir / "lammps.screen").write_text("")
+        (run_dir / "run.json").write_text(json.dumps({
+            "schema": "filmfriction.run/1", "status": "interrupted", "error": "interrupted",
+            "scene": scene.as_dict(), "np": 1, "command": ["mpiexec", "-n", "1", "lmp"],
+            "segments": [], "trace_parameters": {}}))
+        return run_dir
+    return make

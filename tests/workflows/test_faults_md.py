@@ -173,12 +173,16 @@ def test_a_run_that_blows_up_within_the_ledger_is_completed_with_warnings(tmp_pa
     assert "set point 0.7" in record["warnings"][checks.index("film temperature")]
 
 
-def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command):
+@pytest.mark.parametrize("damage", [False, True], ids=["intact", "newest restart damaged"])
+def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command, damage):
     """kill -9 (runner and LAMMPS) after the second restart, resume on the same
     single rank: trace.csv equals the uninterrupted run's byte for byte (the
-    thermostat is re-seeded at every restart boundary in both)."""
+    thermostat is re-seeded at every restart boundary in both).  Damaged: the
+    newest restart file keeps its size but its second half is zeros (a tail that
+    never reached the disk); the resume falls back to the one before, and the
+    result is still the uninterrupted run's."""
     settings = {**SMALL, "equilibrate_steps": 500, "slide_steps": 8000}
-    whole = md.execute(md.scene("stick-slip", **settings), tmp_path / "whole")
+    whole = md.shared("stick-slip", **settings).path
     out = tmp_path / "killed"
     proc = _start(filmfriction_command, out, md, **settings)
     try:
@@ -196,8 +200,18 @@ def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command):
         proc.wait()
     rows = runner.read_trace_dat(out / "trace.dat")
     assert rows[-1, 0] < settings["slide_steps"], "the run finished before the kill"
+    if damage:
+        newest = sorted(out.glob("restart.*"), key=lambda p: int(p.suffix[1:]))[-1]
+        size = newest.stat().st_size
+        with open(newest, "r+b") as fh:
+            fh.seek(size // 2)
+            fh.write(bytes(size - size // 2))
     runner.resume(out, progress=False)
-    assert json.loads((out / "run.json").read_text())["np"] == 1
+    record = json.loads((out / "run.json").read_text())
+    assert record["np"] == 1
+    if damage:
+        assert newest.name in record["unusable_restarts"]
+        assert int(record["resumed_from"].split(".")[1]) < int(newest.suffix[1:])
     assert (out / "trace.csv").read_bytes() == (whole / "trace.csv").read_bytes()
 
 

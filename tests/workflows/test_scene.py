@@ -101,8 +101,12 @@ def test_injection_via_scene_file_is_rejected(tmp_path):
     bad.write_text('name = "evil"\n[parameters]\nlammps_command = 1\n')
     with pytest.raises(SceneError, match="unknown parameter"):
         load(str(bad))
-    bad.write_text('name = "evil"\nscript = "shell ls"\n')
+    bad.write_text('name = "evil"\nlammps_command = "shell ls"\n')
     with pytest.raises(SceneError, match="unknown keys"):
+        load(str(bad))
+    # a scene's own script is a file named by path, never text run as commands
+    bad.write_text('name = "evil"\nscript = "shell ls"\n')
+    with pytest.raises(SceneError, match="no such file"):
         load(str(bad))
 
 

@@ -255,14 +255,16 @@ def test_slurm_profile_dry_run_declares_mpi_on_every_run(tmp_path, cli, small_ar
     pytest.importorskip("snakemake_executor_plugin_slurm",
                         reason="pip install snakemake-executor-plugin-slurm (the sweep extra)")
     out = tmp_path / "sweep"
+    ranks = 4 * (os.cpu_count() or 1)       # more than this machine has: fine on Slurm
     r = cli("stick-slip", "--grid", "drive_velocity=0.05,0.5", "--grid", "seed=1,2",
-            "--out", str(out), "--profile", "slurm", "--dry-run", *small_args, timeout=120)
+            "--np", str(ranks), "--out", str(out), "--profile", "slurm", "--dry-run",
+            *small_args, timeout=120)
     assert r.returncode == 0, r.stderr[-3000:]
     blocks = [b for b in r.stdout.split("rule ")[1:] if b.startswith("point:")]
     assert len(blocks) == 4
     for b in blocks:
         resources = next(line for line in b.splitlines() if "resources:" in line)
-        assert "mpi=srun" in resources and "tasks=4" in resources
+        assert "mpi=srun" in resources and f"tasks={ranks}" in resources
         assert "cpus_per_task=1" in resources and "runtime=" in resources
     assert "This was a dry-run" in r.stdout
     assert not (out / "points").exists()

@@ -1,0 +1,166 @@
+"""A user's own SFB trace end to end, through the command line: the documented example
+(docs/examples/: tab-separated, its own column names, SI) goes through analyze →
+calibrate → report → sfb with SI units in every output, and the outputs validate
+against the shipped JSON Schemas."""
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import jsonschema
+import pytest
+
+from filmfriction.analysis.util import json_schema
+from filmfriction.workflows.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"
+COLUMNS = ["--column", "time=t_s", "--column", "spring_force=shear_force_N",
+           "--column", "drive_position=drive_x_m"]
+LJ_LABELS = ("ε", "σ", "τ")
+
+
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory):
+    """The guide's commands on a copy of the example; the printed text of each."""
+    d = tmp_path_factory.mktemp("measured")
+    for name in ("sfb_trace.tsv", "my_sfb.toml"):
+        shutil.copy(EXAMPLES / name, d / name)
+    printed = {}
+    commands = {
+        "analyze": ["analyze", str(d / "sfb_trace.tsv"), "--setup", str(d / "my_sfb.toml")]
+                   + COLUMNS,
+        "calibrate": ["calibrate", str(d)],
+        "sfb": ["sfb", "--setup", str(d / "my_sfb.toml"), "--measured", str(d),
+                "--calibration", str(d / "calibration.json"), "--out", str(d / "sfb.json")],
+        "report": ["report", str(d)],
+    }
+    import contextlib
+    import io
+
+    for step, argv in commands.items():
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            assert main(argv) == 0, step
+        printed[step] = buf.getvalue()
+    return d, printed
+
+
+def _labels(doc) -> set:
+    """Every ``units`` label in a document."""
+    out = set()
+    if isinstance(doc, dict):
+        for k, v in doc.items():
+            if k == "units" and isinstance(v, str):
+                out.add(v)
+            else:
+                out |= _labels(v)
+    elif isinstance(doc, list):
+        for v in doc:
+            out |= _labels(v)
+    return out
+
+
+def test_analyze_reads_the_users_columns_and_labels_si(chain):
+    d, printed = chain
+    doc = json.loads((d / "analysis.json").read_text())
+    jsonschema.validate(doc, json_schema("analysis"))
+    assert doc["units"] == "si"
+    assert doc["source"]["delimiter"] == "tab"
+    assert doc["source"]["columns"] == {"time": "t_s", "spring_force": "shear_force_N",
+                                        "drive_position": "drive_x_m"}
+    # the set-up's values, read from my_sfb.toml (contact_radius 11.3 um -> A = pi a^2)
+    assert doc["source"]["parameters"]["spring_constant"] == 97.0
+    assert doc["source"]["parameters"]["area"] == pytest.approx(3.14159265 * 11.3e-6 ** 2)
+    assert doc["slips"]["static_force"]["units"] == "N"
+    assert doc["viscosity"]["from_slip"]["eta_eff"]["units"] == "Pa·s"
+    labels = _labels(doc)
+    assert labels and not any(c in "".join(labels) for c in LJ_LABELS), labels
+    # the synthetic trace's slips: Klein's Fs and eta_eff come back
+    assert doc["slips"]["count"] >= 4 and "stick-slip" in printed["analyze"]
+    assert doc["slips"]["static_force"]["mean"] == pytest.approx(9.7e-6, rel=0.01)
+    assert (d / doc["figure"]).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_calibrate_works_in_si(chain):
+    d, printed = chain
+    cal = json.loads((d / "calibration.json").read_text())
+    assert cal["units"] == "si"
+    labels = _labels(cal)
+    assert {"N", "Pa·s"} <= labels and not any(c in "".join(labels) for c in LJ_LABELS)
+    text = printed["calibrate"]
+    assert "static_force       9.7" in text and " N\n" in text
+    assert not any(c in text for c in LJ_LABELS) and "MD" not in text, text
+
+
+def test_sfb_runs_on_the_users_setup_and_slip(chain):
+    d, printed = chain
+    doc = json.loads((d / "sfb.json").read_text())
+    jsonschema.validate(doc, json_schema("sfb"))
+    analysis = json.loads((d / "analysis.json").read_text())
+    assert doc["setup"]["spring_constant"] == {"value": 97.0, "error": 3.0, "units": "N/m"}
+    assert doc["experiment"]["spring_constant"] == 97.0
+    row = next(r for r in doc["rows"] if r["name"] == "slip_time"
+               and r["source"] == "sfb-parameters")
+    # the measured slip time is the trace's, not Klein's 25 ms
+    assert row["klein"] == pytest.approx(analysis["slips"]["slip_duration"]["mean"])
+    assert row["uncertainty"][0] < row["model"] < row["uncertainty"][1]
+    assert doc["units"]["name"] == "SI (identity)"      # an SI calibration is not re-mapped
+    assert "measured" in printed["sfb"].splitlines()[2]
+    assert not any(c in "".join(r["units"] for r in doc["rows"]) for c in LJ_LABELS)
+    # the calibrated rows speak SI too: no LJ mapping in their notes
+    calibrated = [r["note"] for r in doc["rows"] if r["source"] == "md-calibrated"]
+    assert calibrated and not any("eps/sigma" in n or "/tau" in n for n in calibrated)
+
+
+def test_report_is_written(chain):
+    d, printed = chain
+    assert (d / "report.html").stat().st_size > 10_000 and "report:" in printed["report"]
+
+
+@pytest.mark.xfail(strict=True, reason="workflows/report.py labels every trace in LJ units "
+                                       "(its figures' axes and its tables); a measured SI trace "
+                                       "needs SI labels there")
+def test_report_labels_a_measured_trace_in_si(chain):
+    d, _ = chain
+    text = (d / "report.md").read_text()
+    assert "ε/σ" not in text and "LJ unit" not in text
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["--column", "time=t"], "no column 't' in the header (columns: t_s, shear_force_N, drive_x_m)"),
+    (["--column", "tim=t_s"], "unknown name 'tim'"),
+    ([], "required column 'time' missing (header: t_s, shear_force_N, drive_x_m)"),
+])
+def test_bad_mappings_are_one_line_errors(tmp_path, capsys, argv, message):
+    shutil.copy(EXAMPLES / "sfb_trace.tsv", tmp_path / "t.tsv")
+    assert main(["analyze", str(tmp_path / "t.tsv"), "--units", "si"] + argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1, err
+    assert not (tmp_path / "analysis.json").exists()
+
+
+def test_a_mapping_without_equals_sign_is_refused(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["analyze", str(EXAMPLES / "sfb_trace.tsv"), "--column", "time"])
+    assert exc.value.code == 2 and "give NAME=COLUMN" in capsys.readouterr().err
+
+
+def test_bad_setups_are_one_line_errors(tmp_path, capsys, chain):
+    d, _ = chain
+    cases = {"spring_constant = -1\n": "spring_constant = -1.0: must be positive",
+             "spring_constant = {value = 97, error = -1}\n": "spring_constant error = -1.0",
+             "spring_constant = 97\nfoo = 1\n": "unknown set-up key(s) foo",
+             "contact_area = 4e-10\ncontact_radius = 1e-5\n": "not both",
+             "spring_constant = 97\n": "the set-up lacks mass"}
+    for text, message in cases.items():
+        (tmp_path / "s.toml").write_text(text)
+        assert main(["sfb", "--setup", str(tmp_path / "s.toml"), "--measured", str(d)]) == 2
+        err = capsys.readouterr().err
+        assert message in err and len(err.strip().splitlines()) == 1, err
+    # a set-up that is not the instrument the analysis used
+    (tmp_path / "s.toml").write_text((d / "my_sfb.toml").read_text().replace(
+        "value = 97.0", "value = 90.0"))
+    assert main(["sfb", "--setup", str(tmp_path / "s.toml"), "--measured", str(d)]) == 2
+    assert "differs from the 97" in capsys.readouterr().err
+
