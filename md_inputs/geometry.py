@@ -272,9 +272,10 @@ class ConfinedFilm:
     def atoms(self):
         """Every atom as ``ase.Atoms``: bottom wall, film, top wall; atomic number = type.
 
-        The cell spans the box's lengths; positions are the simulation's (z
-        from the bottom wall's first plane at 0, below the box's ``zlo``'s
-        origin: :meth:`lammps_data` writes the true z bounds).
+        The cell has the box's lengths; positions are the simulation's, the
+        bottom wall's first plane at z = 0, half a plane spacing above the
+        box's ``zlo`` (an ``ase.Atoms`` cell starts at 0: :meth:`lammps_data`
+        writes the box's own z bounds).
         """
         out = []
         for stack, rigid, mobile, outer in (
