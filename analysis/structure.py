@@ -30,8 +30,9 @@ from scipy.spatial import cKDTree
 
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
-__all__ = ["DensityProfile", "HexaticOrder", "FilmThickness", "find_layers",
-           "frame_steps", "summarize_run"]
+__all__ = ["DensityProfile", "HexaticOrder", "LayerNeighbours", "psi6_per_layer",
+           "FilmThickness", "find_layers",
+           "frame_steps", "lammps_frame_interval", "open_trajectory", "summarize_run"]
 
 
 def find_layers(centers, density, *, min_spacing: float = 0.5,
@@ -150,13 +151,21 @@ class HexaticOrder(AnalysisBase):
 
     Atoms are assigned to layers by z (``layer_edges``, e.g. from
     :class:`DensityProfile`).  In each layer, neighbours are the atoms closer
-    in-plane than ``cutoff`` (periodic in x and y; ``scipy.spatial.cKDTree``
-    with ``boxsize``), and ψ6_j = (1/n_j) Σ_k exp(6iθ_jk).  The default
-    cutoff, 1.37 a with a = (2/(√3 ρ₂))^½ the triangular-lattice spacing
-    of the layer's areal density ρ₂, lies between the first (a) and second
-    (√3 a) shells.  Per layer and frame: ``psi6`` = |⟨ψ6_j⟩| (orientational
-    order of the layer as a whole: ≈ 1 crystal, ≈ 0 liquid) and
-    ``psi6_local`` = ⟨|ψ6_j|⟩ over atoms with neighbours.
+    in-plane than ``cutoff`` (periodic in x and y), and
+    ψ6_j = (1/n_j) Σ_k exp(6iθ_jk).  The default cutoff, 1.37 a with
+    a = (2/(√3 ρ₂))^½ the triangular-lattice spacing of the layer's areal
+    density ρ₂, lies between the first (a) and second (√3 a) shells.  Per
+    layer and frame: ``psi6`` = |⟨ψ6_j⟩| (orientational order of the layer as
+    a whole: ≈ 1 crystal, ≈ 0 liquid) and ``psi6_local`` = ⟨|ψ6_j|⟩ over atoms
+    with neighbours.  The same ψ6_j as ``freud.order.Hexatic(k=6)`` with
+    ``neighbors={"r_max": cutoff}`` (tested).
+
+    Neighbours come from a Verlet list (:class:`LayerNeighbours`): pairs
+    within the cutoff plus a skin, found with ``scipy.spatial.cKDTree``
+    (``boxsize``, periodic) and kept while no atom has moved half the skin
+    and no atom has changed layer, so a film that holds its structure
+    between frames (stick) is searched once, not every frame.  Exact either
+    way: every pair within the cutoff is found in every frame.
 
     Parameters
     ----------
@@ -172,6 +181,9 @@ class HexaticOrder(AnalysisBase):
     results.psi6, results.psi6_local : ndarray, shape (n_frames, n_layers)
     results.frames : ndarray
         Frame indices analysed.
+    results.neighbour_searches : int
+        Frames in which the neighbours were searched afresh (the rest reused
+        the Verlet list).
 
     Examples
     --------
@@ -190,6 +202,7 @@ class HexaticOrder(AnalysisBase):
         n_layers = self._edges.size - 1
         self._psi = np.full((self.n_frames, n_layers), np.nan)
         self._local = np.full((self.n_frames, n_layers), np.nan)
+        self._neighbours = LayerNeighbours(n_layers, self._cutoff)
 
     def _single_frame(self):
         pos = self._ag.positions
@@ -197,33 +210,151 @@ class HexaticOrder(AnalysisBase):
         layer = np.searchsorted(self._edges, pos[:, 2]) - 1
         xy = np.mod(pos[:, :2].astype(float), box)
         xy[xy >= box] = 0.0           # guard the upper edge after rounding
-        for i in range(self._edges.size - 1):
-            sel = xy[layer == i]
-            n = sel.shape[0]
-            if n < 3:
-                continue
-            rc = self._cutoff or 1.37 * math.sqrt(2.0 * box[0] * box[1] / (math.sqrt(3.0) * n))
-            tree = cKDTree(sel, boxsize=box, balanced_tree=False, compact_nodes=False)
-            pairs = tree.query_pairs(rc, output_type="ndarray")
-            if pairs.size == 0:
-                continue
-            d = sel[pairs[:, 1]] - sel[pairs[:, 0]]
-            d -= box * np.round(d / box)                  # minimum image
-            z6 = ((d[:, 0] + 1j * d[:, 1]) / np.hypot(d[:, 0], d[:, 1])) ** 6
-            # exp(6i(θ+π)) = exp(6iθ): the same term for both atoms of a pair
-            ends = np.concatenate([pairs[:, 0], pairs[:, 1]])
-            zz = np.concatenate([z6, z6])
-            count = np.bincount(ends, minlength=n)
-            has = count > 0
-            psi_j = (np.bincount(ends, zz.real, n) + 1j * np.bincount(ends, zz.imag, n))[has] \
-                / count[has]
-            self._psi[self._frame_index, i] = abs(psi_j.mean())
-            self._local[self._frame_index, i] = np.abs(psi_j).mean()
+        i, j, dx, dy = self._neighbours.pairs(xy, layer, box)
+        psi, local = psi6_per_layer(i, j, dx, dy, layer, self._edges.size - 1)
+        self._psi[self._frame_index] = psi
+        self._local[self._frame_index] = local
 
     def _conclude(self):
         self.results.psi6 = self._psi
         self.results.psi6_local = self._local
         self.results.frames = np.asarray(self.frames)
+        self.results.neighbour_searches = self._neighbours.searches
+
+
+def psi6_per_layer(i, j, dx, dy, layer, n_layers: int) -> tuple[np.ndarray, np.ndarray]:
+    """|⟨ψ6_j⟩| and ⟨|ψ6_j|⟩ of each layer from its neighbour pairs.
+
+    ``i``, ``j``: the atoms of each pair (each pair once), ``dx``, ``dy``: the
+    in-plane vector from i to j, ``layer``: each atom's layer (pairs join atoms
+    of one layer).  exp(6iθ) = (z/|z|)⁶ with z = dx + i dy, here as ((dx² − dy²) +
+    i 2 dx dy)³ / r⁶, the same for both atoms of a pair (θ + π).  A layer
+    with no pairs is NaN.
+    """
+    n = layer.size
+    a, b = dx * dx - dy * dy, 2.0 * dx * dy       # z² = a + ib, |z²| = r²
+    a2, b2 = a * a, b * b
+    r6 = a2 + b2
+    r6 *= np.sqrt(r6)
+    re, im = a * (a2 - 3.0 * b2) / r6, b * (3.0 * a2 - b2) / r6
+    ends = np.concatenate([i, j])
+    count = np.bincount(ends, minlength=n)
+    has = count > 0
+    c = count[has]
+    pre = np.bincount(ends, np.concatenate([re, re]), n)[has] / c
+    pim = np.bincount(ends, np.concatenate([im, im]), n)[has] / c
+    lh = layer[has]
+    atoms = np.bincount(lh, minlength=n_layers)[:n_layers]
+    with np.errstate(invalid="ignore", divide="ignore"):     # a layer without pairs: NaN
+        mean_re = np.bincount(lh, pre, n_layers)[:n_layers] / atoms
+        mean_im = np.bincount(lh, pim, n_layers)[:n_layers] / atoms
+        local = np.bincount(lh, np.hypot(pre, pim), n_layers)[:n_layers] / atoms
+    return np.hypot(mean_re, mean_im), local
+
+
+class LayerNeighbours:
+    """In-plane neighbour pairs within each layer, frame after frame (a Verlet list).
+
+    The pairs within each layer's cutoff plus a skin (:attr:`SKIN` of the
+    cutoff) are searched with ``scipy.spatial.cKDTree`` (periodic
+    ``boxsize``), one tree per layer.  In a later frame the list is complete
+    as long as the box and every atom's layer are unchanged and no atom has
+    moved more than half the skin (minimum image), so only its pairs' lengths
+    are checked (each pair's vector is its vector at the search plus the two
+    atoms' moves since).  When a list is discarded without ever having been reused
+    (the film moves fast: slip, a liquid), the next :attr:`PLAIN_FRAMES`
+    searches use no skin, which finds fewer pairs.
+
+    Parameters
+    ----------
+    n_layers : int
+        Layers 0 … n_layers − 1 (atoms of any other index are outside the film).
+    cutoff : float, optional
+        The neighbour distance; default 1.37 a from each layer's areal density.
+    """
+
+    SKIN = 0.5
+    PLAIN_FRAMES = 10
+
+    def __init__(self, n_layers: int, cutoff: float | None = None):
+        self.n_layers = n_layers
+        self.cutoff = cutoff
+        self.searches = 0
+        # at the search: i, j, dx, dy, cutoff² of each pair, skin, xy, layer, box
+        self._list = None
+        self._reused = 0
+        self._plain = 0
+
+    def cutoffs(self, layer, box) -> np.ndarray:
+        """The neighbour distance of each layer (inf for a layer of fewer than 3 atoms)."""
+        n = np.bincount(layer[(layer >= 0) & (layer < self.n_layers)],
+                        minlength=self.n_layers)
+        if self.cutoff is not None:
+            rc = np.full(self.n_layers, float(self.cutoff))
+        else:
+            with np.errstate(divide="ignore"):
+                rc = 1.37 * np.sqrt(2.0 * box[0] * box[1] / (math.sqrt(3.0) * n))
+        rc[n < 3] = np.inf                   # too few atoms for an order: no pairs
+        return rc
+
+    def pairs(self, xy, layer, box):
+        """``(i, j, dx, dy)``: every pair of atoms of one layer closer than its cutoff
+        (each pair once), with the minimum-image vector (dx, dy) from i to j."""
+        box = np.asarray(box, float)
+        moved = self._moved(xy, layer, box)
+        if moved is None:
+            self._search(xy, layer, box)
+        i, j, dx, dy, rc2, skin = self._list[:6]
+        if moved is None and skin == 0:
+            return i, j, dx, dy                   # searched at the cutoff itself
+        if moved is not None:                     # each atom's move since the search
+            mx, my = moved[:, 0], moved[:, 1]
+            dx = dx + (mx.take(j) - mx.take(i))
+            dy = dy + (my.take(j) - my.take(i))
+        near = np.flatnonzero(dx * dx + dy * dy < rc2)
+        return i.take(near), j.take(near), dx.take(near), dy.take(near)
+
+    def _moved(self, xy, layer, box):
+        """Each atom's move (minimum image) since the list's search if the list still
+        holds every pair within the cutoff, else None."""
+        if self._list is None:
+            return None
+        skin, xy0, layer0, box0 = self._list[5:]
+        if skin > 0 and np.array_equal(box, box0) and np.array_equal(layer, layer0):
+            moved = xy - xy0
+            moved -= box * np.round(moved / box)
+            if np.einsum("ij,ij->i", moved, moved).max(initial=0.0) < (0.5 * skin) ** 2:
+                self._reused += 1
+                return moved
+        if skin > 0 and self._reused == 0:
+            self._plain = self.PLAIN_FRAMES          # a list that was never reused
+        return None
+
+    def _search(self, xy, layer, box):
+        rc = self.cutoffs(layer, box)
+        finite = rc[np.isfinite(rc)]
+        skin = self.SKIN * finite.min() if finite.size and self._plain == 0 else 0.0
+        self._plain = max(0, self._plain - 1)
+        order = np.argsort(layer, kind="stable")
+        bounds = np.searchsorted(layer[order], np.arange(self.n_layers + 1))
+        found_i, found_j = [np.empty(0, np.intp)], [np.empty(0, np.intp)]
+        for k in range(self.n_layers):
+            members = order[bounds[k]:bounds[k + 1]]
+            if not np.isfinite(rc[k]):
+                continue
+            tree = cKDTree(xy[members], boxsize=box, balanced_tree=False, compact_nodes=False)
+            pairs = tree.query_pairs(rc[k] + skin, output_type="ndarray")
+            found_i.append(members.take(pairs[:, 0]))
+            found_j.append(members.take(pairs[:, 1]))
+        i, j = np.concatenate(found_i), np.concatenate(found_j)
+        x, y = xy[:, 0].copy(), xy[:, 1].copy()
+        dx, dy = x.take(j) - x.take(i), y.take(j) - y.take(i)
+        dx -= box[0] * np.round(dx / box[0])        # minimum image
+        dy -= box[1] * np.round(dy / box[1])
+        self._list = (i, j, dx, dy, rc.take(layer.take(i)) ** 2, skin,
+                      xy.copy(), layer.copy(), box.copy())
+        self._reused = 0
+        self.searches += 1
 
 
 class FilmThickness(AnalysisBase):
@@ -298,6 +429,55 @@ def frame_steps(universe) -> np.ndarray | None:
     return header["istart"] + header["nsavc"] * np.arange(n)
 
 
+def lammps_frame_interval(trajectory) -> float | None:
+    """Time between frames of a DCD that LAMMPS wrote, in the run's units (τ in LJ), or None.
+
+    LAMMPS writes its own timestep, unconverted, as the DCD header's float32
+    ``delta`` and the dump interval as ``nsavc``; MDAnalysis reads ``delta`` as
+    CHARMM's AKMA time unit (48.9 fs) and so reports a wrong time.  The
+    interval is nsavc × the timestep, the timestep being the shortest
+    decimal that rounds to ``delta`` in float32 (0.005, not 0.004999999888).
+    """
+    import struct
+
+    with open(trajectory, "rb") as f:
+        head = f.read(100)
+    if len(head) < 48 or head[4:8] != b"CORD":
+        return None
+    order = "<" if struct.unpack("<i", head[:4])[0] == 84 else ">"
+    nsavc = struct.unpack(order + "i", head[16:20])[0]      # CORD, NSET, ISTART, NSAVC
+    delta = struct.unpack(order + "f", head[44:48])[0]
+    if nsavc <= 0 or not delta > 0:
+        return None
+    return nsavc * float(str(np.float32(delta)))
+
+
+def open_trajectory(topology, trajectory, dt: float | None = None):
+    """A filmfriction run's trajectory as an MDAnalysis ``Universe``, with times in τ.
+
+    ``dt``: the time between frames (dump_every × timestep); default from
+    the DCD header (:func:`lammps_frame_interval`).  ``u.trajectory.time`` is
+    then step × timestep, the trace's ``time``; lengths are in σ (MDAnalysis
+    labels them Å and times ps, but converts neither).
+
+    For a user's own script the same is::
+
+        mda.Universe("topology.data", "trajectory.dcd", atom_style="id type x y z",
+                     dt=dump_every * timestep)
+    """
+    import warnings
+
+    import MDAnalysis as mda
+
+    if dt is None:
+        dt = lammps_frame_interval(trajectory)
+    with warnings.catch_warnings():      # DCDReader's 3.0 deprecation notice
+        warnings.simplefilter("ignore", DeprecationWarning)
+        return mda.Universe(str(topology), str(trajectory), format="DCD",
+                            topology_format="DATA", atom_style="id type x y z",
+                            **({"dt": dt} if dt else {}))
+
+
 def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
                   film_types=FILM_TYPES, bottom_types=BOTTOM_WALL_TYPES,
                   top_types=TOP_WALL_TYPES, step: int = 1) -> dict:
@@ -309,14 +489,7 @@ def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
     and gap are reported for each.  The film and each wall are the atoms of
     the given types (default: the script's contract, either wall model).
     """
-    import warnings
-
-    import MDAnalysis as mda
-
-    with warnings.catch_warnings():      # DCDReader's 3.0 deprecation notice
-        warnings.simplefilter("ignore", DeprecationWarning)
-        u = mda.Universe(str(topology), str(trajectory), format="DCD",
-                         topology_format="DATA", atom_style="id type x y z")
+    u = open_trajectory(topology, trajectory)
     film = _select_types(u, film_types)
     if film.n_atoms == 0:
         raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "

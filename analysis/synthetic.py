@@ -130,7 +130,7 @@ def write_csv(path, columns: dict) -> None:
 
 def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2,
                  frames=20, thermal=0.05, melt_frames=(), nsavc=100, seed=0,
-                 flexible_walls=False):
+                 flexible_walls=False, timestep=0.005):
     """Write ``topology.data`` + ``trajectory.dcd`` of a film of ``layers``
     close-packed (111) planes between two walls, for structure tests.
 
@@ -143,7 +143,8 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     film, 2 bottom wall, 3 top wall; with ``flexible_walls`` (the script's
     ``wall_model = flexible``) only each wall's outermost plane keeps type 2
     or 3, its planes facing the film are types 4 and 5 and rattle as the
-    film does.
+    film does.  The DCD header holds ``nsavc`` and ``timestep`` as LAMMPS
+    writes them (its timestep unconverted, as ``delta``).
 
     Returns
     -------
@@ -187,7 +188,12 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     u = mda.Universe.empty(n, trajectory=True)
     u.dimensions = [lx, ly, lz, 90, 90, 90]
     traj = directory / "trajectory.dcd"
-    with mda.Writer(str(traj), n, nsavc=nsavc, istart=0) as w:
+    # MDAnalysis writes delta = dt (ps, converted to AKMA) / nsavc: ask for the dt that
+    # puts the bare timestep there, as LAMMPS does
+    from MDAnalysis import units as mda_units
+
+    dt = mda_units.convert(timestep * nsavc, "AKMA", "ps")
+    with mda.Writer(str(traj), n, nsavc=nsavc, istart=0, dt=dt) as w:
         for f in range(frames):
             u.atoms.positions = coords[f]
             u.dimensions = [lx, ly, lz, 90, 90, 90]

@@ -2,7 +2,9 @@
 
 One table each for what the script and its readers must agree on:
 
-* :data:`ATOM_TYPES` -- the atom types the script creates and what they are;
+* :data:`DATA_FILE` -- the data file the script starts from (the walls and
+  the film, :mod:`filmfriction.md_inputs.geometry`), in the run directory;
+* :data:`ATOM_TYPES` -- the atom types of that file and what they are;
 * :data:`TRACE` -- the columns of ``trace.dat`` (the script's ``fix print``),
   in the order LAMMPS prints them, with the LAMMPS expression and format
   that print them, their unit and their meaning.
@@ -26,14 +28,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
-__all__ = ["AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
+__all__ = ["DATA_FILE", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
            "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
            "column", "fix_print_text", "fix_print_title", "check_head"]
 
 
+#: The script's ``data_file`` default: the runner writes the geometry there.
+DATA_FILE = "geometry.data"
+
+
 # ---------------------------------------------------------------- atom types
 class AtomType(IntEnum):
-    """Atom types of ``film_slide.lmp`` (``create_box 5``)."""
+    """Atom types of ``film_slide.lmp`` (its data file has 5 atom types)."""
 
     FILM = 1
     BOTTOM_WALL = 2        # rigid walls: the whole bottom wall (fixed); flexible: its outer plane

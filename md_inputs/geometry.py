@@ -1,30 +1,51 @@
-"""The fcc(111) geometry that ``film_slide.lmp`` builds, in Python.
+"""The geometry of ``film_slide.lmp``: fcc(111) walls and a close-packed film, built with ASE.
 
-The script builds its walls and its film with LAMMPS's own ``lattice custom``
-command: a 6-atom orthogonal cell of an ABC-stacked fcc(111) crystal, x along
-a close-packed row, y across the rows, z normal to the planes.  The Python
-that needs the same geometry (the scene's derived quantities, the synthetic
-films of the analysis tests) calls :func:`fcc111`, and
-``tests/test_md_contract.py`` checks it against the atoms a tiny LAMMPS run
-of the script creates.
+:class:`ConfinedFilm` builds the whole system with ``ase.build.fcc111``: a
+bottom wall, the film and a top wall, one ABC stacking running through all
+three, and writes it as the LAMMPS data file the script reads
+(``read_data``; ``ase.io``'s ``lammps-data`` writer, ``atom_style atomic``,
+the five atom types of :mod:`filmfriction.md_inputs.contract`).  The runner
+writes that file into each run directory; ``filmfriction geometry --out
+geometry.data`` writes it for a run by hand.  :func:`fcc111` is one stack of
+planes (the scene's atom counts, the synthetic films of the analysis tests).
 
-A close-packed plane of nearest-neighbour distance ``a`` in a box of
-``cells_x`` x ``cells_y`` cells: ``cells_x`` rows along x (Lx = cells_x a),
-``2 cells_y`` rows along y (Ly = cells_y sqrt(3) a), so 2 cells_x cells_y
-atoms.  Planes are sqrt(2/3) a apart; plane k of the stack is shifted in the
-plane by (k mod 3) (a/2, a/(2 sqrt(3))) (A, B, C stacking).
+Conventions (those of ``ase.build.fcc111(orthogonal=True)``): x along a
+close-packed row, y across the rows, z normal to the planes.  A close-packed
+plane of nearest-neighbour distance ``a`` in a box of ``cells_x`` x ``cells_y``
+cells holds ``cells_x`` rows along x (Lx = cells_x a) and ``2 cells_y`` rows
+along y (Ly = cells_y sqrt(3) a), so 2 cells_x cells_y atoms.  Planes are
+sqrt(2/3) a apart; plane k of the stack is shifted in the plane by
+(k mod 3) (a/2, a/(2 sqrt(3))) (A, B, C stacking).  Lengths are in σ: ASE's
+length unit is read as σ, and the data file is written with ASE's ``metal``
+units, which write lengths unconverted.
+
+ASE is imported when atoms are first built, not with this module: the
+counts and the box need no ASE.
 """
 from __future__ import annotations
 
+import io
 import math
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
-__all__ = ["Fcc111", "fcc111", "plane_spacing"]
+from .contract import AtomType
+
+__all__ = ["Fcc111", "fcc111", "plane_spacing", "fewest_wall_planes", "ConfinedFilm",
+           "TYPE_SYMBOLS"]
 
 SQRT3 = math.sqrt(3.0)
+#: In-plane shift of every stack, in fractions of its cell: off the periodic
+#: boundary, so that no row sits on it (a row there could be written on either side).
+ORIGIN = (0.25, 0.125)
+#: Chemical symbol standing for each atom type in the ASE atoms: atomic number = type,
+#: which is also how ``ase.io.read(..., format="lammps-data")`` maps types back.
+TYPE_SYMBOLS = ("H", "He", "Li", "Be", "B")
+#: Room left between the film's top plane and the top wall's first plane beyond one
+#: film plane spacing: the load settles the gap in the first steps [σ].
+TOP_WALL_ROOM = 0.3
 
 
 def plane_spacing(spacing: float) -> float:
@@ -32,12 +53,19 @@ def plane_spacing(spacing: float) -> float:
     return math.sqrt(2.0 / 3.0) * spacing
 
 
+def fewest_wall_planes(cutoff: float, spacing: float) -> int:
+    """(111) planes a wall needs so that a film atom sees none of the wall's far side:
+    enough to span the cutoff, plus one."""
+    return math.ceil(cutoff / plane_spacing(spacing)) + 1
+
+
 @dataclass(frozen=True)
 class Fcc111:
     """A stack of close-packed (111) planes in an orthogonal periodic box.
 
-    Build it with :func:`fcc111`.  ``positions`` and ``plane`` are computed
-    when first asked for; everything else is a number.
+    Build it with :func:`fcc111`.  :meth:`atoms` (an ``ase.Atoms``),
+    ``positions`` and ``plane`` are built when first asked for; everything
+    else is a number.
     """
 
     spacing: float                  # nearest-neighbour distance asked for [length]
@@ -71,6 +99,40 @@ class Fcc111:
     def n_atoms(self) -> int:
         return self.atoms_per_plane * self.planes
 
+    @property
+    def top(self) -> float:
+        """z of the last plane."""
+        return self.z0 + (self.planes - 1) * self.plane_spacing
+
+    def atoms(self, symbol: str = "H"):
+        """The stack as ``ase.Atoms`` (periodic in x and y), plane by plane from ``z0`` up.
+
+        ``ase.build.fcc111`` builds the planes at the asked spacing; they are
+        then shifted in the plane (``stacking``, ``origin``), stretched to the
+        box and wrapped into it.
+        """
+        from ase import Atoms
+        from ase.build import fcc111 as ase_fcc111
+
+        cx, cy = self.cells
+        if self.planes == 0:
+            return Atoms(cell=[*self.box, 0.0], pbc=(True, True, False))
+        a = self.spacing
+        slab = ase_fcc111(symbol, size=(cx, 2 * cy, self.planes), a=a * math.sqrt(2.0),
+                          orthogonal=True, periodic=True)
+        # ase ends its slab on an A plane (its last plane has index 0), so its
+        # first plane has index 1 - planes: move that to the asked stacking index
+        k = (self.stacking - (1 - self.planes)) % 3
+        slab.translate([(k * 0.5 + self.origin[0]) * a,
+                        (k / 6.0 + self.origin[1]) * SQRT3 * a, self.z0])
+        # stretch the planes to the box (the film fits the walls' box)
+        slab.set_cell([self.box[0], self.box[1], slab.cell[2, 2]], scale_atoms=True)
+        slab.pbc = (True, True, False)
+        slab.wrap()
+        order = np.argsort(np.round((slab.positions[:, 2] - self.z0) / self.plane_spacing),
+                           kind="stable")
+        return slab[order]
+
     @cached_property
     def plane(self) -> np.ndarray:
         """Index of each atom's plane, 0 for the plane at ``z0``."""
@@ -79,18 +141,8 @@ class Fcc111:
     @cached_property
     def positions(self) -> np.ndarray:
         """(n_atoms, 3) positions, plane by plane from ``z0`` up, wrapped into the box."""
-        (cx, cy), (ax, ay) = self.cells, self.cell
-        i, j = np.meshgrid(np.arange(cx), np.arange(2 * cy), indexing="ij")
-        # row j of a plane: x offset by half a spacing on odd rows, rows ay/2 apart
-        base = np.column_stack([(i + 0.5 * (j % 2) + self.origin[0]).ravel() * ax,
-                                (0.5 * j + self.origin[1]).ravel() * ay])
-        out = []
-        for p in range(self.planes):
-            k = (self.stacking + p) % 3
-            xy = np.mod(base + k * np.array([0.5 * ax, ay / 6.0]), self.box)
-            z = np.full((xy.shape[0], 1), self.z0 + p * self.plane_spacing)
-            out.append(np.hstack([xy, z]))
-        return np.vstack(out) if out else np.empty((0, 3))
+        pos = self.atoms().positions
+        return pos if len(pos) else np.empty((0, 3))
 
 
 def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1, *,
@@ -111,16 +163,16 @@ def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1
     fit : (float, float), optional
         Instead of ``cells``: a box (Lx, Ly) to fill with the nearest whole
         number of rows, the lattice stretched to fit it exactly (as the
-        script builds its film).
+        film is built).
     z0 : float
         z of the first plane.
     stacking : int
         Stacking index of the first plane: plane p takes the in-plane shift of
         index (stacking + p) mod 3, so a stack continued above another keeps
-        one ABC sequence (the script's film starts at index ``wall_layers``).
+        one ABC sequence (the film starts at index ``wall_layers``).
     origin : (float, float)
-        In-plane shift of every plane, in fractions of the cell (the script's
-        lattices use (0.25, 0.125), off the periodic boundary).
+        In-plane shift of every plane, in fractions of the cell
+        (:class:`ConfinedFilm` uses :data:`ORIGIN`, off the periodic boundary).
 
     Returns
     -------
@@ -148,3 +200,126 @@ def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1
         raise ValueError(f"planes {planes}: need 0 or more")
     return Fcc111(float(spacing), cells, (lx, ly), int(planes), float(z0), int(stacking),
                   (float(origin[0]), float(origin[1])))
+
+
+@dataclass(frozen=True)
+class ConfinedFilm:
+    """The film between its two walls, as ``film_slide.lmp`` simulates it.
+
+    Parameters
+    ----------
+    wall_spacing, film_spacing : float
+        Nearest-neighbour distance in the walls' and the film's planes [σ].
+    cells : (int, int)
+        Wall rows along x and row pairs along y (the box).
+    film_layers : int
+        Close-packed film planes.
+    wall_planes : int
+        (111) planes per wall (:func:`fewest_wall_planes` for the fewest that
+        span the cutoff).
+    cutoff : float
+        LJ cutoff [σ]: the room above the top wall.
+    flexible_walls : bool
+        Every wall plane but the outermost one of each wall is mobile (types
+        ``BOTTOM_FLEXIBLE`` and ``TOP_FLEXIBLE``).
+
+    Layout along z: the bottom wall's planes from z = 0 up; the film's first
+    plane one film plane spacing above the bottom wall's last; the top wall's
+    first plane one film plane spacing plus :data:`TOP_WALL_ROOM` above the
+    film's last.  The box runs from half a wall plane spacing below the bottom
+    wall to three wall plane spacings plus a cutoff above the top wall.
+
+    Examples
+    --------
+    >>> g = ConfinedFilm(1.1, 1.1, (7, 4), film_layers=3, wall_planes=4, cutoff=2.5,
+    ...                  flexible_walls=False)
+    >>> g.film.n_atoms, g.bottom.n_atoms + g.top.n_atoms, len(g.atoms())
+    (168, 448, 616)
+    """
+
+    wall_spacing: float
+    film_spacing: float
+    cells: tuple[int, int]
+    film_layers: int
+    wall_planes: int
+    cutoff: float
+    flexible_walls: bool
+
+    @cached_property
+    def bottom(self) -> Fcc111:
+        return fcc111(self.wall_spacing, self.cells, self.wall_planes, origin=ORIGIN)
+
+    @cached_property
+    def film(self) -> Fcc111:
+        # continues the stacking above the bottom wall, stretched to fit its box
+        return fcc111(self.film_spacing, planes=self.film_layers, fit=self.bottom.box,
+                      z0=self.bottom.top + plane_spacing(self.film_spacing),
+                      stacking=self.wall_planes, origin=ORIGIN)
+
+    @cached_property
+    def top(self) -> Fcc111:
+        z0 = self.film.top + self.film.plane_spacing + TOP_WALL_ROOM
+        return fcc111(self.wall_spacing, self.cells, self.wall_planes, z0=z0,
+                      stacking=self.wall_planes + self.film_layers, origin=ORIGIN)
+
+    @property
+    def box(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
+        """((xlo, xhi), (ylo, yhi), (zlo, zhi))."""
+        hw = self.bottom.plane_spacing
+        return ((0.0, self.bottom.box[0]), (0.0, self.bottom.box[1]),
+                (-0.5 * hw, self.top.top + 3.0 * hw + self.cutoff))
+
+    def atoms(self):
+        """Every atom as ``ase.Atoms``: bottom wall, film, top wall; atomic number = type.
+
+        The cell has the box's lengths; positions are the simulation's, the
+        bottom wall's first plane at z = 0, half a plane spacing above the
+        box's ``zlo`` (an ``ase.Atoms`` cell starts at 0: :meth:`lammps_data`
+        writes the box's own z bounds).
+        """
+        out = []
+        for stack, rigid, mobile, outer in (
+                (self.bottom, AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE, 0),
+                (self.film, AtomType.FILM, AtomType.FILM, None),
+                (self.top, AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE, self.wall_planes - 1)):
+            part = stack.atoms()
+            kind = np.full(len(part), int(rigid))
+            if self.flexible_walls and outer is not None:
+                kind[stack.plane != outer] = int(mobile)
+            part.numbers = kind
+            out.append(part)
+        system = out[0] + out[1] + out[2]
+        (_, lx), (_, ly), (zlo, zhi) = self.box
+        system.set_cell([lx, ly, zhi - zlo])
+        system.pbc = (True, True, False)
+        return system
+
+    def lammps_data(self, title: str = "") -> str:
+        """The LAMMPS data file (``atom_style atomic``, 5 atom types), as text.
+
+        Written by ``ase.io`` (``lammps-data``); ASE puts every box's lower
+        corner at 0, so the z bounds line is set to the box's own, and the
+        first line (a comment for LAMMPS) says what the file holds.
+        """
+        from ase.io import write
+
+        buf = io.StringIO()
+        write(buf, self.atoms(), format="lammps-data", specorder=list(TYPE_SYMBOLS),
+              atom_style="atomic", units="metal")
+        lines = buf.getvalue().splitlines()
+        (zlo, zhi) = self.box[2]
+        for i, line in enumerate(lines):
+            if line.endswith("zlo zhi"):
+                lines[i] = f"{zlo!r} {zhi!r}  zlo zhi"
+                break
+        else:                                       # pragma: no cover - ase's format
+            raise RuntimeError("ase wrote no 'zlo zhi' line")
+        lines[0] = "# filmfriction " + (title or self.describe()) + " (written by ASE)"
+        return "\n".join(lines) + "\n"
+
+    def describe(self) -> str:
+        """The parameters in one line (the data file's first line)."""
+        return (f"film_slide geometry: wall_spacing={self.wall_spacing!r} "
+                f"film_spacing={self.film_spacing!r} cells={self.cells[0]}x{self.cells[1]} "
+                f"film_layers={self.film_layers} wall_planes={self.wall_planes} "
+                f"cutoff={self.cutoff!r} walls={'flexible' if self.flexible_walls else 'rigid'}")

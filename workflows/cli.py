@@ -16,6 +16,7 @@ import sys
 COMMANDS = {
     "run": "filmfriction.workflows.run_cli",
     "scenes": "filmfriction.workflows.run_cli",
+    "geometry": "filmfriction.workflows.run_cli",
     "bench": "filmfriction.workflows.bench",
     "analyze": "filmfriction.workflows.analyze_cli",
     "map": "filmfriction.workflows.map_cli",

@@ -60,6 +60,24 @@ def register(subparsers) -> None:
                         "and meaning")
     s.set_defaults(func=list_scenes)
 
+    from filmfriction.md_inputs.contract import DATA_FILE
+
+    g = subparsers.add_parser(
+        "geometry", help="write a scene's walls and film as a LAMMPS data file",
+        description="Build a scene's walls and film with ASE and write them as the LAMMPS "
+                    "data file film_slide.lmp starts from (what 'run' writes into each run "
+                    "directory), to run the script by hand.  Give the script the same "
+                    "parameter values with -var.")
+    g.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
+                   help=f"scene name or TOML file (default: {DEFAULT_SCENE})")
+    g.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene parameter (LJ units), e.g. --set film_layers=4")
+    g.add_argument("--fidelity", choices=_fidelities(), default=None,
+                   help="numerical preset, as for 'run'")
+    g.add_argument("--out", type=Path, default=Path(DATA_FILE),
+                   help=f"data file to write (default {DATA_FILE}, the script's data_file)")
+    g.set_defaults(func=write_geometry)
+
 
 def _number(value) -> str:
     return str(value) if isinstance(value, int) else f"{value:g}"
@@ -128,7 +146,7 @@ def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
 def run(args: argparse.Namespace) -> int:
     from .cli import UserError
     from .runner import RunFailed, execute, resume
-    from .scene import SceneError, load
+    from .scene import SceneError
 
     check_ranks(args.np)
     if args.resume and (args.overrides or args.fidelity or args.out):
@@ -143,20 +161,7 @@ def run(args: argparse.Namespace) -> int:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
                              lmp=args.lmp)
         else:
-            user = _overrides(args)
-            if args.fidelity:
-                from .fidelity import preset
-
-                extra = preset(args.fidelity, load(args.scene, user).parameters)
-                clash = sorted(set(extra) & set(user))
-                if clash:
-                    # the preset rescales step counts with its timestep: a --set of
-                    # the same keys would silently break that
-                    raise UserError(f"--set {', '.join(clash)} conflicts with "
-                                    f"--fidelity {args.fidelity}")
-                user = {**extra, **user}
-            scene = load(args.scene, user)
-            run_dir = execute(scene, out=args.out, nprocs=args.np or 2,
+            run_dir = execute(_scene(args), out=args.out, nprocs=args.np or 2,
                               progress=not args.quiet, lmp=args.lmp)
     except SceneError as exc:
         raise UserError(str(exc)) from None
@@ -178,6 +183,46 @@ def run(args: argparse.Namespace) -> int:
     if args.md_only:
         return 0
     return post_process(run_dir)
+
+
+def _scene(args: argparse.Namespace):
+    """The scene of ``args.scene`` with ``--fidelity`` and ``--set`` applied."""
+    from .cli import UserError
+    from .scene import load
+
+    user = _overrides(args)
+    if args.fidelity:
+        from .fidelity import preset
+
+        extra = preset(args.fidelity, load(args.scene, user).parameters)
+        clash = sorted(set(extra) & set(user))
+        if clash:
+            # the preset rescales step counts with its timestep: a --set of
+            # the same keys would silently break that
+            raise UserError(f"--set {', '.join(clash)} conflicts with "
+                            f"--fidelity {args.fidelity}")
+        user = {**extra, **user}
+    return load(args.scene, user)
+
+
+def write_geometry(args: argparse.Namespace) -> int:
+    from filmfriction.analysis.util import write_atomic
+
+    from .cli import UserError, check_writable
+    from .scene import SceneError
+
+    try:
+        scene = _scene(args)
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    check_writable(args.out, "--out")
+    g = scene.geometry()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(args.out, g.lammps_data())
+    print(f"{args.out}: {g.film.n_atoms} film atoms, {g.bottom.n_atoms} + {g.top.n_atoms} "
+          f"wall atoms ({g.wall_planes} planes each, {'flexible' if g.flexible_walls else 'rigid'}"
+          f" walls), box {g.box[0][1]:.6g} x {g.box[1][1]:.6g} sigma")
+    return 0
 
 
 def _print_warnings(run_dir: Path) -> None:

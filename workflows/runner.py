@@ -4,6 +4,7 @@ A run directory holds::
 
     scene.toml      the resolved scene (every parameter, as run)
     command.txt     the exact command line
+    geometry.data   the walls and the film LAMMPS starts from (built with ASE)
     run.json        the record: scene, versions, seeds, atoms, timing, status
     trace.csv       the trace in LJ units (columns: TRACE_COLUMNS)
     trace.dat       LAMMPS's own trace (fix print), kept for --resume
@@ -48,6 +49,7 @@ OWN_SCRIPT = "script.lmp"
 DAT_COLUMNS = contract.DAT_COLUMNS
 TRACE_COLUMNS = contract.TRACE_COLUMNS
 TRACE_UNITS = contract.TRACE_UNITS
+DATA_FILE = contract.DATA_FILE
 
 
 class RunFailed(RuntimeError):
@@ -569,6 +571,8 @@ def _execute(scene, run_dir, nprocs, progress, launcher, state, build, threads=1
     state["record"] = record = _record(scene, run_dir, cmd, nprocs, threads)
     record["lammps"] = build.as_dict()
     write_atomic(run_dir / "scene.toml", scene_toml(scene))
+    # the walls and the film, built with ASE: the script reads them (read_data)
+    write_atomic(run_dir / DATA_FILE, scene.geometry().lammps_data())
     write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
     write_json(run_dir / "run.json", record)
     return _drive(scene, run_dir, record, cmd, total, 0, progress)

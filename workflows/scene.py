@@ -34,7 +34,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from filmfriction.md_inputs.geometry import fcc111, plane_spacing
+from filmfriction.md_inputs.geometry import ConfinedFilm, fewest_wall_planes
 
 
 # A scene name: it names the run directory, so no path separators, no "..".
@@ -212,6 +212,10 @@ class Scene:
     def derived(self) -> dict[str, float]:
         return derived_quantities(self.parameters)
 
+    def geometry(self) -> ConfinedFilm:
+        """The walls and the film: :meth:`ConfinedFilm.lammps_data` is the script's data file."""
+        return geometry(self.parameters)
+
     def lammps_variables(self) -> dict[str, str]:
         """``-var`` values for ``film_slide.lmp``: numbers formatted here, nothing else."""
         p = dict(self.parameters)
@@ -240,14 +244,21 @@ class Scene:
                 "script": self.script, "lammps_packages": list(self.lammps_packages)}
 
 
+def geometry(p: dict) -> ConfinedFilm:
+    """The walls and the film the parameters describe (built with ASE when asked for)."""
+    return ConfinedFilm(
+        wall_spacing=p["wall_spacing"], film_spacing=p["film_spacing"],
+        cells=(p["cells_x"], p["cells_y"]), film_layers=p["film_layers"],
+        wall_planes=p["wall_layers"] or fewest_wall_planes(p["cutoff"], p["wall_spacing"]),
+        cutoff=p["cutoff"], flexible_walls=p["wall_model"] == "flexible")
+
+
 def derived_quantities(p: dict) -> dict[str, float]:
     """Box, atom counts and time scales implied by the parameters (before LAMMPS runs)."""
-    d = p["wall_spacing"]
     # the walls' (111) planes, and the film's, stretched to fit the walls' box
-    # (the same geometry film_slide.lmp builds with its lattice commands)
-    wall_layers = p["wall_layers"] or math.ceil(p["cutoff"] / plane_spacing(d)) + 1
-    wall = fcc111(d, (p["cells_x"], p["cells_y"]), wall_layers)
-    film = fcc111(p["film_spacing"], planes=p["film_layers"], fit=wall.box)
+    # (the geometry film_slide.lmp reads from its data file)
+    g = geometry(p)
+    wall, film, wall_layers = g.bottom, g.film, g.wall_planes
     lx, ly = wall.box
     omega = math.sqrt(p["spring_constant"] / p["wall_mass"])
     flexible = p["wall_model"] == "flexible"

@@ -100,32 +100,40 @@ def test_contract_lookup():
 
 
 # ---------------------------------------------------------------- atom types
-def test_the_script_creates_the_contract_types():
+def test_the_script_reads_the_contract_types():
     cmds = script_commands()
-    assert "create_box 5 box" in cmds
+    assert "read_data ${data_file}" in cmds
+    assert "variable data_file index " + contract.DATA_FILE in cmds
     assert len(AtomType) == 5
-    created = {m.group(2): int(m.group(1)) for c in cmds
-               for m in [re.fullmatch(r"create_atoms\s+(\d)\s+region\s+(\w+)", c)] if m}
-    assert created == {"rbot": AtomType.BOTTOM_WALL, "rtop": AtomType.TOP_WALL,
-                       "rfilm": AtomType.FILM}
-    flexible = next(c for c in cmds
-                    if c.startswith('if "${wall_model} == 1" then') and "set region" in c)
-    assert f'"set region rbflex type {int(AtomType.BOTTOM_FLEXIBLE)}"' in flexible
-    assert f'"set region rtflex type {int(AtomType.TOP_FLEXIBLE)}"' in flexible
     groups = {m.group(1): tuple(int(t) for t in m.group(2).split()) for c in cmds
               for m in [re.fullmatch(r"group\s+(\w+)\s+type\s+([\d ]+)", c)] if m}
     assert groups == {"film": contract.FILM_TYPES, "bottom": (AtomType.BOTTOM_WALL,),
                       "top": (AtomType.TOP_WALL,), "bflex": (AtomType.BOTTOM_FLEXIBLE,),
                       "tflex": (AtomType.TOP_FLEXIBLE,),
                       "walls": (AtomType.BOTTOM_FLEXIBLE, AtomType.TOP_FLEXIBLE)}
+    unions = {m.group(1): m.group(2).split() for c in cmds
+              for m in [re.fullmatch(r"group\s+(\w+)\s+union\s+([\w ]+)", c)] if m}
+    assert unions == {"bwall": ["bottom", "bflex"], "twall": ["top", "tflex"]}
     assert contract.BOTTOM_WALL_TYPES == (AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE)
     assert contract.TOP_WALL_TYPES == (AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE)
 
 
+def test_the_data_file_has_the_contract_types():
+    from filmfriction.md_inputs.geometry import TYPE_SYMBOLS
+
+    text = Scene(name="types", description="", models="", observables=(), expected_cost="",
+                 parameters=resolve({"wall_model": "flexible"})).geometry().lammps_data()
+    assert f"{len(AtomType)} atom types" in text
+    atoms = text[text.index("Atoms # atomic"):].splitlines()[2:]
+    assert {int(line.split()[1]) for line in atoms if line.strip()} == set(map(int, AtomType))
+    assert len(TYPE_SYMBOLS) == len(AtomType)
+
+
 # ---------------------------------------------------------------- defaults
-# index variables the scene does not set: the runner's progress interval and
-# the offsets of a resumed run (the runner reads them from the run directory)
-SCRIPT_ONLY = {"thermo_every", "resume", "restart_file", "drive_origin", "wall_z0",
+# index variables the scene does not set: the runner's progress interval, the data
+# file (the runner writes it under the script's default name) and the offsets of a
+# resumed run (the runner reads them from the run directory)
+SCRIPT_ONLY = {"thermo_every", "data_file", "resume", "restart_file", "drive_origin", "wall_z0",
                "drive_work0", "heat0", "mount_heat0"}
 # the scene's default applies only when its observables ask for the output;
 # otherwise the runner passes 0, which is the script's default

@@ -1,18 +1,20 @@
-"""One fcc(111) geometry (md_inputs/geometry.py): the scene's derived quantities and the
-synthetic films use it, ase builds the same crystal, and so does film_slide.lmp (a tiny
-real LAMMPS run, marker md)."""
+"""One geometry (md_inputs/geometry.py, built with ASE): the scene's derived quantities, the
+synthetic films and film_slide.lmp's data file.  Checked against the crystal's own
+properties, against LAMMPS's lattice commands (tests/md_inputs/lattice_reference.lmp, a tiny
+real LAMMPS run, marker md), and run by the script (marker md)."""
 import math
+import re
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
-from ase.build import fcc111 as ase_fcc111
 
 from filmfriction import md_inputs
-from filmfriction.md_inputs.contract import AtomType
+from filmfriction.md_inputs.contract import DATA_FILE, AtomType
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 from filmfriction.workflows import engine
-from filmfriction.workflows.scene import Scene, derived_quantities, resolve
+from filmfriction.workflows.scene import Scene, derived_quantities, geometry, resolve
 
 
 def _same_sites(a, b, box, atol=1e-9):
@@ -52,23 +54,6 @@ def test_spacings_counts_and_stacking():
     d = lat.positions[lat.plane == 0][:, None] - nxt[None]
     d[..., :2] -= np.asarray(lat.box) * np.round(d[..., :2] / np.asarray(lat.box))
     assert np.all(np.sum(np.isclose(np.sqrt((d ** 2).sum(-1)), a), axis=1) == 3)
-
-
-@pytest.mark.parametrize("planes", [3, 4])
-def test_the_same_crystal_as_ase(planes):
-    # ase's orthogonal fcc111 (cubic constant a*sqrt(2), 2 rows per cell along y)
-    # ends every slab on an A plane: its first plane has stacking index 1 - planes
-    a = 1.1
-    ref = ase_fcc111("Cu", size=(5, 6, planes), a=a * math.sqrt(2), orthogonal=True,
-                     periodic=True)
-    ours = fcc111(a, (5, 3), planes=planes, stacking=1 - planes)
-    np.testing.assert_allclose(ours.box, ref.cell.lengths()[:2], rtol=1e-12)
-    assert ref.positions[:, 2].min() == 0.0
-    _same_sites(ours.positions, ref.positions, ours.box)
-    # and not another stacking
-    with pytest.raises(AssertionError):
-        _same_sites(fcc111(a, (5, 3), planes=planes, stacking=2 - planes).positions,
-                    ref.positions, ours.box)
 
 
 def test_a_fitted_film_is_stretched_to_the_box():
@@ -116,18 +101,19 @@ def test_the_synthetic_film_is_the_geometry(tmp_path):
     shifts = [(0.0, 0.0), (0.5 * a, a / (2 * np.sqrt(3))), (a, a / np.sqrt(3))]
     old = np.vstack([np.column_stack([np.mod(base + shifts[p % 3], [nx * a, ny * np.sqrt(3) * a]),
                                       np.full(len(base), (p + 1) * h)]) for p in range(7)])
-    np.testing.assert_allclose(lat.positions, old, rtol=0, atol=1e-12)
+    _same_sites(lat.positions, old, lat.box, atol=1e-12)
     assert list(np.unique(u.atoms.types.astype(int))) == [1, 2, 3]
 
 
 def _atoms(data_file):
-    """Box (Lx, Ly) and (type, x, y, z) rows of a LAMMPS data file (atom_style atomic)."""
+    """Box ((lo, hi) along x, y, z) and (type, x, y, z) rows of a LAMMPS data file
+    (atom_style atomic)."""
     lines = data_file.read_text().splitlines()
     box = {}
     for line in lines:
         parts = line.split()
-        if len(parts) == 4 and parts[2:] in (["xlo", "xhi"], ["ylo", "yhi"]):
-            box[parts[2][0]] = float(parts[1]) - float(parts[0])
+        if len(parts) >= 4 and parts[2:4] in (["xlo", "xhi"], ["ylo", "yhi"], ["zlo", "zhi"]):
+            box[parts[2][0]] = (float(parts[0]), float(parts[1]))
     start = next(i for i, line in enumerate(lines) if line.startswith("Atoms")) + 2
     rows = []
     for line in lines[start:]:
@@ -135,50 +121,149 @@ def _atoms(data_file):
             break
         f = line.split()
         rows.append([int(f[1]), float(f[2]), float(f[3]), float(f[4])])
-    return (box["x"], box["y"]), np.array(rows)
+    return (box["x"], box["y"], box["z"]), np.array(rows)
+
+
+def _sorted_rows(rows, box):
+    """Rows wrapped into the box in x and y (a site on the boundary at 0) and sorted."""
+    rows = rows.copy()
+    lengths = np.array([box[0][1] - box[0][0], box[1][1] - box[1][0]])
+    rows[:, 1:3] = np.mod(rows[:, 1:3] + 1e-9, lengths) - 1e-9
+    key = np.round(rows, 6)
+    return rows[np.lexsort((key[:, 2], key[:, 1], key[:, 3], key[:, 0]))]
+
+
+def _geometry(wall_model="rigid", **overrides):
+    return geometry(resolve({"wall_model": wall_model, **overrides}))
+
+
+def test_the_data_file_holds_the_geometry(tmp_path):
+    g = _geometry("flexible")
+    path = tmp_path / "geometry.data"
+    path.write_text(g.lammps_data())
+    box, rows = _atoms(path)
+    assert "5 atom types" in path.read_text()
+    assert box[0] == (0.0, g.bottom.box[0]) and box[1] == (0.0, g.bottom.box[1])
+    assert box[2] == pytest.approx(g.box[2], rel=1e-15)
+    # every atom inside the box, the bottom wall's first plane half a plane above zlo
+    assert rows[:, 3].min() == 0.0 == box[2][0] + 0.5 * g.bottom.plane_spacing
+    assert rows[:, 3].max() < box[2][1] - g.cutoff
+    types, counts = np.unique(rows[:, 0].astype(int), return_counts=True)
+    nw, per_plane = g.wall_planes, g.bottom.atoms_per_plane
+    assert dict(zip(types.tolist(), counts.tolist())) == {
+        AtomType.FILM: g.film.n_atoms, AtomType.BOTTOM_WALL: per_plane,
+        AtomType.TOP_WALL: per_plane, AtomType.BOTTOM_FLEXIBLE: (nw - 1) * per_plane,
+        AtomType.TOP_FLEXIBLE: (nw - 1) * per_plane}
+    # the outermost plane of each wall is the rigid one
+    z = {t: rows[rows[:, 0] == t, 3] for t in types}
+    assert z[AtomType.BOTTOM_WALL].max() < z[AtomType.BOTTOM_FLEXIBLE].min()
+    assert z[AtomType.TOP_WALL].min() > z[AtomType.TOP_FLEXIBLE].max()
+    # the layout: the film one film plane above the bottom wall, the top wall one film
+    # plane and 0.3 sigma of room above the film
+    hf = plane_spacing(g.film_spacing)
+    assert z[AtomType.FILM].min() == pytest.approx(z[AtomType.BOTTOM_FLEXIBLE].max() + hf)
+    assert z[AtomType.TOP_FLEXIBLE].min() == pytest.approx(z[AtomType.FILM].max() + hf + 0.3)
+    # rigid walls: no flexible types, and ase reads the file back type for type
+    from ase.io import read
+
+    rigid = _geometry()
+    path.write_text(rigid.lammps_data())
+    back = read(path, format="lammps-data", atom_style="atomic", units="metal")
+    assert "5 atom types" in path.read_text()
+    assert sorted(set(back.numbers)) == [AtomType.FILM, AtomType.BOTTOM_WALL, AtomType.TOP_WALL]
+    assert len(back) == rigid.film.n_atoms + 2 * rigid.bottom.n_atoms
+
+
+def test_one_abc_stacking_through_wall_film_and_wall():
+    g = _geometry()
+    atoms = g.atoms()
+    z = np.round(atoms.positions[:, 2], 9)
+    planes = np.unique(z)
+    assert planes.size == 2 * g.wall_planes + g.film_layers
+    # consecutive planes never sit over each other; planes three apart do (the film
+    # has the walls' spacing in the default scene)
+    xy = [np.sort(atoms.positions[z == p, :2].round(6), axis=0) for p in planes]
+    for i in range(planes.size - 1):
+        assert not np.array_equal(xy[i], xy[i + 1]), i
+    for i in range(planes.size - 3):
+        assert np.array_equal(xy[i], xy[i + 3]), i
+
+
+@pytest.mark.md
+@pytest.mark.parametrize("wall_model,overrides", [
+    ("rigid", {}), ("flexible", {}),
+    ("rigid", {"film_spacing": 1.05, "cells_x": 9, "cells_y": 5, "film_layers": 4,
+               "wall_spacing": 1.0})])
+def test_ase_builds_what_the_lattice_commands_built(tmp_path, wall_model, overrides):
+    """ASE's data file against the atoms LAMMPS's lattice commands create (the geometry
+    section film_slide.lmp had, tests/md_inputs/lattice_reference.lmp): same box, same
+    types, same positions (1e-6 sigma) after sorting."""
+    p = resolve({"wall_model": wall_model, **overrides})
+    names = ("wall_spacing", "film_spacing", "wall_layers", "cells_x", "cells_y", "film_layers",
+             "cutoff")
+    variables = {n: repr(p[n]) if isinstance(p[n], float) else str(p[n]) for n in names}
+    variables["wall_model"] = str(int(wall_model == "flexible"))
+    reference = Path(__file__).with_name("lattice_reference.lmp")
+    cmd = engine.lmp_command(1, reference, variables)
+    out = subprocess.run(cmd, cwd=tmp_path, env=engine.engine_env(), capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stdout[-3000:]
+    box_ref, ref = _atoms(tmp_path / "lattice.data")
+    (tmp_path / "geometry.data").write_text(geometry(p).lammps_data())
+    box, ours = _atoms(tmp_path / "geometry.data")
+    np.testing.assert_allclose(np.array(box), np.array(box_ref), rtol=0, atol=1e-9)
+    assert ours.shape == ref.shape
+    ref, ours = _sorted_rows(ref, box), _sorted_rows(ours, box)
+    np.testing.assert_array_equal(ours[:, 0], ref[:, 0])
+    np.testing.assert_allclose(ours[:, 1:], ref[:, 1:], rtol=0, atol=1e-6)
+    # and the test can fail: one plane of the film moved by 1e-5 sigma is seen
+    moved = ours.copy()
+    moved[moved[:, 0] == AtomType.FILM, 3] += 1e-5
+    with pytest.raises(AssertionError):
+        np.testing.assert_allclose(moved[:, 1:], ref[:, 1:], rtol=0, atol=1e-6)
 
 
 @pytest.mark.md
 @pytest.mark.parametrize("wall_model", ["rigid", "flexible"])
-def test_the_script_builds_the_python_geometry(tmp_path, wall_model):
-    """film_slide.lmp's lattice commands, run for 0 steps with the default scene, place
-    every atom where md_inputs.geometry.fcc111 does (the script's z layout: the film one
-    film plane above the bottom wall, the top wall 0.3 sigma of room above the film)."""
+def test_the_script_reads_the_geometry(tmp_path, wall_model):
+    """film_slide.lmp, run for 0 steps with the default scene, starts from the data file:
+    its topology.data (written before any step) holds the same atoms, and the gap is
+    measured between the walls' facing planes."""
     p = resolve({"wall_model": wall_model})
     scene = Scene(name="geometry", description="", models="", observables=(),
                   expected_cost="", parameters=p)
+    g = scene.geometry()
+    (tmp_path / DATA_FILE).write_text(g.lammps_data())
     variables = {**scene.lammps_variables(), "equilibrate_steps": "0", "slide_steps": "0",
                  "dump_every": "1000", "thermo_every": "1000"}
     cmd = engine.lmp_command(1, md_inputs.script("film_slide.lmp"), variables)
     out = subprocess.run(cmd, cwd=tmp_path, env=engine.engine_env(), capture_output=True,
                          text=True, timeout=300)
     assert out.returncode == 0, out.stdout[-3000:]
-    box, atoms = _atoms(tmp_path / "topology.data")   # written before any step is taken
+    box, atoms = _atoms(tmp_path / "topology.data")
+    box0, atoms0 = _atoms(tmp_path / DATA_FILE)
+    np.testing.assert_allclose(np.array(box), np.array(box0), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(_sorted_rows(atoms, box), _sorted_rows(atoms0, box), atol=1e-9)
+    # the gap: the top wall's first plane above the bottom wall's last
+    gap = re.search(r"^\s*0\s+0\s+\S+\s+\S+\s+\S+\s+(\S+)", out.stdout, re.M)
+    assert gap, out.stdout[-2000:]
+    assert float(gap.group(1)) == pytest.approx(g.top.z0 - g.bottom.top, rel=1e-6)  # thermo: 7 digits
 
-    q = derived_quantities(p)
-    d, n, nw = p["wall_spacing"], p["film_layers"], q["wall_layers"]
-    origin = (0.25, 0.125)            # the script's lattice origin, off the boundary
-    bottom = fcc111(d, (p["cells_x"], p["cells_y"]), nw, origin=origin)
-    assert box == pytest.approx(bottom.box, rel=1e-12)
-    hw, hf = bottom.plane_spacing, plane_spacing(p["film_spacing"])
-    zf0 = (nw - 1) * hw + hf
-    film = fcc111(p["film_spacing"], planes=n, fit=bottom.box, z0=zf0, stacking=nw,
-                  origin=origin)
-    top = fcc111(d, (p["cells_x"], p["cells_y"]), nw, z0=zf0 + n * hf + 0.3, stacking=nw + n,
-                 origin=origin)
 
-    def sites(types):
-        return atoms[np.isin(atoms[:, 0], [int(t) for t in types]), 1:]
-
-    flexible = wall_model == "flexible"
-    _same_sites(sites([AtomType.FILM]), film.positions, box)
-    _same_sites(sites([AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE]), bottom.positions, box)
-    _same_sites(sites([AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE]), top.positions, box)
-    # flexible walls: every plane but the outermost one of each wall is mobile
-    _same_sites(sites([AtomType.BOTTOM_WALL]),
-                bottom.positions[bottom.plane == 0] if flexible else bottom.positions, box)
-    _same_sites(sites([AtomType.TOP_WALL]),
-                top.positions[top.plane == nw - 1] if flexible else top.positions, box)
-    assert len(sites([AtomType.BOTTOM_FLEXIBLE])) == (nw - 1) * bottom.atoms_per_plane * flexible
-    assert len(sites([AtomType.TOP_FLEXIBLE])) == (nw - 1) * top.atoms_per_plane * flexible
-    assert len(sites([AtomType.FILM])) == q["film_atoms"]
+@pytest.mark.md
+def test_the_script_refuses_a_data_file_of_other_parameters(tmp_path):
+    p = resolve({})
+    scene = Scene(name="geometry", description="", models="", observables=(),
+                  expected_cost="", parameters=p)
+    (tmp_path / DATA_FILE).write_text(_geometry(film_layers=4).lammps_data())
+    variables = {**scene.lammps_variables(), "equilibrate_steps": "0", "slide_steps": "0"}
+    cmd = engine.lmp_command(1, md_inputs.script("film_slide.lmp"), variables)
+    out = subprocess.run(cmd, cwd=tmp_path, env=engine.engine_env(), capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode != 0
+    assert "was not built for these parameters" in out.stdout
+    assert "4 film planes" in out.stdout and "film_layers 3" in out.stdout
+    (tmp_path / DATA_FILE).unlink()
+    out = subprocess.run(cmd, cwd=tmp_path, env=engine.engine_env(), capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode != 0 and f"no data file {DATA_FILE}" in out.stdout
