@@ -21,15 +21,10 @@ TRAJECTORY, TOPOLOGY = "trajectory.dcd", "topology.data"
 
 
 def universe(run_dir: Path):
-    """The MDAnalysis Universe of a run directory's trajectory."""
-    import warnings
+    """The MDAnalysis Universe of a run directory's trajectory, with times in τ."""
+    from ..structure import open_trajectory
 
-    import MDAnalysis as mda
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return mda.Universe(str(run_dir / TOPOLOGY), str(run_dir / TRAJECTORY),
-                            format="DCD", topology_format="DATA", atom_style="id type x y z")
+    return open_trajectory(run_dir / TOPOLOGY, run_dir / TRAJECTORY)
 
 
 class Structure(Observable):
