@@ -141,8 +141,10 @@ def test_film_above_melting_slides_without_stick_slip(run):
     # film is liquid: the wall slides at V after the spring's transient
     # 40 tau at V = 0.2: a solid film would slip every 1.1 sigma, 7 times
     _, d = run(temperature=1.2, drive_velocity=0.2, slide_steps=8000)
-    # at most the start-up overshoot of the spring, no periodic slips
-    assert detect_slips(d["time"], d["spring_force"]).count <= 1
+    # no periodic slips: the start-up yield of the film (still crystalline after
+    # 2.5 tau at kT 1.2), and at most one more event from the liquid's force
+    # fluctuations (0-2 events over 48 seeds; a solid film would slip 7 times)
+    assert detect_slips(d["time"], d["spring_force"]).count <= 2
     half = len(d) // 2
     v = (d["wall_position"][-1] - d["wall_position"][half]) / (d["time"][-1] - d["time"][half])
     assert v == pytest.approx(0.2, rel=0.1)
