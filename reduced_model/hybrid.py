@@ -165,6 +165,11 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     # laws with a state go to LSODA, which switches to BDF when (and only when) needed.
     # A heavily overdamped slip (zeta >> 1: velocity relaxes in M/B, slides in B/K) is stiff too.
     method = "LSODA" if (law.stiff or law.state_names or zeta > 10.0) else "DOP853"
+    if not has_stick and law.state_names:
+        from .limit_cycle import run_smooth
+        fast = run_smooth(p, rtol, atol, max_step)
+        if fast is not None:
+            return fast
     rec = p.recorder()
     n_stick = max(p.samples // 8, 2)
     T = p.duration
