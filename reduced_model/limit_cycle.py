@@ -112,7 +112,6 @@ class _SmoothRun:
             (ss0,), (si0,) = st_scale, st_inv
 
             def f(tau, z):
-                self.nfev += 1
                 z0, z1, _, _, _, z5 = z.tolist()
                 vb = z1 * s1
                 f_spring = ks0 * z0
@@ -122,7 +121,6 @@ class _SmoothRun:
                         fr * s * i3, dv_i4 * vb * vb, r[0] * si0]
         else:
             def f(tau, z):
-                self.nfev += 1
                 zl = z.tolist()
                 vb = zl[1] * s1
                 f_spring = ks0 * zl[0]
@@ -159,22 +157,26 @@ class _SmoothRun:
         self.ts, self.zs = ts, zs
         self.events, self.slips, self.flushed = [], [], 0
         self.e_ref = K * float(z0[0] * scale[0])
-        s1 = float(scale[1])
+        s1, k0 = float(scale[1]), K * float(scale[0])
         g_prev = [float(z0[1]) * s1 - va]
-        budget = [1000 + 400.0 * (T - t0) / p.period]
+        budget = 1000 + 400.0 * (T - t0) / p.period
         stop = {}
 
         def solout(tau, z):
             if not tau > ts[-1]:
                 return 0
             ts.append(tau)
-            zs.append(np.array(z))
-            if len(ts) > budget[0]:
+            zs.append(z.copy())
+            if len(ts) > budget:
                 stop["stiff"] = True
                 return -1
-            f_spring = K * float(z[0]) * float(scale[0])
-            self.f_min, self.f_max = min(self.f_min, f_spring), max(self.f_max, f_spring)
-            g = float(z[1]) * s1 - va
+            z0, z1 = z[:2].tolist()
+            f_spring = k0 * z0
+            if f_spring < self.f_min:
+                self.f_min = f_spring
+            elif f_spring > self.f_max:
+                self.f_max = f_spring
+            g = z1 * s1 - va
             crossed = (g > 0.0) != (g_prev[0] > 0.0) and g != 0.0 and g_prev[0] != 0.0
             rising = g_prev[0] < 0.0
             g_prev[0] = g
@@ -197,6 +199,7 @@ class _SmoothRun:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")     # "probably stiff": the caller takes over
                 solver.integrate(T - t0)
+            self.nfev += int(solver._integrator.iwork[16])      # NFCN of this call
             if stop.get("stiff") or (not solver.successful() and not stop):
                 return False, None
             if "extremum" in stop:
@@ -211,6 +214,7 @@ class _SmoothRun:
         """dz/dt and d2z/dt2 (a central difference along the flow, over 1e-3 of the step)."""
         fz = np.array(self.f(0.0, z))
         eps = 1e-3 * h
+        self.nfev += 3
         return fz, (np.array(self.f(0.0, z + eps * fz)) - np.array(self.f(0.0, z - eps * fz))) / (2.0 * eps)
 
     def _extremum(self, is_max):
@@ -259,6 +263,7 @@ class _SmoothRun:
         integ = self.sub._integrator
         integ.work[6] = t_e - t_a               # the first (and only) step
         _, z, istate = integ.runner(self.f, t_a, np.array(z_a), t_e, *integ.call_args, ())
+        self.nfev += int(integ.iwork[16])
         return z if istate > 0 else None
 
     def _keep(self, t_e, kind, force, j):
