@@ -1,7 +1,7 @@
 """Fast path for smooth laws with a state (rate-and-state): compiled steps, exact
 extrema, and the converged limit cycle tiled.
 
-A smooth law (no static threshold) with a state makes the block an autonomous
+A smooth law (no static threshold) with one state variable makes the block an autonomous
 system in (spring extension, velocity, state).  Where the slip is not
 overdamped it is not stiff, and the run goes through here:
 
@@ -79,7 +79,7 @@ def run_smooth(p, rtol, atol, max_step):
     energies, the state) as the general path uses them."""
     law, N, M, K, d, u, va = p.law, p.normal_load, p.mass, p.stiffness, p.damping, p.u, p.va
     rates = law.scalar_state_rates(N)
-    if rates is None or M <= 0.0 or not law.state_names:
+    if rates is None or M <= 0.0 or len(law.state_names) != 1:
         return None
     if law.static_force(p.state0, N) is not None:
         return None
@@ -92,13 +92,13 @@ def run_smooth(p, rtol, atol, max_step):
 
 
 class _SmoothRun:
-    """The integration of :func:`run_smooth` (state: ext, v, three energies, the law's state)."""
+    """The integration of :func:`run_smooth`; the ODE's variables are (extension, v, drive
+    work, friction and damper dissipation, the law's one state variable)."""
 
     def __init__(self, p, rates, rtol, atol, max_step):
         self.p, self.rtol, self.max_step = p, float(rtol), float(max_step)
         M, K, d, u, va = (float(c) for c in (p.mass, p.stiffness, p.damping, p.u, p.va))
         self.K, self.va = K, va
-        n_state = len(p.law.state_names)
         # DOP853 takes one atol: integrate z = y / scale, the tolerances folded into the scale
         self.scale = scale = np.asarray(atol, dtype=float) / 1e-12
         s0, s1, s2, s3, s4 = (float(c) for c in scale[:5])
@@ -108,31 +108,21 @@ class _SmoothRun:
         a1, ks0, dv_i4 = i1 / M, K * s0, d * i4
         self.nfev = 0
 
-        if n_state == 1:                        # rate-and-state: the hot loop, unrolled
-            (ss0,), (si0,) = st_scale, st_inv
+        (ss0,), (si0,) = st_scale, st_inv        # one state variable (run_smooth checks)
 
-            def f(tau, z):
-                z0, z1, _, _, _, z5 = z.tolist()
-                vb = z1 * s1
-                f_spring = ks0 * z0
-                s = vb - u
-                fr, r = rates(s, (z5 * ss0,))
-                return [(va - vb) * i0, (f_spring - d * vb - fr) * a1, (f_spring * va - fr * u) * i2,
-                        fr * s * i3, dv_i4 * vb * vb, r[0] * si0]
-        else:
-            def f(tau, z):
-                zl = z.tolist()
-                vb = zl[1] * s1
-                f_spring = ks0 * zl[0]
-                s = vb - u
-                fr, r = rates(s, [c * sc for c, sc in zip(zl[5:], st_scale)])
-                return [(va - vb) * i0, (f_spring - d * vb - fr) * a1, (f_spring * va - fr * u) * i2,
-                        fr * s * i3, dv_i4 * vb * vb] + [c * si for c, si in zip(r, st_inv)]
+        def f(tau, z):                          # the hot loop: plain floats only
+            z0, z1, _, _, _, z5 = z.tolist()
+            vb = z1 * s1
+            f_spring = ks0 * z0
+            s = vb - u
+            fr, r = rates(s, (z5 * ss0,))
+            return [(va - vb) * i0, (f_spring - d * vb - fr) * a1, (f_spring * va - fr * u) * i2,
+                    fr * s * i3, dv_i4 * vb * vb, r[0] * si0]
         self.f = f
-        self.n_state = n_state
         self.rec = p.recorder()
         self.events = []          # kept extrema: [time, kind, force, sample list index]
-        self.slips = []           # (time, z at the maximum, energies there) of kept maxima
+        self.slips = []           # sample indices of the kept maxima
+        self.cycles = {}          # (start, end sample of a cycle) -> (its quantities, tolerances)
 
     # -- one stretch of integration ----------------------------------------------------
     def integrate(self):
@@ -155,7 +145,7 @@ class _SmoothRun:
         self.t0, self.xa0 = t0, xa0
         ts, zs = [0.0], [z0]
         self.ts, self.zs = ts, zs
-        self.events, self.slips, self.flushed = [], [], 0
+        self.events, self.slips, self.flushed, self.cycles = [], [], 0, {}
         self.e_ref = K * float(z0[0] * scale[0])
         s1, k0 = float(scale[1]), K * float(scale[0])
         g_prev = [float(z0[1]) * s1 - va]
@@ -291,11 +281,14 @@ class _SmoothRun:
     def _cycle(self, k):
         """(period, extension and state at the k-th kept maximum, energies gained since the one before)."""
         ja, jb = self.slips[k - 1], self.slips[k]
+        if (ja, jb) in self.cycles:
+            return self.cycles[ja, jb]
         za, zb = self.zs[ja] * self.scale, self.zs[jb] * self.scale
         q = np.concatenate(([self.ts[jb] - self.ts[ja], zb[0]], zb[5:], zb[2:5] - za[2:5]))
         tol = self.rtol * np.abs(q) + np.concatenate(([0.0, self.scale[0] * 1e-12],
                                                       np.full(zb.size - 5, self.rtol),
                                                       self.scale[2:5] * 1e-12))
+        self.cycles[ja, jb] = q, tol
         return q, tol
 
     def _converged(self):

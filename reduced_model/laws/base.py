@@ -148,7 +148,8 @@ class FrictionLaw:
 
     def scalar_state_rates(self, normal_load):
         """``(s, state) -> (friction(s, state, N), state_rate(|s|, state))`` on Python floats
-        (``state`` a list, the rates a list), for a smooth law with a state, or ``None``.
+        (``state`` a sequence, the rates a list), for a smooth law with one state variable,
+        or ``None``.
 
         A law that returns a closure gets the fast path of smooth runs
         (``reduced_model/limit_cycle.py``); it must agree with ``friction`` and
