@@ -11,10 +11,13 @@ overdamped it is not stiff, and the run goes through here:
   ``x_a - x`` is integrated, not the position, so rtol applies to the spring
   force rather than to a growing x; the three energy integrals ride along.
 * **extrema of the spring force** (the ``slip``/``stick`` events: ``v`` crosses
-  the drive speed) are roots of a quintic Hermite interpolant of the step
-  (values, first and second derivatives at both ends; the second from one
-  directional difference of the right-hand side), inserted as samples.  Wiggles
-  smaller than 10^-6 of the force level are dropped, as on the general path.
+  the drive speed): the step loop stops at the step that crosses (DOP853 is not
+  re-entrant) and goes on from there.  The time is the
+  root of a quintic Hermite interpolant of ``v`` over the step (values, first and
+  second derivatives at both ends; the second from a central difference along
+  the flow), the state there one more DOP853 step from the step's start, inserted
+  as a sample.  Wiggles smaller than 10^-6 of the force level are dropped, as on
+  the general path.
 * **limit cycle:** at every force maximum the cycle just finished (period,
   extension and state at the maximum, energy gained per cycle) is compared with
   the one before.  Once the change per cycle shrinks geometrically with ratio
@@ -149,7 +152,7 @@ class _SmoothRun:
         self.e_ref = K * float(z0[0] * scale[0])
         s1, k0 = float(scale[1]), K * float(scale[0])
         g_prev = [float(z0[1]) * s1 - va]
-        budget = 1000 + 400.0 * (T - t0) / p.period
+        budget = 1000 + 400.0 * (T - t0) / p.period     # steps; more is a stiff run
         stop = {}
 
         def solout(tau, z):
@@ -181,9 +184,7 @@ class _SmoothRun:
         self.sub = ode(self.f).set_integrator("dop853", rtol=self.rtol, atol=1e-12, nsteps=10 ** 6)
         self.sub.set_initial_value(z0, 0.0)
         while True:
-            # go on from the last accepted step, with the step size it had
-            if len(ts) > 1:
-                solver._integrator.first_step = ts[-1] - ts[-2]
+            # go on from the last accepted step (DOP853 picks its first step anew)
             solver.set_initial_value(zs[-1], ts[-1])
             stop.clear()
             with warnings.catch_warnings():
