@@ -43,7 +43,9 @@ def test_tiled_limit_cycle_equals_every_cycle_integrated(monkeypatch):
     np.testing.assert_allclose(ta, tb, rtol=0, atol=rtol * T)
     np.testing.assert_allclose(fa, fb, rtol=0, atol=10 * rtol * np.abs(fb).max())
     assert tiled.x[-1] == pytest.approx(full.x[-1], rel=10 * rtol)
-    assert tiled.state[0, -1] == pytest.approx(full.state[0, -1], abs=10 * rtol)
+    # the state where the phase is pinned (the last maximum), not at a time a phase error shifts
+    last = [[e.index for e in r.events if e.kind == "slip"][-1] for r in (tiled, full)]
+    assert tiled.psi[last[0]] == pytest.approx(full.psi[last[1]], abs=10 * rtol)
     assert tiled.energy.drive_work == pytest.approx(full.energy.drive_work, rel=10 * rtol)
     assert tiled.energy.closure < 1e-8
     assert tiled.t[-1] == full.t[-1] == T and np.all(np.diff(tiled.t) > 0)
