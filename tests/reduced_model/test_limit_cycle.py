@@ -106,3 +106,19 @@ def test_a_run_that_turns_stiff_falls_back(monkeypatch):
     general = block.simulate(300.0, initial_velocity=0.05)
     assert r.nfev == general.nfev and [e.time for e in r.events] == [e.time for e in general.events]
     np.testing.assert_array_equal(r.x, general.x)
+
+
+@pytest.mark.parametrize("options", [{"damping": 0.05}, {"drive": "belt"}], ids=["damper", "belt"])
+def test_fast_path_with_a_damper_or_a_belt(monkeypatch, options):
+    block = SpringBlock(mass=1.0, stiffness=10.0, drive_velocity=0.1, law=LAW, **options)
+    used = _spy(monkeypatch)
+    fast = block.simulate(40.0, initial_velocity=0.05)
+    assert used == [True]
+    _general_path(monkeypatch)
+    general = block.simulate(40.0, initial_velocity=0.05)
+    (ta, fa, ka), (tb, fb, kb) = _events(fast), _events(general)
+    assert ka == kb and len(ka) > 30
+    np.testing.assert_allclose(ta, tb, rtol=0, atol=1e-7)
+    assert fast.x[-1] == pytest.approx(general.x[-1], abs=1e-8)
+    assert fast.energy.damper_dissipation == pytest.approx(general.energy.damper_dissipation, rel=1e-8)
+    assert fast.energy.closure < 1e-10
