@@ -190,7 +190,7 @@ class _SmoothRun:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")     # "probably stiff": the caller takes over
                 solver.integrate(T - t0)
-            self.nfev += int(solver._integrator.iwork[16])      # NFCN of this call
+            self.nfev += int(getattr(solver._integrator, "iwork", [0] * 17)[16])  # its NFCN
             if stop.get("stiff") or (not solver.successful() and not stop):
                 return False, None
             if "extremum" in stop:
@@ -251,11 +251,17 @@ class _SmoothRun:
         accurate as the steps themselves; an interpolant is not, for a fast state)."""
         if not t_e > t_a:
             return None
-        integ = self.sub._integrator
-        integ.work[6] = t_e - t_a               # the first (and only) step
-        _, z, istate = integ.runner(self.f, t_a, np.array(z_a), t_e, *integ.call_args, ())
-        self.nfev += int(integ.iwork[16])
-        return z if istate > 0 else None
+        try:    # scipy's DOP853 wrapper called directly: no new solver object per event
+            integ = self.sub._integrator
+            integ.work[6] = t_e - t_a           # the first (and only) step
+            _, z, istate = integ.runner(self.f, t_a, np.array(z_a), t_e, *integ.call_args, ())
+            self.nfev += int(integ.iwork[16])
+            return z if istate > 0 else None
+        except (AttributeError, IndexError, TypeError, ValueError):     # other scipy internals
+            sub = ode(self.f).set_integrator("dop853", rtol=self.rtol, atol=1e-12, first_step=t_e - t_a)
+            sub.set_initial_value(z_a, t_a)
+            z = sub.integrate(t_e)
+            return z if sub.successful() else None
 
     def _keep(self, t_e, kind, force, j):
         events = self.events
