@@ -12,8 +12,11 @@ paths, i.e. at least as accurate).  Times are CPU seconds of this process
 (``time.process_time``), median, spread (min-max) and best of N repeats.
 Problems: M = K = 1, V = 0.1, d = 0.02, 100 cycles (Coulomb Fs = 1, Fk = 0.5;
 exponential Stribeck with v_s = 0.05); rate-and-state mu0 = 0.6, a = 0.01,
-b = 0.015, dc = 0.01, v0 = 0.1, K = 10, ~100 cycles from v = 0.05.  Then the
-creeping hold (M = 1e-6, K = 1e5, 1 s) and the slide-hold-slide healing.
+b = 0.015, dc = 0.01, v0 = 0.1, K = 10, ~100 cycles from v = 0.05 (and ~500 cycles,
+where the converged limit cycle is tiled), with the yield times and peak forces
+of both sides against a tight DOP853 run (rtol 1e-13), and the reference's LSODA
+on the law's plain-float closure for scale.  Then the creeping hold (M = 1e-6,
+K = 1e5, 1 s) and the slide-hold-slide healing.
 
 Older sections: ``--radau`` (against Radau at equal accuracy), ``--map``.
 
@@ -178,6 +181,39 @@ def fmt(ts):
             f"max {1e3 * ts.max():.2f}, n={ts.size})")
 
 
+def _rs_start(law, K):
+    psi0 = float(law.steady_state(V)[0])
+    return [float(law.friction(V, [psi0], 1.0)) / K, 0.05, psi0]     # extension, v, psi
+
+
+def _rs_rhs(law, K):
+    rates = law.scalar_state_rates(1.0)
+
+    def rhs(t, y):
+        fr, r = rates(y[1], [y[2]])
+        return [V - y[1], (K * y[0] - fr) / M, r[0]]
+    return rhs
+
+
+def rate_state_truth(law, K, duration):
+    """Yield times and peak forces of a tight DOP853 run (the reference's rule for yields)."""
+    rhs = _rs_rhs(law, K)
+
+    def extremum(t, y):
+        return y[1] - V
+    sol = solve_ivp(rhs, (0.0, duration), _rs_start(law, K), method="DOP853", rtol=1e-13,
+                    atol=1e-15, events=extremum)
+    te, ye = sol.t_events[0], sol.y_events[0]
+    rising = np.array([rhs(t, y)[1] > 0.0 for t, y in zip(te, ye)])
+    return {"yield_time": te[rising], "static_force": K * ye[rising, 0]}
+
+
+def lean_reference(law, K, duration):
+    """The reference's LSODA (rtol 1e-7) with the law as a plain-float closure, no events."""
+    return solve_ivp(_rs_rhs(law, K), (0.0, duration), _rs_start(law, K), method="LSODA",
+                     rtol=1e-7, atol=[1e-12, 1e-12, 1e-10])
+
+
 def issue14(repeat):
     import reference_event_driven as ref
 
@@ -212,25 +248,37 @@ def issue14(repeat):
     law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
     k_rs, T_rs = 10.0, 200.0
     block = SpringBlock(mass=M, stiffness=k_rs, drive_velocity=V, law=law)
-
-    def reduced_rs(rtol=1e-10):
-        return block.simulate(T_rs, initial_velocity=0.05, rtol=rtol).cycles()
-
-    def reference_rs():
-        return ref.rate_state(law, M=M, K=k_rs, V=V, duration=T_rs, v_start=0.05)
-    cyc, table = reduced_rs(), reference_rs()
-    n = min(len(cyc), table["yield_time"].size)
-    err = np.max(np.abs(cyc.static_force[:n] - table["static_force"][:n]))
     rs_repeat = max(3, repeat // 5)
-    t_ours, t_ours7, t_ref = (timings(reduced_rs, rs_repeat), timings(lambda: reduced_rs(1e-7), rs_repeat),
-                              timings(reference_rs, rs_repeat))
-    print(f"RateState {len(cyc)} cycles (reference {table['yield_time'].size}), K = {k_rs}; peak forces "
-          f"differ by <= {err:.1e}")
-    print(f"  reduced_model rtol 1e-10:      {fmt(t_ours)}")
-    print(f"  reduced_model rtol 1e-7:       {fmt(t_ours7)}")
-    print(f"  reference LSODA rtol 1e-7:     {fmt(t_ref)}")
-    print(f"  speed ratio: {np.median(t_ref) / np.median(t_ours):6.2f}x (rtol 1e-10), "
-          f"{np.median(t_ref) / np.median(t_ours7):.2f}x (rtol 1e-7); target >= 20x")
+    truth = rate_state_truth(law, k_rs, T_rs)
+    print(f"RateState, K = {k_rs}, {T_rs:g} time units from v = 0.05; truth: solve_ivp DOP853 rtol 1e-13, "
+          f"atol 1e-15 ({truth['yield_time'].size} yields)")
+    for T_run in (T_rs, 5 * T_rs):
+        def reduced_rs(rtol=1e-10):
+            return block.simulate(T_run, initial_velocity=0.05, rtol=rtol).cycles()
+
+        def reference_rs():
+            return ref.rate_state(law, M=M, K=k_rs, V=V, duration=T_run, v_start=0.05)
+        ours10, ours7, table = reduced_rs(), reduced_rs(1e-7), reference_rs()
+        if T_run == T_rs:
+            for label, yt, fy in (("reduced_model rtol 1e-10", ours10.yield_time, ours10.static_force),
+                                  ("reduced_model rtol 1e-7 ", ours7.yield_time, ours7.static_force),
+                                  ("reference LSODA rtol 1e-7", table["yield_time"], table["static_force"])):
+                n = min(yt.size, truth["yield_time"].size)
+                print(f"  {label}: {yt.size} cycles; against the truth yield times within "
+                      f"{np.max(np.abs(yt[:n] - truth['yield_time'][:n])):.1e}, peak forces within "
+                      f"{np.max(np.abs(fy[:n] - truth['static_force'][:n])):.1e}")
+        t_ours, t_ours7, t_ref = (timings(reduced_rs, rs_repeat), timings(lambda: reduced_rs(1e-7), rs_repeat),
+                                  timings(reference_rs, rs_repeat))
+        print(f"  {T_run:g} time units ({len(ours10)} cycles):")
+        print(f"    reduced_model rtol 1e-10:      {fmt(t_ours)}")
+        print(f"    reduced_model rtol 1e-7:       {fmt(t_ours7)}")
+        print(f"    reference LSODA rtol 1e-7:     {fmt(t_ref)}")
+        if T_run == T_rs:
+            t_lean = timings(lambda: lean_reference(law, k_rs, T_run), rs_repeat)
+            print(f"    the reference's LSODA on the law's plain-float closure (scalar_state_rates), "
+                  f"events off: {fmt(t_lean)}")
+        print(f"    speed ratio: {np.median(t_ref) / np.median(t_ours):6.2f}x (rtol 1e-10), "
+              f"{np.median(t_ref) / np.median(t_ours7):.2f}x (rtol 1e-7); target >= 20x")
 
     rs = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-5, v0=1e-6)
     hold = SpringBlock(mass=1e-6, stiffness=1e5, drive_velocity=0.0, drive="fixed", law=rs)

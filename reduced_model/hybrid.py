@@ -31,7 +31,12 @@ local damping ratio (:class:`_LocalCapLSODA`): a creeping hold of a light block
 no longer crawls at a sixteenth of the natural period.
 
 Smooth laws (rate-and-state, films without a yield force) are one ODE; their
-``slip``/``stick`` events mark the maxima/minima of the spring force.  A
+``slip``/``stick`` events mark the maxima/minima of the spring force.  Those with
+one state variable and a plain-float closure (``law.scalar_state_rates``) first
+try the fast path of :mod:`.limit_cycle` (compiled DOP853, the converged limit
+cycle tiled), which hands back to LSODA here where the run is stiff.  LSODA
+past ``STEPS_PER_PERIOD`` steps per natural period counts as stalled and Radau
+redoes the segment.  A
 massless block (M = 0) is integrated quasi-statically: the slip velocity
 follows from ``friction(v) = spring force`` (``law.quasi_static_speed``).
 """
@@ -67,14 +72,22 @@ class _LocalCapLSODA(LSODA):
     change HMAX mid-run).  scipy's C port of LSODA restarts its history on
     ISTATE = 3, so the cap changes only when it moves by more than 10x.  Should scipy's
     internals differ, the constructor's fixed cap stays (the old behaviour).
+
+    A stick-slip run of a light block can still trap LSODA in steps far below any
+    time scale of the motion (10^5 steps per natural period where 10^2 do).  More
+    than :data:`STEPS_PER_PERIOD` steps per natural period elapsed (plus as many
+    to start) count as a failure, and the caller redoes the segment with Radau.
     """
 
-    def __init__(self, fun, t0, y0, t_bound, *, cap=None, **kwargs):
+    def __init__(self, fun, t0, y0, t_bound, *, cap=None, period=math.inf, **kwargs):
         super().__init__(fun, t0, y0, t_bound, **kwargs)
-        self._cap = cap
+        self._cap, self._t_start, self._period = cap, t0, period
 
     def _step_impl(self):
         self._count = getattr(self, "_count", 0) + 1
+        if self._count > STEPS_PER_PERIOD * (1.0 + (self.t - self._t_start) / self._period):
+            return False, (f"LSODA took more than {STEPS_PER_PERIOD} steps per natural period "
+                           f"by t = {self.t:.6g}")
         if self._count % 4 != 1:                # the cap is a slow variable: look every 4 steps
             return super()._step_impl()
         try:
@@ -165,6 +178,11 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     # laws with a state go to LSODA, which switches to BDF when (and only when) needed.
     # A heavily overdamped slip (zeta >> 1: velocity relaxes in M/B, slides in B/K) is stiff too.
     method = "LSODA" if (law.stiff or law.state_names or zeta > 10.0) else "DOP853"
+    if not has_stick and law.state_names:
+        from .limit_cycle import run_smooth
+        fast = run_smooth(p, rtol, atol, max_step)
+        if fast is not None:
+            return fast
     rec = p.recorder()
     n_stick = max(p.samples // 8, 2)
     T = p.duration
@@ -253,7 +271,7 @@ def run_ode(p: Problem, rtol: float = 1e-10):
         solver, extra = method, {}
         if method == "LSODA":
             solver = _LocalCapLSODA
-            extra = {"cap": _local_cap(friction, u, d, M, K, p.period, max_step)}
+            extra = {"cap": _local_cap(friction, u, d, M, K, p.period, max_step), "period": p.period}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
@@ -263,8 +281,12 @@ def run_ode(p: Problem, rtol: float = 1e-10):
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         if sol.status == -1 and solver is _LocalCapLSODA:
             rec.nfev += sol.nfev
-            sol = solve_ivp(rhs, (0.0, remaining), y0, method=_LocalCapRadau, rtol=rtol, atol=atol,
-                            max_step=max_step, events=events, dense_output=not has_stick, **extra)
+            # scipy's finite-difference Jacobian may overflow while it grows an increment;
+            # it recovers, and the RuntimeWarning would only alarm the user
+            with np.errstate(over="ignore"):
+                sol = solve_ivp(rhs, (0.0, remaining), y0, method=_LocalCapRadau, rtol=rtol,
+                                atol=atol, max_step=max_step, events=events,
+                                dense_output=not has_stick, **extra)
         rec.nfev += sol.nfev
         ts, ys = sol.t, sol.y
         if not has_stick:
@@ -289,6 +311,8 @@ def run_ode(p: Problem, rtol: float = 1e-10):
 
 #: local damping ratio above which the step cap is lifted (far from any oscillation)
 OVERDAMPED = 1000.0
+#: LSODA steps per natural period beyond which it counts as stalled (Radau takes over)
+STEPS_PER_PERIOD = 5_000
 
 
 class _LocalCapRadau(Radau):
@@ -296,7 +320,7 @@ class _LocalCapRadau(Radau):
     fallback when LSODA fails, e.g. starting a hold deep in creep, where the
     relaxation rate a N / (M v) reaches 10^12 /s."""
 
-    def __init__(self, fun, t0, y0, t_bound, *, cap=None, **kwargs):
+    def __init__(self, fun, t0, y0, t_bound, *, cap=None, period=None, **kwargs):
         super().__init__(fun, t0, y0, t_bound, **kwargs)
         self._cap, self._floor = cap, self.max_step
 

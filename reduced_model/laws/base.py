@@ -146,6 +146,16 @@ class FrictionLaw:
             return sliding(speed, (), normal_load)
         return force
 
+    def scalar_state_rates(self, normal_load):
+        """``(s, state) -> (friction(s, state, N), state_rate(|s|, state))`` on Python floats
+        (``state`` a sequence, the rates a list), for a smooth law with one state variable,
+        or ``None``.
+
+        A law that returns a closure gets the fast path of smooth runs
+        (``reduced_model/limit_cycle.py``); it must agree with ``friction`` and
+        ``state_rate`` (the contract test checks it)."""
+        return None
+
     def closed_form(self, normal_load):
         """``(static or None, kinetic, viscous)`` forces if the law is Coulomb + viscous.
 

@@ -93,6 +93,34 @@ class RateState(FrictionLaw):
             return np.array([0.0])
         return np.array([-(speed / self.dc) * (math.log(speed / self.v0) + psi)])
 
+    def scalar_state_rates(self, normal_load):
+        """The friction and the state rate on plain floats (the ODE hot loop); the same
+        formulas as :meth:`coefficient` and :meth:`state_rate`."""
+        N, mu0, a, b, v0, dc = (float(c) for c in (normal_load, self.mu0, self.a, self.b,
+                                                   self.v0, self.dc))
+        log, exp, asinh, ln2 = math.log, math.exp, math.asinh, math.log(2.0)
+        aging, regularized = self.evolution == "aging", self.regularized
+        heal = v0 / dc
+
+        def rates(s, state):
+            psi = state[0]
+            speed = -s if s < 0.0 else s
+            if not regularized:
+                mu = mu0 + a * log(speed / v0) + b * psi
+            elif speed == 0.0:
+                mu = 0.0
+            else:
+                logz = log(speed / (2.0 * v0)) + (mu0 + b * psi) / a
+                mu = a * (logz + ln2 if logz > 30.0 else asinh(exp(logz)))
+                if s < 0.0:
+                    mu = -mu
+            if aging:
+                rate = heal * exp(-psi) - speed / dc
+            else:
+                rate = -(speed / dc) * (log(speed / v0) + psi) if speed > 0.0 else 0.0
+            return N * mu, [rate]
+        return rates
+
     def theta(self, state):
         """The state variable theta = (dc / v0) exp(psi) [time] of a (n_state, ...) state array."""
         return (self.dc / self.v0) * np.exp(np.asarray(state, dtype=float)[0])

@@ -7,7 +7,7 @@ through the same checks:
 
 * the law is a frozen dataclass, and ``example()`` builds an instance of it;
 * friction opposes the slip, ``friction`` and ``sliding_force`` describe one
-  curve, and a stateless law's hot-loop closure (``scalar_sliding``) is that curve;
+  curve, and a law's hot-loop closure (``scalar_sliding``, ``scalar_state_rates``) is that curve;
 * a run of the example closes its energy ledger (closed form <= 1e-10, ODE path
   <= 1e-8, as the rest of the suite asks) and friction only takes energy out;
 * each invalid example, and NaN in any real parameter, raises ``ValueError``
@@ -111,6 +111,12 @@ def check_friction_curve(cls):
         assert float(law.sliding_force(speed, state, 1.0)) == pytest.approx(ahead, rel=1e-12)
         if not law.state_names:
             assert law.scalar_sliding(1.0)(speed) == pytest.approx(ahead, rel=1e-12)
+        rates = law.scalar_state_rates(1.0)
+        if rates is not None:       # the smooth fast path's closure is the same law
+            for s in (speed, -speed):
+                fr, rate = rates(s, [float(c) for c in state])
+                assert fr == pytest.approx(law.friction(s, state, 1.0), rel=1e-12)
+                np.testing.assert_allclose(rate, law.state_rate(speed, state), rtol=1e-12)
     assert law.friction(0.0, state, 1.0) == 0.0
 
 

@@ -25,3 +25,20 @@ def test_creeping_hold_light_block_no_stall():
     assert np.isclose(r.v[-1], ref.y[1, -1], rtol=1e-6, atol=0)
     assert np.isclose(r.state[0, -1], ref.y[2, -1], rtol=0, atol=1e-9)
     assert r.energy.closure < 1e-8
+
+
+def test_light_block_stick_slip_no_stall(monkeypatch):
+    # M = 0.1, K = 0.05: between slips the block creeps at ~1e-6 and LSODA used to crawl
+    # (1.6e6 evaluations, ~30 s for 80 time units); past STEPS_PER_PERIOD Radau takes over
+    from filmfriction.reduced_model import hybrid
+    law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
+    block = SpringBlock(mass=0.1, stiffness=0.05, drive_velocity=0.1, law=law)
+    r = block.simulate(80.0, initial_velocity=0.05)
+    assert r.success and r.nfev < 400_000
+    monkeypatch.setattr(hybrid, "_LocalCapLSODA", hybrid._LocalCapRadau)   # Radau throughout
+    with np.errstate(over="ignore"):
+        radau = block.simulate(80.0, initial_velocity=0.05)
+    assert [e.kind for e in r.events] == [e.kind for e in radau.events] and len(r.events) >= 6
+    np.testing.assert_allclose([e.time for e in r.events], [e.time for e in radau.events],
+                               rtol=0, atol=1e-6)
+    assert np.isclose(r.x[-1], radau.x[-1], rtol=1e-8) and np.isclose(r.psi[-1], radau.psi[-1], atol=1e-7)
