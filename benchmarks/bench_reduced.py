@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/bench_reduced.py [--repeat N] [--radau] [--map]
 
-Issue 14 (default sections).  The reference (benchmarks/reference_event_driven.py)
+The default sections.  The reference (benchmarks/reference_event_driven.py)
 is what an efficient scipy user writes: the stick solved in closed form, each
 slip ``solve_ivp(method="LSODA", rtol=1e-7, atol=1e-12)`` with a terminal event
 on the slip velocity; for rate-and-state one LSODA run (rtol 1e-7) with an event
@@ -214,10 +214,10 @@ def lean_reference(law, K, duration):
                      rtol=1e-7, atol=[1e-12, 1e-12, 1e-10])
 
 
-def issue14(repeat):
+def against_event_driven(repeat):
     import reference_event_driven as ref
 
-    print("== issue 14: reduced model against the event-driven LSODA reference ==")
+    print("== the reduced model against the event-driven LSODA reference ==")
     print(f"(CPU time per run; repeat={repeat}; the reference gets max(3, repeat // 5) repeats)")
     rows = []
     for name, law in (("Coulomb", laws.Coulomb(static=1.0, kinetic=0.5)),
@@ -317,7 +317,7 @@ def main(argv=None):
     p.add_argument("--quick", action="store_true", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    issue14(args.repeat)
+    against_event_driven(args.repeat)
     if args.radau:
         print(f"== against Radau at equal accuracy: M={M} K={K} V={V} d={D} duration={T}; "
               f"match criterion {MATCH:g} on every event time ==")

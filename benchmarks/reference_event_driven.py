@@ -1,4 +1,4 @@
-"""The event-driven reference the reduced model is timed against (issue 14).
+"""The event-driven reference the reduced model is timed against.
 
 What an efficient scipy user writes for a spring-block slider, M x'' = K (V t - x)
 - d x' - F:
