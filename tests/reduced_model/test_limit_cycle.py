@@ -54,16 +54,23 @@ def test_tiled_limit_cycle_equals_every_cycle_integrated(monkeypatch):
                                rtol=10 * rtol)
 
 
+def _same_events_on_the_general_path(monkeypatch, block, duration, fast, more_than):
+    """Run ``block`` on the general path; its events equal the fast path's (kind, time to
+    1e-7, force to 1e-8), and there are more than ``more_than`` of them."""
+    _general_path(monkeypatch)
+    general = block.simulate(duration, initial_velocity=0.05)
+    (ta, fa, ka), (tb, fb, kb) = _events(fast), _events(general)
+    assert ka == kb and len(ka) > more_than
+    np.testing.assert_allclose(ta, tb, rtol=0, atol=1e-7)
+    np.testing.assert_allclose(fa, fb, rtol=0, atol=1e-8)
+    return general
+
+
 def test_fast_path_agrees_with_the_general_path(monkeypatch):
     used = _spy(monkeypatch)
     fast = BLOCK.simulate(100.0, initial_velocity=0.05)
     assert used == [True]
-    _general_path(monkeypatch)
-    general = BLOCK.simulate(100.0, initial_velocity=0.05)
-    (ta, fa, ka), (tb, fb, kb) = _events(fast), _events(general)
-    assert ka == kb and len(ka) > 90
-    np.testing.assert_allclose(ta, tb, rtol=0, atol=1e-7)
-    np.testing.assert_allclose(fa, fb, rtol=0, atol=1e-8)
+    general = _same_events_on_the_general_path(monkeypatch, BLOCK, 100.0, fast, more_than=90)
     for name in ("x", "v", "psi", "theta"):
         assert getattr(fast, name)[-1] == pytest.approx(getattr(general, name)[-1], rel=1e-6)
     assert fast.energy.friction_dissipation == pytest.approx(general.energy.friction_dissipation, rel=1e-8)
@@ -80,12 +87,7 @@ def test_fast_path_for_the_other_variants(monkeypatch, evolution, regularized):
     used = _spy(monkeypatch)
     fast = block.simulate(40.0, initial_velocity=0.05)
     assert used == [True]
-    _general_path(monkeypatch)
-    general = block.simulate(40.0, initial_velocity=0.05)
-    (ta, fa, ka), (tb, fb, kb) = _events(fast), _events(general)
-    assert ka == kb and len(ka) > 10
-    np.testing.assert_allclose(ta, tb, rtol=0, atol=1e-7)
-    np.testing.assert_allclose(fa, fb, rtol=0, atol=1e-8)
+    _same_events_on_the_general_path(monkeypatch, block, 40.0, fast, more_than=10)
 
 
 def test_steady_sliding_has_no_events(monkeypatch):
