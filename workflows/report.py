@@ -218,9 +218,13 @@ def fig_sfb(check) -> bytes:
         if math.isfinite(run.slip_time):
             ax.plot(run.slip_time * 1e3, run.slip_distance * 1e9, "o", color="k", ms=4)
     ax.set_xscale("symlog", linthresh=1e-2)
+    # slips from tens of nm (Klein) to tens of µm (an MD-calibrated film): a linear axis
+    # would flatten the small ones onto zero
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.set_ylim(bottom=0)
     ax.set_xlabel("time since yield [ms]")
-    ax.set_ylabel("slip x(t) [nm]")
-    ax.legend(fontsize=7)
+    ax.set_ylabel("slip x(t) [nm] (log above 1 nm)")
+    ax.legend(fontsize=7, loc="upper left")
     ax.set_title("SFB-scale slips in the reduced model (● = s)", fontsize=9)
     return _png(fig)
 
