@@ -25,9 +25,9 @@ run: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
-# the edit-test loop: everything but the real-LAMMPS tests (marker md)
+# the edit-test loop: everything but the real-LAMMPS tests (marker md), on two processes
 test-fast: $(STAMP)
-	$(BIN)/python -m pytest -q -m "not md"
+	$(BIN)/python -m pytest -q -m "not md" -n 2
 
 bench: $(STAMP)
 	$(BIN)/filmfriction bench
