@@ -53,19 +53,16 @@ class RunData:
         return float(tr.parameters.require("thickness", "eta_eff = B D / A"))
 
 
-def _as_analysed(trace, doc: dict):
-    """The trace with the unit system and the parameters its analysis used
-    (``analysis.json``'s ``units`` and ``source.parameters``: a measured trace
-    analysed with ``--units si --spring-constant ...`` is read as such again)."""
-    from filmfriction.analysis.trace import read_trace
-
+def _analysed_parameters(doc: dict) -> dict:
+    """The unit system and the parameters an analysis used (``analysis.json``'s
+    ``units`` and ``source.parameters``), as :func:`read_trace` overrides: a
+    measured trace analysed with ``--units si --spring-constant ...`` is read as
+    such again."""
     used = {k: v for k, v in ((doc.get("source") or {}).get("parameters") or {}).items()
             if v is not None}
     if doc.get("units") in ("lj", "si"):
         used["units"] = doc["units"]
-    if all(getattr(trace.parameters, k, None) == v for k, v in used.items()):
-        return trace
-    return read_trace(trace.run_dir or trace.path, **used)
+    return used
 
 
 def load_run(run_dir, *, analyse: bool = True) -> RunData:
@@ -91,7 +88,6 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise ValueError(f"{run_dir}: not a run directory")
-    trace = read_trace(run_dir)
     apath = run_dir / "analysis.json"
     cpath = run_dir / "analysis_cycles.csv"
     if apath.exists() and cpath.exists():
@@ -100,11 +96,13 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
         except json.JSONDecodeError as exc:
             raise ValueError(f"{apath}: not valid JSON: {exc}") from None
         cycles = read_cycles_csv(cpath)
-        trace = _as_analysed(trace, doc)
+        # read once, as analysed (not with the run's parameters, then again)
+        trace = read_trace(run_dir, **_analysed_parameters(doc))
     elif not analyse:
         missing = " and ".join(p.name for p in (apath, cpath) if not p.exists())
         raise ValueError(f"{run_dir}: no {missing}; make it with `filmfriction analyze {run_dir}`")
     else:
+        trace = read_trace(run_dir)
         doc, per_cycle = analyze(trace)
         try:
             write_outputs(doc, per_cycle, apath)

@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import re
 import resource
 import statistics
 import subprocess
@@ -31,9 +30,7 @@ from pathlib import Path
 
 from filmfriction import md_inputs
 from . import engine
-
-_LOOP = re.compile(r"Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps with (\d+) atoms")
-
+from .runner import loop_totals
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(
@@ -81,14 +78,6 @@ def bulk_cells(n_atoms: int) -> tuple[int, int, int]:
     return best[1]
 
 
-def loop_rate(log_text: str) -> tuple[int, int, float]:
-    """(atoms, steps, loop seconds) summed over every ``run`` of a LAMMPS log."""
-    runs = _LOOP.findall(log_text)
-    if not runs:
-        raise RuntimeError("no 'Loop time' line in the LAMMPS log")
-    return int(runs[-1][2]), sum(int(r[1]) for r in runs), sum(float(r[0]) for r in runs)
-
-
 def time_film(scene, cores: int, threads: int, where: Path) -> dict:
     """The scene as ``filmfriction run --md-only`` runs it; throughput from its wall time."""
     from .runner import RunFailed, execute
@@ -99,7 +88,7 @@ def time_film(scene, cores: int, threads: int, where: Path) -> dict:
     except RunFailed as exc:
         raise RuntimeError(f"the film run failed: {exc}") from None
     record = json.loads((run_dir / "run.json").read_text())
-    atoms, steps, loop = loop_rate((run_dir / "lammps.log").read_text())
+    atoms, steps, loop = loop_totals((run_dir / "lammps.log").read_text())
     return {"atoms": atoms, "steps": steps, "wall": record["wall_time"],
             "rate": atoms * steps / record["wall_time"], "loop_rate": atoms * steps / loop}
 
@@ -118,7 +107,7 @@ def time_bulk(atoms: int, steps: int, cores: int, cutoff: float, timestep: float
     if out.returncode != 0 or "ERROR" in out.stdout:
         err = [l for l in out.stdout.splitlines() if "ERROR" in l] or [out.stderr.strip()]
         raise RuntimeError(f"the bulk LJ run failed: {err[0]}")
-    n, s, loop = loop_rate((where / "lammps.log").read_text())
+    n, s, loop = loop_totals((where / "lammps.log").read_text())
     return {"atoms": n, "steps": s, "wall": wall, "rate": n * s / wall,
             "loop_rate": n * s / loop}
 

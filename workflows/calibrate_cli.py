@@ -79,19 +79,14 @@ def format_calibration(cal) -> str:
 def run(args) -> int:
     """Entry point; returns the exit code."""
     from filmfriction.analysis import calibrate, write_calibration
-    from filmfriction.workflows.cli import UserError, check_run_json
+    from filmfriction.workflows.cli import UserError, check_run_source
 
     from filmfriction.workflows.report import _split_sweeps
 
     for d in args.run_dirs:
         if not d.is_dir():
             raise UserError(f"{d}: not a directory")
-        if not any((d / name).exists() for name in ("trace.csv", "aggregate.json",
-                                                     "analysis.json")):
-            raise UserError(f"{d}: neither a run directory (trace.csv), a finished sweep "
-                            "(aggregate.json) nor an analysed trace file (analysis.json; "
-                            "'filmfriction analyze TRACE_FILE' writes it)")
-        check_run_json(d)
+        check_run_source(d)
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
     run_dirs, _ = _split_sweeps(list(args.run_dirs))
     try:

@@ -180,3 +180,19 @@ def check_run_json(run_dir, flag: str = "") -> dict | None:
         return read_json_object(path, where, what="a JSON object (a run record)")
     except ValueError as exc:
         raise UserError(str(exc)) from None
+
+
+def check_run_source(path) -> None:
+    """``path`` holds something to calibrate or report on: a run directory
+    (``trace.csv``), a finished sweep (``aggregate.json``) or an analysed trace
+    file (``analysis.json``), with a readable ``run.json`` if any; UserError
+    otherwise."""
+    from pathlib import Path
+
+    path = Path(path)
+    if not any((path / name).exists() for name in ("trace.csv", "aggregate.json",
+                                                  "analysis.json")):
+        raise UserError(f"{path}: neither a run directory (trace.csv), a finished sweep "
+                        "(aggregate.json) nor an analysed trace file (analysis.json; "
+                        "'filmfriction analyze TRACE_FILE' writes it)")
+    check_run_json(path)

@@ -43,7 +43,7 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from filmfriction.workflows.cli import UserError, check_run_json, check_writable
+    from filmfriction.workflows.cli import UserError, check_run_source, check_writable
     from filmfriction.workflows.report import build_report
 
     for d in args.compare:
@@ -51,12 +51,7 @@ def run(args) -> int:
             raise UserError(f"--compare {d}: not an analysed run directory (analysis.json and "
                             "run.json; 'filmfriction analyze RUN_DIR' writes the first)")
     for d in args.run_dirs:
-        if not any((d / name).exists() for name in ("trace.csv", "aggregate.json",
-                                                     "analysis.json")):
-            raise UserError(f"{d}: neither a run directory (trace.csv), a finished sweep "
-                            "(aggregate.json) nor an analysed trace file (analysis.json; "
-                            "'filmfriction analyze TRACE_FILE' writes it)")
-        check_run_json(d)
+        check_run_source(d)
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     out = args.out if args.out is not None else args.run_dirs[0] / "report.html"

@@ -178,7 +178,7 @@ _THERMO_LINE = re.compile(r"^\s*(\d+)\s+[-+0-9.eE]+")
 _STAGE = re.compile(r"^FILMFRICTION stage (\w+) (\d+)")
 _ATOMS = re.compile(r"^FILMFRICTION atoms film=(\d+) top=(\d+) area=([0-9.eE+-]+)")
 _PERF = re.compile(r"Performance: .*?([0-9.]+) timesteps/s, ([0-9.]+) (\w?)atom-step/s")
-_ATOMS_TOTAL = re.compile(r"Loop time of [0-9.]+ on \d+ procs for \d+ steps with (\d+) atoms")
+_LOOP = re.compile(r"Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps with (\d+) atoms")
 _SI_PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
 
 
@@ -190,8 +190,16 @@ def atom_steps_per_second(line: str) -> float | None:
 
 def loop_atoms(line: str) -> int | None:
     """Atom count from a LAMMPS "Loop time of ..." line (None for any other line)."""
-    m = _ATOMS_TOTAL.search(line)
-    return int(m.group(1)) if m else None
+    m = _LOOP.search(line)
+    return int(m.group(3)) if m else None
+
+
+def loop_totals(log_text: str) -> tuple[int, int, float]:
+    """(atoms, steps, loop seconds) summed over every ``run`` of a LAMMPS log."""
+    runs = _LOOP.findall(log_text)
+    if not runs:
+        raise RuntimeError("no 'Loop time' line in the LAMMPS log")
+    return int(runs[-1][2]), sum(int(r[1]) for r in runs), sum(float(r[0]) for r in runs)
 
 
 @dataclass
