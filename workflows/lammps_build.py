@@ -37,6 +37,7 @@ import re
 import shutil
 import subprocess
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 from . import engine
@@ -128,20 +129,28 @@ def resolve(lmp: str | Path | None, source: str = "--lmp") -> tuple[Path, str]:
     return path.resolve(), source
 
 
+@lru_cache(maxsize=8)
+def _help(path: Path, mtime_ns: int, size: int) -> tuple[int, str, str]:
+    """``path -h`` once per process for each version of the file (it takes ~0.4 s;
+    a bench or a test session starts many runs)."""
+    done = subprocess.run([str(path), "-h"], capture_output=True, text=True, timeout=120,
+                          env=engine.engine_env(lmp=path), stdin=subprocess.DEVNULL)
+    return done.returncode, done.stdout, done.stderr
+
+
 def probe(path: Path, source: str) -> LammpsBuild:
     """Ask ``path -h`` for the version and the packages; SceneError when it does not
     answer as LAMMPS does."""
-    env = engine.engine_env(lmp=path)
     try:
-        done = subprocess.run([str(path), "-h"], capture_output=True, text=True,
-                              timeout=120, env=env, stdin=subprocess.DEVNULL)
+        stat = Path(path).stat()
+        returncode, stdout, stderr = _help(Path(path), stat.st_mtime_ns, stat.st_size)
     except (OSError, subprocess.TimeoutExpired) as exc:
         raise SceneError(f"{source} {path}: cannot run it ({exc})") from None
-    version, packages = parse_help(done.stdout)
-    if done.returncode != 0 or not packages:
-        tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
+    version, packages = parse_help(stdout)
+    if returncode != 0 or not packages:
+        tail = (stderr or stdout).strip().splitlines()[-1:] or ["no output"]
         raise SceneError(f"{source} {path}: '{path.name} -h' did not answer as LAMMPS does "
-                         f"(exit {done.returncode}: {tail[0][:200]}); give a LAMMPS "
+                         f"(exit {returncode}: {tail[0][:200]}); give a LAMMPS "
                          "executable")
     return LammpsBuild(path=path, source=source, version=version, packages=packages)
 
