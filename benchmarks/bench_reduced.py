@@ -15,7 +15,9 @@ exponential Stribeck with v_s = 0.05); rate-and-state mu0 = 0.6, a = 0.01,
 b = 0.015, dc = 0.01, v0 = 0.1, K = 10, ~100 cycles from v = 0.05 (and ~500 cycles,
 where the converged limit cycle is tiled), with the yield times and peak forces
 of both sides against a tight DOP853 run (rtol 1e-13), and the reference's LSODA
-on the law's plain-float closure for scale.  Then the creeping hold (M = 1e-6,
+on the law's plain-float closure for scale; then what the first run of a new
+process costs (numba's import, the compiled steps loaded from the cache or, with
+an empty cache, compiled).  Then the creeping hold (M = 1e-6,
 K = 1e5, 1 s) and the slide-hold-slide healing.
 
 Older sections: ``--radau`` (against Radau at equal accuracy), ``--map``.
@@ -280,6 +282,8 @@ def against_event_driven(repeat):
         print(f"    speed ratio: {np.median(t_ref) / np.median(t_ours):6.2f}x (rtol 1e-10), "
               f"{np.median(t_ref) / np.median(t_ours7):.2f}x (rtol 1e-7); target >= 20x")
 
+    fresh_process(rs_repeat)
+
     rs = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-5, v0=1e-6)
     hold = SpringBlock(mass=1e-6, stiffness=1e5, drive_velocity=0.0, drive="fixed", law=rs)
     psi0 = rs.steady_state(1e-6)
@@ -307,6 +311,47 @@ def against_event_driven(repeat):
         print(f"  {th:7.0f}   {math.log(th / theta_ss):8.3f}   {dmu:10.5f}   {rs.b * math.log(th / theta_ss):10.5f}"
               f"   {r.theta[i1]:12.1f}   {cpu:.2f} s")
     return rows
+
+
+FRESH = """
+import time
+t0 = time.perf_counter()
+from filmfriction.reduced_model import SpringBlock, laws
+law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
+block = SpringBlock(mass=1.0, stiffness=10.0, drive_velocity=0.1, law=law)
+t1 = time.perf_counter()
+block.simulate(200.0, initial_velocity=0.05)
+t2 = time.perf_counter()
+block.simulate(200.0, initial_velocity=0.05)
+t3 = time.perf_counter()
+print(t1 - t0, t2 - t1, t3 - t2)
+"""
+
+
+def fresh_process(repeat):
+    """What a script's first rate-and-state run costs: numba's import and the compiled steps,
+    loaded from numba's cache or (empty cache) compiled.  Wall time in a new process each."""
+    import os
+    import subprocess
+    import tempfile
+
+    def once(env):
+        out = subprocess.run([sys.executable, "-c", FRESH], env=env, check=True, capture_output=True,
+                             text=True).stdout.split()
+        return [float(c) for c in out]
+    print("  a new process, the 200-time-unit run at rtol 1e-10 (wall time; numba's cache as "
+          "the package leaves it, then empty):")
+    for label, empty in (("cache filled", False), ("cache empty ", True)):
+        rows = []
+        for _ in range(repeat if not empty else 1):
+            env = dict(os.environ)
+            with tempfile.TemporaryDirectory() as cache:
+                if empty:
+                    env["NUMBA_CACHE_DIR"] = cache      # numba compiles into a new cache
+                rows.append(once(env))
+        first, second = np.median([r[1] for r in rows]), np.median([r[2] for r in rows])
+        print(f"    {label}: first simulate {first:.3f} s, the second {1e3 * second:.1f} ms "
+              f"(import of filmfriction.reduced_model {np.median([r[0] for r in rows]):.2f} s; n={len(rows)})")
 
 
 def main(argv=None):

@@ -32,9 +32,9 @@ no longer crawls at a sixteenth of the natural period.
 
 Smooth laws (rate-and-state, films without a yield force) are one ODE; their
 ``slip``/``stick`` events mark the maxima/minima of the spring force.  Those with
-one state variable and a plain-float closure (``law.scalar_state_rates``) first
-try the fast path of :mod:`.limit_cycle` (compiled DOP853, the converged limit
-cycle tiled), which hands back to LSODA here where the run is stiff.  LSODA
+one state variable (rate-and-state) first try the fast path of :mod:`.limit_cycle`
+(DOP853 and the law compiled with numba, the converged limit cycle tiled), which
+hands back to LSODA here where the run is stiff.  LSODA
 past ``STEPS_PER_PERIOD`` steps per natural period counts as stalled and Radau
 redoes the segment.  A
 massless block (M = 0) is integrated quasi-statically: the slip velocity

@@ -1,18 +1,18 @@
-"""Fast path for smooth laws with a state (rate-and-state): compiled steps, exact
-extrema, and the converged limit cycle tiled.
+"""Fast path for rate-and-state (a smooth law with one state variable): compiled
+steps, exact extrema, and the converged limit cycle tiled.
 
 A smooth law (no static threshold) with one state variable makes the block an autonomous
 system in (spring extension, velocity, state).  Where the slip is not
 overdamped it is not stiff, and the run goes through here:
 
-* **steps:** Hairer's Fortran DOP853 (``scipy.integrate.ode``), the step loop
-  compiled, the right-hand side a closure on Python floats built from
-  ``law.scalar_state_rates`` (no NumPy per evaluation).  The extension
-  ``x_a - x`` is integrated, not the position, so rtol applies to the spring
-  force rather than to a growing x; the three energy integrals ride along.
+* **steps:** DOP853 compiled with its right-hand side (:mod:`.smooth_steps`,
+  numba): Python is entered once per spring-force extremum, not once per
+  evaluation.  The extension ``x_a - x`` is integrated, not the position, so
+  rtol applies to the spring force rather than to a growing x; the three
+  energy integrals ride along.
 * **extrema of the spring force** (the ``slip``/``stick`` events: ``v`` crosses
-  the drive speed): the step loop stops at the step that crosses (DOP853 is not
-  re-entrant) and goes on from there.  The time is the
+  the drive speed): the steps stop after the step that crosses and go on from
+  there with the step size they had.  The time is the
   root of a quintic Hermite interpolant of ``v`` over the step (values, first and
   second derivatives at both ends; the second from a central difference along
   the flow), the state there one more DOP853 step from the step's start, inserted
@@ -29,9 +29,10 @@ overdamped it is not stiff, and the run goes through here:
   most ``rtol`` x period per cycle, what the integrator's own phase error
   accumulates at that tolerance anyway.
 
-:func:`run_smooth` returns ``None`` where this path does not apply, or when
-DOP853 finds the run stiff after all (a slip slowing to a creep): the caller
-then integrates with its stiff-aware LSODA path from the start.
+:func:`run_smooth` returns ``None`` where this path does not apply, when the
+steps find the run stiff after all (a slip slowing to a creep: the step size
+underflows or the step budget is spent), or when numba cannot be imported: the
+caller then integrates with its stiff-aware LSODA path from the start.
 """
 from __future__ import annotations
 
@@ -39,7 +40,8 @@ import math
 import warnings
 
 import numpy as np
-from scipy.integrate import ode
+
+from .laws.rate_state import RateState
 
 __all__ = ["run_smooth"]
 
@@ -81,16 +83,20 @@ def run_smooth(p, rtol, atol, max_step):
     ``atol`` are the absolute tolerances of (position, velocity, the three
     energies, the state) as the general path uses them."""
     law, N, M, K, d, u, va = p.law, p.normal_load, p.mass, p.stiffness, p.damping, p.u, p.va
+    if not isinstance(law, RateState) or M <= 0.0:
+        return None
     rates = law.scalar_state_rates(N)
-    if rates is None or M <= 0.0 or len(law.state_names) != 1:
-        return None
-    if law.static_force(p.state0, N) is not None:
-        return None
     state0 = [float(c) for c in p.state0]
     for s_ref in {abs(va - u), abs(p.v0 - u)}:
         if s_ref > 0.0 and not _local_zeta(rates, s_ref, state0, d, K, M) < EXPLICIT_ZETA:
             return None
-    run = _SmoothRun(p, rates, rtol, atol, max_step)
+    try:
+        from . import smooth_steps
+    except ImportError as err:          # numba missing or broken: the general path runs
+        warnings.warn(f"the compiled rate-and-state path is unavailable ({err}); "
+                      "integrating with LSODA instead (slower)", RuntimeWarning, stacklevel=3)
+        return None
+    run = _SmoothRun(p, smooth_steps, law.rate_parameters(N), rtol, atol, max_step)
     return run.result() if run.integrate() else None
 
 
@@ -98,133 +104,92 @@ class _SmoothRun:
     """The integration of :func:`run_smooth`; the ODE's variables are (extension, v, drive
     work, friction and damper dissipation, the law's one state variable)."""
 
-    def __init__(self, p, rates, rtol, atol, max_step):
-        self.p, self.rtol, self.max_step = p, float(rtol), float(max_step)
+    def __init__(self, p, steps, law_params, rtol, atol, max_step):
+        self.p, self.steps, self.law = p, steps, law_params
+        self.rtol, self.max_step = float(rtol), float(max_step)
+        self.atol = np.asarray(atol, dtype=float)
         M, K, d, u, va = (float(c) for c in (p.mass, p.stiffness, p.damping, p.u, p.va))
-        self.K, self.va = K, va
-        # DOP853 takes one atol: integrate z = y / scale, the tolerances folded into the scale
-        self.scale = scale = np.asarray(atol, dtype=float) / 1e-12
-        s0, s1, s2, s3, s4 = (float(c) for c in scale[:5])
-        st_scale = [float(c) for c in scale[5:]]
-        i0, i1, i2, i3, i4 = 1.0 / s0, 1.0 / s1, 1.0 / s2, 1.0 / s3, 1.0 / s4
-        st_inv = [1.0 / c for c in st_scale]
-        a1, ks0, dv_i4 = i1 / M, K * s0, d * i4
+        self.K, self.va, self.block = K, va, (K, M, d, u, va)
         self.nfev = 0
-
-        (ss0,), (si0,) = st_scale, st_inv        # one state variable (run_smooth checks)
-
-        def f(tau, z):                          # the hot loop: plain floats only
-            z0, z1, _, _, _, z5 = z.tolist()
-            vb = z1 * s1
-            f_spring = ks0 * z0
-            s = vb - u
-            fr, r = rates(s, (z5 * ss0,))
-            return [(va - vb) * i0, (f_spring - d * vb - fr) * a1, (f_spring * va - fr * u) * i2,
-                    fr * s * i3, dv_i4 * vb * vb, r[0] * si0]
-        self.f = f
         self.rec = p.recorder()
-        self.events = []          # kept extrema: [time, kind, force, sample list index]
+        self.events = []          # kept extrema: [time, kind, force, sample index]
         self.slips = []           # sample indices of the kept maxima
         self.cycles = {}          # (start, end sample of a cycle) -> (its quantities, tolerances)
 
     # -- one stretch of integration ----------------------------------------------------
     def integrate(self):
-        """Integrate to the end (tiling once converged); False if DOP853 gave up (stiff)."""
+        """Integrate to the end (tiling once converged); False if the run turned stiff."""
         p = self.p
         t0, xa0 = 0.0, p.xa0
-        z0 = np.concatenate(([p.xa0 - p.x0, p.v0, 0.0, 0.0, 0.0], p.state0)) / self.scale
+        y0 = np.concatenate(([p.xa0 - p.x0, p.v0, 0.0, 0.0, 0.0], p.state0)).astype(float)
         self.f_min = self.f_max = self.K * (p.xa0 - p.x0)
+        self.h = min(1e-3 * p.period, self.max_step)    # the first step; then the steps' own
         while True:
-            ok, tiled = self._stretch(t0, xa0, z0)
+            ok, tiled = self._stretch(t0, xa0, y0)
             if not ok:
                 return False
             if tiled is None:
                 return True
-            t0, xa0, z0 = tiled
+            t0, xa0, y0 = tiled
 
-    def _stretch(self, t0, xa0, z0):
-        p, K, va, scale = self.p, self.K, self.va, self.scale
-        T = p.duration
+    def _stretch(self, t0, xa0, y0):
+        p, steps = self.p, self.steps
+        T = p.duration - t0
         self.t0, self.xa0 = t0, xa0
-        ts, zs = [0.0], [z0]
-        self.ts, self.zs = ts, zs
+        budget = int(1000 + 400.0 * T / p.period)       # steps; more is a stiff run
+        rows = min(budget, 4096) + 2
+        self.ts, self.ys = np.empty(rows), np.empty((rows, y0.size))
+        self.ts[0], self.ys[0] = 0.0, y0
+        self.n = 1
         self.events, self.slips, self.flushed, self.cycles = [], [], 0, {}
-        self.e_ref = K * float(z0[0] * scale[0])
-        s1, k0 = float(scale[1]), K * float(scale[0])
-        g_prev = [float(z0[1]) * s1 - va]
-        budget = 1000 + 400.0 * (T - t0) / p.period     # steps; more is a stiff run
-        stop = {}
-
-        def solout(tau, z):
-            if not tau > ts[-1]:
-                return 0
-            ts.append(tau)
-            zs.append(z.copy())
-            if len(ts) > budget:
-                stop["stiff"] = True
-                return -1
-            z0, z1 = z[:2].tolist()
-            f_spring = k0 * z0
-            if f_spring < self.f_min:
-                self.f_min = f_spring
-            elif f_spring > self.f_max:
-                self.f_max = f_spring
-            g = z1 * s1 - va
-            crossed = (g > 0.0) != (g_prev[0] > 0.0) and g != 0.0 and g_prev[0] != 0.0
-            rising = g_prev[0] < 0.0
-            g_prev[0] = g
-            if crossed:
-                stop["extremum"] = rising
-                return -1                       # handled out here: DOP853 is not re-entrant
-            return 0
-
-        solver = ode(self.f).set_integrator("dop853", rtol=self.rtol, atol=1e-12, nsteps=10 ** 9,
-                                            max_step=self.max_step)
-        solver.set_solout(solout)
-        self.sub = ode(self.f).set_integrator("dop853", rtol=self.rtol, atol=1e-12, nsteps=10 ** 6)
-        self.sub.set_initial_value(z0, 0.0)
+        self.e_ref = self.K * float(y0[0])
         while True:
-            # go on from the last accepted step (DOP853 picks its first step anew)
-            solver.set_initial_value(zs[-1], ts[-1])
-            stop.clear()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")     # "probably stiff": the caller takes over
-                solver.integrate(T - t0)
-            self.nfev += int(getattr(solver._integrator, "iwork", [0] * 17)[16])  # its NFCN
-            if stop.get("stiff") or (not solver.successful() and not stop):
+            if self.n + 2 > self.ts.size:               # room for the step and an extremum
+                self._grow(min(budget + 2, 2 * self.ts.size))
+            n0 = self.n - 1
+            code, n, self.h, nfev = steps.advance(
+                float(self.ts[n0]), self.ys[n0], T, self.h, self.rtol, self.atol, self.max_step,
+                self.block, self.law, True, self.ts, self.ys, self.n, self.ts.size - 1)
+            self.nfev += nfev
+            self.n = n
+            if n > n0 + 1:
+                spring = self.K * self.ys[n0 + 1:n, 0]
+                self.f_min, self.f_max = min(self.f_min, spring.min()), max(self.f_max, spring.max())
+            if code == steps.UNDERFLOW or (code == steps.FULL and n >= budget):
                 return False, None
-            if "extremum" in stop:
-                if self._extremum(stop["extremum"]):
+            if code == steps.CROSSED:
+                if self._extremum(self.ys[n - 2, 1] < self.va):
                     return True, self._tile()
-                continue
-            self._flush(len(ts) - 1)
-            return True, None
+            elif code == steps.END:
+                self._flush(self.n - 1)
+                return True, None
+
+    def _grow(self, rows):
+        ts, ys = np.empty(rows), np.empty((rows, self.ys.shape[1]))
+        ts[:self.n], ys[:self.n] = self.ts[:self.n], self.ys[:self.n]
+        self.ts, self.ys = ts, ys
 
     # -- extrema -----------------------------------------------------------------------
-    def _derivatives(self, z, h):
-        """dz/dt and d2z/dt2 (a central difference along the flow, over 1e-3 of the step)."""
-        fz = np.array(self.f(0.0, z))
-        eps = 1e-3 * h
-        self.nfev += 3
-        return fz, (np.array(self.f(0.0, z + eps * fz)) - np.array(self.f(0.0, z - eps * fz))) / (2.0 * eps)
-
     def _extremum(self, is_max):
         """Locate the extremum in the last step, insert it as a sample, keep it or not;
         True when the run has converged to its limit cycle and should be tiled."""
-        ts, zs, va, s1 = self.ts, self.zs, self.va, float(self.scale[1])
-        t_a, t_b, z_a, z_b = ts[-2], ts[-1], zs[-2], zs[-1]
+        ts, ys, va, n = self.ts, self.ys, self.va, self.n
+        t_a, t_b, y_a, y_b = float(ts[n - 2]), float(ts[n - 1]), ys[n - 2], ys[n - 1]
         h = t_b - t_a
-        (da, ca), (db, cb) = self._derivatives(z_a, h), self._derivatives(z_b, h)
-        g_a, g_b = float(z_a[1]) * s1 - va, float(z_b[1]) * s1 - va
+        eps = 1e-3 * h
+        (da, ca), (db, cb) = (self.steps.derivatives(y, eps, self.block, self.law) for y in (y_a, y_b))
+        self.nfev += 6
+        g_a, g_b = float(y_a[1]) - va, float(y_b[1]) - va
         frac, lo, hi = g_a / (g_a - g_b), 0.0, 1.0
         for _ in range(12):
-            val, slope = _hermite5(h, z_a[1], da[1], ca[1], z_b[1], db[1], cb[1], frac)
-            g = float(val) * s1 - va
+            val, slope = _hermite5(h, float(y_a[1]), float(da[1]), float(ca[1]),
+                                   float(y_b[1]), float(db[1]), float(cb[1]), frac)
+            g = val - va
             if (g > 0.0) == (g_a > 0.0):
                 lo = frac
             else:
                 hi = frac
-            step = g / (float(slope) * s1) if slope != 0.0 else math.inf
+            step = g / slope if slope != 0.0 else math.inf
             new = frac - step
             if not lo <= new <= hi:
                 new = 0.5 * (lo + hi)
@@ -233,35 +198,27 @@ class _SmoothRun:
                 break
             frac = new
         t_e = t_a + frac * h
-        z_e = self._step(z_a, t_a, t_e)
-        if z_e is None:
-            z_e, _ = _hermite5(h, z_a, da, ca, z_b, db, cb, frac)
         if t_a < t_e < t_b:
-            ts.insert(-1, t_e)
-            zs.insert(-1, z_e)
-            j = len(ts) - 2
+            y_e = self._step(y_a, t_a, t_e)
+            if y_e is None:
+                y_e, _ = _hermite5(h, y_a, da, ca, y_b, db, cb, frac)
+            ts[n], ys[n] = t_b, y_b                 # the step's end moves one row on
+            ts[n - 1], ys[n - 1] = t_e, y_e
+            self.n = n + 1
+            j = n - 1
         else:
-            j = len(ts) - 2 if t_e <= t_a else len(ts) - 1
-            z_e = zs[j]
-        force = self.K * float(z_e[0]) * float(self.scale[0])
-        return self._keep(t_e, "slip" if is_max else "stick", force, j)
+            j = n - 2 if t_e <= t_a else n - 1
+        force = self.K * float(ys[j, 0])
+        return self._keep(float(ts[j]), "slip" if is_max else "stick", force, j)
 
-    def _step(self, z_a, t_a, t_e):
+    def _step(self, y_a, t_a, t_e):
         """The state at ``t_e`` by one DOP853 step from the accepted step at ``t_a`` (as
         accurate as the steps themselves; an interpolant is not, for a fast state)."""
-        if not t_e > t_a:
-            return None
-        try:    # scipy's DOP853 wrapper called directly: no new solver object per event
-            integ = self.sub._integrator
-            integ.work[6] = t_e - t_a           # the first (and only) step
-            _, z, istate = integ.runner(self.f, t_a, np.array(z_a), t_e, *integ.call_args, ())
-            self.nfev += int(integ.iwork[16])
-            return z if istate > 0 else None
-        except (AttributeError, IndexError, TypeError, ValueError):     # other scipy internals
-            sub = ode(self.f).set_integrator("dop853", rtol=self.rtol, atol=1e-12, first_step=t_e - t_a)
-            sub.set_initial_value(z_a, t_a)
-            z = sub.integrate(t_e)
-            return z if sub.successful() else None
+        ts, ys = np.empty(9), np.empty((9, y_a.size))
+        code, n, _, nfev = self.steps.advance(t_a, y_a, t_e, t_e - t_a, self.rtol, self.atol,
+                                              self.max_step, self.block, self.law, False, ts, ys, 0, 8)
+        self.nfev += nfev
+        return ys[n - 1].copy() if code == self.steps.END and n > 0 else None
 
     def _keep(self, t_e, kind, force, j):
         events = self.events
@@ -290,11 +247,10 @@ class _SmoothRun:
         ja, jb = self.slips[k - 1], self.slips[k]
         if (ja, jb) in self.cycles:
             return self.cycles[ja, jb]
-        za, zb = self.zs[ja] * self.scale, self.zs[jb] * self.scale
-        q = np.concatenate(([self.ts[jb] - self.ts[ja], zb[0]], zb[5:], zb[2:5] - za[2:5]))
-        tol = self.rtol * np.abs(q) + np.concatenate(([0.0, self.scale[0] * 1e-12],
-                                                      np.full(zb.size - 5, self.rtol),
-                                                      self.scale[2:5] * 1e-12))
+        ya, yb = self.ys[ja], self.ys[jb]
+        q = np.concatenate(([self.ts[jb] - self.ts[ja], yb[0]], yb[5:], yb[2:5] - ya[2:5]))
+        tol = self.rtol * np.abs(q) + np.concatenate(([0.0, self.atol[0]], np.full(yb.size - 5, self.rtol),
+                                                      self.atol[2:5]))
         self.cycles[ja, jb] = q, tol
         return q, tol
 
@@ -332,10 +288,10 @@ class _SmoothRun:
         mark = self.rec.mark()
         self._flush(jb)
         dt, dx, dxa = self.rec.repeat(mark, copies)
-        z = self.zs[jb].copy()
-        z[2:5] = 0.0
-        tau = self.ts[jb]
-        return self.t0 + tau + dt, self.xa0 + self.va * tau + dxa, z
+        y = self.ys[jb].copy()
+        y[2:5] = 0.0
+        tau = float(self.ts[jb])
+        return self.t0 + tau + dt, self.xa0 + self.va * tau + dxa, y
 
     # -- recording -----------------------------------------------------------------------
     def _flush(self, j_end):
@@ -343,14 +299,14 @@ class _SmoothRun:
         j0 = self.flushed
         if j_end <= j0:
             return
-        ts = np.array(self.ts[j0:j_end + 1])
-        ys = (np.array(self.zs[j0:j_end + 1]) * self.scale).T
+        ts = self.ts[j0:j_end + 1].copy()
+        ys = self.ys[j0:j_end + 1].T.copy()
         xa = self.xa0 + self.va * ts
         e0 = ys[2:5, 0:1]
         self.rec.append(self.t0 + ts, xa - ys[0], ys[1], xa, ys[5:], *(ys[2:5] - e0))
         self.rec.nfev = self.nfev
         kept = [e for e in self.events if j0 < e[3] <= j_end]
-        self.rec.insert_events([self.t0 + self.ts[e[3]] for e in kept], [e[1] for e in kept])
+        self.rec.insert_events([self.t0 + float(self.ts[e[3]]) for e in kept], [e[1] for e in kept])
         self.flushed = j_end
 
     def result(self):

@@ -8,7 +8,7 @@ import numpy as np
 
 from .base import FrictionLaw, non_negative, positive
 
-__all__ = ["RateState"]
+__all__ = ["RateState", "state_rates"]
 
 
 @dataclass(frozen=True)
@@ -93,32 +93,21 @@ class RateState(FrictionLaw):
             return np.array([0.0])
         return np.array([-(speed / self.dc) * (math.log(speed / self.v0) + psi)])
 
+    def rate_parameters(self, normal_load):
+        """The parameters of :func:`state_rates`: (N, mu0, a, b, v0, dc, aging, regularized)
+        as a tuple of floats (the flags 1.0 or 0.0)."""
+        return tuple(float(c) for c in (normal_load, self.mu0, self.a, self.b, self.v0, self.dc,
+                                        self.evolution == "aging", self.regularized))
+
     def scalar_state_rates(self, normal_load):
-        """The friction and the state rate on plain floats (the ODE hot loop); the same
-        formulas as :meth:`coefficient` and :meth:`state_rate`."""
-        N, mu0, a, b, v0, dc = (float(c) for c in (normal_load, self.mu0, self.a, self.b,
-                                                   self.v0, self.dc))
-        log, exp, asinh, ln2 = math.log, math.exp, math.asinh, math.log(2.0)
-        aging, regularized = self.evolution == "aging", self.regularized
-        heal = v0 / dc
+        """The friction and the state rate on plain floats (:func:`state_rates`, the
+        formula the compiled fast path runs); the same law as :meth:`coefficient` and
+        :meth:`state_rate`."""
+        params = self.rate_parameters(normal_load)
 
         def rates(s, state):
-            psi = state[0]
-            speed = -s if s < 0.0 else s
-            if not regularized:
-                mu = mu0 + a * log(speed / v0) + b * psi
-            elif speed == 0.0:
-                mu = 0.0
-            else:
-                logz = log(speed / (2.0 * v0)) + (mu0 + b * psi) / a
-                mu = a * (logz + ln2 if logz > 30.0 else asinh(exp(logz)))
-                if s < 0.0:
-                    mu = -mu
-            if aging:
-                rate = heal * exp(-psi) - speed / dc
-            else:
-                rate = -(speed / dc) * (log(speed / v0) + psi) if speed > 0.0 else 0.0
-            return N * mu, [rate]
+            friction, rate = state_rates(s, state[0], params)
+            return friction, [rate]
         return rates
 
     def theta(self, state):
@@ -148,3 +137,30 @@ class RateState(FrictionLaw):
         n = positive("normal_load", normal_load, "the critical stiffness scales with the normal load")
         m = non_negative("mass", mass, "block mass")
         return n * (self.b - self.a) / self.dc * (1.0 + m * velocity ** 2 / (n * self.a * self.dc))
+
+
+def state_rates(s, psi, params):
+    """Friction force and d psi/dt at slip velocity ``s`` and log state ``psi``.
+
+    ``params`` is :meth:`RateState.rate_parameters`.  Plain float arithmetic with
+    ``math`` only, so that :mod:`..smooth_steps` compiles this very function
+    (numba) for the ODE's hot loop: one formula for both paths."""
+    N, mu0, a, b, v0, dc, aging, regularized = params
+    speed = -s if s < 0.0 else s
+    if regularized == 0.0:
+        mu = mu0 + a * math.log(speed / v0) + b * psi
+    elif speed == 0.0:
+        mu = 0.0
+    else:
+        # asinh(z), z = speed/(2 v0) exp((mu0 + b psi)/a), in log form past z = e^30
+        logz = math.log(speed / (2.0 * v0)) + (mu0 + b * psi) / a
+        mu = a * (logz + math.log(2.0) if logz > 30.0 else math.asinh(math.exp(logz)))
+        if s < 0.0:
+            mu = -mu
+    if aging != 0.0:
+        rate = (v0 / dc) * math.exp(-psi) - speed / dc
+    elif speed > 0.0:
+        rate = -(speed / dc) * (math.log(speed / v0) + psi)
+    else:
+        rate = 0.0
+    return N * mu, rate

@@ -124,3 +124,15 @@ def test_fast_path_with_a_damper_or_a_belt(monkeypatch, options):
     assert fast.x[-1] == pytest.approx(general.x[-1], abs=1e-8)
     assert fast.energy.damper_dissipation == pytest.approx(general.energy.damper_dissipation, rel=1e-8)
     assert fast.energy.closure < 1e-10
+
+
+def test_without_numba_the_general_path_runs(monkeypatch):
+    import sys
+
+    from filmfriction import reduced_model
+    monkeypatch.setitem(sys.modules, "filmfriction.reduced_model.smooth_steps", None)   # import fails
+    monkeypatch.delattr(reduced_model, "smooth_steps", raising=False)
+    used = _spy(monkeypatch)
+    with pytest.warns(RuntimeWarning, match="compiled rate-and-state path is unavailable"):
+        r = BLOCK.simulate(20.0, initial_velocity=0.05)
+    assert used == [False] and len(r.events) > 10
