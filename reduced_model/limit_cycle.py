@@ -92,7 +92,7 @@ def run_smooth(p, rtol, atol, max_step):
             return None
     try:
         from . import smooth_steps
-    except ImportError as err:          # numba missing or broken: the general path runs
+    except (ImportError, RuntimeError, OSError) as err:  # numba missing, or no cache dir to write
         warnings.warn(f"the compiled rate-and-state path is unavailable ({err}); "
                       "integrating with LSODA instead (slower)", RuntimeWarning, stacklevel=3)
         return None
