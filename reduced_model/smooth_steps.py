@@ -19,7 +19,10 @@ extremum, not once per evaluation.
 * **stop:** at the end time, after the first accepted step across
   ``v = V`` (a spring-force extremum) when ``detect``, when the output arrays
   are full, or when the step underflows (the run is stiff: the caller hands it
-  to the stiff-aware path).
+  to the stiff-aware path).  With the unregularized law (the log form, defined
+  for forward slip only) a step that would end at ``v <= u`` is rejected: a
+  block that creeps towards rest is stiff, and an explicit step must not carry
+  it across into backward slip, where the log form is no law at all.
 
 Compiled functions are cached on disk (``cache=True``): the first run on a
 machine compiles for about 3 s, a new process loads them in about 0.2 s.
@@ -94,7 +97,8 @@ def advance(t, y0, t_end, h, rtol, atol, max_step, block, law, detect, ts, ys, n
     y, y_new, probe = y0.copy(), np.empty(dim), np.empty(dim)
     _flow(y, block, law, k[0])
     nfev = 1
-    va = block[4]
+    u, va = block[3], block[4]
+    log_form = law[7] == 0.0            # RateState(regularized=False)
     g_prev = y[1] - va
     rejected = False
     while t < t_end:
@@ -130,6 +134,8 @@ def advance(t, y0, t_end, h, rtol, atol, max_step, block, law, detect, ts, ys, n
             error = 0.0
         else:
             error = step * err5 / math.sqrt((err5 + 0.01 * err3) * dim)
+        if log_form and not y_new[1] - u > 0.0:
+            error = math.inf        # the log form holds for forward slip only: step shorter
         if error < 1.0:                                 # accepted (a NaN error is not)
             factor = 10.0 if error == 0.0 else min(10.0, 0.9 * error ** _EXPONENT)
             if rejected:

@@ -28,6 +28,7 @@ Example
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -230,6 +231,9 @@ class SpringBlock:
                                    shear_stiffness=shear)
         from .hybrid import run_ode
         result = run_ode(problem, rtol=rtol)
+        leaving = law.outside_domain(result.t, result.v - u)
+        if leaving:
+            warnings.warn(leaving, RuntimeWarning, stacklevel=2)
         theta = getattr(law, "theta", None)
         if theta is not None and result.state.size:
             result.extras["theta"] = theta(result.state)

@@ -164,6 +164,11 @@ class FrictionLaw:
         form (``reduced_model/coulomb.py``) instead of the ODE path."""
         return None
 
+    def outside_domain(self, t, slip_velocity):
+        """A message if a run's slip velocities (at times ``t``) left where the law holds,
+        else ``None``; ``simulate`` turns it into a warning."""
+        return None
+
     def quasi_static_speed(self, force, state, normal_load):
         """Slip speed at which friction equals ``force`` (massless limit), or None."""
         return None

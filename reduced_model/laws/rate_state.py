@@ -110,6 +110,20 @@ class RateState(FrictionLaw):
             return friction, [rate]
         return rates
 
+    def outside_domain(self, t, slip_velocity):
+        """The log form (``regularized=False``) holds for forward slip only: as v -> 0+
+        its friction falls without bound, so an exact solution never stops, but a
+        creep below what float64 and the integrator resolve may still step to v <= 0."""
+        if self.regularized or slip_velocity.size == 0:
+            return None
+        backward = np.flatnonzero(~(slip_velocity > 0.0))
+        if backward.size == 0:
+            return None
+        return (f"RateState(regularized=False): the slip velocity fell to 0 at t = "
+                f"{t[backward[0]]:.6g} (lowest {np.min(slip_velocity):.3g}); the log form holds for "
+                "v > 0 only, so the run past that point does not follow the law. Use "
+                "regularized=True (defined through v = 0).")
+
     def theta(self, state):
         """The state variable theta = (dc / v0) exp(psi) [time] of a (n_state, ...) state array."""
         return (self.dc / self.v0) * np.exp(np.asarray(state, dtype=float)[0])

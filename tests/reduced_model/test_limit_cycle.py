@@ -1,6 +1,8 @@
 """The fast path of smooth laws with a state (``reduced_model/limit_cycle.py``): it agrees
 with the general LSODA path, its tiled limit cycle agrees with integrating every cycle,
 and a run that turns stiff falls back to the general path."""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -136,3 +138,33 @@ def test_without_numba_the_general_path_runs(monkeypatch):
     with pytest.warns(RuntimeWarning, match="compiled rate-and-state path is unavailable"):
         r = BLOCK.simulate(20.0, initial_velocity=0.05)
     assert used == [False] and len(r.events) > 10
+
+
+def test_the_log_form_never_slips_backwards(monkeypatch):
+    # the unregularized law holds for forward slip only; this block creeps towards rest
+    # between slips (v ~ 1e-11), stiff: explicit steps once carried it into backward slip
+    # (v down to -0.06), where the log form is no law.  The fast path hands it over instead.
+    law = laws.RateState(mu0=0.6, a=0.005858, b=0.014064, dc=0.0019423, v0=0.7894, regularized=False)
+    block = SpringBlock(mass=3.0416, stiffness=3.6167, drive_velocity=0.065826, damping=0.05, law=law)
+    used = _spy(monkeypatch)
+    r = block.simulate(117.0, initial_velocity=0.015524)
+    assert used == [False]
+    assert r.v.min() > 0.0 and len(r.events) >= 30
+
+
+def test_a_log_form_run_that_steps_into_backward_slip_is_flagged():
+    # the same law creeping below what the steps resolve: v crosses 0 (the general path's
+    # LSODA steps over the singular creep); the result says so rather than passing quietly
+    law = laws.RateState(mu0=0.6, a=0.0078217, b=0.0194656, dc=0.019228, v0=0.0601096,
+                         evolution="slip", regularized=False)
+    block = SpringBlock(mass=6.7985, stiffness=0.38849, drive_velocity=0.320095, law=law)
+    with pytest.warns(RuntimeWarning, match=r"regularized=False.*fell to 0 at t = "):
+        r = block.simulate(529.3, initial_velocity=0.428138)
+    assert r.v.min() <= 0.0
+    forward = SpringBlock(mass=1.0, stiffness=10.0, drive_velocity=0.1,
+                          law=laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1,
+                                             regularized=False))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")          # a run that stays forward is not flagged
+        r = forward.simulate(40.0, initial_velocity=0.05)
+    assert r.v.min() > 0.0
