@@ -245,7 +245,17 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             def friction(s, st):
                 return law.friction(s, st, N)
 
-        if law.state_names:
+        rates = None if has_stick else law.scalar_state_rates(N)
+        if rates is not None:
+            # a smooth law with a plain-float form (rate-and-state): the hot loop on floats
+            def rhs(tau, y):
+                x_, v_ = float(y[0]), float(y[1])
+                f_spring = K * (xa_seg + va * tau - x_)
+                s = v_ - u
+                fr, r = rates(s, y[5:].tolist())
+                return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s,
+                                 d * v_ * v_, *r))
+        elif law.state_names:
             def rhs(tau, y):
                 f_spring = K * (xa_seg + va * tau - y[0])
                 s = y[1] - u
