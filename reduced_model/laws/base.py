@@ -151,8 +151,9 @@ class FrictionLaw:
         (``state`` a sequence, the rates a list), for a smooth law with one state variable,
         or ``None``.
 
-        A cheap evaluation of the law for scalar work (the fast path's damping check in
-        ``reduced_model/limit_cycle.py``, benchmarks); it must agree with ``friction`` and
+        A cheap evaluation of the law for scalar work (the right-hand side of the general
+        ODE path, the fast path's damping check in ``reduced_model/limit_cycle.py``,
+        benchmarks); it must agree with ``friction`` and
         ``state_rate`` (the contract test checks it).  The compiled fast path itself is
         rate-and-state's (``reduced_model/smooth_steps.py``)."""
         return None
