@@ -47,6 +47,14 @@ def _list_run(tmp: Path) -> Path:
     return d
 
 
+def _run_dir(tmp: Path) -> Path:
+    d = tmp / "run"
+    d.mkdir()
+    _trace(d)
+    (d / "run.json").write_text("{}")
+    return d
+
+
 def _nan_wall(tmp: Path) -> Path:
     wall = np.arange(400) * 0.1
     wall[::3] = np.nan
@@ -145,6 +153,13 @@ CASES = {
                                          "--dry-run", "--out", t / "s"], "given twice", 2),
     "--resume with --set": (lambda t: ["run", "--resume", t, "--set", "seed=1"],
                             "not accepted with it", 2),
+    # -- wrote a sweep into it (sweep.json, inputs/, .snakemake/)
+    "sweep --out a run directory": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                               "--dry-run", "--out", _run_dir(t)],
+                                    "is a run directory", 2),
+    "sweep --out another folder": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                              "--dry-run", "--out", _afile(t).parent],
+                                   "not a sweep directory", 2),
 }
 
 
