@@ -173,7 +173,7 @@ def run(args: argparse.Namespace) -> int:
         if run_dir is None:
             raise
         command = getattr(exc, "resume_command", None)
-        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); "
+        print(f"filmfriction run: interrupted ({str(exc) or 'SIGINT'}); "
               + (f"resume with {command}" if command else
                  f"nothing to resume yet (no restart file): start the run again; {run_dir}/"
                  "run.json records the interruption"), file=sys.stderr)
