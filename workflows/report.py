@@ -325,7 +325,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
               f"{_fmt(KLEIN.eta_eff * dep['sfb_shear_rate_si'] / 1e3, 3)} kPa at that rate.")
     for r in cal["runs"]:
         if r.get("eta_eff") is not None:
-            sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")
+            sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
     return sec
 
 
@@ -769,8 +769,9 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
         if log is not None:
             log(f"missing or out of date: {what}; make it with: {command}")
     out = Path(out) if out is not None else run.run_dir / "report.html"
-    scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
-    title = f"filmfriction report — {scene} ({run.run_dir.name})"
+    name = run.run_dir.resolve().name           # "." has no name of its own
+    scene = (run.trace.run or {}).get("scene", {}).get("name", run.trace.path.name)
+    title = f"filmfriction report — {scene} ({name})"
     units = run.analysis.get("units", "lj")
     intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. " + (
         "MD quantities are in LJ units (σ, ε, m, τ) unless marked SI; SI values go through "

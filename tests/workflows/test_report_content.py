@@ -124,6 +124,7 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
     monkeypatch.setattr(Figure, "savefig", capture)
     assert run_cli("report", tmp_path).code == 0
     md = (tmp_path / "report.md").read_text()
+    assert md.splitlines()[0] == f"# filmfriction report — trace.csv ({tmp_path.name})"
     named = [label for fig in labels for axis in fig for label in axis if label]
     units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
     assert {"N", "s", "J", "Pa·s", "1/s"} <= units, units
@@ -132,3 +133,23 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
         assert lj not in md, lj
     assert re.search(r"^\| static force \| 9\.7\d*e-06 ± \S+ N \|", md, re.M) and "(SI)" in md
     assert all(re.search(r"\[[^\]]+\]", label) for label in named), named
+
+
+@pytest.mark.parametrize("calibrated_from, reported_from", [("parent", "run"), ("run", "parent")],
+                         ids=["calibrate RUN, report .", "calibrate ., report RUN"])
+def test_the_calibration_is_found_from_any_working_directory(synthetic_study, tmp_path, run_cli,
+                                                             monkeypatch, calibrated_from,
+                                                             reported_from):
+    import shutil
+
+    run = tmp_path / "myrun"
+    shutil.copytree(synthetic_study.path, run)
+    where = {"parent": (tmp_path, "myrun"), "run": (run, ".")}
+    monkeypatch.chdir(where[calibrated_from][0])
+    assert run_cli("calibrate", where[calibrated_from][1]).code == 0
+    monkeypatch.chdir(where[reported_from][0])
+    r = run_cli("report", where[reported_from][1])
+    assert r.code == 0, r.err
+    assert "calibration.json across the runs given" not in r.out, r.out
+    md = (run / "report.md").read_text()
+    assert md.splitlines()[0] == "# filmfriction report — synthetic (myrun)", md.splitlines()[0]
