@@ -203,11 +203,25 @@ def fig_replay_errors(errors: dict, source: str = "MD") -> bytes:
     return _png(fig)
 
 
+def _sfb_reference(check) -> dict:
+    """Whose numbers the SFB check sets the model beside: Klein's, or a measured slip on
+    one's own set-up (``sfb.json`` with ``setup`` and ``measured``, ``sfb --setup``)."""
+    measured = check.doc.get("measured")
+    if not measured:
+        return {"column": "Klein", "whose": "Klein's", "title": "Klein, OMCTS",
+                "curve": "Klein's parameters (η_eff = 27 Pa·s)", "calibrated": "MD-calibrated"}
+    name = (check.doc.get("setup") or {}).get("name") or "your set-up"
+    eta = measured.get("eta_eff")
+    return {"column": "measured", "whose": "the measured value", "title": name,
+            "curve": "the set-up's parameters" + (f" (η_eff = {eta:.3g} Pa·s)" if eta else ""),
+            "calibrated": "calibrated"}
+
+
 def fig_sfb(check) -> bytes:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6.5, 3.4))
-    labels = {"klein": "Klein's parameters (η_eff = 27 Pa·s)", "bulk": "bulk viscosity",
-              "md": "MD-calibrated film"}
+    ref = _sfb_reference(check)
+    labels = {"klein": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
     for key, run in check.slips.items():
         if key not in labels or run.t is None:
             continue
@@ -405,7 +419,8 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.documents.SFBDocument`)."""
     from filmfriction.reduced_model.klein import BRAUN_TOSATTI_NOTE
 
-    sec = Section("Comparison with the SFB experiment (Klein, OMCTS)")
+    ref = _sfb_reference(check) if check is not None else None
+    sec = Section(f"Comparison with the SFB experiment ({ref['title'] if ref else 'Klein, OMCTS'})")
     for r in remarks:
         sec.p(r)
     if check is None:
@@ -416,8 +431,9 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     if any(run.t is not None for run in check.slips.values()):
         png = _attempt(failures, "figure: sfb", fig_sfb, check)
     if png:
-        sec.add(Figure("sfb", png, "SFB-scale slips of the reduced model: Klein's parameters, the same "
-                                   "with bulk viscosity, and (if calibrated) the MD film."))
+        sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
+                                   f"with bulk viscosity, and (if calibrated) the {ref['calibrated']} "
+                                   "film."))
     rows = []
     for r in check.rows:
         if r["source"] == "similarity":   # their own section
@@ -426,7 +442,7 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
         rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
                      "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
                      "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
-    sec.add(Table(("quantity", "source", "Klein", "model", "ratio", "model range", "units", "note"),
+    sec.add(Table(("quantity", "source", ref["column"], "model", "ratio", "model range", "units", "note"),
                   tuple(rows)))
     sec.p(BRAUN_TOSATTI_NOTE)
     sec.p(_sfb_reading(check))
@@ -553,20 +569,27 @@ def _sfb_reading(check) -> str:
             return check.row(name, source)["ratio"]
         except KeyError:
             return None
+    ref = _sfb_reference(check)
     parts = []
     r = ratio("slip_time", "sfb-parameters")
-    if r is not None:
+    if r is not None and ref["column"] == "Klein":
         parts.append(f"With Klein's own parameters the reduced model gives his slip time to a ratio of "
                      f"{r:.2f} and viscous energy to {ratio('viscous_energy', 'sfb-parameters') or float('nan'):.2f}: "
                      "his Eq. (1) analysis is internally consistent.")
+    elif r is not None:
+        parts.append(f"With the set-up's parameters and the measured η_eff the reduced model gives the "
+                     f"measured slip time to a ratio of {r:.2f}.")
     ri = ratio("inertial_slip_time", "sfb-parameters")
     if ri is not None:
         parts.append(f"With bulk viscosity the same slip would last {ri:.2g} × the observed time.")
     for name in ("yield_stress", "eta_eff", "slip_time"):
         rm = ratio(name, "md-calibrated")
         if rm is not None:
-            parts.append(f"MD-calibrated {name.replace('_', ' ')}: ratio {rm:.3g} to Klein's.")
-    if any(r_["source"] == "md-calibrated" for r_ in check.rows):
+            parts.append(f"{ref['calibrated'][0].upper()}{ref['calibrated'][1:]} "
+                         f"{name.replace('_', ' ')}: ratio {rm:.3g} to {ref['whose']}.")
+    if ref["column"] != "Klein":
+        pass                    # a measured slip: no MD path to read
+    elif any(r_["source"] == "md-calibrated" for r_ in check.rows):
         parts.append("Ratios far from 1 on the MD path measure how far a 3-layer LJ film at MD shear rates, "
                      "carried through the unit mapping and the rate law, is from the SFB film; they do not "
                      "by themselves decide between Klein's high effective viscosity and Braun & Tosatti's "

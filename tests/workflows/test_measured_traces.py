@@ -124,6 +124,16 @@ def test_report_labels_a_measured_trace_in_si(chain):
     assert "ε/σ" not in text and "LJ unit" not in text
 
 
+def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
+    d, _ = chain
+    text = (d / "report.md").read_text()
+    sfb = text[text.index("## Comparison with the SFB experiment"):]
+    sfb = sfb[:sfb.index("\n## ")]
+    assert sfb.startswith("## Comparison with the SFB experiment (example SFB")
+    assert "| quantity | source | measured | model |" in sfb
+    assert "Klein's parameters" not in sfb and "to Klein's" not in sfb, sfb
+
+
 @pytest.mark.parametrize("argv,message", [
     (["--column", "time=t"], "no column 't' in the header (columns: t_s, shear_force_N, drive_x_m)"),
     (["--column", "tim=t_s"], "unknown name 'tim'"),
