@@ -87,7 +87,8 @@ class Parameter:
         if below or value > self.high:
             bracket = "(" if self.low_open else "["
             raise SceneError(
-                f"{self.name} = {value} {self.unit}: outside the allowed range "
+                f"{self.name} = {value}{'' if self.unit == '-' else ' ' + self.unit}: outside "
+                "the allowed range "
                 f"{bracket}{self.low}, {self.high}] ({self.help})")
         return value
 

@@ -35,7 +35,7 @@ def test_outputs_follow_observables():
 
 
 @pytest.mark.parametrize("key,value,fragment", [
-    ("film_layers", 9, "film_layers = 9"),
+    ("film_layers", 9, "film_layers = 9: outside the allowed range [1, 8]"),
     ("film_layers", 2.5, "whole number"),
     ("drive_velocity", 0.0, "drive_velocity = 0.0"),
     ("drive_velocity", math.nan, "finite"),
