@@ -509,6 +509,9 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
         csv_path = path / "trace.csv"
         if not csv_path.exists():
             analysed = _analysed_trace_file(path)
+            if analysed is None and (path / "sweep.json").is_file():
+                raise ValueError(f"{path}: a sweep directory, not a run: give one of its runs, "
+                                 f"{path}/points/<point>")
             if analysed is None:
                 raise ValueError(f"{path}: run directory without trace.csv (and no "
                                  "analysis.json of a trace file)")

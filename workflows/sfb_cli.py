@@ -204,10 +204,14 @@ def run(args) -> int:
     contact = None
     if args.run is not None:
         from filmfriction.analysis.contact import contact_from_run
-        for name in ("analysis.json", "run.json"):
-            if not (args.run / name).is_file():
-                raise UserError(f"--run {args.run}: no {name} there (run 'filmfriction analyze "
-                                f"{args.run}' on a run directory first)")
+        if not (args.run / "run.json").is_file():
+            sweep = (args.run / "sweep.json").is_file()
+            raise UserError(f"--run {args.run}: not a run directory of 'filmfriction run' (no "
+                            "run.json)" + (f"; a sweep's runs are {args.run}/points/<point>"
+                                           if sweep else ""))
+        if not (args.run / "analysis.json").is_file():
+            raise UserError(f"--run {args.run}: no analysis.json there (run 'filmfriction "
+                            f"analyze {args.run}' first)")
         try:
             contact = contact_from_run(args.run)
         except (ValueError, KeyError, TypeError) as exc:

@@ -55,6 +55,20 @@ def _run_dir(tmp: Path) -> Path:
     return d
 
 
+def _sweep_dir(tmp: Path) -> Path:
+    d = tmp / "sweep"
+    (d / "points").mkdir(parents=True)
+    (d / "sweep.json").write_text("{}")
+    return d
+
+
+def _analysed_file_dir(tmp: Path) -> Path:
+    d = tmp / "measured"
+    d.mkdir()
+    (d / "analysis.json").write_text("{}")
+    return d
+
+
 def _nan_wall(tmp: Path) -> Path:
     wall = np.arange(400) * 0.1
     wall[::3] = np.nan
@@ -153,6 +167,14 @@ CASES = {
                                          "--dry-run", "--out", t / "s"], "given twice", 2),
     "--resume with --set": (lambda t: ["run", "--resume", t, "--set", "seed=1"],
                             "not accepted with it", 2),
+    # -- pointed the user at a command that fails in turn
+    "analyze a sweep directory": (lambda t: ["analyze", _sweep_dir(t)],
+                                  "a sweep directory, not a run", 2),
+    "sfb --run a sweep directory": (lambda t: ["sfb", "--run", _sweep_dir(t)],
+                                    "a sweep's runs are", 2),
+    "sfb --run an analysed trace file's directory": (
+        lambda t: ["sfb", "--run", _analysed_file_dir(t)],
+        "not a run directory of 'filmfriction run' (no run.json)", 2),
     # -- wrote a sweep into it (sweep.json, inputs/, .snakemake/)
     "sweep --out a run directory": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
                                                "--dry-run", "--out", _run_dir(t)],
