@@ -111,6 +111,9 @@ def test_sfb_runs_on_the_users_setup_and_slip(chain):
     # the calibrated rows speak SI too: no LJ mapping in their notes
     calibrated = [r["note"] for r in doc["rows"] if r["source"] == "md-calibrated"]
     assert calibrated and not any("eps/sigma" in n or "/tau" in n for n in calibrated)
+    # what the set-up does not give (the ringing, Klein's heating) is said, not printed as nan
+    import re
+    assert not [r["note"] for r in doc["rows"] if re.search(r"\bnan\b", r["note"])]
 
 
 def test_report_is_written(chain):
