@@ -175,6 +175,9 @@ CASES = {
     "sfb --run an analysed trace file's directory": (
         lambda t: ["sfb", "--run", _analysed_file_dir(t)],
         "not a run directory of 'filmfriction run' (no run.json)", 2),
+    # -- wrote the HTML under the Markdown twin's name, which then replaced it
+    "report --out FILE.md": (lambda t: ["report", _run_dir(t), "--out", t / "rep.md"],
+                             "give a .html file name", 2),
     # -- wrote a sweep into it (sweep.json, inputs/, .snakemake/)
     "sweep --out a run directory": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
                                                "--dry-run", "--out", _run_dir(t)],
