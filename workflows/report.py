@@ -696,14 +696,21 @@ def _split_sweeps(paths: list) -> tuple[list, list]:
     """
     from filmfriction.workflows.sweep_aggregate import load_aggregate
 
-    runs, sweeps = [], []
+    runs, sweeps, seen = [], [], set()
+
+    def add(d):
+        # each run once, however it is written (r1, ./r1/, /abs/r1, or within a sweep)
+        if Path(d).resolve() not in seen:
+            seen.add(Path(d).resolve())
+            runs.append(d)
     for p in paths:
         if (p / "aggregate.json").exists():
             agg = load_aggregate(p)
             sweeps.append(agg)
-            runs += [d for d in (agg.calibration_runs or agg.run_dirs) if d not in runs]
-        elif p not in runs:
-            runs.append(p)
+            for d in agg.calibration_runs or agg.run_dirs:
+                add(d)
+        else:
+            add(p)
     return runs, sweeps
 
 

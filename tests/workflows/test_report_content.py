@@ -153,3 +153,15 @@ def test_the_calibration_is_found_from_any_working_directory(synthetic_study, tm
     assert "calibration.json across the runs given" not in r.out, r.out
     md = (run / "report.md").read_text()
     assert md.splitlines()[0] == "# filmfriction report — synthetic (myrun)", md.splitlines()[0]
+
+
+def test_a_run_given_twice_counts_once(synthetic_study, tmp_path, run_cli, monkeypatch):
+    """r1 and /abs/r1 (or ./r1/) are one run: calibrating 'both' must not count its slips twice."""
+    import shutil
+
+    run = tmp_path / "r1"
+    shutil.copytree(synthetic_study.path, run)
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("calibrate", "r1", run, "./r1/")
+    assert r.code == 0, r.err
+    assert len(json.loads((run / "calibration.json").read_text())["runs"]) == 1
