@@ -175,6 +175,13 @@ CASES = {
     "sfb --run an analysed trace file's directory": (
         lambda t: ["sfb", "--run", _analysed_file_dir(t)],
         "not a run directory of 'filmfriction run' (no run.json)", 2),
+    # -- named a dataclass field, not the option, or gave Python's errno text
+    "sfb --sigma-nm negative": (lambda t: ["sfb", "--sigma-nm", "-1"],
+                                "argument --sigma-nm: must be a positive number: '-1'", 2),
+    "sfb --epsilon-K zero": (lambda t: ["sfb", "--epsilon-K", "0"],
+                             "argument --epsilon-K: must be a positive number: '0'", 2),
+    "sfb --calibration a directory": (lambda t: ["sfb", "--calibration", _run_dir(t)],
+                                      "a directory; give its calibration.json", 2),
     # -- wrote the HTML under the Markdown twin's name, which then replaced it
     "report --out FILE.md": (lambda t: ["report", _run_dir(t), "--out", t / "rep.md"],
                              "give a .html file name", 2),
