@@ -277,14 +277,22 @@ def _split(line: str, sep: str | None) -> list[str]:
 
 def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
     """Index of the header line (after blank and ``#`` lines), its text, the delimiter."""
-    head = raw[:65536].decode("utf-8", errors="replace").splitlines()
+    # utf-8-sig: a spreadsheet's CSV export may start with a byte-order mark
+    head = raw[:65536].decode("utf-8-sig", errors="replace").splitlines()
     start = 0
     while start < len(head) and (not head[start].strip() or head[start].lstrip().startswith("#")):
         start += 1
     if start == len(head):
         raise ValueError(f"{path}: empty file (no header line)")
     first_row = head[start + 1] if start + 1 < len(head) else None
-    return start, head[start], detect_delimiter(head[start], first_row)
+    sep = detect_delimiter(head[start], first_row)
+    named = next((s for s in (",", "\t", ";") if s in head[start]), None)
+    if sep is None and named is not None and first_row is not None and named in first_row:
+        raise ValueError(f"{path}: the header has {len(head[start].split(named))} "
+                         f"{_DELIMITER_NAMES[named]}-separated columns, the first data row (line "
+                         f"{start + 2}) {len(first_row.split(named))}: every row needs one value "
+                         "per column")
+    return start, head[start], sep
 
 
 def _read_table(path: Path) -> tuple[list[str], np.ndarray, list[str], str | None]:
