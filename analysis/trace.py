@@ -485,8 +485,8 @@ def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
     source = doc.get("source") or {}
     if source.get("run_dir") or not source.get("path"):
         return None
-    given = Path(source["path"])
-    for candidate in (directory / given.name, given):
+    given = Path(source["path"])          # relative to the directory (older: to the cwd)
+    for candidate in (directory / given.name, directory / given, given):
         if candidate.is_file():
             return candidate, doc
     raise ValueError(f"{doc_path}: the trace it was made from, {given}, is not there "

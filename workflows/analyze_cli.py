@@ -148,6 +148,12 @@ def run(args: argparse.Namespace) -> int:
         # how the file was read: `calibrate`, `report` and `analyze DIR` read it again so
         doc["source"]["delimiter"] = layout.delimiter
         doc["source"]["columns"] = dict(layout.columns)
+        # the file as seen from analysis.json (not from this working directory), so that
+        # `calibrate`/`report` of its directory find it from anywhere, --output elsewhere too
+        import os
+
+        doc["source"]["path"] = os.path.relpath(Path(trace.path).resolve(),
+                                                Path(out).parent.resolve())
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     if not args.no_figure:
         from filmfriction.analysis.trace_figure import write_trace_figure

@@ -174,3 +174,20 @@ def test_bad_setups_are_one_line_errors(tmp_path, capsys, chain):
     assert main(["sfb", "--setup", str(tmp_path / "s.toml"), "--measured", str(d)]) == 2
     assert "differs from the 97" in capsys.readouterr().err
 
+
+
+def test_an_analysis_written_elsewhere_finds_its_trace_from_any_directory(tmp_path, run_cli,
+                                                                         monkeypatch):
+    """analyze data/trace --output results/analysis.json, then calibrate results from
+    another working directory: the trace is found from the analysis' own directory."""
+    (tmp_path / "data").mkdir()
+    for name in ("sfb_trace.tsv", "my_sfb.toml"):
+        shutil.copy(EXAMPLES / name, tmp_path / "data" / name)
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("analyze", "data/sfb_trace.tsv", "--setup", "data/my_sfb.toml", *COLUMNS,
+                "--output", "results/analysis.json")
+    assert r.code == 0, r.err
+    monkeypatch.chdir(tmp_path / "results")
+    r = run_cli("calibrate", ".")
+    assert r.code == 0, r.err
+    assert (tmp_path / "results" / "calibration.json").is_file()
