@@ -216,6 +216,13 @@ def write_geometry(args: argparse.Namespace) -> int:
     except SceneError as exc:
         raise UserError(str(exc)) from None
     check_writable(args.out, "--out")
+    if args.out.is_file():
+        # a geometry file written before is replaced; any other file (a trace, a script) is not
+        with open(args.out, "rb") as fh:
+            first = fh.readline()
+        if not first.startswith(b"# filmfriction "):
+            raise UserError(f"--out {args.out}: exists and is not a data file of 'filmfriction "
+                            "geometry' (its first line); choose another name, or remove it")
     g = scene.geometry()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out, g.lammps_data())

@@ -182,6 +182,9 @@ CASES = {
                              "argument --epsilon-K: must be a positive number: '0'", 2),
     "sfb --calibration a directory": (lambda t: ["sfb", "--calibration", _run_dir(t)],
                                       "a directory; give its calibration.json", 2),
+    # -- replaced the user's file
+    "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
+                                    "is not a data file of 'filmfriction geometry'", 2),
     # -- wrote the HTML under the Markdown twin's name, which then replaced it
     "report --out FILE.md": (lambda t: ["report", _run_dir(t), "--out", t / "rep.md"],
                              "give a .html file name", 2),
