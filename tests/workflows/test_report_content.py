@@ -165,3 +165,44 @@ def test_a_run_given_twice_counts_once(synthetic_study, tmp_path, run_cli, monke
     r = run_cli("calibrate", "r1", run, "./r1/")
     assert r.code == 0, r.err
     assert len(json.loads((run / "calibration.json").read_text())["runs"]) == 1
+
+
+def test_no_legend_covers_data(synthetic_study, tmp_path, monkeypatch):
+    """Every figure's legend sits off its data: no point or line vertex under it; the slip-law
+    figure's loops fill its plane, so its legend is above the axes."""
+    import shutil
+
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from filmfriction.workflows import study
+
+    covered, outside, savefig = [], {}, Figure.savefig
+
+    def check(fig, *args, **kwargs):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        for ax in fig.axes:
+            legend = ax.get_legend()
+            if legend is None:
+                continue
+            box = legend.get_window_extent(renderer)
+            outside[ax.get_ylabel()] = not box.overlaps(ax.get_window_extent(renderer))
+            points = [ln.get_transform().transform(np.column_stack(ln.get_data()).astype(float))
+                      for ln in ax.get_lines() if len(ln.get_xdata())]
+            points += [c.get_offset_transform().transform(np.asarray(c.get_offsets(), float))
+                       for c in ax.collections if len(c.get_offsets())]
+            p = np.vstack(points) if points else np.empty((0, 2))
+            p = p[np.isfinite(p).all(axis=1)]
+            if ((p[:, 0] > box.x0) & (p[:, 0] < box.x1) & (p[:, 1] > box.y0)
+                    & (p[:, 1] < box.y1)).any():
+                covered.append(ax.get_ylabel())
+        return savefig(fig, *args, **kwargs)
+
+    run = tmp_path / "run"
+    shutil.copytree(synthetic_study.path, run)
+    monkeypatch.setattr(Figure, "savefig", check)
+    assert study.finish_study(run) == 0
+    assert not covered, covered
+    slip_law = [ok for label, ok in outside.items() if label.startswith("film force")]
+    assert slip_law == [True], outside
