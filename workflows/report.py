@@ -121,7 +121,8 @@ def fig_lambda_zeta(points: list) -> bytes:
     ax.set_yscale("log")
     ax.set_xlabel("damping ratio ζ = (B + γM)/(2√(KM)) [1]")
     ax.set_ylabel("λ = (F_s − F_k)/(V√(KM)) [1]")
-    ax.legend(loc="lower right", fontsize=7)
+    # beside the axes: the contacts' points may fall anywhere in the plane
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)
     return _png(fig)
 
 

@@ -206,3 +206,23 @@ def test_no_legend_covers_data(synthetic_study, tmp_path, monkeypatch):
     assert not covered, covered
     slip_law = [ok for label, ok in outside.items() if label.startswith("film force")]
     assert slip_law == [True], outside
+
+
+def test_the_lambda_zeta_legend_is_off_the_plane(monkeypatch):
+    """A contact in the lower right of the plane (a compared run, Klein's) was under the legend."""
+    from matplotlib.figure import Figure
+
+    from filmfriction.workflows.report import fig_lambda_zeta
+
+    clear, savefig = [], Figure.savefig
+
+    def check(fig, *args, **kwargs):
+        fig.canvas.draw()
+        r = fig.canvas.get_renderer()
+        clear.extend(not ax.get_legend().get_window_extent(r).overlaps(ax.get_window_extent(r))
+                     for ax in fig.axes)
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", check)
+    fig_lambda_zeta([("run (MD)", 3.0, 0.2, 0.3, 0.05), ("Klein", 4.1, 0.5, 128.0, 10.0)])
+    assert clear == [True]
