@@ -226,3 +226,22 @@ def test_the_lambda_zeta_legend_is_off_the_plane(monkeypatch):
     monkeypatch.setattr(Figure, "savefig", check)
     fig_lambda_zeta([("run (MD)", 3.0, 0.2, 0.3, 0.05), ("Klein", 4.1, 0.5, 128.0, 10.0)])
     assert clear == [True]
+
+
+def test_a_run_without_slips_prints_no_nan(synthetic_study, tmp_path, capsys):
+    """A run too short for a slip: the study's summary lines say what is missing, not 'nan'."""
+    import shutil
+
+    from filmfriction.workflows import study
+
+    run = tmp_path / "short"
+    shutil.copytree(synthetic_study.path, run)
+    for name in ("analysis.json", "calibration.json", "sfb.json"):
+        (run / name).unlink(missing_ok=True)
+    lines = (run / "trace.csv").read_text().splitlines()
+    (run / "trace.csv").write_text("\n".join(lines[:40]) + "\n")      # the first stick only
+    capsys.readouterr()
+    study.finish_study(run)
+    out = capsys.readouterr().out
+    assert "analysis: unresolved, 0 slips ->" in out, out
+    assert "nan" not in out, out
