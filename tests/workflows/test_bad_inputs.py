@@ -55,6 +55,16 @@ def _run_dir(tmp: Path) -> Path:
     return d
 
 
+def _md_run(tmp: Path) -> Path:
+    d = tmp / "md-run"
+    d.mkdir()
+    _trace(d)
+    (d / "run.json").write_text('{"trace_parameters": {"spring_constant": 100.0, "mass": 500.0, '
+                                '"area": 58.7, "thickness": null, "drive_velocity": 0.02, '
+                                '"units": "lj"}}')
+    return d
+
+
 def _sweep_dir(tmp: Path) -> Path:
     d = tmp / "sweep"
     (d / "points").mkdir(parents=True)
@@ -182,6 +192,14 @@ CASES = {
                              "argument --epsilon-K: must be a positive number: '0'", 2),
     "sfb --calibration a directory": (lambda t: ["sfb", "--calibration", _run_dir(t)],
                                       "a directory; give its calibration.json", 2),
+    # -- relabelled an MD run (its analysis.json) with another K or in SI
+    "analyze a run with another K": (lambda t: ["analyze", _md_run(t), "--spring-constant", "5"],
+                                     "ran with spring_constant = 100.0", 2),
+    "analyze a run in SI": (lambda t: ["analyze", _md_run(t), "--units", "si"],
+                            "ran with units = lj", 2),
+    "analyze a run with a set-up": (lambda t: ["analyze", _md_run(t), "--setup",
+                                               _toml(t, "s.toml", "name = 'x'\n")],
+                                    "--setup is for a trace file", 2),
     # -- replaced the user's file
     "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
                                     "is not a data file of 'filmfriction geometry'", 2),
