@@ -517,9 +517,13 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
                              "–" if not r.get("uncertainty") else
                              f"{_fmt(r['uncertainty'][0], 2)} … {_fmt(r['uncertainty'][1], 2)}",
                              r["note"]) for r in rows)))
-    else:
+    elif (Path(run_dirs[0]) / "run.json").is_file():
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
+    else:
+        sec.p("Not an MD run: these numbers set an MD film beside Klein's contact. A measured "
+              "trace is an experiment of its own: its slip is set beside the model in the SFB "
+              "section above.")
     others = {}
     for d in list(run_dirs[1:]) + [Path(c) for c in compare]:
         try:

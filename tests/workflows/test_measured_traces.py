@@ -135,6 +135,8 @@ def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
     assert sfb.startswith("## Comparison with the SFB experiment (example SFB")
     assert "| quantity | source | measured | model |" in sfb
     assert "Klein's parameters" not in sfb and "to Klein's" not in sfb, sfb
+    # the similarity numbers are an MD run's: no command that cannot apply here
+    assert "filmfriction sfb --run" not in text and "Not an MD run" in text
 
 
 @pytest.mark.parametrize("argv,message", [
