@@ -459,9 +459,13 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     sec = Section(obs.title)
     section = run.analysis.get(obs.key)
     if not section or not obs.shown(section):
-        why = run.analysis.get("skipped", {}).get(
-            obs.key, "nothing to show for this run" if obs.key in run.analysis else
-            f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
+        why = run.analysis.get("skipped", {}).get(obs.key)
+        if why is None and obs.key in run.analysis:
+            why = "nothing to show for this run"
+        elif why is None and not (run.run_dir / "run.json").is_file():
+            why = "a trace file has none: it is not an MD run"
+        elif why is None:
+            why = f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)"
         sec.p(f"{obs.absent}: {why}.")
         return sec
     what = obs.key.replace("_", " ")

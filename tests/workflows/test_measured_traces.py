@@ -137,6 +137,7 @@ def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
     assert "Klein's parameters" not in sfb and "to Klein's" not in sfb, sfb
     # the similarity numbers are an MD run's: no command that cannot apply here
     assert "filmfriction sfb --run" not in text and "Not an MD run" in text
+    assert "rerun `filmfriction analyze" not in text      # it cannot make a film structure
 
 
 @pytest.mark.parametrize("argv,message", [
