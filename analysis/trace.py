@@ -277,6 +277,13 @@ def _split(line: str, sep: str | None) -> list[str]:
 
 def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
     """Index of the header line (after blank and ``#`` lines), its text, the delimiter."""
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise ValueError(f"{path}: UTF-16 text (a spreadsheet's 'Unicode text' export): save it "
+                         "as UTF-8 or plain CSV")
+    if b"\0" in raw[:65536]:
+        raise ValueError(f"{path}: binary data (compressed, NumPy, an image, ...), not a text "
+                         "trace: give a header line, then rows of numbers (decompress or export "
+                         "it as text first)")
     # utf-8-sig: a spreadsheet's CSV export may start with a byte-order mark
     head = raw[:65536].decode("utf-8-sig", errors="replace").splitlines()
     start = 0
