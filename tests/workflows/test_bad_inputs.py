@@ -200,6 +200,16 @@ CASES = {
     "analyze a run with a set-up": (lambda t: ["analyze", _md_run(t), "--setup",
                                                _toml(t, "s.toml", "name = 'x'\n")],
                                     "--setup is for a trace file", 2),
+    # -- accepted, to fail (as a note) only after the whole sweep had run
+    "sweep --calibration not a calibration": (
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s",
+                   "--calibration", _toml(t, "a.json", '{"schema": "filmfriction.analysis/1"}')],
+        "not a calibration.json", 2),
+    "sweep --calibration in SI": (
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s",
+                   "--calibration", _toml(t, "c.json", '{"schema": "filmfriction.calibration/1",'
+                                                       ' "units": "si"}')],
+        "needs an MD calibration, in LJ units", 2),
     # -- replaced the user's file
     "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
                                     "is not a data file of 'filmfriction geometry'", 2),

@@ -180,7 +180,8 @@ def fake_point(sweep_dir, plan, name, regime, slips, eta, rate):
 
 def test_aggregate_of_a_v_by_k_sweep(tmp_path):
     cal = tmp_path / "calibration.json"
-    cal.write_text(json.dumps({"runs": [{"static_force": {"value": 60.0},
+    cal.write_text(json.dumps({"schema": "filmfriction.calibration/1", "units": "lj",
+                               "runs": [{"static_force": {"value": 60.0},
                                          "kinetic_force": {"value": 20.0},
                                          "film_damping": {"value": 10.0}}]}))
     plan = sweep.plan_sweep("stick-slip", ["drive_velocity=0.01:1:3:log",
