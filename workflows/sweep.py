@@ -171,6 +171,9 @@ def main_sweep(args: argparse.Namespace) -> int:
         check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
     try:
         plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
+        from .lammps_build import resolve
+
+        resolve(None)            # every point would fail on a $FILMFRICTION_LMP that is none
     except SceneError as exc:
         raise _user_error(str(exc)) from None
     check_installed(profile)

@@ -330,3 +330,20 @@ def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, ca
     flag = next(a for a in args if str(a).startswith("--o"))
     assert f"error: {flag} {read_only_dir}" in err, err
     assert _snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("command", [
+    lambda t: ["bench", "--np", "1", "--steps", "10", "--repeat", "1"],
+    lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s"],
+], ids=["bench", "sweep"])
+def test_a_bad_filmfriction_lmp_is_refused_before_any_run(command, tmp_path, monkeypatch, capsys):
+    """bench started its first run, a sweep its points, before the executable was looked at."""
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    monkeypatch.chdir(inputs)
+    monkeypatch.setenv("FILMFRICTION_LMP", str(tmp_path / "no-lmp"))
+    before = _snapshot(tmp_path)
+    rc, out, err = _cli(capsys, *command(inputs))
+    assert rc == 2 and f"FILMFRICTION_LMP {tmp_path / 'no-lmp'}: no such file" in err, err
+    assert "[1/" not in out and "Traceback" not in err
+    assert _snapshot(tmp_path) == before
