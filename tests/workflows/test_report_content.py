@@ -245,3 +245,15 @@ def test_a_run_without_slips_prints_no_nan(synthetic_study, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "analysis: unresolved, 0 slips ->" in out, out
     assert "nan" not in out, out
+
+
+def test_a_moved_run_keeps_its_calibration(synthetic_study, tmp_path, run_cli):
+    """calibrate, then move or rename the run directory: its calibration.json is still its own."""
+    import shutil
+
+    shutil.copytree(synthetic_study.path, tmp_path / "before")
+    assert run_cli("calibrate", tmp_path / "before").code == 0
+    (tmp_path / "before").rename(tmp_path / "after")
+    r = run_cli("report", tmp_path / "after")
+    assert r.code == 0, r.err
+    assert "calibration.json across the runs given" not in r.out, r.out
