@@ -152,10 +152,12 @@ def run(args: argparse.Namespace) -> int:
     if args.resume and (args.overrides or args.fidelity or args.out):
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
-    if args.out is not None:
-        from .cli import check_writable
+    from .cli import check_writable
 
+    if args.out is not None:
         check_writable(args.out, "--out", directory=True)
+    elif not args.resume:
+        check_writable(Path("runs"), "the default --out,", directory=True)
     try:
         if args.resume:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,

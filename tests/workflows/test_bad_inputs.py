@@ -65,6 +65,13 @@ def _md_run(tmp: Path) -> Path:
     return d
 
 
+def _with_runs_file(tmp: Path, args: list) -> list:
+    """``args``, with a file called runs in the working directory (the cases' cwd is
+    tmp/../work), where a run's default directory would go."""
+    (tmp.parent / "work" / "runs").write_text("not a directory")
+    return args
+
+
 def _sweep_dir(tmp: Path) -> Path:
     d = tmp / "sweep"
     (d / "points").mkdir(parents=True)
@@ -210,6 +217,9 @@ CASES = {
                    "--calibration", _toml(t, "c.json", '{"schema": "filmfriction.calibration/1",'
                                                        ' "units": "si"}')],
         "needs an MD calibration, in LJ units", 2),
+    # -- ended in "runs: File exists"
+    "run with runs/ a file": (lambda t: _with_runs_file(t, ["run", "--md-only"]),
+                              "the default --out, runs: is a file", 2),
     # -- replaced the user's file
     "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
                                     "is not a data file of 'filmfriction geometry'", 2),
