@@ -401,7 +401,8 @@ def main(args: argparse.Namespace) -> int:
     from .run_cli import check_ranks
 
     check_ranks(args.np)
-    check_writable(args.out if args.out is not None else Path("runs"), "--out", directory=True)
+    check_writable(args.out if args.out is not None else Path("runs"),
+                   "--out" if args.out is not None else "the default --out,", directory=True)
     try:
         run_dir = new_run_dir(f"viscosity-T{settings.temperature:g}-rho{settings.density:g}",
                               args.out)

@@ -220,6 +220,9 @@ CASES = {
     # -- ended in "runs: File exists"
     "run with runs/ a file": (lambda t: _with_runs_file(t, ["run", "--md-only"]),
                               "the default --out, runs: is a file", 2),
+    "viscosity with runs/ a file": (lambda t: _with_runs_file(
+        t, ["viscosity", "--temperature", "0.722", "--density", "0.8442"]),
+        "the default --out, runs: is a file", 2),
     # -- replaced the user's file
     "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
                                     "is not a data file of 'filmfriction geometry'", 2),
