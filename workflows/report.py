@@ -536,7 +536,10 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
             failures.setdefault(f"similarity rows of {Path(d).name}", str(exc))
     for d in compare:
         mine = {r["name"]: r for r in others.get(Path(d), [])}
-        if mine and rows:
+        if not mine:
+            sec.p(f"`{Path(d).name}` (compared): no similarity rows in its `sfb.json` (a run "
+                  "without slips has none); nothing of it to set beside this run.")
+        elif mine and rows:
             sec.p(f"Beside it, `{d.name}` (its own `sfb.json`):")
             sec.add(Table(("number", "Klein", "this run", d.name, f"{d.name}'s range"),
                           tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),

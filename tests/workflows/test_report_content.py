@@ -257,3 +257,19 @@ def test_a_moved_run_keeps_its_calibration(synthetic_study, tmp_path, run_cli):
     r = run_cli("report", tmp_path / "after")
     assert r.code == 0, r.err
     assert "calibration.json across the runs given" not in r.out, r.out
+
+
+def test_a_compared_run_without_similarity_rows_is_named(synthetic_study, tmp_path, run_cli):
+    """--compare OTHER whose sfb.json has no similarity rows (no slips): it was left out
+    without a word."""
+    import shutil
+
+    other = tmp_path / "other"
+    shutil.copytree(synthetic_study.path, other)
+    doc = json.loads((other / "sfb.json").read_text())
+    doc["rows"] = [r for r in doc["rows"] if r["source"] != "similarity"]
+    (other / "sfb.json").write_text(json.dumps(doc))
+    out = tmp_path / "cmp.html"
+    r = run_cli("report", synthetic_study.path, "--compare", other, "--out", out)
+    assert r.code == 0, r.err
+    assert "`other` (compared): no similarity rows" in out.with_suffix(".md").read_text()
