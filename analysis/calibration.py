@@ -161,7 +161,7 @@ class RunCalibration:
     failures: dict = field(default_factory=dict)
 
     def as_dict(self) -> dict:
-        out = {"run_dir": str(self.run.run_dir), "regime": self.regime,
+        out = {"run_dir": str(Path(self.run.run_dir).resolve()), "regime": self.regime,
                "area": _num(self.area), "thickness": _num(self.thickness),
                "slips": self.run.n_slips, "skipped_first": self.run.skip}
         for name in ("static_force", "restick_force", "first_yield_force", "kinetic_force",

@@ -277,14 +277,29 @@ def _split(line: str, sep: str | None) -> list[str]:
 
 def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
     """Index of the header line (after blank and ``#`` lines), its text, the delimiter."""
-    head = raw[:65536].decode("utf-8", errors="replace").splitlines()
+    if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise ValueError(f"{path}: UTF-16 text (a spreadsheet's 'Unicode text' export): save it "
+                         "as UTF-8 or plain CSV")
+    if b"\0" in raw[:65536]:
+        raise ValueError(f"{path}: binary data (compressed, NumPy, an image, ...), not a text "
+                         "trace: give a header line, then rows of numbers (decompress or export "
+                         "it as text first)")
+    # utf-8-sig: a spreadsheet's CSV export may start with a byte-order mark
+    head = raw[:65536].decode("utf-8-sig", errors="replace").splitlines()
     start = 0
     while start < len(head) and (not head[start].strip() or head[start].lstrip().startswith("#")):
         start += 1
     if start == len(head):
         raise ValueError(f"{path}: empty file (no header line)")
     first_row = head[start + 1] if start + 1 < len(head) else None
-    return start, head[start], detect_delimiter(head[start], first_row)
+    sep = detect_delimiter(head[start], first_row)
+    named = next((s for s in (",", "\t", ";") if s in head[start]), None)
+    if sep is None and named is not None and first_row is not None and named in first_row:
+        raise ValueError(f"{path}: the header has {len(head[start].split(named))} "
+                         f"{_DELIMITER_NAMES[named]}-separated columns, the first data row (line "
+                         f"{start + 2}) {len(first_row.split(named))}: every row needs one value "
+                         "per column")
+    return start, head[start], sep
 
 
 def _read_table(path: Path) -> tuple[list[str], np.ndarray, list[str], str | None]:
@@ -477,8 +492,8 @@ def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
     source = doc.get("source") or {}
     if source.get("run_dir") or not source.get("path"):
         return None
-    given = Path(source["path"])
-    for candidate in (directory / given.name, given):
+    given = Path(source["path"])          # relative to the directory (older: to the cwd)
+    for candidate in (directory / given.name, directory / given, given):
         if candidate.is_file():
             return candidate, doc
     raise ValueError(f"{doc_path}: the trace it was made from, {given}, is not there "
@@ -509,6 +524,9 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
         csv_path = path / "trace.csv"
         if not csv_path.exists():
             analysed = _analysed_trace_file(path)
+            if analysed is None and (path / "sweep.json").is_file():
+                raise ValueError(f"{path}: a sweep directory, not a run: give one of its runs, "
+                                 f"{path}/points/<point>")
             if analysed is None:
                 raise ValueError(f"{path}: run directory without trace.csv (and no "
                                  "analysis.json of a trace file)")

@@ -45,7 +45,7 @@ BRAUN_TOSATTI_NOTE = (
     "explain Klein's stick-slip with a totally normal (bulk-like) lubricant viscosity. "
     "Klein's eta_eff = 27 Pa s (~1e4 x bulk) is the damping his Eq. (1) needs if all "
     "dissipation is Newtonian shear of the film; it is not a direct measurement of the "
-    "film's viscosity. The sfb-parameters rows below test the internal consistency of "
+    "film's viscosity. The sfb-parameters rows test the internal consistency of "
     "Klein's analysis with the reduced model; they cannot decide between the two readings.")
 
 

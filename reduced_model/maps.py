@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
@@ -183,12 +184,20 @@ class RegimeMap:
     boundary: np.ndarray
     seconds: float
 
-    def to_csv(self, path) -> str:
-        """Write ``x, y, stick_slip`` rows."""
+    def csv_text(self) -> str:
+        """The map as CSV text: a header, then ``x, y, stick_slip`` rows."""
+        import io
+
         X, Y = np.meshgrid(self.x, self.y)
         data = np.column_stack([X.ravel(), Y.ravel(), self.stick_slip.ravel().astype(int)])
-        np.savetxt(path, data, delimiter=",", header=f"{self.x_name},{self.y_name},stick_slip",
+        buf = io.StringIO()
+        np.savetxt(buf, data, delimiter=",", header=f"{self.x_name},{self.y_name},stick_slip",
                    comments="", fmt=["%.10g", "%.10g", "%d"])
+        return buf.getvalue()
+
+    def to_csv(self, path) -> str:
+        """Write ``x, y, stick_slip`` rows."""
+        Path(path).write_text(self.csv_text())
         return str(path)
 
 

@@ -265,11 +265,14 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         _row("ringing_energy", ex.ringing_energy, ring, "J", src,
              f"M_eff (2 a0 nu_c)^2 / 2 with a0 = {ex.ringing_amplitude * 1e9:g} nm, nu_c = "
              f"{ex.ringing_frequency:g} Hz, M_eff = {ex.ringing_mass * 1e3:g} g (Klein's v0 = 2 a0 nu); "
-             f"with v0 = 2 pi a0 nu: {ring_h:.2g} J"),
+             f"with v0 = 2 pi a0 nu: {ring_h:.2g} J" if math.isfinite(ring_h) else
+             "M_eff (2 a0 nu_c)^2 / 2: no ringing amplitude, frequency or mass given"),
         _row("temperature_rise", ex.temperature_rise, heat(main), "K", src,
              f"viscous energy / (rho c_p A D), film volume {A * D:.2g} m3, bulk liquid OMCTS "
-             f"rho c_p = {liquid.volumetric_heat_capacity:.3g} J/(m3 K) ({liquid.source}); "
-             f"Klein's 0.6 C implies rho c_p ~ {ex.spring_energy_released / (ex.temperature_rise * A * D):.2g}",
+             f"rho c_p = {liquid.volumetric_heat_capacity:.3g} J/(m3 K) ({liquid.source})"
+             + (f"; Klein's 0.6 C implies rho c_p ~ "
+                f"{ex.spring_energy_released / (ex.temperature_rise * A * D):.2g}"
+                if math.isfinite(ex.temperature_rise) and ex.temperature_rise > 0 else ""),
              (heat(lo), heat(hi))),
         _row("inertial_slip_time", ex.slip_time, bulk.slip_time, "s", src,
              f"same slip with the bulk viscosity {ex.eta_bulk:g} Pa s (B = "

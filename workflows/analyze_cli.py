@@ -85,8 +85,22 @@ def run(args: argparse.Namespace) -> int:
     from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
                                              write_binary_copy)
 
-    if args.path.is_dir():
-        check_run_json(args.path)
+    record = check_run_json(args.path) if args.path.is_dir() else None
+    recorded = (record or {}).get("trace_parameters") or {}
+    if recorded:
+        # a run of `filmfriction run` is analysed with the parameters it ran with
+        if args.setup is not None:
+            raise UserError(f"--setup {args.setup}: {args.path} is an MD run directory, analysed "
+                            "with the K, M, A, V of its run.json; --setup is for a trace file")
+        for flag, name, value in (("--units", "units", args.units),
+                                  ("--spring-constant", "spring_constant", args.spring_constant),
+                                  ("--mass", "mass", args.mass), ("--area", "area", args.area),
+                                  ("--thickness", "thickness", args.thickness),
+                                  ("--drive-velocity", "drive_velocity", args.drive_velocity)):
+            ran = recorded.get(name, "lj" if name == "units" else None)
+            if value is not None and ran is not None and value != ran:
+                raise UserError(f"{flag} {value}: {args.path} ran with {name} = {ran} (its "
+                                f"run.json), and is analysed with it; leave {flag} out")
     if args.output is not None:
         check_writable(args.output, "--output")
     if args.setup is not None:
@@ -148,6 +162,12 @@ def run(args: argparse.Namespace) -> int:
         # how the file was read: `calibrate`, `report` and `analyze DIR` read it again so
         doc["source"]["delimiter"] = layout.delimiter
         doc["source"]["columns"] = dict(layout.columns)
+        # the file as seen from analysis.json (not from this working directory), so that
+        # `calibrate`/`report` of its directory find it from anywhere, --output elsewhere too
+        import os
+
+        doc["source"]["path"] = os.path.relpath(Path(trace.path).resolve(),
+                                                Path(out).parent.resolve())
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     if not args.no_figure:
         from filmfriction.analysis.trace_figure import write_trace_figure

@@ -150,6 +150,9 @@ def main(args: argparse.Namespace) -> int:
         if args.steps is not None:
             overrides["slide_steps"] = args.steps
         scene = load(args.scene, overrides)
+        from .lammps_build import resolve
+
+        resolve(None)            # a $FILMFRICTION_LMP that is no executable: before any run
     except SceneError as exc:
         raise UserError(str(exc)) from None
     cutoff, timestep = scene.parameters["cutoff"], scene.parameters["timestep"]

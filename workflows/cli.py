@@ -119,6 +119,13 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader went away (`filmfriction sfb | head`): stop quietly, as a tool that
+        # SIGPIPE ends does; stdout to /dev/null so that the exit's flush does not fail again
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     except Exception as exc:  # noqa: BLE001 -- the one error path of the CLI
         if args.debug:
             import traceback

@@ -178,10 +178,16 @@ def _failed(failures: dict, step: str) -> str | None:
 def _same_runs(recorded, given) -> bool:
     """Whether ``calibration.json``'s runs are the report's (paths as written may be relative)."""
     def same(a, b):
+        # a relative recorded path is relative to where calibrate ran: only its name is known
         a, b = Path(a), Path(b)
-        if a.exists() and b.exists():
+        if a.is_absolute() and a.exists() and b.exists():
             return a.resolve() == b.resolve()
-        return a.name == b.name
+        return a.name == b.resolve().name
+    if recorded and given and recorded[0] and Path(recorded[0]).is_absolute() \
+            and not Path(recorded[0]).exists():
+        # calibrate writes into its first run, and the file was read from the report's first
+        # run: that run was moved or renamed since
+        recorded = [given[0], *recorded[1:]]
     return (len(recorded) == len(given) and all(any(same(r, g) for g in given) for r in recorded)
             and all(any(same(r, g) for r in recorded) for g in given))
 

@@ -67,7 +67,9 @@ def run(args) -> int:
         result = maps.velocity_stiffness_map(np.logspace(-3, 0, n), np.logspace(-1, 2, n),
                                              processes=args.processes)
     stem = args.kind.replace("-", "_")
-    csv_path = result.to_csv(out / f"{stem}.csv")
+    from filmfriction.analysis.util import write_atomic
+
+    csv_path = write_atomic(out / f"{stem}.csv", result.csv_text())
     png_path = _plot(result, args.kind, out / f"{stem}.png")
     print(csv_path)
     print(png_path)
@@ -77,10 +79,14 @@ def run(args) -> int:
 
 
 def _plot(result, kind, path) -> str:
+    import io
+
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
+
+    from filmfriction.analysis.util import write_atomic
 
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
     ax.pcolormesh(result.x, result.y, result.stick_slip.astype(float), shading="nearest",
@@ -92,19 +98,22 @@ def _plot(result, kind, path) -> str:
         z = result.x
         ax.plot(z, np.sqrt(4 * math.pi * z), "k--", lw=1, label=r"$\lambda^2 = 4\pi\zeta$")
         ax.axvline(1.0, color="k", ls=":", lw=1, label=r"$\zeta = 1$")
-        ax.set_xlabel(r"$\zeta = d / (2\sqrt{KM})$")
-        ax.set_ylabel(r"$\lambda = \Delta F / (V\sqrt{KM})$")
+        ax.set_xlabel(r"$\zeta = d / (2\sqrt{KM})$ [1]")
+        ax.set_ylabel(r"$\lambda = \Delta F / (V\sqrt{KM})$ [1]")
         ax.set_ylim(result.y[0], result.y[-1])
         ax.set_title("Coulomb block: stick-slip (red) / smooth (blue)")
     else:
-        ax.set_xlabel("drive velocity V")
-        ax.set_ylabel("stiffness K")
+        # the block's own units: mass M, load times static coefficient N f_s, ageing time tau
+        ax.set_xlabel("drive velocity V [N f_s τ/M]")
+        ax.set_ylabel("stiffness K [M/τ²]")
         ax.set_xlim(result.x[0], result.x[-1])
-        ax.set_title("contact-age block: stick-slip (red) / smooth (blue)")
+        ax.set_title("contact-age block (M = N f_s = τ = 1): stick-slip (red) / smooth (blue)",
+                     fontsize=10)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=120)
     plt.close(fig)
-    return str(path)
+    return str(write_atomic(path, buf.getvalue()))

@@ -121,7 +121,8 @@ def fig_lambda_zeta(points: list) -> bytes:
     ax.set_yscale("log")
     ax.set_xlabel("damping ratio ζ = (B + γM)/(2√(KM)) [1]")
     ax.set_ylabel("λ = (F_s − F_k)/(V√(KM)) [1]")
-    ax.legend(loc="lower right", fontsize=7)
+    # beside the axes: the contacts' points may fall anywhere in the plane
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)
     return _png(fig)
 
 
@@ -203,11 +204,25 @@ def fig_replay_errors(errors: dict, source: str = "MD") -> bytes:
     return _png(fig)
 
 
+def _sfb_reference(check) -> dict:
+    """Whose numbers the SFB check sets the model beside: Klein's, or a measured slip on
+    one's own set-up (``sfb.json`` with ``setup`` and ``measured``, ``sfb --setup``)."""
+    measured = check.doc.get("measured")
+    if not measured:
+        return {"column": "Klein", "whose": "Klein's", "title": "Klein, OMCTS",
+                "curve": "Klein's parameters (η_eff = 27 Pa·s)", "calibrated": "MD-calibrated"}
+    name = (check.doc.get("setup") or {}).get("name") or "your set-up"
+    eta = measured.get("eta_eff")
+    return {"column": "measured", "whose": "the measured value", "title": name,
+            "curve": "the set-up's parameters" + (f" (η_eff = {eta:.3g} Pa·s)" if eta else ""),
+            "calibrated": "calibrated"}
+
+
 def fig_sfb(check) -> bytes:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6.5, 3.4))
-    labels = {"klein": "Klein's parameters (η_eff = 27 Pa·s)", "bulk": "bulk viscosity",
-              "md": "MD-calibrated film"}
+    ref = _sfb_reference(check)
+    labels = {"klein": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
     for key, run in check.slips.items():
         if key not in labels or run.t is None:
             continue
@@ -325,7 +340,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
               f"{_fmt(KLEIN.eta_eff * dep['sfb_shear_rate_si'] / 1e3, 3)} kPa at that rate.")
     for r in cal["runs"]:
         if r.get("eta_eff") is not None:
-            sec.p(f"`{Path(r['run_dir']).name}`: {r['eta_eff']['method']}.")
+            sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
     return sec
 
 
@@ -405,7 +420,8 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.documents.SFBDocument`)."""
     from filmfriction.reduced_model.klein import BRAUN_TOSATTI_NOTE
 
-    sec = Section("Comparison with the SFB experiment (Klein, OMCTS)")
+    ref = _sfb_reference(check) if check is not None else None
+    sec = Section(f"Comparison with the SFB experiment ({ref['title'] if ref else 'Klein, OMCTS'})")
     for r in remarks:
         sec.p(r)
     if check is None:
@@ -416,8 +432,9 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
     if any(run.t is not None for run in check.slips.values()):
         png = _attempt(failures, "figure: sfb", fig_sfb, check)
     if png:
-        sec.add(Figure("sfb", png, "SFB-scale slips of the reduced model: Klein's parameters, the same "
-                                   "with bulk viscosity, and (if calibrated) the MD film."))
+        sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
+                                   f"with bulk viscosity, and (if calibrated) the {ref['calibrated']} "
+                                   "film."))
     rows = []
     for r in check.rows:
         if r["source"] == "similarity":   # their own section
@@ -426,7 +443,7 @@ def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
         rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
                      "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
                      "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
-    sec.add(Table(("quantity", "source", "Klein", "model", "ratio", "model range", "units", "note"),
+    sec.add(Table(("quantity", "source", ref["column"], "model", "ratio", "model range", "units", "note"),
                   tuple(rows)))
     sec.p(BRAUN_TOSATTI_NOTE)
     sec.p(_sfb_reading(check))
@@ -442,9 +459,13 @@ def _observable_section(obs: Observable, run, failures) -> Section:
     sec = Section(obs.title)
     section = run.analysis.get(obs.key)
     if not section or not obs.shown(section):
-        why = run.analysis.get("skipped", {}).get(
-            obs.key, "nothing to show for this run" if obs.key in run.analysis else
-            f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)")
+        why = run.analysis.get("skipped", {}).get(obs.key)
+        if why is None and obs.key in run.analysis:
+            why = "nothing to show for this run"
+        elif why is None and not (run.run_dir / "run.json").is_file():
+            why = "a trace file has none: it is not an MD run"
+        elif why is None:
+            why = f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)"
         sec.p(f"{obs.absent}: {why}.")
         return sec
     what = obs.key.replace("_", " ")
@@ -500,9 +521,13 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
                              "–" if not r.get("uncertainty") else
                              f"{_fmt(r['uncertainty'][0], 2)} … {_fmt(r['uncertainty'][1], 2)}",
                              r["note"]) for r in rows)))
-    else:
+    elif (Path(run_dirs[0]) / "run.json").is_file():
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
+    else:
+        sec.p("Not an MD run: these numbers set an MD film beside Klein's contact. A measured "
+              "trace is an experiment of its own: its slip is set beside the model in the SFB "
+              "section above.")
     others = {}
     for d in list(run_dirs[1:]) + [Path(c) for c in compare]:
         try:
@@ -511,7 +536,10 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
             failures.setdefault(f"similarity rows of {Path(d).name}", str(exc))
     for d in compare:
         mine = {r["name"]: r for r in others.get(Path(d), [])}
-        if mine and rows:
+        if not mine:
+            sec.p(f"`{Path(d).name}` (compared): no similarity rows in its `sfb.json` (a run "
+                  "without slips has none); nothing of it to set beside this run.")
+        elif mine and rows:
             sec.p(f"Beside it, `{d.name}` (its own `sfb.json`):")
             sec.add(Table(("number", "Klein", "this run", d.name, f"{d.name}'s range"),
                           tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
@@ -553,20 +581,27 @@ def _sfb_reading(check) -> str:
             return check.row(name, source)["ratio"]
         except KeyError:
             return None
+    ref = _sfb_reference(check)
     parts = []
     r = ratio("slip_time", "sfb-parameters")
-    if r is not None:
+    if r is not None and ref["column"] == "Klein":
         parts.append(f"With Klein's own parameters the reduced model gives his slip time to a ratio of "
                      f"{r:.2f} and viscous energy to {ratio('viscous_energy', 'sfb-parameters') or float('nan'):.2f}: "
                      "his Eq. (1) analysis is internally consistent.")
+    elif r is not None:
+        parts.append(f"With the set-up's parameters and the measured η_eff the reduced model gives the "
+                     f"measured slip time to a ratio of {r:.2f}.")
     ri = ratio("inertial_slip_time", "sfb-parameters")
     if ri is not None:
         parts.append(f"With bulk viscosity the same slip would last {ri:.2g} × the observed time.")
     for name in ("yield_stress", "eta_eff", "slip_time"):
         rm = ratio(name, "md-calibrated")
         if rm is not None:
-            parts.append(f"MD-calibrated {name.replace('_', ' ')}: ratio {rm:.3g} to Klein's.")
-    if any(r_["source"] == "md-calibrated" for r_ in check.rows):
+            parts.append(f"{ref['calibrated'][0].upper()}{ref['calibrated'][1:]} "
+                         f"{name.replace('_', ' ')}: ratio {rm:.3g} to {ref['whose']}.")
+    if ref["column"] != "Klein":
+        pass                    # a measured slip: no MD path to read
+    elif any(r_["source"] == "md-calibrated" for r_ in check.rows):
         parts.append("Ratios far from 1 on the MD path measure how far a 3-layer LJ film at MD shear rates, "
                      "carried through the unit mapping and the rate law, is from the SFB film; they do not "
                      "by themselves decide between Klein's high effective viscosity and Braun & Tosatti's "
@@ -673,14 +708,21 @@ def _split_sweeps(paths: list) -> tuple[list, list]:
     """
     from filmfriction.workflows.sweep_aggregate import load_aggregate
 
-    runs, sweeps = [], []
+    runs, sweeps, seen = [], [], set()
+
+    def add(d):
+        # each run once, however it is written (r1, ./r1/, /abs/r1, or within a sweep)
+        if Path(d).resolve() not in seen:
+            seen.add(Path(d).resolve())
+            runs.append(d)
     for p in paths:
         if (p / "aggregate.json").exists():
             agg = load_aggregate(p)
             sweeps.append(agg)
-            runs += [d for d in (agg.calibration_runs or agg.run_dirs) if d not in runs]
-        elif p not in runs:
-            runs.append(p)
+            for d in agg.calibration_runs or agg.run_dirs:
+                add(d)
+        else:
+            add(p)
     return runs, sweeps
 
 
@@ -769,8 +811,9 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
         if log is not None:
             log(f"missing or out of date: {what}; make it with: {command}")
     out = Path(out) if out is not None else run.run_dir / "report.html"
-    scene = (run.trace.run or {}).get("scene", {}).get("name", run.run_dir.name)
-    title = f"filmfriction report — {scene} ({run.run_dir.name})"
+    name = run.run_dir.resolve().name           # "." has no name of its own
+    scene = (run.trace.run or {}).get("scene", {}).get("name", run.trace.path.name)
+    title = f"filmfriction report — {scene} ({name})"
     units = run.analysis.get("units", "lj")
     intro = [f"Runs: {', '.join('`' + str(d) + '`' for d in run_dirs)}. " + (
         "MD quantities are in LJ units (σ, ε, m, τ) unless marked SI; SI values go through "

@@ -52,6 +52,9 @@ def run(args) -> int:
                             "run.json; 'filmfriction analyze RUN_DIR' writes the first)")
     for d in args.run_dirs:
         check_run_source(d)
+    if args.out is not None and args.out.suffix.lower() not in (".html", ".htm"):
+        raise UserError(f"--out {args.out}: the report is HTML: give a .html file name (its "
+                        "Markdown twin is written beside it as .md)")
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     out = args.out if args.out is not None else args.run_dirs[0] / "report.html"

@@ -152,10 +152,12 @@ def run(args: argparse.Namespace) -> int:
     if args.resume and (args.overrides or args.fidelity or args.out):
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
-    if args.out is not None:
-        from .cli import check_writable
+    from .cli import check_writable
 
+    if args.out is not None:
         check_writable(args.out, "--out", directory=True)
+    elif not args.resume:
+        check_writable(Path("runs"), "the default --out,", directory=True)
     try:
         if args.resume:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
@@ -173,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         if run_dir is None:
             raise
         command = getattr(exc, "resume_command", None)
-        print(f"filmfriction run: interrupted ({exc or 'SIGINT'}); "
+        print(f"filmfriction run: interrupted ({str(exc) or 'SIGINT'}); "
               + (f"resume with {command}" if command else
                  f"nothing to resume yet (no restart file): start the run again; {run_dir}/"
                  "run.json records the interruption"), file=sys.stderr)
@@ -216,6 +218,13 @@ def write_geometry(args: argparse.Namespace) -> int:
     except SceneError as exc:
         raise UserError(str(exc)) from None
     check_writable(args.out, "--out")
+    if args.out.is_file():
+        # a geometry file written before is replaced; any other file (a trace, a script) is not
+        with open(args.out, "rb") as fh:
+            first = fh.readline()
+        if not first.startswith(b"# filmfriction "):
+            raise UserError(f"--out {args.out}: exists and is not a data file of 'filmfriction "
+                            "geometry' (its first line); choose another name, or remove it")
     g = scene.geometry()
     args.out.parent.mkdir(parents=True, exist_ok=True)
     write_atomic(args.out, g.lammps_data())

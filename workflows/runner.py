@@ -379,11 +379,15 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 def lost_atoms_hint(scene: Scene) -> str:
     """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
     likely causes found in the actual parameters, most likely first."""
-    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, derived_quantities
+    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
 
     p = scene.parameters
     d = derived_quantities(p)
     causes = []
+    if p["cutoff"] <= WCA_CUTOFF * (1 + 1e-6):
+        causes.append(f"cutoff {p['cutoff']:.4g} sigma is purely repulsive (WCA): with no "
+                      f"wall-film attraction, normal_pressure {p['normal_pressure']:g} does not "
+                      "hold the top wall")
     limit = d["timestep_limit"]
     if p["timestep"] > limit:
         causes.append(f"timestep {p['timestep']:g} tau is above the stability limit "

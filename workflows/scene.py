@@ -87,7 +87,8 @@ class Parameter:
         if below or value > self.high:
             bracket = "(" if self.low_open else "["
             raise SceneError(
-                f"{self.name} = {value} {self.unit}: outside the allowed range "
+                f"{self.name} = {value}{'' if self.unit == '-' else ' ' + self.unit}: outside "
+                "the allowed range "
                 f"{bracket}{self.low}, {self.high}] ({self.help})")
         return value
 
@@ -381,10 +382,17 @@ def parse_assignment(text: str) -> tuple[str, float | int]:
         return key, PARAMETERS[key].check(value.strip())
     spec = PARAMETERS[key]
     try:
-        number = int(value) if spec.kind is int else float(value)
-    except ValueError:
+        number = float(value)
+        if spec.kind is int:
+            # 1e5 or 3.0 are whole numbers too (a TOML file may write them so as well)
+            number = int(value) if value.strip().lstrip("+-").isdigit() else int(number) \
+                if number.is_integer() else None
+            if number is None:
+                raise ValueError(value)
+    except (ValueError, OverflowError):
+        bracket = "(" if spec.low_open else "["
         what = (f"a whole number in [{spec.low}, {spec.high}]" if spec.kind is int
-                else f"a number in [{spec.low}, {spec.high}] {spec.unit}")
+                else f"a number in {bracket}{spec.low:g}, {spec.high:g}] {spec.unit}")
         raise SceneError(f"--set {key}={value.strip()!r}: not {what} ({spec.help})") from None
     return key, number
 

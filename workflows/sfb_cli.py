@@ -59,9 +59,11 @@ def register(subparsers) -> None:
                    help="the LJ time unit carried to SI: sigma*sqrt(m/eps) of the OMCTS molecule "
                         "(mass, default) or the one that maps the LJ liquid's eta onto OMCTS's "
                         "2.5 mPa s (viscosity; see docs/viscosity.md)")
-    p.add_argument("--sigma-nm", type=float, default=None,
+    from .analyze_cli import _positive
+
+    p.add_argument("--sigma-nm", type=_positive, default=None,
                    help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
-    p.add_argument("--epsilon-K", type=float, default=None,
+    p.add_argument("--epsilon-K", type=_positive, default=None,
                    help=f"override eps/k_B of the mapping (default {OMCTS.temperature:.1f} K)")
     p.set_defaults(func=run)
 
@@ -94,6 +96,9 @@ def _calibration(path: Path | None):
     from filmfriction.workflows.cli import UserError
     from filmfriction.analysis.util import read_json_object
 
+    if path.is_dir():
+        raise UserError(f"--calibration {path}: a directory; give its calibration.json "
+                        f"({path / 'calibration.json'}, from 'filmfriction calibrate {path}')")
     try:
         data = read_json_object(path, f"cannot read calibration file {path}")
     except FileNotFoundError:
@@ -204,10 +209,14 @@ def run(args) -> int:
     contact = None
     if args.run is not None:
         from filmfriction.analysis.contact import contact_from_run
-        for name in ("analysis.json", "run.json"):
-            if not (args.run / name).is_file():
-                raise UserError(f"--run {args.run}: no {name} there (run 'filmfriction analyze "
-                                f"{args.run}' on a run directory first)")
+        if not (args.run / "run.json").is_file():
+            sweep = (args.run / "sweep.json").is_file()
+            raise UserError(f"--run {args.run}: not a run directory of 'filmfriction run' (no "
+                            "run.json)" + (f"; a sweep's runs are {args.run}/points/<point>"
+                                           if sweep else ""))
+        if not (args.run / "analysis.json").is_file():
+            raise UserError(f"--run {args.run}: no analysis.json there (run 'filmfriction "
+                            f"analyze {args.run}' first)")
         try:
             contact = contact_from_run(args.run)
         except (ValueError, KeyError, TypeError) as exc:

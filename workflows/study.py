@@ -56,19 +56,21 @@ def finish_study(run_dir: Path) -> int:
     if doc is not None:
         s = doc["slips"]
         fs = s["static_force"]
-        print(f"analysis: {doc['regime']}, {s['count']} slips, static force "
-              f"{fs['mean'] if fs['mean'] is not None else float('nan'):.4g} ± {fs['stderr'] or 0:.2g} "
-              f"{fs['units']} -> {run_dir / 'analysis.json'}")
+        force = ("" if fs["mean"] is None else
+                 f", static force {fs['mean']:.4g} ± {fs['stderr'] or 0:.2g} {fs['units']}")
+        print(f"analysis: {doc['regime']}, {s['count']} slips{force} -> "
+              f"{run_dir / 'analysis.json'}")
 
     from filmfriction.analysis import calibrate, write_calibration
     cal = _step("calibration", failures, calibrate, [run_dir])
     if cal is not None:
         path = _step("calibration (write)", failures, write_calibration, cal)
         rc = cal.main
-        fk = rc.kinetic_force
-        print(f"calibration: F_s {rc.static_force.value if rc.static_force else float('nan'):.4g}, "
-              f"F_k {fk.value if fk else float('nan'):.4g}, B "
-              f"{rc.film_damping.value if rc.film_damping else float('nan'):.4g}"
+
+        def value(e):       # "-" where the run gave none (no slips: nothing to fit)
+            return "-" if e is None or e.value is None or e.value != e.value else f"{e.value:.4g}"
+        print(f"calibration: F_s {value(rc.static_force)}, F_k {value(rc.kinetic_force)}, "
+              f"B {value(rc.film_damping)}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
     from filmfriction.analysis.contact import contact_from_run

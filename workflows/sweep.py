@@ -145,6 +145,18 @@ def check_installed(profile: Path | None) -> None:
                               "installed: pip install snakemake-executor-plugin-slurm")
 
 
+def check_sweep_dir(out: Path) -> None:
+    """``out`` must be new, empty or a sweep's own directory (``sweep.json`` or its lock):
+    a sweep never writes into a run directory or any other folder."""
+    out = Path(out)
+    if (out.is_dir() and any(out.iterdir()) and not (out / "sweep.json").exists()
+            and not (out / ".sweep.lock").exists()):
+        what = "a run directory" if (out / "run.json").exists() else "not a sweep directory"
+        raise _user_error(f"--out {out}: exists and is {what} (no sweep.json); a sweep writes "
+                          "only into a new or empty directory or its own, to resume or extend "
+                          "it: choose a new --out")
+
+
 def main_sweep(args: argparse.Namespace) -> int:
     from .scene import SceneError
 
@@ -159,6 +171,9 @@ def main_sweep(args: argparse.Namespace) -> int:
         check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
     try:
         plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
+        from .lammps_build import resolve
+
+        resolve(None)            # every point would fail on a $FILMFRICTION_LMP that is none
     except SceneError as exc:
         raise _user_error(str(exc)) from None
     check_installed(profile)
@@ -166,6 +181,7 @@ def main_sweep(args: argparse.Namespace) -> int:
     from .cli import check_writable
 
     check_writable(out, "--out", directory=True)
+    check_sweep_dir(out)
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)

@@ -36,11 +36,20 @@ def _numeric_axes(doc: dict) -> list[str]:
 
 
 def _plain_log_axis(axis) -> None:
-    """Log axis labelled 0.01, 0.1, 1 rather than 10^-2 (and no crowded minor labels)."""
-    from matplotlib.ticker import FuncFormatter, NullFormatter
+    """Log axis labelled 0.01, 0.1, 1 rather than 10^-2; the minor ticks are labelled too
+    when the axis spans about a decade or less (else it may have no label at all), and
+    left bare over wider ranges, where they would crowd."""
+    from matplotlib.ticker import FuncFormatter, LogFormatter
 
-    axis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
-    axis.set_minor_formatter(NullFormatter())
+    plain = FuncFormatter(lambda x, _: f"{x:g}")
+    minor = LogFormatter(labelOnlyBase=False, minor_thresholds=(1, 0.4))
+
+    def minor_label(x, pos=None):
+        # LogFormatter decides which minor ticks to label (all, a few, none) by the range
+        return plain(x) if minor(x, pos) else ""
+    axis.set_major_formatter(plain)
+    axis.set_minor_formatter(FuncFormatter(minor_label))
+    minor.set_axis(axis)
 
 
 def _group_label(group: dict) -> str:

@@ -282,10 +282,18 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
         if not calibration.is_file():
             raise SceneError(f"--calibration {calibration}: no such file")
         try:
-            read_json_object(calibration, f"--calibration {calibration}",
-                             what="a JSON object (calibration.json)")
+            cal = read_json_object(calibration, f"--calibration {calibration}",
+                                   what="a JSON object (calibration.json)")
         except ValueError as exc:
             raise SceneError(str(exc)) from None
+        # checked now, not after the whole sweep has run (the map's boundary is drawn last)
+        if not str(cal.get("schema", "")).startswith("filmfriction.calibration/"):
+            raise SceneError(f"--calibration {calibration}: not a calibration.json (schema "
+                             f"{cal.get('schema')!r}; 'filmfriction calibrate RUN_DIR' writes one)")
+        if cal.get("units", "lj") != "lj":
+            raise SceneError(f"--calibration {calibration}: in {cal.get('units')!r} units (a "
+                             "measured trace's); the (V, K) map of MD runs needs an MD "
+                             "calibration, in LJ units")
     return SweepPlan(scene=base.name, scene_source=str(Path(base.source).resolve()),
                      grid=tuple(axes), fixed=fixed, np=np_, points=tuple(points),
                      parameters=params,

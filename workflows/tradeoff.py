@@ -651,8 +651,10 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
             ax.legend(fontsize=7)
         fig.tight_layout()
         path = out / f"pareto_{name}.png"
-        fig.savefig(path, dpi=110)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=110)
         plt.close(fig)
+        write_atomic(path, buf.getvalue())
         paths.append(path)
     return paths
 

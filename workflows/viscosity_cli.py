@@ -24,6 +24,7 @@ docs/viscosity.md); at higher viscosity (denser, colder) ask for more steps.
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import subprocess
@@ -36,6 +37,7 @@ import numpy as np
 
 from filmfriction import md_inputs
 from filmfriction.analysis import green_kubo as gk
+from filmfriction.analysis.util import write_atomic
 from filmfriction.reduced_model import units as U
 from . import engine
 
@@ -229,9 +231,10 @@ def _progress(message: str) -> None:
 def run(settings: Settings, run_dir: Path, progress=_progress) -> dict:
     """Run the Green-Kubo script in ``run_dir`` (which must exist) and return the result dict."""
     script = md_inputs.script(SCRIPT)
+    # LAMMPS runs in run_dir: a relative path (the default runs/...) would not be found there
     cmd = engine.lmp_command(settings.np, script, settings.lammps_variables(),
-                             log=run_dir / "lammps.log")
-    (run_dir / "command.txt").write_text(" ".join(cmd) + "\n")
+                             log=Path(run_dir).resolve() / "lammps.log")
+    write_atomic(run_dir / "command.txt", " ".join(cmd) + "\n")
     total = settings.melt_steps + settings.equilibrate_steps + settings.steps
     progress(f"viscosity: {settings.n_atoms} atoms, T = {settings.temperature:g}, "
              f"rho = {settings.density:g}, rc = {settings.cutoff:g}; {total} steps on "
@@ -300,8 +303,10 @@ def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> d
     t, eta_t, err_t = gk.running_integral(corr, volume=volume,
                                           temperature=blocks["temperature"],
                                           timestep=settings.timestep)
-    np.savetxt(run_dir / "gk_integral.csv", np.column_stack([t, eta_t, err_t]), delimiter=",",
+    buf = io.StringIO()
+    np.savetxt(buf, np.column_stack([t, eta_t, err_t]), delimiter=",",
                header="correlation_time_tau,eta,eta_stderr", comments="", fmt="%.8g")
+    write_atomic(run_dir / "gk_integral.csv", buf.getvalue())
     # the last quarter of the window: a plateau has stopped moving there
     late = int(np.searchsorted(t, 0.75 * t[-1]))
     notes = []
@@ -357,7 +362,7 @@ def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> d
         "notes": notes,
         "settings": asdict(settings),
     }
-    (run_dir / "viscosity.json").write_text(json.dumps(out, indent=2) + "\n")
+    write_atomic(run_dir / "viscosity.json", json.dumps(out, indent=2) + "\n")
     return out
 
 
@@ -396,7 +401,8 @@ def main(args: argparse.Namespace) -> int:
     from .run_cli import check_ranks
 
     check_ranks(args.np)
-    check_writable(args.out if args.out is not None else Path("runs"), "--out", directory=True)
+    check_writable(args.out if args.out is not None else Path("runs"),
+                   "--out" if args.out is not None else "the default --out,", directory=True)
     try:
         run_dir = new_run_dir(f"viscosity-T{settings.temperature:g}-rho{settings.density:g}",
                               args.out)

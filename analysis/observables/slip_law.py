@@ -112,5 +112,6 @@ class SlipLaw(Observable):
         ax.axhline(0, color="0.6", lw=0.5)
         ax.set_xlabel(f"wall velocity during the slip v [{lab('velocity')}]")
         ax.set_ylabel(f"film force F_spring − M·a − γM(v − V) [{lab('force')}]")
-        ax.legend(loc="best", fontsize=8)
+        # above the axes: inside, it hid slips' points (the loops fill the plane)
+        ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         return png_bytes(fig)

@@ -49,6 +49,35 @@ def test_decimal_commas_in_a_semicolon_table(tmp_path, columns):
     assert any("decimal commas" in n for n in tr.notes)
 
 
+@pytest.mark.parametrize("sep", [",", ";", "\t"])
+def test_a_byte_order_mark_is_not_part_of_the_first_name(tmp_path, columns, sep):
+    # a spreadsheet's "CSV UTF-8" export starts with one
+    path = _write(tmp_path / "trace.csv", columns, sep)
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes().split(b"\n", 1)[1])
+    tr = read_trace(path, columns=NAMES)
+    np.testing.assert_allclose(tr.columns["time"], columns["time"], rtol=1e-9)
+
+
+@pytest.mark.parametrize("data, says", [
+    (b"\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03", "binary data"),       # gzip
+    (b"\x93NUMPY\x01\x00v\x00{'descr': '<f8'}", "binary data"),           # .npy
+    ("time\tF\n0\t1\n".encode("utf-16"), "UTF-16 text"),
+])
+def test_a_file_that_is_not_a_text_trace_says_what_it_is(tmp_path, data, says):
+    path = tmp_path / "trace.csv"
+    path.write_bytes(data)
+    with pytest.raises(ValueError, match=says):
+        read_trace(path)
+
+
+def test_rows_that_do_not_match_the_header_say_so(tmp_path):
+    path = tmp_path / "trace.csv"
+    path.write_text("time,spring_force,gap\n0,1\n1,2\n")
+    with pytest.raises(ValueError, match=r"the header has 3 comma-separated columns, the first "
+                                         r"data row \(line 2\) 2"):
+        read_trace(path)
+
+
 def test_mapping_errors_name_what_exists():
     with pytest.raises(ValueError, match=r"unknown name 'force'.*spring_force"):
         map_columns(["t_s", "F_N"], {"time": "t_s", "force": "F_N"})

@@ -47,6 +47,45 @@ def _list_run(tmp: Path) -> Path:
     return d
 
 
+def _run_dir(tmp: Path) -> Path:
+    d = tmp / "run"
+    d.mkdir()
+    _trace(d)
+    (d / "run.json").write_text("{}")
+    return d
+
+
+def _md_run(tmp: Path) -> Path:
+    d = tmp / "md-run"
+    d.mkdir()
+    _trace(d)
+    (d / "run.json").write_text('{"trace_parameters": {"spring_constant": 100.0, "mass": 500.0, '
+                                '"area": 58.7, "thickness": null, "drive_velocity": 0.02, '
+                                '"units": "lj"}}')
+    return d
+
+
+def _with_runs_file(tmp: Path, args: list) -> list:
+    """``args``, with a file called runs in the working directory (the cases' cwd is
+    tmp/../work), where a run's default directory would go."""
+    (tmp.parent / "work" / "runs").write_text("not a directory")
+    return args
+
+
+def _sweep_dir(tmp: Path) -> Path:
+    d = tmp / "sweep"
+    (d / "points").mkdir(parents=True)
+    (d / "sweep.json").write_text("{}")
+    return d
+
+
+def _analysed_file_dir(tmp: Path) -> Path:
+    d = tmp / "measured"
+    d.mkdir()
+    (d / "analysis.json").write_text("{}")
+    return d
+
+
 def _nan_wall(tmp: Path) -> Path:
     wall = np.arange(400) * 0.1
     wall[::3] = np.nan
@@ -145,6 +184,58 @@ CASES = {
                                          "--dry-run", "--out", t / "s"], "given twice", 2),
     "--resume with --set": (lambda t: ["run", "--resume", t, "--set", "seed=1"],
                             "not accepted with it", 2),
+    # -- pointed the user at a command that fails in turn
+    "analyze a sweep directory": (lambda t: ["analyze", _sweep_dir(t)],
+                                  "a sweep directory, not a run", 2),
+    "sfb --run a sweep directory": (lambda t: ["sfb", "--run", _sweep_dir(t)],
+                                    "a sweep's runs are", 2),
+    "sfb --run an analysed trace file's directory": (
+        lambda t: ["sfb", "--run", _analysed_file_dir(t)],
+        "not a run directory of 'filmfriction run' (no run.json)", 2),
+    # -- named a dataclass field, not the option, or gave Python's errno text
+    "sfb --sigma-nm negative": (lambda t: ["sfb", "--sigma-nm", "-1"],
+                                "argument --sigma-nm: must be a positive number: '-1'", 2),
+    "sfb --epsilon-K zero": (lambda t: ["sfb", "--epsilon-K", "0"],
+                             "argument --epsilon-K: must be a positive number: '0'", 2),
+    "sfb --calibration a directory": (lambda t: ["sfb", "--calibration", _run_dir(t)],
+                                      "a directory; give its calibration.json", 2),
+    # -- relabelled an MD run (its analysis.json) with another K or in SI
+    "analyze a run with another K": (lambda t: ["analyze", _md_run(t), "--spring-constant", "5"],
+                                     "ran with spring_constant = 100.0", 2),
+    "analyze a run in SI": (lambda t: ["analyze", _md_run(t), "--units", "si"],
+                            "ran with units = lj", 2),
+    "analyze a run with a set-up": (lambda t: ["analyze", _md_run(t), "--setup",
+                                               _toml(t, "s.toml", "name = 'x'\n")],
+                                    "--setup is for a trace file", 2),
+    # -- accepted, to fail (as a note) only after the whole sweep had run
+    "sweep --calibration not a calibration": (
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s",
+                   "--calibration", _toml(t, "a.json", '{"schema": "filmfriction.analysis/1"}')],
+        "not a calibration.json", 2),
+    "sweep --calibration in SI": (
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s",
+                   "--calibration", _toml(t, "c.json", '{"schema": "filmfriction.calibration/1",'
+                                                       ' "units": "si"}')],
+        "needs an MD calibration, in LJ units", 2),
+    # -- ended in "runs: File exists"
+    "run with runs/ a file": (lambda t: _with_runs_file(t, ["run", "--md-only"]),
+                              "the default --out, runs: is a file", 2),
+    "viscosity with runs/ a file": (lambda t: _with_runs_file(
+        t, ["viscosity", "--temperature", "0.722", "--density", "0.8442"]),
+        "the default --out, runs: is a file", 2),
+    # -- replaced the user's file
+    "geometry --out another file": (lambda t: ["geometry", "--out", _afile(t)],
+                                    "is not a data file of 'filmfriction geometry'", 2),
+    # -- wrote the HTML under the Markdown twin's name, which then replaced it
+    "report --out FILE.md": (lambda t: ["report", _run_dir(t), "--out", t / "rep.md"],
+                             "give a .html file name", 2),
+    # -- wrote a sweep into it (sweep.json, inputs/, .snakemake/)
+    "sweep --out a run directory": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                               "--dry-run", "--out", _run_dir(t)],
+                                    "is a run directory", 2),
+    "sweep --out another folder": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                              "--dry-run", "--out", _afile(t).parent],
+                                   "not a sweep directory", 2),
 }
 
 
@@ -251,4 +342,21 @@ def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, ca
     # refused by the check before any compute, which names the option
     flag = next(a for a in args if str(a).startswith("--o"))
     assert f"error: {flag} {read_only_dir}" in err, err
+    assert _snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("command", [
+    lambda t: ["bench", "--np", "1", "--steps", "10", "--repeat", "1"],
+    lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s"],
+], ids=["bench", "sweep"])
+def test_a_bad_filmfriction_lmp_is_refused_before_any_run(command, tmp_path, monkeypatch, capsys):
+    """bench started its first run, a sweep its points, before the executable was looked at."""
+    inputs = tmp_path / "in"
+    inputs.mkdir()
+    monkeypatch.chdir(inputs)
+    monkeypatch.setenv("FILMFRICTION_LMP", str(tmp_path / "no-lmp"))
+    before = _snapshot(tmp_path)
+    rc, out, err = _cli(capsys, *command(inputs))
+    assert rc == 2 and f"FILMFRICTION_LMP {tmp_path / 'no-lmp'}: no such file" in err, err
+    assert "[1/" not in out and "Traceback" not in err
     assert _snapshot(tmp_path) == before

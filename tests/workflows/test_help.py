@@ -63,3 +63,19 @@ def test_scenes_parameters_says_what_each_one_is(run_cli):
     for spec in PARAMETERS.values():
         i = next(i for i, ln in enumerate(lines) if ln.split()[:1] == [spec.name])
         assert spec.help.split()[0] in lines[i + 1], (spec.name, lines[i + 1])
+
+
+@pytest.mark.parametrize("args", [["sfb"], ["scenes", "--parameters"], ["run", "--help"]],
+                         ids=["sfb", "scenes", "run --help"])
+def test_output_into_a_closed_pipe_stops_quietly(args, filmfriction_command):
+    """`filmfriction sfb | head`: the reader is gone before the output is written; no
+    'error: Broken pipe' line, no traceback."""
+    import subprocess
+
+    proc = subprocess.Popen([filmfriction_command, *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()                 # as `head` does once it has its lines
+    err = proc.stderr.read()
+    code = proc.wait(timeout=60)
+    assert err == "", err
+    assert code in (0, 141), code

@@ -1,4 +1,4 @@
-"""SIGTERM / SIGHUP while a run or a resume sets up, before LAMMPS starts.
+"""SIGTERM / SIGHUP / Ctrl-C (SIGINT) while a run or a resume sets up, before LAMMPS starts.
 
 Each test starts ``filmfriction run`` in a child process in which one step of
 the set-up is replaced by a pause (it writes a "ready" file, then sleeps): the
@@ -21,7 +21,8 @@ import pytest
 
 # the child: pause at one step of the set-up, then the real command line
 CHILD = """
-import sys, time, pathlib
+import signal, sys, time, pathlib
+signal.signal(signal.SIGINT, signal.default_int_handler)   # Ctrl-C even if the parent ignores it
 from filmfriction.workflows import runner
 from filmfriction.workflows.cli import main
 
@@ -59,7 +60,8 @@ SMALL = ["--set", "slide_steps=4000", "--set", "restart_every=2000",
          "--set", "equilibrate_steps=100"]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT],
+                         ids=["SIGTERM", "SIGHUP", "SIGINT"])
 @pytest.mark.parametrize("where", ["_record", "run_engine"],
                          ids=["before run.json", "run.json written, engine not started"])
 def test_signal_during_setup_of_a_run(tmp_path, where, sig):

@@ -111,6 +111,9 @@ def test_sfb_runs_on_the_users_setup_and_slip(chain):
     # the calibrated rows speak SI too: no LJ mapping in their notes
     calibrated = [r["note"] for r in doc["rows"] if r["source"] == "md-calibrated"]
     assert calibrated and not any("eps/sigma" in n or "/tau" in n for n in calibrated)
+    # what the set-up does not give (the ringing, Klein's heating) is said, not printed as nan
+    import re
+    assert not [r["note"] for r in doc["rows"] if re.search(r"\bnan\b", r["note"])]
 
 
 def test_report_is_written(chain):
@@ -122,6 +125,19 @@ def test_report_labels_a_measured_trace_in_si(chain):
     d, _ = chain
     text = (d / "report.md").read_text()
     assert "ε/σ" not in text and "LJ unit" not in text
+
+
+def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
+    d, _ = chain
+    text = (d / "report.md").read_text()
+    sfb = text[text.index("## Comparison with the SFB experiment"):]
+    sfb = sfb[:sfb.index("\n## ")]
+    assert sfb.startswith("## Comparison with the SFB experiment (example SFB")
+    assert "| quantity | source | measured | model |" in sfb
+    assert "Klein's parameters" not in sfb and "to Klein's" not in sfb, sfb
+    # the similarity numbers are an MD run's: no command that cannot apply here
+    assert "filmfriction sfb --run" not in text and "Not an MD run" in text
+    assert "rerun `filmfriction analyze" not in text      # it cannot make a film structure
 
 
 @pytest.mark.parametrize("argv,message", [
@@ -161,3 +177,20 @@ def test_bad_setups_are_one_line_errors(tmp_path, capsys, chain):
     assert main(["sfb", "--setup", str(tmp_path / "s.toml"), "--measured", str(d)]) == 2
     assert "differs from the 97" in capsys.readouterr().err
 
+
+
+def test_an_analysis_written_elsewhere_finds_its_trace_from_any_directory(tmp_path, run_cli,
+                                                                         monkeypatch):
+    """analyze data/trace --output results/analysis.json, then calibrate results from
+    another working directory: the trace is found from the analysis' own directory."""
+    (tmp_path / "data").mkdir()
+    for name in ("sfb_trace.tsv", "my_sfb.toml"):
+        shutil.copy(EXAMPLES / name, tmp_path / "data" / name)
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("analyze", "data/sfb_trace.tsv", "--setup", "data/my_sfb.toml", *COLUMNS,
+                "--output", "results/analysis.json")
+    assert r.code == 0, r.err
+    monkeypatch.chdir(tmp_path / "results")
+    r = run_cli("calibrate", ".")
+    assert r.code == 0, r.err
+    assert (tmp_path / "results" / "calibration.json").is_file()

@@ -124,6 +124,7 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
     monkeypatch.setattr(Figure, "savefig", capture)
     assert run_cli("report", tmp_path).code == 0
     md = (tmp_path / "report.md").read_text()
+    assert md.splitlines()[0] == f"# filmfriction report — trace.csv ({tmp_path.name})"
     named = [label for fig in labels for axis in fig for label in axis if label]
     units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
     assert {"N", "s", "J", "Pa·s", "1/s"} <= units, units
@@ -132,3 +133,143 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
         assert lj not in md, lj
     assert re.search(r"^\| static force \| 9\.7\d*e-06 ± \S+ N \|", md, re.M) and "(SI)" in md
     assert all(re.search(r"\[[^\]]+\]", label) for label in named), named
+
+
+@pytest.mark.parametrize("calibrated_from, reported_from", [("parent", "run"), ("run", "parent")],
+                         ids=["calibrate RUN, report .", "calibrate ., report RUN"])
+def test_the_calibration_is_found_from_any_working_directory(synthetic_study, tmp_path, run_cli,
+                                                             monkeypatch, calibrated_from,
+                                                             reported_from):
+    import shutil
+
+    run = tmp_path / "myrun"
+    shutil.copytree(synthetic_study.path, run)
+    where = {"parent": (tmp_path, "myrun"), "run": (run, ".")}
+    monkeypatch.chdir(where[calibrated_from][0])
+    assert run_cli("calibrate", where[calibrated_from][1]).code == 0
+    monkeypatch.chdir(where[reported_from][0])
+    r = run_cli("report", where[reported_from][1])
+    assert r.code == 0, r.err
+    assert "calibration.json across the runs given" not in r.out, r.out
+    md = (run / "report.md").read_text()
+    assert md.splitlines()[0] == "# filmfriction report — synthetic (myrun)", md.splitlines()[0]
+
+
+def test_a_run_given_twice_counts_once(synthetic_study, tmp_path, run_cli, monkeypatch):
+    """r1 and /abs/r1 (or ./r1/) are one run: calibrating 'both' must not count its slips twice."""
+    import shutil
+
+    run = tmp_path / "r1"
+    shutil.copytree(synthetic_study.path, run)
+    monkeypatch.chdir(tmp_path)
+    r = run_cli("calibrate", "r1", run, "./r1/")
+    assert r.code == 0, r.err
+    assert len(json.loads((run / "calibration.json").read_text())["runs"]) == 1
+
+
+def test_no_legend_covers_data(synthetic_study, tmp_path, monkeypatch):
+    """Every figure's legend sits off its data: no point or line vertex under it; the slip-law
+    figure's loops fill its plane, so its legend is above the axes."""
+    import shutil
+
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from filmfriction.workflows import study
+
+    covered, outside, savefig = [], {}, Figure.savefig
+
+    def check(fig, *args, **kwargs):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        for ax in fig.axes:
+            legend = ax.get_legend()
+            if legend is None:
+                continue
+            box = legend.get_window_extent(renderer)
+            outside[ax.get_ylabel()] = not box.overlaps(ax.get_window_extent(renderer))
+            points = [ln.get_transform().transform(np.column_stack(ln.get_data()).astype(float))
+                      for ln in ax.get_lines() if len(ln.get_xdata())]
+            points += [c.get_offset_transform().transform(np.asarray(c.get_offsets(), float))
+                       for c in ax.collections if len(c.get_offsets())]
+            p = np.vstack(points) if points else np.empty((0, 2))
+            p = p[np.isfinite(p).all(axis=1)]
+            if ((p[:, 0] > box.x0) & (p[:, 0] < box.x1) & (p[:, 1] > box.y0)
+                    & (p[:, 1] < box.y1)).any():
+                covered.append(ax.get_ylabel())
+        return savefig(fig, *args, **kwargs)
+
+    run = tmp_path / "run"
+    shutil.copytree(synthetic_study.path, run)
+    monkeypatch.setattr(Figure, "savefig", check)
+    assert study.finish_study(run) == 0
+    assert not covered, covered
+    slip_law = [ok for label, ok in outside.items() if label.startswith("film force")]
+    assert slip_law == [True], outside
+
+
+def test_the_lambda_zeta_legend_is_off_the_plane(monkeypatch):
+    """A contact in the lower right of the plane (a compared run, Klein's) was under the legend."""
+    from matplotlib.figure import Figure
+
+    from filmfriction.workflows.report import fig_lambda_zeta
+
+    clear, savefig = [], Figure.savefig
+
+    def check(fig, *args, **kwargs):
+        fig.canvas.draw()
+        r = fig.canvas.get_renderer()
+        clear.extend(not ax.get_legend().get_window_extent(r).overlaps(ax.get_window_extent(r))
+                     for ax in fig.axes)
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", check)
+    fig_lambda_zeta([("run (MD)", 3.0, 0.2, 0.3, 0.05), ("Klein", 4.1, 0.5, 128.0, 10.0)])
+    assert clear == [True]
+
+
+def test_a_run_without_slips_prints_no_nan(synthetic_study, tmp_path, capsys):
+    """A run too short for a slip: the study's summary lines say what is missing, not 'nan'."""
+    import shutil
+
+    from filmfriction.workflows import study
+
+    run = tmp_path / "short"
+    shutil.copytree(synthetic_study.path, run)
+    for name in ("analysis.json", "calibration.json", "sfb.json"):
+        (run / name).unlink(missing_ok=True)
+    lines = (run / "trace.csv").read_text().splitlines()
+    (run / "trace.csv").write_text("\n".join(lines[:40]) + "\n")      # the first stick only
+    capsys.readouterr()
+    study.finish_study(run)
+    out = capsys.readouterr().out
+    assert "analysis: unresolved, 0 slips ->" in out, out
+    assert "nan" not in out, out
+
+
+def test_a_moved_run_keeps_its_calibration(synthetic_study, tmp_path, run_cli):
+    """calibrate, then move or rename the run directory: its calibration.json is still its own."""
+    import shutil
+
+    shutil.copytree(synthetic_study.path, tmp_path / "before")
+    assert run_cli("calibrate", tmp_path / "before").code == 0
+    (tmp_path / "before").rename(tmp_path / "after")
+    r = run_cli("report", tmp_path / "after")
+    assert r.code == 0, r.err
+    assert "calibration.json across the runs given" not in r.out, r.out
+
+
+def test_a_compared_run_without_similarity_rows_is_named(synthetic_study, tmp_path, run_cli):
+    """--compare OTHER whose sfb.json has no similarity rows (no slips): it was left out
+    without a word."""
+    import shutil
+
+    other = tmp_path / "other"
+    shutil.copytree(synthetic_study.path, other)
+    doc = json.loads((other / "sfb.json").read_text())
+    doc["rows"] = [r for r in doc["rows"] if r["source"] != "similarity"]
+    (other / "sfb.json").write_text(json.dumps(doc))
+    out = tmp_path / "cmp.html"
+    r = run_cli("report", synthetic_study.path, "--compare", other, "--out", out)
+    assert r.code == 0, r.err
+    assert "`other` (compared): no similarity rows" in out.with_suffix(".md").read_text()

@@ -82,6 +82,7 @@ def test_finish_records_completed_with_warnings(tmp_path):
     ({"film_spacing": 0.9, "cells_x": 8, "cells_y": 5}, "film_spacing 0.9 sigma against"),
     ({"timestep": 0.009}, "close to the stability limit"),
     ({"normal_pressure": 0.1}, "normal_pressure 0.1 is low for temperature 0.7"),
+    ({"cutoff": 2 ** (1 / 6)}, "cutoff 1.122 sigma is purely repulsive (WCA)"),
 ])
 def test_lost_atoms_hint_names_the_cause_from_the_parameters(params, cause):
     s = _scene()

@@ -35,7 +35,7 @@ def test_outputs_follow_observables():
 
 
 @pytest.mark.parametrize("key,value,fragment", [
-    ("film_layers", 9, "film_layers = 9"),
+    ("film_layers", 9, "film_layers = 9: outside the allowed range [1, 8]"),
     ("film_layers", 2.5, "whole number"),
     ("drive_velocity", 0.0, "drive_velocity = 0.0"),
     ("drive_velocity", math.nan, "finite"),
@@ -155,3 +155,20 @@ def test_version(capsys):
     assert exc.value.code == 0
     assert capsys.readouterr().out.strip() == f"filmfriction {__version__}"
     assert __version__ != "0+unknown"
+
+
+@pytest.mark.parametrize("text, value", [("slide_steps=1e5", 100000), ("film_layers=3.0", 3),
+                                         ("film_layers=3", 3), ("seed=+12", 12)])
+def test_set_takes_a_whole_number_written_as_a_float(text, value):
+    """--set slide_steps=1e5 was refused as 'not a whole number' (a TOML 3.0 was accepted)."""
+    from filmfriction.workflows.scene import parse_assignment
+
+    key, got = parse_assignment(text)
+    assert got == value and isinstance(got, int)
+
+
+def test_set_refusal_shows_the_parameters_own_range():
+    from filmfriction.workflows.scene import parse_assignment
+
+    with pytest.raises(SceneError, match=r"not a number in \(0, 5\] sigma/tau"):
+        parse_assignment("drive_velocity=fast")

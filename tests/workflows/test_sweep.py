@@ -180,7 +180,8 @@ def fake_point(sweep_dir, plan, name, regime, slips, eta, rate):
 
 def test_aggregate_of_a_v_by_k_sweep(tmp_path):
     cal = tmp_path / "calibration.json"
-    cal.write_text(json.dumps({"runs": [{"static_force": {"value": 60.0},
+    cal.write_text(json.dumps({"schema": "filmfriction.calibration/1", "units": "lj",
+                               "runs": [{"static_force": {"value": 60.0},
                                          "kinetic_force": {"value": 20.0},
                                          "film_damping": {"value": 10.0}}]}))
     plan = sweep.plan_sweep("stick-slip", ["drive_velocity=0.01:1:3:log",
@@ -367,3 +368,22 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
         assert json.loads((run_dir / "run.json").read_text())["status"] == "completed"
         assert (run_dir / "analysis.json").exists()
     assert not (out / "superseded").exists()
+
+
+@pytest.mark.parametrize("lo, hi, at_least", [(0.013, 0.062, 2), (8.0, 60.0, 2), (1e-3, 1.0, 4)])
+def test_a_log_axis_of_the_sweep_figures_is_labelled_over_any_range(lo, hi, at_least):
+    """Under a decade there is no power of ten to label: the axis had no numbers at all."""
+    from filmfriction.analysis.util import pyplot
+    from filmfriction.workflows.sweep_figures import _plain_log_axis
+
+    plt = pyplot()
+    fig, ax = plt.subplots()
+    ax.plot([lo, hi], [1.0, 2.0])
+    ax.set_xscale("log")
+    _plain_log_axis(ax.xaxis)
+    fig.canvas.draw()
+    labels = [t.get_text() for t in ax.get_xticklabels(minor=False) + ax.get_xticklabels(minor=True)
+              if t.get_text() and lo * 0.9 <= t.get_position()[0] <= hi * 1.1]
+    plt.close(fig)
+    assert len(labels) >= at_least, labels
+    assert all("10^" not in t and "$" not in t for t in labels), labels

@@ -147,3 +147,19 @@ def test_tiny_study_writes_table_json_and_figures(tmp_path, monkeypatch, run_cli
     assert len(table) == len(rows) and "error_period_uncertainty" in table[0]
     for name in tradeoff.OBSERVABLES:
         assert (out / f"pareto_{name}.png").stat().st_size > 1000
+
+
+def test_figures_are_written_atomically(tmp_path, monkeypatch):
+    written, write_atomic = [], tradeoff.write_atomic
+
+    def record(path, data):
+        written.append(path.name)
+        return write_atomic(path, data)
+
+    monkeypatch.setattr(tradeoff, "write_atomic", record)
+    row = {"knob": "timestep", "value": "0.01", "reference": False, "cost_seconds": 2.0,
+           **{f"error_{n}": 0.1 for n in tradeoff.OBSERVABLES},
+           **{f"error_{n}_uncertainty": 0.01 for n in tradeoff.OBSERVABLES}}
+    paths = tradeoff.plot([row, {**row, "value": "0.005", "reference": True}], tmp_path)
+    assert sorted(written) == sorted(p.name for p in paths) == sorted(
+        f"pareto_{n}.png" for n in tradeoff.OBSERVABLES)

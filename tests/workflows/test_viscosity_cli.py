@@ -67,6 +67,32 @@ def test_existing_output_directory_is_refused(no_compute, capsys):
     assert sorted(p.name for p in out.iterdir()) == ["keep.txt"]
 
 
+def test_the_default_relative_run_directory_reaches_lammps(monkeypatch, tmp_path):
+    """LAMMPS runs inside the run directory: the log path it is given must name the run
+    directory's lammps.log from there, also for the default relative runs/... ."""
+    from pathlib import Path
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def popen(cmd, cwd, **kwargs):
+        seen.update(cmd=cmd, cwd=cwd)
+        raise Stop
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(viscosity_cli.subprocess, "Popen", popen)
+    run_dir = Path("runs") / "viscosity-relative"
+    run_dir.mkdir(parents=True)
+    settings = viscosity_cli.settings_from_args(viscosity_cli.argparse.Namespace(
+        **{**viscosity_cli.DEFAULTS, "temperature": 0.722, "density": 0.8442, "np": 1}))
+    with pytest.raises(Stop):
+        viscosity_cli.run(settings, run_dir, progress=lambda message: None)
+    log = Path(seen["cmd"][seen["cmd"].index("-log") + 1])
+    assert (tmp_path / seen["cwd"] / log).resolve() == (tmp_path / run_dir / "lammps.log")
+
+
 def test_missing_state_is_an_argparse_error(no_compute, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["viscosity", "--density", "0.8442"])
