@@ -163,3 +163,30 @@ def test_figures_are_written_atomically(tmp_path, monkeypatch):
     paths = tradeoff.plot([row, {**row, "value": "0.005", "reference": True}], tmp_path)
     assert sorted(written) == sorted(p.name for p in paths) == sorted(
         f"pareto_{n}.png" for n in tradeoff.OBSERVABLES)
+
+
+def test_point_labels_do_not_overlap_each_other_or_the_markers():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    # the study's crowded corner: four settings that cost the same as the default run
+    points = [("0.005", 18.2, 1.0), ("7x4", 18.2, 2.0), ("0.25", 18.2, 0.4), ("50", 18.2, 0.1),
+              ("250", 21.1, 0.9), ("both", 29.7, 2.6), ("film", 30.0, 3.7), ("0.5", 10.1, 2.6)]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot([p[1] for p in points], [p[2] for p in points], "o")
+    ax.set_xscale("log")
+    ax.set_ylim(0, 25)
+    fig.tight_layout()
+    anns = tradeoff.place_labels(ax, points)
+    renderer = fig.canvas.get_renderer()
+    boxes = [a.get_window_extent(renderer) for a in anns]
+    assert [a.get_text() for a in anns] == [p[0] for p in points]
+    for k, box in enumerate(boxes):
+        assert all(not box.overlaps(other) for other in boxes[k + 1:]), anns[k].get_text()
+        for _, x, y in points:
+            mx, my = ax.transData.transform((x, y))
+            assert not (box.x0 < mx < box.x1 and box.y0 < my < box.y1), (anns[k].get_text(), x, y)
+        assert ax.get_window_extent(renderer).contains(box.x0, box.y0)
+    plt.close(fig)
