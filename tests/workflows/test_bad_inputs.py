@@ -39,30 +39,27 @@ def _afile(tmp: Path) -> Path:
     return tmp / "afile"
 
 
-def _list_run(tmp: Path) -> Path:
-    d = tmp / "run-list"
+def _run_with(tmp: Path, name: str, run_json: str) -> Path:
+    """A directory with a trace and the given run.json text."""
+    d = tmp / name
     d.mkdir()
     _trace(d)
-    (d / "run.json").write_text("[1, 2]")
+    (d / "run.json").write_text(run_json)
     return d
+
+
+def _list_run(tmp: Path) -> Path:
+    return _run_with(tmp, "run-list", "[1, 2]")
 
 
 def _run_dir(tmp: Path) -> Path:
-    d = tmp / "run"
-    d.mkdir()
-    _trace(d)
-    (d / "run.json").write_text("{}")
-    return d
+    return _run_with(tmp, "run", "{}")
 
 
 def _md_run(tmp: Path) -> Path:
-    d = tmp / "md-run"
-    d.mkdir()
-    _trace(d)
-    (d / "run.json").write_text('{"trace_parameters": {"spring_constant": 100.0, "mass": 500.0, '
-                                '"area": 58.7, "thickness": null, "drive_velocity": 0.02, '
-                                '"units": "lj"}}')
-    return d
+    return _run_with(tmp, "md-run", '{"trace_parameters": {"spring_constant": 100.0, "mass": 500.0, '
+                                    '"area": 58.7, "thickness": null, "drive_velocity": 0.02, '
+                                    '"units": "lj"}}')
 
 
 def _with_runs_file(tmp: Path, args: list) -> list:
