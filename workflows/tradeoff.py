@@ -359,6 +359,38 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
                        area=area)
 
 
+def combine(measurements: list[Measurement]) -> Measurement:
+    """One setting's runs with different seeds as one measurement: each observable's mean
+    over the runs, with the standard error of that mean over the runs (the runs' own
+    standard errors for a single run).  Cycles add up; the regime is the runs' regimes."""
+    if len(measurements) == 1:
+        return measurements[0]
+    values = {}
+    for name in measurements[0].values:
+        means = np.array([m.values[name][0] for m in measurements], float)
+        ok = means[np.isfinite(means)]
+        values[name] = ((float(ok.mean()), float(ok.std(ddof=1) / math.sqrt(ok.size)))
+                        if ok.size > 1 else
+                        (float(ok[0]) if ok.size else math.nan, math.nan))
+    regimes = sorted({m.regime for m in measurements})
+    return Measurement(values=values, cycles=sum(m.cycles for m in measurements),
+                       regime=regimes[0] if len(regimes) == 1 else "mixed: " + ", ".join(regimes),
+                       area=measurements[0].area)
+
+
+def _seeded(params: dict, k: int) -> dict:
+    """The scene's parameters for the k-th seed of a setting (k = 0: as they are)."""
+    if k == 0:
+        return params
+    from .scene import PARAMETERS
+
+    return {**params, "seed": int(params.get("seed", PARAMETERS["seed"].default)) + k}
+
+
+def _dirname(label: str) -> str:
+    return label.replace("=", "-").replace(" ", "-")
+
+
 def compare(setting: Measurement, reference: Measurement, is_reference: bool) -> dict:
     """``error_<obs>`` = setting − reference with ``error_<obs>_uncertainty``.
 
@@ -483,19 +515,26 @@ def _atom_steps(overrides: dict) -> float:
     return float(atoms * (p["equilibrate_steps"] + p["slide_steps"]))
 
 
-def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
-    """Run every MD setting of ``study`` (each distinct scene once) and tabulate."""
+def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print, seeds: int = 1) -> list[dict]:
+    """Run every MD setting of ``study`` (each distinct scene once per seed) and tabulate.
+
+    With ``seeds`` > 1 each setting also runs with the seeds following the scene's
+    (``seed`` + 1, ...); its observables are then the mean over the runs, with the
+    standard error of that mean over the runs (:func:`combine`), so that an error
+    includes the run-to-run scatter of a chaotic trajectory."""
     runs: dict[str, RunCost] = {}
     failed: dict[str, str] = {}
     todo = []
     for s in study.settings:
-        key = _key({**study.base, **s.overrides})
-        if key not in runs and key not in [k for k, _ in todo]:
-            todo.append((key, s))
-    work = [_atom_steps({**study.base, **s.overrides}) for _, s in todo]
+        for k in range(seeds):
+            params = _seeded({**study.base, **s.overrides}, k)
+            key = _key(params)
+            if key not in runs and key not in [t[0] for t in todo]:
+                todo.append((key, s, k, params))
+    work = [_atom_steps(params) for *_, params in todo]
     started, done = time.perf_counter(), 0.0
-    for i, (key, s) in enumerate(todo, 1):
-        label = f"{s.knob}={s.value}" if s.overrides else "base"
+    for i, (key, s, k, params) in enumerate(todo, 1):
+        label = (f"{s.knob}={s.value}" if s.overrides else "base") + (f" seed+{k}" if k else "")
         elapsed = time.perf_counter() - started
         # ETA from the atom-steps done so far: settings differ in atoms and steps
         eta = (f", about {elapsed / done * sum(work[i - 1:]) / 60:.0f} min left" if done
@@ -504,8 +543,7 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
         t0 = time.perf_counter()
         done += work[i - 1]
         try:
-            runs[key] = run_setting({**study.base, **s.overrides},
-                                    out / "runs" / f"{i:02d}-{label.replace('=', '-')}", nprocs)
+            runs[key] = run_setting(params, out / "runs" / f"{i:02d}-{_dirname(label)}", nprocs)
         except RuntimeError as exc:
             # one failed setting is a result (the knob is past its limit), not the end
             failed[key] = str(exc).splitlines()[0]
@@ -517,24 +555,29 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
     if base_key not in runs:
         raise RuntimeError(f"the base run failed: {failed[base_key]}")
     area_ref = measure(runs[base_key].run_dir).area
+    keys = {(s.knob, s.value): [_key(_seeded({**study.base, **s.overrides}, k)) for k in range(seeds)]
+            for s in study.settings}
     measured = {}
     for s in study.settings:
-        key = _key({**study.base, **s.overrides})
-        if key in runs:
-            measured[(s.knob, s.value)] = measure(runs[key].run_dir, area_ref=area_ref,
-                                                  prefix=s.prefix)
+        done_keys = [key for key in keys[(s.knob, s.value)] if key in runs]
+        if done_keys:
+            measured[(s.knob, s.value)] = combine([measure(runs[key].run_dir, area_ref=area_ref,
+                                                           prefix=s.prefix) for key in done_keys])
     rows = []
     for s in study.settings:
         ref = next(r for r in study.settings if r.knob == s.knob and r.reference)
-        key = _key({**study.base, **s.overrides})
-        if key not in runs or (ref.knob, ref.value) not in measured:
-            why = failed.get(key) or f"its reference {ref.value} failed"
+        done_keys = [key for key in keys[(s.knob, s.value)] if key in runs]
+        if not done_keys or (ref.knob, ref.value) not in measured:
+            why = (next((failed[key] for key in keys[(s.knob, s.value)] if key in failed), None)
+                   or f"its reference {ref.value} failed")
             rows.append({"knob": s.knob, "value": s.value, "reference": s.reference,
                          "regime": f"failed: {why}"})
             continue
         meas = measured[(s.knob, s.value)]
-        cost = runs[key]
-        seconds, tau = cost.wall_seconds, cost.simulated_tau
+        cost = runs[done_keys[0]]
+        # the cost of one run: the mean over the seeds (same scene, same work)
+        seconds = float(np.mean([runs[key].wall_seconds for key in done_keys]))
+        tau = cost.simulated_tau
         if s.prefix < 1.0:
             # a shorter run costs its share of the slide plus the whole equilibration
             f_eq = cost.equilibrate_seconds_fraction
@@ -549,7 +592,7 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
                "memory_peak_rss_mb": cost.peak_rss_mb,
                "memory_lammps_mb_per_rank": cost.lammps_mb_per_rank,
                "atoms": cost.atoms, "steps": cost.steps, "simulated_tau": tau,
-               "cycles": meas.cycles, "regime": meas.regime}
+               "cycles": meas.cycles, "regime": meas.regime, "seeds": len(done_keys)}
         row.update(compare(meas, measured[(ref.knob, ref.value)], s.reference))
         row["run_dir"] = str(cost.run_dir)
         rows.append(row)
@@ -557,7 +600,7 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print) -> list[dict]:
 
 
 def columns() -> list[str]:
-    cols = ["knob", "value", "reference", *COST_FIELDS, "regime"]
+    cols = ["knob", "value", "reference", *COST_FIELDS, "regime", "seeds"]
     for name in OBSERVABLES:
         cols += [f"value_{name}", f"error_{name}", f"error_{name}_uncertainty"]
     return cols + ["run_dir"]
@@ -726,12 +769,13 @@ def plot(rows: list[dict], out: Path) -> list[Path]:
     return paths
 
 
-def study(quick: bool, out: Path, nprocs: int = 2, log=print) -> list[dict]:
+def study(quick: bool, out: Path, nprocs: int = 2, log=print, seeds: int = 1) -> list[dict]:
     """Run the study; write ``tradeoff.csv``, ``tradeoff.json`` and the PNGs under ``out``."""
     out.mkdir(parents=True, exist_ok=False)
     p = plan(quick)
-    log(f"tradeoff ({p.description}); output in {out}")
-    rows = md_rows(p, out, nprocs, log) + reduced_rows()
+    log(f"tradeoff ({p.description}{f', {seeds} seeds per setting' if seeds > 1 else ''}); "
+        f"output in {out}")
+    rows = md_rows(p, out, nprocs, log, seeds) + reduced_rows()
     rows = json_safe(rows)
     write_csv(rows, out / "tradeoff.csv")
     write_atomic(out / "tradeoff.json", json.dumps(rows, indent=1, allow_nan=False) + "\n")
@@ -752,6 +796,10 @@ def register(subparsers) -> None:
     p.add_argument("--out", type=Path, default=None,
                    help="directory to create (default runs/tradeoff-<time>)")
     p.add_argument("--np", type=int, default=2, help="MPI ranks per run (default 2)")
+    p.add_argument("--seeds", type=int, default=1,
+                   help="runs per setting with successive seeds (default 1); with 2 or more "
+                        "each error's uncertainty is the scatter over the runs, which one "
+                        "run's slips can understate (N times the cost)")
     p.set_defaults(func=main)
 
 
@@ -760,6 +808,8 @@ def main(args: argparse.Namespace) -> int:
 
     if args.np < 1:
         raise UserError(f"--np {args.np}: need at least 1 MPI rank")
+    if not 1 <= args.seeds <= 100:
+        raise UserError(f"--seeds {args.seeds}: allowed 1 to 100 runs per setting")
     out = args.out or Path("runs") / f"tradeoff-{datetime.now():%Y%m%d-%H%M%S}"
     if out.exists():
         raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
@@ -774,7 +824,7 @@ def main(args: argparse.Namespace) -> int:
     def log(msg):
         print(msg, file=stream, flush=True)
     try:
-        rows = study(args.quick, out, args.np, log)
+        rows = study(args.quick, out, args.np, log, args.seeds)
     except RuntimeError as exc:
         print(f"filmfriction tradeoff: {exc}", file=sys.stderr)
         return 1

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import math
 
 import numpy as np
@@ -190,3 +191,47 @@ def test_point_labels_do_not_overlap_each_other_or_the_markers():
             assert not (box.x0 < mx < box.x1 and box.y0 < my < box.y1), (anns[k].get_text(), x, y)
         assert ax.get_window_extent(renderer).contains(box.x0, box.y0)
     plt.close(fig)
+
+
+def test_seeds_combine_into_the_mean_and_its_scatter():
+    runs = [tradeoff.Measurement(values={"static_force": (m, 0.1)}, cycles=6, regime=r, area=58.7)
+            for m, r in ((90.0, "stick-slip"), (96.0, "stick-slip"), (99.0, "irregular"))]
+    both = tradeoff.combine(runs)
+    mean, se = both.values["static_force"]
+    assert mean == pytest.approx(95.0)
+    # the scatter over the runs (std 4.58), not the runs' own 0.1
+    assert se == pytest.approx(np.std([90.0, 96.0, 99.0], ddof=1) / np.sqrt(3))
+    assert both.cycles == 18 and both.regime == "mixed: irregular, stick-slip"
+    assert tradeoff.combine(runs[:1]) is runs[0]
+
+
+@pytest.mark.parametrize("value", ["0", "101", "-2"])
+def test_seeds_out_of_range_are_refused(run_cli, tmp_path, value):
+    result = run_cli("tradeoff", "--seeds", value, "--out", tmp_path / "s")
+    assert result.code == 2 and f"--seeds {value}: allowed 1 to 100" in result.err
+    assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.md
+def test_a_study_with_two_seeds_runs_each_setting_twice(tmp_path, monkeypatch, run_cli, md):
+    base = {**md.box, "equilibrate_steps": 500, "slide_steps": 4000, "trace_every": 20,
+            "restart_every": 0}
+    settings = (tradeoff.Setting("trace_every", "20", {}, reference=True),
+                tradeoff.Setting("trace_every", "40", {"trace_every": 40}))
+    monkeypatch.setattr(tradeoff, "plan", lambda quick: tradeoff.Plan(base, settings, "tiny"))
+    monkeypatch.setattr(tradeoff, "reduced_rows", lambda repeat=2: [])
+    out = tmp_path / "study"
+    result = run_cli("tradeoff", "--quick", "--json", "--np", "1", "--seeds", "2", "--out", out)
+    assert result.code == 0, result.err
+    rows = result.json()
+    assert [r["seeds"] for r in rows] == [2, 2]
+    dirs = sorted(d.name for d in (out / "runs").iterdir())
+    assert len(dirs) == 4 and sum("seed+1" in d for d in dirs) == 2, dirs
+    seeded = [json.loads((out / "runs" / d / "run.json").read_text())["scene"]["parameters"]["seed"]
+              for d in dirs]
+    assert len(set(seeded)) == 2
+    # the coarse trace's ledger closure: the mean over its two runs, measured one by one
+    one = [tradeoff.measure(out / "runs" / d).values["ledger_closure"][0]
+           for d in dirs if "trace_every-40" in d]
+    assert rows[1]["value_ledger_closure"] == pytest.approx(np.mean(one), rel=1e-9)
+    assert rows[0]["error_static_force"] == 0.0
