@@ -82,7 +82,7 @@ def test_one_error_gives_the_interval_of_that_input_moved():
     exact = sfb_check_setup(setup, SLIP)
     lo, hi = exact.row("slip_time")["uncertainty"]
     assert lo == hi == exact.row("slip_time")["model"]
-    assert "no input (no errors given)" in exact.notes[-1]
+    assert "no input (no errors given)" in exact.notes[0]
 
 
 def test_errors_add_in_quadrature():
