@@ -65,6 +65,12 @@ What is assumed (all in :data:`ASSUMPTIONS`, printed by the CLI)
   errors of η_eff (±4 Pa·s), A (±10 %) and D (±0.3 nm) through B = Aη/D
   (±20 %); the undetermined x0 is not in them (see above).
 
+With a set-up's measured slip in Klein's place (``setup=``,
+:func:`~filmfriction.reduced_model.sfb_setup.sfb_check_setup`) x0 = F_s/K and Δx0
+come from the trace, so the notes name the set-up and its measured numbers and
+leave out what only Klein's text has: the x0 reading and its ΔE_f sensitivity,
+his error bars, his ringing convention (no ringing is measured).
+
 Braun & Tosatti's reading
 --------------------------
 :data:`~filmfriction.reduced_model.klein.BRAUN_TOSATTI_NOTE` — any comparison with
