@@ -65,6 +65,12 @@ What is assumed (all in :data:`ASSUMPTIONS`, printed by the CLI)
   errors of η_eff (±4 Pa·s), A (±10 %) and D (±0.3 nm) through B = Aη/D
   (±20 %); the undetermined x0 is not in them (see above).
 
+With a set-up's measured slip in Klein's place (``setup=``,
+:func:`~filmfriction.reduced_model.sfb_setup.sfb_check_setup`) x0 = F_s/K and Δx0
+come from the trace, so the notes name the set-up and its measured numbers and
+leave out what only Klein's text has: the x0 reading and its ΔE_f sensitivity,
+his error bars, his ringing convention (no ringing is measured).
+
 Braun & Tosatti's reading
 --------------------------
 :data:`~filmfriction.reduced_model.klein.BRAUN_TOSATTI_NOTE` — any comparison with
@@ -161,24 +167,34 @@ class SFBCheck:
                           for k, run in self.slips.items()}}
 
 
-ASSUMPTIONS = (
+#: How x0 and dx0 are read off Klein's text (not said of a measured slip).
+_X0_FROM_KLEINS_TEXT = (
     "x0 (spring extension at yield) from Klein's dE_f ~ K x0 delta ~ 1e-14 J with delta ~ 1 nm; "
     "slip distance dx0 from dE_spring = K(x0 - dx0/2) dx0 ~ 4e-13 J. Both are one-figure "
-    "estimates in the paper; slip_time is sensitive to x0 (see slip_time's note).",
+    "estimates in the paper; slip_time is sensitive to x0 (see slip_time's note).")
+#: Klein's convention for the ringing (said only when a ringing is given).
+_RINGING = "Ringing energy with Klein's v0 = 2 a0 nu_c (a harmonic v0 = 2 pi a0 nu_c gives ~10x more)."
+#: The intervals from Klein's error bars (a set-up propagates its own errors instead).
+_KLEINS_ERRORS = (
+    "Uncertainty intervals of sfb-parameters rows: B = A eta/D at +/-1 sigma from Klein's errors "
+    "(eta +/-4 Pa s, A +/-10 %, D +/-0.3 nm -> +/-20 %); the x0 ambiguity is not included.")
+
+ASSUMPTIONS = (
+    _X0_FROM_KLEINS_TEXT,
     "tau_s is Klein's definition, the time from yield y to solidification s; in the model s is "
     "where the slip reaches dx0 (spring force back down to K(x0 - dx0)). Eq. (1) has no "
     "solidification of its own, so s is imposed from the data (md path: from the MD re-stick stress).",
     "Spring end fixed during the slip (tau_s << tau_ss), as in Klein's Eq. (1).",
     "Temperature rise: viscous energy into the film volume A D, bulk-liquid OMCTS heat capacity "
     "(rho c_p = 956 kg/m3 x 1.49 kJ/(kg K)), no heat loss during the slip (upper bound).",
-    "Ringing energy with Klein's v0 = 2 a0 nu_c (a harmonic v0 = 2 pi a0 nu_c gives ~10x more).",
-    "Uncertainty intervals of sfb-parameters rows: B = A eta/D at +/-1 sigma from Klein's errors "
-    "(eta +/-4 Pa s, A +/-10 %, D +/-0.3 nm -> +/-20 %); the x0 ambiguity is not included.",
+    _RINGING,
+    _KLEINS_ERRORS,
 )
 
 
 def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperiment = KLEIN,
-              liquid: LiquidProperties = OMCTS_LIQUID, contact=None) -> SFBCheck:
+              liquid: LiquidProperties = OMCTS_LIQUID, contact=None,
+              setup: str | None = None) -> SFBCheck:
     """Run the SFB check.
 
     Parameters
@@ -195,6 +211,11 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         An MD run's measured contact (:func:`filmfriction.analysis.contact.contact_from_run`):
         adds the ``similarity`` rows, its dimensionless numbers beside Klein's
         (:func:`.similarity.similarity_rows`).
+    setup : str, optional
+        The name of the SFB set-up whose measured slip ``experiment`` holds
+        (:func:`.sfb_setup.setup_experiment`): the notes then speak of that set-up
+        and its trace (x0 = F_s/K and Δx0 measured) instead of Klein's text, and
+        leave out what only Klein's text has (his ΔE_f, his error bars, his ringing).
 
     Returns
     -------
@@ -235,8 +256,9 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         return (getattr(lo, attr), getattr(hi, attr))
 
     heat = lambda run: temperature_rise(run.viscous_energy, A, D, liquid)  # noqa: E731
+    is_klein = setup is None      # Klein's printed numbers, not a measured slip
     sens = []
-    for e_f in (0.95e-14, 1.1e-14):
+    for e_f in (0.95e-14, 1.1e-14) if is_klein else ():
         g = klein_slip_geometry(replace(ex, film_energy=e_f))
         r = klein_run(ex.eta_eff, "sensitivity", restick=g.restick_force(K), x0=g.x0)
         sens.append(f"dE_f = {e_f:.3g} J -> x0 = {g.x0 * 1e9:.0f} nm, tau_s = {r.slip_time * 1e3:.1f} ms")
@@ -246,21 +268,28 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
     rows = [
         _row("slip_time", ex.slip_time, main.slip_time, "s", src,
              f"time for the model's slip (eta_eff = {ex.eta_eff:g} Pa s, B = {ex.damping:.3g} N s/m) "
-             f"to reach dx0 = {geo.slip_distance * 1e9:.1f} nm from x0 = {geo.x0 * 1e9:.1f} nm; "
-             f"sensitivity to x0: {'; '.join(sens)}", unc("slip_time")),
+             f"to reach dx0 = {geo.slip_distance * 1e9:.1f} nm from x0 = {geo.x0 * 1e9:.1f} nm"
+             + (f"; sensitivity to x0: {'; '.join(sens)}" if is_klein else " (both measured)"),
+             unc("slip_time")),
         _row("spring_energy_released", ex.spring_energy_released, main.spring_energy_released, "J", src,
-             "K x0^2/2 - K (x0 - x(tau_s))^2/2 in the model; equals Klein's value by construction "
-             "(dx0 was derived from it), a check of the slip end only"),
+             "K x0^2/2 - K (x0 - x(tau_s))^2/2 in the model; equals "
+             + ("Klein's value by construction (dx0 was derived from it)" if is_klein else
+                "the measured K (x0 - dx0/2) dx0 by construction (the slip ends at the measured dx0)")
+             + ", a check of the slip end only"),
         _row("viscous_energy", ex.spring_energy_released, main.viscous_energy, "J", src,
-             "friction dissipation from y to s in the model's energy ledger; Klein: "
-             "dE_viscous ~ dE_spring ~ 4e-13 J", unc("viscous_energy")),
+             "friction dissipation from y to s in the model's energy ledger; "
+             + ("Klein: dE_viscous ~ dE_spring ~ 4e-13 J" if is_klein else
+                "beside the measured slip's spring energy released (dE_viscous ~ dE_spring)"),
+             unc("viscous_energy")),
         _row("viscous_fraction", ex.viscous_fraction, main.viscous_fraction, "1", src,
-             "viscous / (viscous + kinetic energy left at s) in the model; Klein: 'of order 90 % "
-             "or more' (a lower bound)", unc("viscous_fraction")),
+             "viscous / (viscous + kinetic energy left at s) in the model"
+             + ("; Klein: 'of order 90 % or more' (a lower bound)" if is_klein else ""),
+             unc("viscous_fraction")),
         _row("residual_kinetic_energy", ex.ringing_energy, main.kinetic_energy_at_stick, "J", src,
              f"M v(s)^2/2, the only source of ringing Eq. (1) has (v(s) = "
-             f"{math.sqrt(2 * main.kinetic_energy_at_stick / M) * 1e6:.2f} um/s); Klein: the observed "
-             "ringing dE_osc ~ 1e-14 J, which he attributes to the film energy dE_f, not to Eq. (1)",
+             f"{math.sqrt(2 * main.kinetic_energy_at_stick / M) * 1e6:.2f} um/s)"
+             + ("; Klein: the observed ringing dE_osc ~ 1e-14 J, which he attributes to the film "
+                "energy dE_f, not to Eq. (1)" if is_klein else ""),
              unc("kinetic_energy_at_stick")),
         _row("ringing_energy", ex.ringing_energy, ring, "J", src,
              f"M_eff (2 a0 nu_c)^2 / 2 with a0 = {ex.ringing_amplitude * 1e9:g} nm, nu_c = "
@@ -277,28 +306,39 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         _row("inertial_slip_time", ex.slip_time, bulk.slip_time, "s", src,
              f"same slip with the bulk viscosity {ex.eta_bulk:g} Pa s (B = "
              f"{newtonian_damping(A, ex.eta_bulk, D):.3g} N s/m, underdamped): time to cover dx0, "
-             "beside the observed tau_s; Klein's dotted curve in Fig. 2(c), no number in the text"),
+             "beside the observed tau_s"
+             + ("; Klein's dotted curve in Fig. 2(c), no number in the text" if is_klein else "")),
         _row("inertial_peak_slip", None, float(np.max(bulk.x)), "m", src,
              f"largest slip of the bulk-viscosity run if nothing stopped it (~2 x0 = "
-             f"{2 * geo.x0 * 1e9:.0f} nm: inertial overshoot); no Klein number"),
+             f"{2 * geo.x0 * 1e9:.0f} nm: inertial overshoot); "
+             + ("no Klein number" if is_klein else "nothing measured")),
         _row("inertial_residual_kinetic_energy", ex.ringing_energy, bulk.kinetic_energy_at_stick, "J", src,
              "kinetic energy at s with bulk viscosity: what a bulk-viscosity slip would hand to the "
-             "ringing; beside Klein's observed dE_osc"),
+             "ringing" + ("; beside Klein's observed dE_osc" if is_klein else "")),
         _row("slip_time_full_relaxation_63", ex.slip_time, time_to_fraction(full, 1 - math.exp(-1)), "s", src,
-             f"alternative reading: dx0 = x0 = {full_geo.x0 * 1e9:.1f} nm (full relaxation); time to "
-             "1 - 1/e of the slip (~ B/K)"),
+             (f"alternative reading: dx0 = x0 = {full_geo.x0 * 1e9:.1f} nm (full relaxation)" if is_klein
+              else f"what if the measured slip's spring energy came from a full relaxation, dx0 = x0 = "
+                   f"{full_geo.x0 * 1e9:.1f} nm (not the measured x0 and dx0)")
+             + "; time to 1 - 1/e of the slip (~ B/K)"),
         _row("slip_time_full_relaxation_95", ex.slip_time, time_to_fraction(full, 0.95), "s", src,
-             "alternative reading, time to 95 % of the fully relaxed slip"),
+             ("alternative reading" if is_klein else "the same full relaxation")
+             + ", time to 95 % of the fully relaxed slip"),
     ]
 
     slips = {"klein": main, "bulk": bulk, "full_relaxation": full}
-    notes = list(ASSUMPTIONS) + [f"slip geometry: {geo.derivation}",
-                                 f"model vs Klein's Eq. (2): max |dx|/x0 = {deviation:.1e} (closed-form "
-                                 f"path), {ode_deviation:.1e} (ODE path)"]
+    # Klein's text alone gives x0 from dE_f and his error bars; a ringing convention needs a ringing
+    said = [n for n in ASSUMPTIONS if (is_klein or n not in (_X0_FROM_KLEINS_TEXT, _KLEINS_ERRORS))
+            and (n != _RINGING or math.isfinite(ring))]
+    geometry = (geo.derivation if is_klein else
+                f"x0 = F_s/K = {geo.x0 * 1e9:.1f} nm and dx0 = {geo.slip_distance * 1e9:.1f} nm, "
+                "both from the measured trace")
+    notes = said + [f"slip geometry: {geometry}",
+                    f"model vs Klein's Eq. (2): max |dx|/x0 = {deviation:.1e} (closed-form "
+                    f"path), {ode_deviation:.1e} (ODE path)"]
 
     if calibration is not None:
         calibration = MDCalibration.coerce(calibration)
-        extra_rows, md_run, md_notes = md_rows(calibration, units, ex, geo, liquid)
+        extra_rows, md_run, md_notes = md_rows(calibration, units, ex, geo, liquid, setup)
         rows += [without_unfixed_ratio(r) for r in extra_rows]
         slips["md"] = md_run
         notes += md_notes

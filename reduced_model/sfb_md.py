@@ -91,7 +91,7 @@ def md_quantities(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, shear
 
 
 def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGeometry,
-            liquid: LiquidProperties) -> tuple[list, SlipRun, list]:
+            liquid: LiquidProperties, setup: str | None = None) -> tuple[list, SlipRun, list]:
     """The ``md-calibrated`` rows of the SFB table.
 
     Parameters
@@ -104,6 +104,9 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
     geo : SlipGeometry
         Klein's x0 and Δx0 (his slip's shear rate, his re-stick stress).
     liquid : LiquidProperties
+    setup : str, optional
+        The name of the SFB set-up whose measured slip ``ex`` and ``geo`` hold: the
+        notes then speak of it instead of Klein (:func:`~filmfriction.reduced_model.sfb.sfb_check`).
 
     Returns
     -------
@@ -161,7 +164,10 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
     # a measured trace's calibration is SI already (units = SI_IDENTITY): said in SI words
     si = units == SI_IDENTITY
     md, rate_unit = ("calibrated", "1/s") if si else ("MD", "/tau")
-    extrap = (f"{md} law evaluated at Klein's mean slip rate dx0/(tau_s D) = {rate:.3g} 1/s"
+    is_klein = setup is None
+    whose = "Klein's" if is_klein else "the measured"
+    area = "Klein's contact area" if is_klein else f"the contact area of {setup}"
+    extrap = (f"{md} law evaluated at {whose} mean slip rate dx0/(tau_s D) = {rate:.3g} 1/s"
               + ("" if si else f" = {rate_lj:.3g} /tau")
               + (f", {decades:.1f} decades below the lowest {md} rate"
                  if decades is not None else ""))
@@ -170,14 +176,17 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
     klein_restick = geo.restick_force(K) / A
     rows = [
         _row("yield_stress", geo.x0 * K / A, q["yield_stress"], "Pa", src,
-             f"{stress_text}; Klein: K x0/A with "
-             "x0 from dE_f (not printed in the paper)", interval("yield_stress")),
+             f"{stress_text}; "
+             + ("Klein: K x0/A with x0 from dE_f (not printed in the paper)" if is_klein else
+                f"{setup}: F_s/A with the measured static force F_s"), interval("yield_stress")),
         _row("static_force", geo.x0 * K, q["static_force"], "N", src,
-             f"{md} yield stress x Klein's contact area {A:.2g} m2 vs Klein's K x0", interval("static_force")),
+             f"{md} yield stress x {area} {A:.2g} m2 vs "
+             + ("Klein's K x0" if is_klein else "the measured F_s"), interval("static_force")),
     ]
     if q["restick_stress"] is not None:
         rows.append(_row("restick_stress", klein_restick, q["restick_stress"], "Pa", src,
-                         "stress at which the film re-solidifies (s); Klein: K(x0 - dx0)/A",
+                         "stress at which the film re-solidifies (s); "
+                         f"{'Klein' if is_klein else setup}: K(x0 - dx0)/A",
                          interval("restick_stress")))
     rows.append(_row("sliding_stress", None, q["sliding_stress"], "Pa", src,
                      "rate-independent stress while sliding; Klein's Eq. (1) has none (purely viscous)",
@@ -193,7 +202,8 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
                          "Newtonian plateau): upper bracket of eta_eff"))
     for key, klein, unit, note in (
             ("slip_time", ex.slip_time, "s", f"SFB-scale slip of the calibrated model; end: {run.end_rule}"),
-            ("slip_distance", geo.slip_distance, "m", "slip from y to s; Klein's dx0 derived from dE_spring"),
+            ("slip_distance", geo.slip_distance, "m", "slip from y to s; " + (
+                "Klein's dx0 derived from dE_spring" if is_klein else "the measured dx0")),
             ("spring_energy_released", ex.spring_energy_released, "J", "K x0^2/2 - K (x0 - dx)^2/2"),
             ("viscous_energy", ex.spring_energy_released, "J", "friction dissipation y -> s (model ledger)"),
             ("viscous_fraction", ex.viscous_fraction, "1", "viscous / (viscous + kinetic energy at s)"),
@@ -202,6 +212,7 @@ def md_rows(cal: MDCalibration, units: LJUnits, ex: KleinExperiment, geo: SlipGe
     mapping = ("a measured trace's calibration, SI already (no LJ mapping)" if si else
                f"units {units.name} (sigma = {units.sigma * 1e9:.3g} nm, eps/kB = "
                f"{units.temperature:.0f} K, tau = {units.tau * 1e12:.2f} ps)")
-    notes = [f"md-calibrated: {mapping}; stresses x Klein's area; "
+    scaled_by = "Klein's area" if is_klein else area
+    notes = [f"md-calibrated: {mapping}; stresses x {scaled_by}; "
              f"{extrap}." + (f" Calibration source: {cal.source}" if cal.source else "")]
     return rows, run, notes

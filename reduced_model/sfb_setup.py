@@ -276,7 +276,8 @@ def sfb_check_setup(setup: SFBSetup, slip: MeasuredSlip, calibration=None,
                     units: LJUnits = OMCTS) -> SFBCheck:
     """:func:`~filmfriction.reduced_model.sfb.sfb_check` on ``setup`` and ``slip``, each
     model number's interval propagated from every input's error (linear, one input at a
-    time by +1σ, in quadrature).  The ``klein`` column holds the measured numbers.
+    time by +1σ, in quadrature).  The ``klein`` column holds the measured numbers; the
+    notes speak of the set-up (by its ``name``) and its trace, first the propagation.
 
     Raises
     ------
@@ -284,14 +285,14 @@ def sfb_check_setup(setup: SFBSetup, slip: MeasuredSlip, calibration=None,
         The slip does not fit the set-up (:func:`setup_experiment`).
     """
     base = sfb_check(calibration=calibration, units=units,
-                     experiment=setup_experiment(setup, slip))
+                     experiment=setup_experiment(setup, slip), setup=setup.name)
     shifts: dict[tuple, float] = {}
     inputs = []
     for key, s, m in _perturbed(setup, slip):
         inputs.append(key)
         try:
             other = sfb_check(calibration=calibration, units=units,
-                              experiment=setup_experiment(s, m))
+                              experiment=setup_experiment(s, m), setup=setup.name)
         except ValueError as exc:
             raise ValueError(f"{key} + 1 sigma: {exc}") from None
         for r0, r1 in zip(base.rows, other.rows):
@@ -307,8 +308,7 @@ def sfb_check_setup(setup: SFBSetup, slip: MeasuredSlip, calibration=None,
             r["uncertainty"] = [r["model"] - sigma, r["model"] + sigma]
         rows.append(r)
     note = (f"{setup.name}: the measured slip ({slip.source or 'given'}) in place of Klein's "
-            f"numbers, x0 = F_s/K = {slip.static_force / setup.spring_constant * 1e9:.1f} nm, "
-            f"dx0 = {slip.slip_distance * 1e9:.1f} nm; intervals: +/-1 sigma propagated linearly "
-            f"from {', '.join(inputs) if inputs else 'no input (no errors given)'}; no measured "
+            f"numbers; intervals: +/-1 sigma propagated linearly from "
+            f"{', '.join(inputs) if inputs else 'no input (no errors given)'}; no measured "
             "ringing, temperature rise or viscous fraction")
-    return replace(base, rows=rows, notes=base.notes + (note,))
+    return replace(base, rows=rows, notes=(note,) + base.notes)

@@ -3,6 +3,7 @@ and the propagation of the set-up's errors."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import pytest
@@ -82,7 +83,7 @@ def test_one_error_gives_the_interval_of_that_input_moved():
     exact = sfb_check_setup(setup, SLIP)
     lo, hi = exact.row("slip_time")["uncertainty"]
     assert lo == hi == exact.row("slip_time")["model"]
-    assert "no input (no errors given)" in exact.notes[-1]
+    assert "no input (no errors given)" in exact.notes[0]
 
 
 def test_errors_add_in_quadrature():
@@ -104,3 +105,75 @@ def test_unmeasured_rows_have_no_measured_number():
     for name in ("ringing_energy", "temperature_rise", "viscous_fraction"):
         assert check.row(name)["klein"] is None and check.row(name)["ratio"] is None
     assert check.row("slip_time")["klein"] == SLIP.slip_time
+
+
+# -- the words of the notes: the set-up's, not Klein's text --------------------------
+#: What only Klein's printed numbers make true: x0 from his dE_f, his error bars, his ringing,
+#: his contact area and slip rate.
+KLEIN_ONLY = ("dE_f", "Klein's area", "Klein's contact area", "Klein's mean slip rate",
+              "Klein's dx0", "Klein's errors", "Klein's v0", "Klein's K x0", "Klein:",
+              "sensitivity to x0", "alternative reading", "x0 ambiguity")
+
+
+def _si_calibration(setup, slip):
+    """A calibrated film in SI (a measured trace's) that yields at the measured F_s."""
+    from filmfriction.reduced_model.md_film import MDCalibration
+    A = setup.contact_area
+    return MDCalibration(yield_stress=slip.static_force / A,
+                         restick_stress=0.3 * slip.static_force / A, eta_zero=slip.eta_eff,
+                         yield_stress_err=0.05 * slip.static_force / A)
+
+
+def _texts(check):
+    """Every note and row note but Braun & Tosatti's reading (said of Klein on purpose)."""
+    from filmfriction.reduced_model.klein import BRAUN_TOSATTI_NOTE
+    return [n for n in check.notes if n != BRAUN_TOSATTI_NOTE] + [r["note"] for r in check.rows]
+
+
+@pytest.fixture(scope="module")
+def checks():
+    """Klein's check and a named set-up's, both with an SI-calibrated film."""
+    from filmfriction.reduced_model.units import SI_IDENTITY
+    setup = SFBSetup.from_dict({**BASE, "mass": {"value": 1.47e-3, "error": 0.05e-3}},
+                               name="rig 7")
+    mine = sfb_check_setup(setup, SLIP, calibration=_si_calibration(setup, SLIP),
+                           units=SI_IDENTITY)
+    klein = sfb_check(_si_calibration(setup, SLIP), units=SI_IDENTITY)
+    return klein, mine
+
+
+@pytest.mark.parametrize("phrase", KLEIN_ONLY)
+def test_kleins_readings_are_said_of_klein_only(checks, phrase):
+    klein, mine = checks
+    assert any(phrase in t for t in _texts(klein)), phrase          # Klein's check keeps them
+    assert not [t for t in _texts(mine) if phrase in t]
+
+
+def test_setup_notes_take_x0_from_the_trace_and_name_the_setup(checks):
+    _, mine = checks
+    x0_notes = [n for n in mine.notes if re.search(r"\bx0 = [^;]* nm\b", n)]   # x0's value
+    assert len(x0_notes) == 1 and "F_s/K" in x0_notes[0] and "measured" in x0_notes[0]
+    assert mine.notes[0].startswith("rig 7: ")
+    # the calibrated film is carried to the set-up's contact, by its name
+    md = [r["note"] for r in mine.rows if r["source"] == "md-calibrated"
+          and r["name"] in ("yield_stress", "static_force", "restick_stress")]
+    assert len(md) == 3 and all("rig 7" in n for n in md)
+    assert any("the contact area of rig 7" in n for n in mine.notes)
+
+
+def test_kleins_notes_are_his_assumptions_and_his_geometry(checks):
+    """Klein's check: every assumption, his slip geometry from dE_f, the dE_f sensitivity."""
+    from filmfriction.reduced_model.sfb import ASSUMPTIONS
+    klein, _ = checks
+    assert klein.notes[:len(ASSUMPTIONS)] == ASSUMPTIONS
+    assert klein.notes[len(ASSUMPTIONS)] == f"slip geometry: {klein.geometry.derivation}"
+    assert klein.row("slip_time")["note"].count("dE_f = ") == 2
+
+
+def test_a_setup_beyond_kleins_film_energy_runs():
+    """A slip storing more than Klein's dE_f could give (x0 = 1 um): the check runs on it
+    (Klein's dE_f sensitivity runs are not made for a set-up)."""
+    big = replace(SLIP, static_force=97.0 * 1e-6, slip_distance=6e-7)
+    check = sfb_check_setup(SFBSetup.from_dict(BASE), big)
+    assert check.geometry.x0 == pytest.approx(1e-6)
+    assert check.row("slip_time")["model"] > 0

@@ -140,6 +140,26 @@ def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
     assert "rerun `filmfriction analyze" not in text      # it cannot make a film structure
 
 
+def test_sfb_notes_speak_of_the_setup_not_of_kleins_text(chain):
+    """The printed notes, sfb.json's and the report's: x0 from the trace, the set-up by its
+    name; none of Klein's dE_f reading, his area or his slip rate."""
+    from filmfriction.reduced_model.sfb_setup import load_setup
+
+    d, printed = chain
+    name = load_setup(d / "my_sfb.toml").name
+    notes = json.loads((d / "sfb.json").read_text())["notes"]
+    report = (d / "report.md").read_text()
+    report = report[report.index("## Comparison with the SFB experiment"):]
+    report = report[:report.index("\n## ")]
+    for where, text in (("printed", printed["sfb"]), ("sfb.json", "\n".join(notes)),
+                        ("report", report)):
+        for phrase in ("dE_f", "Klein's area", "Klein's contact area", "Klein's mean slip rate",
+                       "Klein:", "sensitivity to x0"):
+            assert phrase not in text, (where, phrase)
+        assert f"{name}: the measured slip" in text and "x0 = F_s/K" in text, where
+    assert any(f"the contact area of {name}" in n for n in notes)
+
+
 @pytest.mark.parametrize("argv,message", [
     (["--column", "time=t"], "no column 't' in the header (columns: t_s, shear_force_N, drive_x_m)"),
     (["--column", "tim=t_s"], "unknown name 'tim'"),
