@@ -195,6 +195,8 @@ def run_ode(p: Problem, rtol: float = 1e-10):
     elif v != u:
         sigma = math.copysign(1.0, v - u)
 
+    # a smooth law's plain-float form (rate-and-state), built once for every segment
+    rates = None if has_stick else law.scalar_state_rates(N)
     while t < T:
         remaining = T - t
         if mode == "stick":
@@ -245,7 +247,6 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             def friction(s, st):
                 return law.friction(s, st, N)
 
-        rates = None if has_stick else law.scalar_state_rates(N)
         if rates is not None:
             # a smooth law with a plain-float form (rate-and-state): the hot loop on floats
             def rhs(tau, y):

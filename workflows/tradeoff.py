@@ -524,13 +524,16 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print, seeds: int = 1) 
     includes the run-to-run scatter of a chaotic trajectory."""
     runs: dict[str, RunCost] = {}
     failed: dict[str, str] = {}
-    todo = []
+    # each setting's runs, one per seed; a scene shared by settings runs once
+    keys, todo = {}, {}
     for s in study.settings:
+        keys[(s.knob, s.value)] = []
         for k in range(seeds):
             params = _seeded({**study.base, **s.overrides}, k)
             key = _key(params)
-            if key not in runs and key not in [t[0] for t in todo]:
-                todo.append((key, s, k, params))
+            keys[(s.knob, s.value)].append(key)
+            todo.setdefault(key, (key, s, k, params))
+    todo = list(todo.values())
     work = [_atom_steps(params) for *_, params in todo]
     started, done = time.perf_counter(), 0.0
     for i, (key, s, k, params) in enumerate(todo, 1):
@@ -555,8 +558,6 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print, seeds: int = 1) 
     if base_key not in runs:
         raise RuntimeError(f"the base run failed: {failed[base_key]}")
     area_ref = measure(runs[base_key].run_dir).area
-    keys = {(s.knob, s.value): [_key(_seeded({**study.base, **s.overrides}, k)) for k in range(seeds)]
-            for s in study.settings}
     measured = {}
     for s in study.settings:
         done_keys = [key for key in keys[(s.knob, s.value)] if key in runs]
