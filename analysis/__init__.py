@@ -8,19 +8,19 @@ Modules (one sitting each):
 * :mod:`filmfriction.analysis.viscosity` — η_eff from steady sliding, velocity profiles,
   power-law fits across runs, and Klein's slip equation;
 * :mod:`filmfriction.analysis.structure` — layers, hexatic order, gap (MDAnalysis);
-* :mod:`filmfriction.analysis.report` — the ``analysis.json`` document;
+* :mod:`filmfriction.analysis.analyze` — the ``analysis.json`` document;
 * :mod:`filmfriction.analysis.observables` — sections of ``analysis.json`` and of the
   report declared one file each (Klein's slip law ...), with their contract;
 * :mod:`filmfriction.analysis.synthetic` — traces and films with known answers;
-* :mod:`filmfriction.analysis.calibration` — the reduced model calibrated on MD runs
-  (:func:`calibrate`), from :mod:`~filmfriction.analysis.rundata`,
-  :mod:`~filmfriction.analysis.slipfit`, :mod:`~filmfriction.analysis.estimators`,
-  :mod:`~filmfriction.analysis.replay` and :mod:`~filmfriction.analysis.md_calibration`.
+* :mod:`filmfriction.analysis.calibration.calibrate` — the reduced model calibrated on MD runs
+  (:func:`calibrate`), from :mod:`~filmfriction.analysis.calibration.rundata`,
+  :mod:`~filmfriction.analysis.calibration.slipfit`, :mod:`~filmfriction.analysis.calibration.estimators`,
+  :mod:`~filmfriction.analysis.calibration.replay` and :mod:`~filmfriction.analysis.calibration.md_estimates`.
 """
 
 if __name__ != "filmfriction.analysis":  # one name only: two would give two copies of every class
     raise ImportError(f"import filmfriction.analysis, not {__name__}")
 
-from .calibration import Calibration, calibrate, load_run, write_calibration  # noqa: E402
+from .calibration.calibrate import Calibration, calibrate, load_run, write_calibration  # noqa: E402
 
 __all__ = ["calibrate", "Calibration", "load_run", "write_calibration"]

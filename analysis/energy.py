@@ -348,7 +348,7 @@ def ledger(columns: dict) -> dict:
     trace has it).
 
     The one ledger of an MD run: the analysis reports it, and the runner
-    (``filmfriction.workflows.runner.ledger_problem``) fails a run whose
+    (``filmfriction.workflows.md.runner.ledger_problem``) fails a run whose
     residual exceeds a share of ``turnover``.
 
     Returns

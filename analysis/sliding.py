@@ -5,7 +5,7 @@ spring force (block-average error), the wall's mean velocity and its ratio to
 the drive's, the force's trend.  :func:`not_sliding` says why such a state is
 not steady sliding (the regime rule's last word on a trace with fewer than 2
 slips).  The ``sliding`` section of ``analysis.json`` is the observable
-:mod:`filmfriction.analysis.observables.sliding`.
+:mod:`filmfriction.analysis.observables.sliding_section`.
 
 Example
 -------

@@ -35,7 +35,7 @@ __all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTabl
 
 class Regime(enum.StrEnum):
     """The sliding regime of a run (the one rule: :func:`classify_regime`, then the
-    analysis' check for a wall that does not slide, :func:`filmfriction.analysis.report.analyze`).
+    analysis' check for a wall that does not slide, :func:`filmfriction.analysis.analyze.analyze`).
 
     A member is its string (``Regime.STICK_SLIP == "stick-slip"``), as written in
     ``analysis.json``.

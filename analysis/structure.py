@@ -11,7 +11,7 @@
 All follow MDAnalysis conventions: ``AnalysisBase`` subclasses, results in
 ``.results``, ``run(start, stop, step, verbose=True)`` with a progress bar.
 Velocity profiles come from ``fix ave/chunk`` files (see
-:mod:`filmfriction.analysis.report`), not from trajectories (DCD holds positions only).
+:mod:`filmfriction.analysis.analyze`), not from trajectories (DCD holds positions only).
 Lengths are in the trajectory's units (σ for an LJ run).
 
 Atom types of a filmfriction run are the script's contract

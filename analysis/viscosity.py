@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import curve_fit
 
-from filmfriction.reduced_model.oscillator import DampedOscillator
+from filmfriction.reduced_model.integrators.oscillator import DampedOscillator
 
 from .stickslip import CycleTable
 
@@ -198,7 +198,7 @@ def slip_force(t, spring_force_at_yield: float, damping: float, mass: float,
     F(t) = K(x0 + V t − x(t)).  With V = v0 = 0 this is Klein's Eq. (2).
     About the steady sliding x_p = x0 + V t − B V/K the slip is the damped
     oscillator M u'' + B u' + K u = 0
-    (:class:`filmfriction.reduced_model.oscillator.DampedOscillator`).
+    (:class:`filmfriction.reduced_model.integrators.oscillator.DampedOscillator`).
 
     Examples
     --------

@@ -49,7 +49,7 @@ def _cpu() -> str:
 
 def bench_trace(n=1_000_000):
     from filmfriction.analysis import energy, stickslip, viscosity
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.synthetic import klein_trace, write_csv
     from filmfriction.analysis.trace import read_trace, write_binary_copy
 

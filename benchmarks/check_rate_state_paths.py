@@ -25,7 +25,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from filmfriction.reduced_model import SpringBlock, laws, limit_cycle  # noqa: E402
+from filmfriction.reduced_model import SpringBlock, laws
+from filmfriction.reduced_model.integrators import limit_cycle  # noqa: E402
 
 
 def draw(rng):

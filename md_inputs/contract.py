@@ -9,7 +9,7 @@ One table each for what the script and its readers must agree on:
   in the order LAMMPS prints them, with the LAMMPS expression and format
   that print them, their unit and their meaning.
 
-The runner (``filmfriction.workflows.runner``) and the analysis
+The runner (``filmfriction.workflows.md.runner``) and the analysis
 (``filmfriction.analysis``) import these names; nothing else lists them.
 
 Why the script's ``fix print`` line is *checked against* this table (by

@@ -4,7 +4,7 @@ A block on a spring with a friction law from the literature, integrated with
 an exact stick phase (no regularisation), closed forms where they exist, an
 energy ledger on every run, the Prandtl-Tomlinson model and stability maps;
 and the SFB check, the model at the scale of Klein's surface-force-balance
-experiment (:func:`sfb_check`, :mod:`filmfriction.reduced_model.sfb`).
+experiment (:func:`sfb_check`, :mod:`filmfriction.reduced_model.sfb.check`).
 
 Example
 -------
@@ -21,10 +21,10 @@ if __name__ != "filmfriction.reduced_model":  # one name only: two would give tw
 from . import laws
 from ._checks import SimulationLimitError
 from .drive import DriveSchedule
-from .klein import KLEIN, KleinExperiment
-from .md_film import MDCalibration
+from .sfb.klein import KLEIN, KleinExperiment
+from .sfb.md_calibration import MDCalibration
 from .result import EnergyLedger, Event, SimulationResult
-from .sfb import SFBCheck, sfb_check, sfb_table
+from .sfb.check import SFBCheck, sfb_check, sfb_table
 from .springblock import SpringBlock
 from .tomlinson import PrandtlTomlinson
 

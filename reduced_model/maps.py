@@ -44,7 +44,7 @@ from scipy.optimize import brentq
 
 from ._checks import non_negative, positive
 from .laws import ContactAge, Coulomb, RateState
-from .oscillator import DampedOscillator
+from .integrators.oscillator import DampedOscillator
 from .springblock import SpringBlock
 
 __all__ = ["stick_slip_parameter", "damping_ratio", "critical_lambda", "coulomb_critical_velocity",

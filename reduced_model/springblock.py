@@ -36,7 +36,7 @@ import numpy as np
 from ._checks import finite, non_negative, positive
 from .laws import Coulomb, FrictionLaw
 from .result import Event
-from .trajectory import Problem
+from .integrators.trajectory import Problem
 
 __all__ = ["SpringBlock"]
 
@@ -226,10 +226,10 @@ class SpringBlock:
                 raise ValueError(f"{type(law).__name__}.{name} = {value!r}: solved in closed "
                                  "form only (mass > 0, method 'auto' or 'closed_form')")
         if closed is not None and method != "ode":
-            from .coulomb import run_closed_form
+            from .integrators.closed_form import run_closed_form
             return run_closed_form(problem, *closed, freeze_velocity=freeze,
                                    shear_stiffness=shear)
-        from .hybrid import run_ode
+        from .integrators.event_driven import run_ode
         result = run_ode(problem, rtol=rtol)
         leaving = law.outside_domain(result.t, result.v - u)
         if leaving:

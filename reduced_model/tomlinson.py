@@ -29,9 +29,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ._checks import finite, non_negative, positive
-from .hybrid import _force_extrema
+from .integrators.event_driven import _force_extrema
 from .result import SimulationResult, ledger_from_series
-from .trajectory import Recorder
+from .integrators.trajectory import Recorder
 
 __all__ = ["PrandtlTomlinson"]
 

@@ -73,7 +73,7 @@ def deadline(seconds: float = DEADLINE):
     The runner starts ``mpiexec`` in a session of its own, so its process
     group id is its pid: ending that group ends exactly this test's engine.
     """
-    from filmfriction.workflows import runner
+    from filmfriction.workflows.md import runner
 
     fired = threading.Event()
 
@@ -131,7 +131,7 @@ class MD:
     @staticmethod
     def scene(name: str = "stick-slip", **overrides):
         """Scene ``name`` on the small box, with ``overrides`` (validated)."""
-        from filmfriction.workflows.scene import load
+        from filmfriction.workflows.md.scene import load
 
         return load(name, {**SMALL_BOX, **overrides})
 
@@ -139,7 +139,7 @@ class MD:
     def execute(scene, out: Path, *, nprocs: int = 1) -> Path:
         """Run ``scene`` into ``out`` under the watchdog; one MPI rank by default
         (no busy-waiting ranks fighting for the shared cores)."""
-        from filmfriction.workflows import runner
+        from filmfriction.workflows.md import runner
 
         with deadline():
             return runner.execute(scene, out=out, nprocs=nprocs, progress=False)
@@ -233,7 +233,7 @@ class CliResult:
 @pytest.fixture
 def run_cli(capsys):
     """``run_cli(*args)``: ``filmfriction ARGS`` in process -> CliResult(code, out, err)."""
-    from filmfriction.workflows.cli import main
+    from filmfriction.workflows.cli.main import main
 
     def run(*args) -> CliResult:
         capsys.readouterr()                     # drop what the test printed before
@@ -246,7 +246,7 @@ def run_cli(capsys):
 @pytest.fixture(scope="session")
 def filmfriction_command() -> str:
     """The installed ``filmfriction`` script of this interpreter's environment
-    (``python -m filmfriction.workflows.cli`` would define a second UserError)."""
+    (``python -m filmfriction.workflows.cli.main`` would define a second UserError)."""
     path = Path(sys.executable).with_name("filmfriction")
     assert path.exists(), f"{path} missing: install the project (make .venv/.installed)"
     return str(path)

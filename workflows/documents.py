@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.util import write_atomic
-from filmfriction.analysis.report import to_json
-from filmfriction.reduced_model.sfb_rows import find_row
+from filmfriction.analysis.analyze import to_json
+from filmfriction.reduced_model.sfb.rows import find_row
 
 __all__ = ["CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
            "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",

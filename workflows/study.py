@@ -15,7 +15,7 @@ from pathlib import Path
 
 
 def analyse(run_dir: Path) -> dict:
-    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.analyze import analyze, write_outputs
     from filmfriction.analysis.trace import read_trace
 
     trace = read_trace(run_dir)
@@ -73,7 +73,7 @@ def finish_study(run_dir: Path) -> int:
               f"B {value(rc.film_damping)}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
-    from filmfriction.analysis.contact import contact_from_run
+    from filmfriction.analysis.calibration.contact import contact_from_run
     from filmfriction.reduced_model import sfb_check
     md = cal.md_calibration if cal is not None else None
     contact = _step("similarity", failures, contact_from_run, run_dir)
@@ -85,7 +85,7 @@ def finish_study(run_dir: Path) -> int:
         print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated, {n_sim} similarity) "
               f"-> {path}")
 
-    from filmfriction.workflows import report
+    from filmfriction.workflows.report import render as report
     path = _step("report", failures, lambda: report.build_report([run_dir], failures=dict(failures)))
     print(f"post-MD steps took {time.perf_counter() - t0:.1f} s"
           + (f"; failed: {', '.join(failures)}" if failures else ""))

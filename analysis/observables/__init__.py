@@ -6,7 +6,7 @@ the run's ledger), ``sliding.py`` (the last half as a sliding state),
 ``viscosity.py`` (steady, per slip, from the velocity profile), ``structure.py``
 (layers, ψ6 and the gap from the trajectory) and ``slip_law.py`` (Klein's slip
 equation fitted on the slips).  The analysis
-(:func:`filmfriction.analysis.report.analyze`) finds the slips and decides the
+(:func:`filmfriction.analysis.analyze.analyze`) finds the slips and decides the
 regime, then runs every registered observable in its ``order``; the report
 renders each with one generic function.
 
@@ -33,8 +33,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
-from .base import (REGISTRY, Context, MissingInput, Need, Observable, column, parameter,
-                   registered)
+from .observable import (REGISTRY, Context, MissingInput, Need, Observable, column, parameter,
+                         registered)
 
 __all__ = ["Observable", "Context", "Need", "MissingInput", "column", "parameter",
            "REGISTRY", "registered"]

@@ -152,17 +152,17 @@ class FrictionLaw:
         or ``None``.
 
         A cheap evaluation of the law for scalar work (the right-hand side of the general
-        ODE path, the fast path's damping check in ``reduced_model/limit_cycle.py``,
+        ODE path, the fast path's damping check in ``reduced_model/integrators/limit_cycle.py``,
         benchmarks); it must agree with ``friction`` and
         ``state_rate`` (the contract test checks it).  The compiled fast path itself is
-        rate-and-state's (``reduced_model/smooth_steps.py``)."""
+        rate-and-state's (``reduced_model/integrators/smooth_steps.py``)."""
         return None
 
     def closed_form(self, normal_load):
         """``(static or None, kinetic, viscous)`` forces if the law is Coulomb + viscous.
 
         Not ``None`` means ``SpringBlock.simulate(method="auto")`` takes the closed
-        form (``reduced_model/coulomb.py``) instead of the ODE path."""
+        form (``reduced_model/integrators/closed_form.py``) instead of the ODE path."""
         return None
 
     def outside_domain(self, t, slip_velocity):

@@ -1,6 +1,6 @@
 """Amontons-Coulomb friction, with a viscous term: the law with a closed form.
 
-``SpringBlock.simulate(method="auto")`` solves it exactly (``reduced_model/coulomb.py``,
+``SpringBlock.simulate(method="auto")`` solves it exactly (``reduced_model/integrators/closed_form.py``,
 through :meth:`Coulomb.closed_form`); ``freeze_velocity`` and ``shear_stiffness``
 exist in that closed form only.
 """

@@ -174,7 +174,7 @@ class ThinningFilmWithSliding(ShearThinningFilm):
     Friction ``sign(s) kinetic + A eta(gamma) gamma`` while sliding; at rest the
     film holds up to ``kinetic`` (so a block released below it stays put).  The
     MD film carried to the SFB (a molten film dragging over the walls'
-    corrugation) in :mod:`filmfriction.reduced_model.md_film`.
+    corrugation) in :mod:`filmfriction.reduced_model.sfb.md_calibration`.
 
     Example
     -------

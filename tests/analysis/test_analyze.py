@@ -170,7 +170,7 @@ SHORT = {
 @pytest.mark.parametrize("case", list(SHORT))
 def test_a_trace_too_short_to_classify_is_unresolved_with_its_reason(tmp_path, run_cli, case):
     from filmfriction.analysis.observables import registered
-    from filmfriction.analysis.report import MIN_ROWS
+    from filmfriction.analysis.analyze import MIN_ROWS
 
     rows, flags, run_dir = SHORT[case]
     assert rows < MIN_ROWS
@@ -196,7 +196,7 @@ def test_a_trace_too_short_to_classify_is_unresolved_with_its_reason(tmp_path, r
 
 
 def test_a_short_trace_is_analysed_from_ten_rows(tmp_path, run_cli):
-    from filmfriction.analysis.report import MIN_ROWS
+    from filmfriction.analysis.analyze import MIN_ROWS
 
     t = np.arange(MIN_ROWS) * 0.5
     p = tmp_path / "ten.csv"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from filmfriction.reduced_model import SpringBlock, laws
-from filmfriction.analysis import calibration as cal_mod
+from filmfriction.analysis.calibration import calibrate as cal_mod
 
 # a heavy wall on a stiff spring, like the MD scene (LJ units)
 M, K, V, D_MOUNT = 500.0, 100.0, 0.02, 50.0
@@ -147,7 +147,7 @@ def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     from types import SimpleNamespace
 
     from filmfriction.analysis.trace import TraceParameters
-    from filmfriction.analysis.replay import _no_restick
+    from filmfriction.analysis.calibration.replay import _no_restick
 
     def run(mass, mount=None):
         p = TraceParameters(spring_constant=100.0, mass=mass, drive_velocity=0.02,

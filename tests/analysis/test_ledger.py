@@ -4,8 +4,8 @@ import pytest
 
 from filmfriction.analysis import energy
 from filmfriction.md_inputs import contract
-from filmfriction.workflows import runner
-from filmfriction.workflows.scene import load
+from filmfriction.workflows.md import runner
+from filmfriction.workflows.md.scene import load
 
 
 def _dat(leak: float, mount: float = 2.0) -> np.ndarray:

@@ -39,8 +39,8 @@ HERE = "slip_temperature"      # the key of the observable defined in this file
 def define_slip_temperature() -> type[Observable]:
     """The whole of what ``analysis/observables/slip_temperature.py`` would hold
     (defined here in a function, so that it registers for this module's tests only)."""
-    from filmfriction.analysis.observables.base import (Observable, column, format_estimate,
-                                                        png_bytes, pyplot)
+    from filmfriction.analysis.observables.observable import (Observable, column, format_estimate,
+                                                              png_bytes, pyplot)
 
     class SlipTemperature(Observable):
         """The film's mean temperature during each slip (y → s)."""
@@ -105,9 +105,9 @@ NEEDS = [(key, i) for key in KEYS for i in range(len(_needs(key)))]
 def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
     """``analyze`` (written out) and ``build_report`` on ``run_dir``: the document,
     the per-slip CSV's columns, report.html and report.md."""
-    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.analyze import analyze, write_outputs
     from filmfriction.analysis.trace import read_trace
-    from filmfriction.workflows.report import build_report
+    from filmfriction.workflows.report.render import build_report
 
     doc, per_cycle = analyze(read_trace(run_dir))
     write_outputs(doc, per_cycle, run_dir / "analysis.json")
@@ -122,7 +122,7 @@ def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
 @pytest.fixture(scope="module")
 def study(tmp_path_factory, slip_temperature):
     """The synthetic run analysed and reported with every observable registered."""
-    from filmfriction.analysis.rundata import load_run
+    from filmfriction.analysis.calibration.rundata import load_run
     from filmfriction.analysis.synthetic import run_directory
 
     run_dir = run_directory(tmp_path_factory.mktemp("observables") / "run")
@@ -139,7 +139,7 @@ def images(html: str) -> dict[str, bytes]:
 # ---------------------------------------------------------------------------- registration
 def test_every_module_of_the_folder_is_imported_and_registers():
     folder = Path(observables.__file__).parent
-    files = {p.stem for p in folder.glob("*.py")} - {"__init__", "base"}
+    files = {p.stem for p in folder.glob("*.py")} - {"__init__", "observable"}
     assert files, "no observable in the package"
     modules = {cls.__module__.rsplit(".", 1)[1] for cls in REGISTRY.values()
                if cls.__module__.startswith(observables.__name__ + ".")}
@@ -147,7 +147,7 @@ def test_every_module_of_the_folder_is_imported_and_registers():
 
 
 def test_the_class_statement_registers_and_refuses_a_taken_key(slip_temperature):
-    from filmfriction.analysis.observables.base import BUILT_IN
+    from filmfriction.analysis.observables.observable import BUILT_IN
 
     assert REGISTRY[HERE] is slip_temperature and HERE in {o.key for o in observables.registered()}
     before = dict(REGISTRY)
@@ -180,7 +180,7 @@ def test_its_section_is_json_and_lands_in_analysis_json(observable, study):
     assert isinstance(section, dict) and section
     assert json.loads(json.dumps(section, allow_nan=False)) == section
     # its per-slip columns, one value a slip (the start-up slips empty unless it covers all)
-    from filmfriction.analysis.report import context, run_observable
+    from filmfriction.analysis.analyze import context, run_observable
 
     _, columns = run_observable(observable, context(study["run"].trace))
     n, skip = doc["slips"]["count"], doc["slips"]["summary_skips_first"]
@@ -242,7 +242,7 @@ def test_without_any_one_need_it_is_skipped_naming_it(key, i, slip_temperature, 
 def test_a_trace_of_its_needs_alone_gives_its_section_or_a_reason(observable, study):
     """No column or parameter read that ``needs`` does not declare: on ``time``,
     ``spring_force`` and the needs, the observable computes or says what is missing."""
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import Trace, TraceParameters
 
     full = study["run"].trace

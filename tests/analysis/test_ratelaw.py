@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from filmfriction.analysis.ratelaw import choose_rate_law, eyring_fit, power_fit
+from filmfriction.analysis.rate_law import choose_rate_law, eyring_fit, power_fit
 
 
 def test_each_law_recovers_its_own_data_and_is_chosen():
@@ -57,7 +57,7 @@ def test_negative_stress_falls_back_to_eyring_and_bad_input():
 
 
 def test_rate_dependence_carries_both_laws_to_klein_rate():
-    from filmfriction.analysis.calibration import rate_dependence
+    from filmfriction.analysis.calibration.calibrate import rate_dependence
     from filmfriction.reduced_model.units import OMCTS
 
     # an Eyring-like film: tau = 1 + 0.2 ln(rate/0.01), eta = tau/rate

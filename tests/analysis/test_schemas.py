@@ -11,7 +11,7 @@ import pytest
 
 from filmfriction.analysis.trace import UNITS
 from filmfriction.analysis.util import json_schema
-from filmfriction.workflows.cli import main
+from filmfriction.workflows.cli.main import main
 
 
 def _validator(name):

@@ -13,7 +13,7 @@ SLIPS = {"equilibrate_steps": 2000, "slide_steps": 60000, "restart_every": 0}
 
 @pytest.fixture(scope="module")
 def analysed(md, tmp_path_factory):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import read_trace
 
     run = md.shared("stick-slip", **SLIPS)

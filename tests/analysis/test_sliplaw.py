@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.sliplaw import film_force, fit_film_force
+from filmfriction.analysis.slip_law import film_force, fit_film_force
 from filmfriction.reduced_model import SpringBlock, laws
 
 

@@ -36,8 +36,8 @@ def test_flexible_walls_gap_is_the_trace_gap(tmp_path):
     the gap measured from the trajectory is the gap LAMMPS traces, the distance between
     the innermost wall planes (types 4 and 5 here, not the rigid backing planes 2 and 3)."""
     from filmfriction.analysis.trace import read_trace
-    from filmfriction.workflows import runner
-    from filmfriction.workflows.scene import load
+    from filmfriction.workflows.md import runner
+    from filmfriction.workflows.md.scene import load
 
     scene = load("film-structure", {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 2000,
                                     "slide_steps": 2000, "trace_every": 20,

@@ -121,7 +121,7 @@ def test_a_foreign_npy_beside_the_text_is_ignored(tmp_path, columns):
 
 
 def test_figure_of_the_trace_is_labelled_in_its_units(tmp_path, columns):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace_figure import trace_figure
 
     path = _write(tmp_path / "trace.tsv", columns, "\t")

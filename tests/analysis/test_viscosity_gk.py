@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis import green_kubo as gk
-from filmfriction.workflows.cli import main
+from filmfriction.workflows.cli.main import main
 
 pytestmark = pytest.mark.md
 

@@ -4,7 +4,7 @@ import re
 import pytest
 
 from filmfriction import md_inputs
-from filmfriction.workflows import runner
+from filmfriction.workflows.md import runner
 
 
 def test_every_script_is_found_by_name():

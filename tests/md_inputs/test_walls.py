@@ -5,7 +5,7 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from filmfriction.workflows.scene import SceneError, load, parse_assignment
+from filmfriction.workflows.md.scene import SceneError, load, parse_assignment
 
 # on the md fixture's 5 x 3 box
 SMALL = {"equilibrate_steps": 2000, "slide_steps": 6000, "trace_every": 20, "wall_mass": 300.0}
@@ -105,7 +105,7 @@ def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path, md):
     # stick (Klein: >= 90 % viscous).  A check of the partition's bookkeeping on
     # a real run; that the light slider keeps the slips regular needs long runs
     # (README, "energy-partition").
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import read_trace
 
     area = 15 / 28  # the 5 x 3 box against the scene's 7 x 4: same drive per area

@@ -222,7 +222,7 @@ def test_freeze_velocity_re_sticks_at_that_speed_and_the_ledger_closes():
 
 
 def test_calibration_recovers_the_freeze_velocity_from_the_restick_force():
-    from filmfriction.reduced_model.coulomb import freeze_velocity_for
+    from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
     law = laws.Coulomb(97.3, 0.0, viscous=97.0, freeze_velocity=0.2)
     fb = SpringBlock(**OVERDAMPED, law=law).simulate(500.0).cycles().backward_force[-1]

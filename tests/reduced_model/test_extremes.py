@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import CubicHermiteSpline
 
-from filmfriction.analysis.report import analyze, to_json
+from filmfriction.analysis.analyze import analyze, to_json
 from filmfriction.analysis.trace import Trace, TraceParameters
 from filmfriction.reduced_model import SimulationLimitError, SpringBlock, laws
 

@@ -190,7 +190,7 @@ def test_scalar_sliding_agrees_with_sliding_force(law):
 
 
 def test_restick_root_newton_and_brentq_fallback():
-    from filmfriction.reduced_model.hybrid import _restick_root
+    from filmfriction.reduced_model.integrators.event_driven import _restick_root
 
     def state_at(t):
         return np.array([0.0, math.cos(t) - 0.5])

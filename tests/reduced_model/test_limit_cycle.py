@@ -1,4 +1,4 @@
-"""The fast path of smooth laws with a state (``reduced_model/limit_cycle.py``): it agrees
+"""The fast path of smooth laws with a state (``reduced_model/integrators/limit_cycle.py``): it agrees
 with the general LSODA path, its tiled limit cycle agrees with integrating every cycle,
 and a run that turns stiff falls back to the general path."""
 import warnings
@@ -6,7 +6,8 @@ import warnings
 import numpy as np
 import pytest
 
-from filmfriction.reduced_model import SpringBlock, laws, limit_cycle
+from filmfriction.reduced_model import SpringBlock, laws
+from filmfriction.reduced_model.integrators import limit_cycle
 
 LAW = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
 BLOCK = SpringBlock(mass=1.0, stiffness=10.0, drive_velocity=0.1, law=LAW)   # K < k_c: stick-slip
@@ -131,9 +132,9 @@ def test_fast_path_with_a_damper_or_a_belt(monkeypatch, options):
 def test_without_numba_the_general_path_runs(monkeypatch):
     import sys
 
-    from filmfriction import reduced_model
-    monkeypatch.setitem(sys.modules, "filmfriction.reduced_model.smooth_steps", None)   # import fails
-    monkeypatch.delattr(reduced_model, "smooth_steps", raising=False)
+    from filmfriction.reduced_model import integrators
+    monkeypatch.setitem(sys.modules, "filmfriction.reduced_model.integrators.smooth_steps", None)   # import fails
+    monkeypatch.delattr(integrators, "smooth_steps", raising=False)
     used = _spy(monkeypatch)
     with pytest.warns(RuntimeWarning, match="compiled rate-and-state path is unavailable"):
         r = BLOCK.simulate(20.0, initial_velocity=0.05)

@@ -3,7 +3,8 @@ computed cycle by cycle (to round-off) for the closed form and the stateless ODE
 import numpy as np
 import pytest
 
-from filmfriction.reduced_model import SpringBlock, coulomb, hybrid, laws
+from filmfriction.reduced_model import SpringBlock, laws
+from filmfriction.reduced_model.integrators import closed_form as coulomb, event_driven as hybrid
 
 CASES = [
     ("closed", SpringBlock(1.0, 1.0, 0.1, damping=0.02, law=laws.Coulomb(1.0, 0.5))),

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from filmfriction.reduced_model import klein, sfb
-from filmfriction.reduced_model.klein import KLEIN
-from filmfriction.reduced_model.md_film import MDCalibration
-from filmfriction.reduced_model.sfb import ROW_KEYS, SOURCES
+from filmfriction.reduced_model.sfb import klein, check as sfb
+from filmfriction.reduced_model.sfb.klein import KLEIN
+from filmfriction.reduced_model.sfb.md_calibration import MDCalibration
+from filmfriction.reduced_model.sfb.check import ROW_KEYS, SOURCES
 from filmfriction.reduced_model.units import OMCTS, LJUnits
-from filmfriction.workflows import cli
+from filmfriction.workflows.cli import main as cli
 
 K, M, A, D = KLEIN.spring_constant, KLEIN.mass, KLEIN.contact_area, KLEIN.film_thickness
 

@@ -8,10 +8,10 @@ from dataclasses import replace
 
 import pytest
 
-from filmfriction.reduced_model.klein import KLEIN, klein_slip_geometry
-from filmfriction.reduced_model.sfb import sfb_check
-from filmfriction.reduced_model.sfb_setup import (MeasuredSlip, SFBSetup, setup_experiment,
-                                                 sfb_check_setup)
+from filmfriction.reduced_model.sfb.klein import KLEIN, klein_slip_geometry
+from filmfriction.reduced_model.sfb.check import sfb_check
+from filmfriction.reduced_model.sfb.user_setup import (MeasuredSlip, SFBSetup, setup_experiment,
+                                                       sfb_check_setup)
 
 BASE = {"spring_constant": 97.0, "mass": 1.47e-3, "contact_area": 4e-10,
         "film_thickness": 3.5e-9, "load": 42e-6, "drive_velocity": 1e-7}
@@ -117,7 +117,7 @@ KLEIN_ONLY = ("dE_f", "Klein's area", "Klein's contact area", "Klein's mean slip
 
 def _si_calibration(setup, slip):
     """A calibrated film in SI (a measured trace's) that yields at the measured F_s."""
-    from filmfriction.reduced_model.md_film import MDCalibration
+    from filmfriction.reduced_model.sfb.md_calibration import MDCalibration
     A = setup.contact_area
     return MDCalibration(yield_stress=slip.static_force / A,
                          restick_stress=0.3 * slip.static_force / A, eta_zero=slip.eta_eff,
@@ -126,7 +126,7 @@ def _si_calibration(setup, slip):
 
 def _texts(check):
     """Every note and row note but Braun & Tosatti's reading (said of Klein on purpose)."""
-    from filmfriction.reduced_model.klein import BRAUN_TOSATTI_NOTE
+    from filmfriction.reduced_model.sfb.klein import BRAUN_TOSATTI_NOTE
     return [n for n in check.notes if n != BRAUN_TOSATTI_NOTE] + [r["note"] for r in check.rows]
 
 
@@ -163,7 +163,7 @@ def test_setup_notes_take_x0_from_the_trace_and_name_the_setup(checks):
 
 def test_kleins_notes_are_his_assumptions_and_his_geometry(checks):
     """Klein's check: every assumption, his slip geometry from dE_f, the dE_f sensitivity."""
-    from filmfriction.reduced_model.sfb import ASSUMPTIONS
+    from filmfriction.reduced_model.sfb.check import ASSUMPTIONS
     klein, _ = checks
     assert klein.notes[:len(ASSUMPTIONS)] == ASSUMPTIONS
     assert klein.notes[len(ASSUMPTIONS)] == f"slip geometry: {klein.geometry.derivation}"

@@ -4,8 +4,8 @@ import math
 import pytest
 
 from filmfriction.reduced_model import sfb_check
-from filmfriction.reduced_model.similarity import (NUMBERS, SlidingContact, klein_contact,
-                                                   similarity_numbers, similarity_rows)
+from filmfriction.reduced_model.sfb.similarity import (NUMBERS, SlidingContact, klein_contact,
+                                                       similarity_numbers, similarity_rows)
 
 
 def test_klein_numbers_by_hand():

@@ -30,7 +30,7 @@ def test_creeping_hold_light_block_no_stall():
 def test_light_block_stick_slip_no_stall(monkeypatch):
     # M = 0.1, K = 0.05: between slips the block creeps at ~1e-6 and LSODA used to crawl
     # (1.6e6 evaluations, ~30 s for 80 time units); past STEPS_PER_PERIOD Radau takes over
-    from filmfriction.reduced_model import hybrid
+    from filmfriction.reduced_model.integrators import event_driven as hybrid
     law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
     block = SpringBlock(mass=0.1, stiffness=0.05, drive_velocity=0.1, law=law)
     r = block.simulate(80.0, initial_velocity=0.05)

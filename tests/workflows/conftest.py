@@ -62,7 +62,7 @@ def images(html: str) -> dict[str, bytes]:
 
 def check_outputs(run_dir: Path) -> None:
     """Every file of the study is there and well formed."""
-    from filmfriction.analysis.calibration import SCHEMA
+    from filmfriction.analysis.calibration.calibrate import SCHEMA
 
     doc = json.loads((run_dir / "analysis.json").read_text())
     assert doc["slips"]["count"] >= 2 and doc["regime"] in ("stick-slip", "irregular")
@@ -204,8 +204,8 @@ def interrupted_run():
         import numpy as np
 
         from filmfriction.md_inputs.contract import DAT_COLUMNS
-        from filmfriction.workflows import restarts
-        from filmfriction.workflows.scene import load
+        from filmfriction.workflows.md import restarts
+        from filmfriction.workflows.md.scene import load
 
         scene = load("stick-slip", {"slide_steps": 8000, "restart_every": 2000,
                                     "equilibrate_steps": 100, "trace_every": 200})

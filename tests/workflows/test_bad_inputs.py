@@ -245,7 +245,7 @@ def _snapshot(root: Path) -> dict:
 
 def _cli(capsys, *args):
     """``filmfriction ARGS`` in process; argparse's own refusals exit via SystemExit."""
-    from filmfriction.workflows.cli import main
+    from filmfriction.workflows.cli.main import main
 
     capsys.readouterr()
     try:
@@ -284,14 +284,14 @@ def test_debug_shows_the_traceback(tmp_path, run_cli):
 
 
 def test_internal_error_is_one_line_exit_1(monkeypatch, run_cli):
-    from filmfriction.workflows import run_cli as run_cli_mod
+    from filmfriction.workflows.cli import run_cli as run_cli_mod
 
     def boom(args):
         raise ZeroDivisionError("boom")
 
     monkeypatch.setattr(run_cli_mod, "list_scenes", boom)
     # the parser holds the function: patch it through the registered default
-    from filmfriction.workflows import cli
+    from filmfriction.workflows.cli import main as cli
 
     parser = cli.build_parser
     monkeypatch.setattr(cli, "build_parser", lambda: _patched(parser(), boom))
@@ -308,7 +308,7 @@ def _patched(parser, func):
 
 def test_umask_is_not_the_check(tmp_path):
     """check_writable probes with a real file (root passes os.access everywhere)."""
-    from filmfriction.workflows.cli import UserError, check_writable
+    from filmfriction.workflows.cli.main import UserError, check_writable
 
     check_writable(tmp_path / "new" / "x.json", "--out")
     assert not (tmp_path / "new").exists() and os.listdir(tmp_path) == []

@@ -8,7 +8,7 @@ import json
 import numpy as np
 import pytest
 
-from filmfriction.workflows import bench
+from filmfriction.workflows.cost import bench
 
 pytestmark = pytest.mark.md
 
@@ -53,7 +53,7 @@ def test_the_layout_is_recorded_and_openmp_threads_run_the_same_scene(md, tmp_pa
     """1 rank x 2 OpenMP threads (-sf omp) runs the scene; its trace has the
     same physics as 1 rank (same temperature set point, spring law)."""
     scene = md.scene(slide_steps=1000, equilibrate_steps=200)
-    from filmfriction.workflows import runner
+    from filmfriction.workflows.md import runner
 
     run_dir = runner.execute(scene, out=tmp_path / "omp", nprocs=1, progress=False, threads=2)
     record = json.loads((run_dir / "run.json").read_text())

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filmfriction.workflows import runner
-from filmfriction.workflows.scene import SceneError
+from filmfriction.workflows.md import runner
+from filmfriction.workflows.md.scene import SceneError
 
 pytestmark = pytest.mark.md
 

@@ -11,8 +11,8 @@ import re
 
 import pytest
 
-from filmfriction.workflows.cli import build_parser
-from filmfriction.workflows.scene import PARAMETERS
+from filmfriction.workflows.cli.main import build_parser
+from filmfriction.workflows.md.scene import PARAMETERS
 
 COMMANDS = sorted(build_parser()._subparsers._group_actions[0].choices)
 
@@ -26,7 +26,7 @@ def test_every_command_is_checked():
 
 @pytest.mark.parametrize("command", COMMANDS)
 def test_help_has_a_plain_description(command, capsys):
-    from filmfriction.workflows.cli import main
+    from filmfriction.workflows.cli.main import main
 
     with pytest.raises(SystemExit) as exc:
         main([command, "--help"])
@@ -40,7 +40,7 @@ def test_help_has_a_plain_description(command, capsys):
 
 
 def test_run_help_lists_every_parameter(capsys):
-    from filmfriction.workflows.cli import main
+    from filmfriction.workflows.cli.main import main
 
     with pytest.raises(SystemExit):
         main(["run", "--help"])

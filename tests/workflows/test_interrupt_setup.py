@@ -23,8 +23,8 @@ import pytest
 CHILD = """
 import signal, sys, time, pathlib
 signal.signal(signal.SIGINT, signal.default_int_handler)   # Ctrl-C even if the parent ignores it
-from filmfriction.workflows import runner
-from filmfriction.workflows.cli import main
+from filmfriction.workflows.md import runner
+from filmfriction.workflows.cli.main import main
 
 ready, where, *argv = sys.argv[1:]
 

@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 
 from filmfriction.md_inputs import contract, script as shipped_script
-from filmfriction.workflows import engine, lammps_build, runner
-from filmfriction.workflows.scene import SceneError
+from filmfriction.workflows.md import engine, lammps_build, runner
+from filmfriction.workflows.md.scene import SceneError
 
 
 def _executable(path: Path, text: str) -> Path:

@@ -12,7 +12,7 @@ import jsonschema
 import pytest
 
 from filmfriction.analysis.util import json_schema
-from filmfriction.workflows.cli import main
+from filmfriction.workflows.cli.main import main
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"
 COLUMNS = ["--column", "time=t_s", "--column", "spring_force=shear_force_N",
@@ -143,7 +143,7 @@ def test_report_sets_the_model_beside_the_measured_slip_not_klein(chain):
 def test_sfb_notes_speak_of_the_setup_not_of_kleins_text(chain):
     """The printed notes, sfb.json's and the report's: x0 from the trace, the set-up by its
     name; none of Klein's dE_f reading, his area or his slip rate."""
-    from filmfriction.reduced_model.sfb_setup import load_setup
+    from filmfriction.reduced_model.sfb.user_setup import load_setup
 
     d, printed = chain
     name = load_setup(d / "my_sfb.toml").name

@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from filmfriction.workflows import cli
+from filmfriction.workflows.cli import main as cli
 
 SECTIONS = ("Scene and parameters", "Stick-slip trace", "Energy partition",
             "Effective viscosity", "The film: density profile and picture",
@@ -54,7 +54,7 @@ def test_report_cli_with_out(study, tmp_path, report_checks):
 
 def test_film_figure_from_a_trajectory(synthetic_run):
     """The film picture and density profile from a (synthetic) trajectory."""
-    from filmfriction.analysis.observables.structure import fig_film
+    from filmfriction.analysis.observables.structure_section import fig_film
 
     png, note = fig_film(synthetic_run)
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 5000
@@ -63,7 +63,7 @@ def test_film_figure_from_a_trajectory(synthetic_run):
 
 def _analysed_synthetic_run(directory):
     """A synthetic run directory (no LAMMPS) with its analysis written, as `filmfriction analyze` does."""
-    from filmfriction.analysis.report import analyze, write_outputs
+    from filmfriction.analysis.analyze import analyze, write_outputs
     from filmfriction.analysis.synthetic import run_directory
     from filmfriction.analysis.trace import read_trace
 
@@ -74,8 +74,9 @@ def _analysed_synthetic_run(directory):
 
 
 def test_report_without_calibration_says_so_and_does_not_calibrate(tmp_path, monkeypatch, capsys):
-    from filmfriction.analysis import calibration
-    from filmfriction.reduced_model import SpringBlock, sfb
+    from filmfriction.analysis.calibration import calibrate as calibration
+    from filmfriction.reduced_model import SpringBlock
+    from filmfriction.reduced_model.sfb import check as sfb
 
     d = _analysed_synthetic_run(tmp_path / "run")
 
@@ -157,7 +158,7 @@ def test_report_of_a_sweep_has_a_sweep_section(study, tmp_path, report_checks):
         "critical_velocity": [{"group": {}, "status": "bracketed", "value": 0.22, "factor": 2.2,
                                "note": "stick-slip up to V = 0.1, smooth from 0.5"}],
         "power_law": {"exponent": -0.7, "exponent_stderr": 0.1, "n": 3, "points": "steady"}}))
-    from filmfriction.workflows import cli
+    from filmfriction.workflows.cli import main as cli
 
     assert cli.main(["report", str(sweep)]) == 0
     text = (sweep / "report.md").read_text()

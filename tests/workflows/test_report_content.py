@@ -45,8 +45,8 @@ def test_every_figure_loads_in_headless_chromium(synthetic_study, report_checks)
 
 
 def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
-    from filmfriction.analysis.observables.structure import Structure, fig_film
-    from filmfriction.workflows import report
+    from filmfriction.analysis.observables.structure_section import Structure, fig_film
+    from filmfriction.workflows.report import render as report
 
     assert fig_film(tmp_path) == (None, "")
     run = SimpleNamespace(run_dir=tmp_path, analysis={"skipped": {
@@ -75,7 +75,7 @@ def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path,
 
 
 def test_markdown_escapes_html_outside_code():
-    from filmfriction.workflows.report import _inline_md, _md_cell
+    from filmfriction.workflows.report.render import _inline_md, _md_cell
 
     assert _inline_md("a <script>x</script> & `<b>`") == "a &lt;script&gt;x&lt;/script&gt; & `<b>`"
     assert _md_cell("<i>|") == "&lt;i&gt;\\|"
@@ -85,7 +85,7 @@ def test_a_run_with_warnings_says_so(synthetic_study, tmp_path, report_study):
     import json as _json
     import shutil
 
-    from filmfriction.workflows.report import build_report
+    from filmfriction.workflows.report.render import build_report
 
     run = tmp_path / "warned"
     shutil.copytree(synthetic_study.path, run)
@@ -212,7 +212,7 @@ def test_the_lambda_zeta_legend_is_off_the_plane(monkeypatch):
     """A contact in the lower right of the plane (a compared run, Klein's) was under the legend."""
     from matplotlib.figure import Figure
 
-    from filmfriction.workflows.report import fig_lambda_zeta
+    from filmfriction.workflows.report.render import fig_lambda_zeta
 
     clear, savefig = [], Figure.savefig
 

@@ -12,8 +12,8 @@ import os
 
 import pytest
 
-from filmfriction.workflows import restarts, runner
-from filmfriction.workflows.scene import SceneError
+from filmfriction.workflows.md import restarts, runner
+from filmfriction.workflows.md.scene import SceneError
 
 
 def _zero_tail(path, keep: int) -> None:

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks
 
-from filmfriction.workflows import runner
-from filmfriction.workflows.scene import SceneError
+from filmfriction.workflows.md import runner
+from filmfriction.workflows.md.scene import SceneError
 
 pytestmark = pytest.mark.md
 
@@ -156,7 +156,7 @@ def test_interrupted_run_resumes(tmp_path, md, filmfriction_command):
 
 def test_analysis_of_a_real_run(film_run):
     """The analysis on a real small run: slips found, ledger closed, n layers in the DCD."""
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import read_trace
 
     doc, per_cycle = analyze(read_trace(film_run.path))

@@ -8,8 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from filmfriction.workflows import runner
-from filmfriction.workflows.scene import load
+from filmfriction.workflows.md import runner
+from filmfriction.workflows.md.scene import load
 
 
 def _scene(**p):

@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filmfriction.analysis.observables.sliding import sliding_section
+from filmfriction.analysis.observables.sliding_section import sliding_section
 from filmfriction.analysis.trace import read_trace
 from filmfriction.workflows import sweep
-from filmfriction.workflows.scene import SceneError
+from filmfriction.workflows.md.scene import SceneError
 
 # on the md fixture's box (about 330 atoms), 4000 steps: a few seconds per point on one rank
 STEPS = {"equilibrate_steps": 1000, "slide_steps": 3000, "trace_every": 20}
@@ -234,7 +234,7 @@ def test_a_run_too_short_to_slip_is_unresolved_not_smooth(tmp_path):
 
 
 def test_launcher_replaces_mpiexec_by_srun():
-    from filmfriction.workflows import engine
+    from filmfriction.workflows.md import engine
 
     plain = engine.lmp_command(4, Path("in.lmp"))
     wrapped = engine.lmp_command(4, Path("in.lmp"), launcher=["srun", "--mpi=pmi2"])
@@ -374,7 +374,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
 def test_a_log_axis_of_the_sweep_figures_is_labelled_over_any_range(lo, hi, at_least):
     """Under a decade there is no power of ten to label: the axis had no numbers at all."""
     from filmfriction.analysis.util import pyplot
-    from filmfriction.workflows.sweep_figures import _plain_log_axis
+    from filmfriction.workflows.sweep.figures import _plain_log_axis
 
     plt = pyplot()
     fig, ax = plt.subplots()

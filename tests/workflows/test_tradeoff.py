@@ -8,8 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.workflows import fidelity, tradeoff
-from filmfriction.workflows.scene import SceneError, load
+from filmfriction.workflows.md import fidelity
+from filmfriction.workflows.cost import tradeoff
+from filmfriction.workflows.md.scene import SceneError, load
 
 
 def test_pareto_front_keeps_only_undominated_points():

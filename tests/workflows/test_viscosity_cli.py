@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis import green_kubo as gk
-from filmfriction.workflows import viscosity_cli
-from filmfriction.workflows.cli import main
+from filmfriction.workflows.cli import viscosity_cli
+from filmfriction.workflows.cli.main import main
 
 STATE = ["viscosity", "--temperature", "0.722", "--density", "0.8442"]
 

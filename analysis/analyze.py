@@ -1,0 +1,223 @@
+"""The ``analysis.json`` document: every analysis that the inputs allow.
+
+:func:`analyze` finds the slips, tabulates them and decides the regime
+(:func:`context`) on a :class:`~filmfriction.analysis.trace.Trace`, then runs
+every registered observable (:mod:`filmfriction.analysis.observables`, one file
+each: the slips, the energy, the sliding state, the viscosity, the structure,
+the slip law ...; :func:`run_observable`) in their order, and returns a
+JSON-ready dict; an output whose input is missing is listed under ``skipped``
+with the reason instead.  :func:`write_outputs` writes the document and the
+per-cycle CSV atomically.  The schema is documented in docs/analysis.md
+("Schema").
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from . import observables, stickslip
+from .observables.observable import Context, Observable
+from .sliding import last_half, not_sliding, sliding_state
+from .stickslip import Regime
+from .trace import MissingInput, Trace, unit
+from .util import finite_or_none as _num, json_safe, write_atomic
+
+SCHEMA = "filmfriction.analysis/1"
+
+#: Fewest trace rows the analysis classifies: below this a trace cannot show one
+#: stick and one slip, and any verdict would be a guess (``unresolved``).
+MIN_ROWS = 10
+
+REGIME_CRITERION = (
+    f"smooth: < 2 slips; stick-slip: >= 2 slips with CV(Fs) and CV(period) "
+    f"<= {stickslip.REGIME_CV_MAX} (first slip excluded when >= 3); "
+    "irregular: otherwise; unresolved: < 2 slips and the last half not steady sliding "
+    "(stuck, or a slip in the last half: too short to tell)")
+
+
+def _source(trace: Trace) -> dict:
+    p = trace.parameters
+    source = {"path": str(trace.path),
+              "run_dir": str(trace.run_dir) if trace.run_dir else None,
+              "samples": len(trace),
+              "parameters": {k: getattr(p, k) for k in
+                             ("spring_constant", "mass", "area", "thickness", "drive_velocity")},
+              "notes": list(trace.notes)}
+    if trace.run:
+        source["run_status"] = trace.run.get("status")
+    return source
+
+
+def context(trace: Trace, *, skip: int | None = None, structure: bool = True) -> Context:
+    """What every section starts from: the slips detected and tabulated, the
+    regime (with the sliding check of the last half), the start-up slips left out.
+
+    The trace must have at least :data:`MIN_ROWS` rows (:func:`analyze` says
+    ``unresolved`` for a shorter one)."""
+    t, f = trace.time, trace.spring_force
+    events = stickslip.detect_slips(t, f)
+    wall = trace.wall_position()
+    table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
+                                  spring_constant=trace.parameters.spring_constant,
+                                  wall_position=wall)
+    table = stickslip.ramp_forces(t, f, table, wall_position=wall)
+    regime = stickslip.classify_regime(table)
+    if skip is None:
+        skip = 1 if len(table) >= 3 else 0
+    half = last_half(trace)
+    state = sliding_state(trace, half)
+    # fewer than 2 slips is smooth sliding only if the wall slides: a wall stuck
+    # (V -> 0, a soft spring) or a run too short for a second yield has as few
+    why = not_sliding(state) if regime == Regime.SMOOTH else None
+    if regime == Regime.SMOOTH and not why:
+        # a start-up yield is followed by sliding; one late in the trace (or one
+        # still under way at its end) is not
+        late = list(events.yield_index)
+        if events.unfinished_yield is not None:
+            late.append(events.unfinished_yield)
+        if late and t[max(late)] > t[half.start]:
+            why = "its slip comes in the last half: too short to tell"
+    note = None
+    if why:
+        regime, note = Regime.UNRESOLVED, f"fewer than 2 slips, but {why}"
+    return Context(trace=trace, all_slips=table, skip=skip, events=events, regime=regime,
+                   regime_note=note, last_half=half, sliding=state,
+                   trajectory_analyses=structure)
+
+
+def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) -> tuple[dict, dict]:
+    """Analyse a trace: the detection and the regime (:func:`context`), then
+    every observable (:mod:`filmfriction.analysis.observables`) in its order.
+
+    Parameters
+    ----------
+    trace : Trace
+    skip : int, optional
+        Slips left out of the summaries (default: 1, the start-up yield, when
+        3 or more slips are found, else 0).
+    structure : bool
+        Run the trajectory analyses when the run has a trajectory.
+
+    Returns
+    -------
+    document : dict
+        The ``analysis.json`` content.
+    per_cycle : dict
+        Per-cycle columns (for the CSV).
+
+    A trace of fewer than :data:`MIN_ROWS` rows is ``unresolved``: its
+    ``regime_note`` says why, and every section is in ``skipped`` with that reason.
+    """
+    doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace)}
+    skipped: dict[str, str] = {}
+    if len(trace) < MIN_ROWS:
+        n = len(trace)
+        why = (f"{n} data row{'' if n == 1 else 's'}: too short to classify (a stick and a "
+               f"slip need at least {MIN_ROWS})")
+        doc.update(regime=Regime.UNRESOLVED, regime_criterion=REGIME_CRITERION, regime_note=why)
+        skipped["detection"] = why
+        none = stickslip.cycle_table(trace.time, trace.spring_force, [], [])
+        ctx = Context(trace=trace, all_slips=none, skip=0, events=None, regime=Regime.UNRESOLVED,
+                      regime_note=why, trajectory_analyses=structure)
+        for obs in observables.registered():
+            if obs.applies(ctx):
+                skipped[obs.key] = why
+        doc["skipped"] = skipped
+        return doc, {}
+    ctx = context(trace, skip=skip, structure=structure)
+    ctx = replace(ctx, sections=doc, skipped=skipped)
+    t, events = trace.time, ctx.events
+    lab = lambda q: unit(trace.units, q)  # noqa: E731
+    doc["regime"] = ctx.regime
+    doc["regime_criterion"] = REGIME_CRITERION
+    if ctx.regime_note:
+        doc["regime_note"] = ctx.regime_note
+    doc["detection"] = {
+        "noise": {"mean": _num(events.noise), "units": lab("force")},
+        "threshold": {"mean": _num(events.threshold), "units": lab("force")},
+        "unfinished_yield_time": (_num(t[events.unfinished_yield])
+                                  if events.unfinished_yield is not None else None)}
+    per_cycle: dict = {}
+    for obs in observables.registered():
+        if not obs.applies(ctx):
+            continue
+        try:
+            section, columns = run_observable(obs, ctx)
+        except MissingInput as exc:
+            skipped[obs.key] = str(exc)
+            continue
+        if section is not None:
+            doc[obs.key] = section
+        pad = [math.nan] * ctx.skip if obs.per_slip == "analysed" else []
+        for name, values in columns.items():
+            column = obs.column_name(name)
+            if column in per_cycle:
+                raise ValueError(f"observable {obs.key!r}: per-slip column {column!r} is "
+                                 "already written by another observable")
+            per_cycle[column] = pad + values
+    doc["skipped"] = skipped
+    return doc, per_cycle
+
+
+def run_observable(obs: Observable, ctx: Context) -> tuple[dict, dict]:
+    """``obs``'s section (made JSON-safe) and per-slip columns (as lists) on ``ctx``.
+
+    Raises
+    ------
+    MissingInput
+        One of ``obs.needs`` is absent (the first, in their order), or ``compute``
+        found an input missing.
+    TypeError, ValueError
+        ``compute`` broke its contract: a section that is not a dict or not JSON
+        data, a per-slip column without one value per analysed slip.
+    """
+    for need in obs.needs:
+        missing = need.missing(ctx.trace)
+        if missing is not None:
+            raise missing
+    section, columns = obs.compute(ctx)
+    who = f"observable {obs.key!r} ({type(obs).__module__}.{type(obs).__qualname__})"
+    if section is not None:
+        if not isinstance(section, dict):
+            raise TypeError(f"{who}: compute() gave a {type(section).__name__} section, "
+                            "not a dict")
+        section = json_safe(section)
+        try:
+            json.dumps(section, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(f"{who}: its section is not JSON data: {exc}") from None
+    rows = len(ctx.table) if obs.per_slip == "analysed" else len(ctx.all_slips)
+    out = {}
+    for name, values in (columns or {}).items():
+        values = np.asarray(values).ravel()
+        # whole numbers (the slips' sample indices) stay whole in the CSV
+        values = (values.tolist() if values.dtype.kind in "iub"
+                  else [float(v) for v in values.astype(float)])
+        if len(values) != rows:
+            raise ValueError(f"{who}: per-slip column {name!r} has {len(values)} values for "
+                             f"{rows} {obs.per_slip} slips")
+        out[name] = values
+    return section, out
+
+
+def to_json(doc: dict) -> str:
+    """Strict JSON (NaN → null)."""
+    return json.dumps(json_safe(doc), indent=2, ensure_ascii=False, allow_nan=False)
+
+
+from .cycles_csv import write_cycles_csv  # noqa: E402
+
+
+def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Path]:
+    """Write ``analysis.json`` and ``analysis_cycles.csv`` atomically."""
+    json_path = Path(json_path)
+    csv_path = json_path.with_name(json_path.stem + "_cycles.csv")
+    doc = dict(doc)
+    doc["cycles_csv"] = csv_path.name
+    write_cycles_csv(per_cycle, csv_path)
+    write_atomic(json_path, to_json(doc) + "\n")
+    return json_path, csv_path

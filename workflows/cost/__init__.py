@@ -1,0 +1,1 @@
+"""What MD fidelity costs: the speed/accuracy trade study and the benchmark."""

@@ -1,0 +1,1 @@
+"""The HTML and Markdown report: renders what the study wrote (templates/)."""
