@@ -19,7 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.md_inputs.contract import ANALYSIS_FILE
+
 from . import observables, stickslip
+from .cycles_csv import write_cycles_csv
 from .observables.observable import Context, Observable
 from .sliding import last_half, not_sliding, sliding_state
 from .stickslip import Regime
@@ -209,8 +212,6 @@ def to_json(doc: dict) -> str:
     return json.dumps(json_safe(doc), indent=2, ensure_ascii=False, allow_nan=False)
 
 
-from .cycles_csv import write_cycles_csv  # noqa: E402
-
 
 def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Path]:
     """Write ``analysis.json`` and ``analysis_cycles.csv`` atomically."""
@@ -221,3 +222,14 @@ def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Pa
     write_cycles_csv(per_cycle, csv_path)
     write_atomic(json_path, to_json(doc) + "\n")
     return json_path, csv_path
+
+
+def analyse_run(run_dir) -> dict:
+    """Analyse the trace of ``run_dir`` and write its ``analysis.json`` (and
+    ``analysis_cycles.csv``) there; returns the document."""
+    from .trace import read_trace
+
+    run_dir = Path(run_dir)
+    doc, per_cycle = analyze(read_trace(run_dir))
+    write_outputs(doc, per_cycle, run_dir / ANALYSIS_FILE)
+    return doc

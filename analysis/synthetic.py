@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.signal import lfilter
 
-from filmfriction.md_inputs.contract import AtomType
+from filmfriction.md_inputs.contract import AtomType, RUN_FILE, TRACE_FILE
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 
 __all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
@@ -233,7 +233,7 @@ def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0)
             "load_work": np.zeros(n), "thermostat_heat": heat,
             "potential_energy": np.full(n, -100.0), "kinetic_energy": kinetic,
             "spring_energy": spring}
-    write_csv(directory / "trace.csv", cols)
+    write_csv(directory / TRACE_FILE, cols)
     area = 12 * 1.1 * 7 * np.sqrt(3) * 1.1
     # run.json as the runner writes it: the film's thickness comes from the gap column
     run = {"status": "done",
@@ -241,7 +241,7 @@ def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0)
                                                          "normal_pressure": 1.0}},
            "trace_parameters": {"spring_constant": k, "mass": m, "area": area,
                                 "thickness": None, "drive_velocity": v, "units": "lj"}}
-    (directory / "run.json").write_text(json.dumps(run, indent=2))
+    (directory / RUN_FILE).write_text(json.dumps(run, indent=2))
     if trajectory:
         frames = 60
         nsavc = int(step[-1] // (frames - 1))

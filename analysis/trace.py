@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE, SWEEP_FILE, TRACE_FILE
+
 __all__ = ["MissingInput", "TraceParameters", "TraceLayout", "Trace", "read_trace",
            "read_csv_trace", "map_columns", "detect_delimiter", "trace_column_names",
            "write_binary_copy", "binary_copy_path", "BINARY_MIN_ROWS", "UNITS", "unit"]
@@ -483,7 +485,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
 def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
     """The plain trace file an ``analysis.json`` in ``directory`` was made from, and
     that document, when the directory holds no ``trace.csv`` (a measured trace)."""
-    doc_path = directory / "analysis.json"
+    doc_path = directory / ANALYSIS_FILE
     if not doc_path.is_file():
         return None
     from .util import read_json_object
@@ -521,10 +523,10 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
     """
     path = Path(path)
     if path.is_dir():
-        csv_path = path / "trace.csv"
+        csv_path = path / TRACE_FILE
         if not csv_path.exists():
             analysed = _analysed_trace_file(path)
-            if analysed is None and (path / "sweep.json").is_file():
+            if analysed is None and (path / SWEEP_FILE).is_file():
                 raise ValueError(f"{path}: a sweep directory, not a run: give one of its runs, "
                                  f"{path}/points/<point>")
             if analysed is None:
@@ -539,9 +541,9 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
             mapping.update(columns or {})
             return read_csv_trace(file, params, mapping)
         run = {}
-        if (path / "run.json").exists():
+        if (path / RUN_FILE).exists():
             try:
-                run = json.loads((path / "run.json").read_text())
+                run = json.loads((path / RUN_FILE).read_text())
             except json.JSONDecodeError as exc:
                 raise ValueError(f"{path / 'run.json'}: not valid JSON: {exc}") from None
         given = dict(run.get("trace_parameters") or {})

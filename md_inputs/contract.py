@@ -13,7 +13,7 @@ The runner (``filmfriction.workflows.md.runner``) and the analysis
 (``filmfriction.analysis``) import these names; nothing else lists them.
 
 Why the script's ``fix print`` line is *checked against* this table (by
-``tests/test_md_contract.py``, which parses the script) rather than generated
+``tests/md_inputs/test_contract.py``, which parses the script) rather than generated
 from it and passed in as a variable: the script must stay a plain LAMMPS
 input that runs by hand with its ``index`` defaults, and a print line handed
 over through ``-var`` would need a default copy of itself in the script
@@ -28,13 +28,32 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
-__all__ = ["DATA_FILE", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
+__all__ = ["DATA_FILE", "RUN_FILE", "SCENE_FILE", "COMMAND_FILE", "LOG_FILE", "TRACE_DAT_FILE",
+           "TRACE_FILE", "RESTARTS_FILE", "ANALYSIS_FILE", "CALIBRATION_FILE", "SFB_FILE",
+           "SWEEP_FILE", "AGGREGATE_FILE", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
            "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
            "column", "fix_print_text", "fix_print_title", "check_head"]
 
 
 #: The script's ``data_file`` default: the runner writes the geometry there.
 DATA_FILE = "geometry.data"
+
+# ------------------------------------------------------------ the run directory
+# Every file a run directory holds, by name: the runner, the analysis, the study,
+# the sweep and the report use these names (workflows/rundir.py reads and writes
+# the study's documents).
+RUN_FILE = "run.json"                  #: the run's record: scene, segments, status, versions
+SCENE_FILE = "scene.toml"              #: the scene as run, parameters resolved
+COMMAND_FILE = "command.txt"           #: the LAMMPS command line
+LOG_FILE = "lammps.log"                #: LAMMPS's log
+TRACE_DAT_FILE = "trace.dat"           #: the script's ``fix print`` rows, as LAMMPS wrote them
+TRACE_FILE = "trace.csv"               #: the trace in :data:`TRACE_COLUMNS`, what the analysis reads
+RESTARTS_FILE = "restarts.json"        #: the restart files' ledger
+ANALYSIS_FILE = "analysis.json"        #: the analysis (``analysis_cycles.csv`` beside it)
+CALIBRATION_FILE = "calibration.json"  #: the reduced model calibrated on the run
+SFB_FILE = "sfb.json"                  #: the SFB check (``sfb_slips.csv`` beside it)
+SWEEP_FILE = "sweep.json"              #: a sweep directory's plan
+AGGREGATE_FILE = "aggregate.json"      #: a finished sweep's aggregate
 
 
 # ---------------------------------------------------------------- atom types

@@ -2,7 +2,10 @@
 
 Every import counts, at module level or inside a function, relative or absolute:
 a lazy import is still a dependency.  No module imports a higher layer, and the
-module graph has no cycle.
+module graph has no cycle.  Inside a layer the sub-folders are floors too
+(:data:`FLOORS`): a sub-folder imports no later one, and with each sub-folder taken
+as one node (the layer's own modules each a node of their own) the graph still has
+no cycle.  The command line (``workflows/cli/``) is imported by nothing outside it.
 """
 import ast
 from pathlib import Path
@@ -11,6 +14,12 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = ("md_inputs", "reduced_model", "analysis", "workflows")
+#: the sub-folders of each layer, lowest first: a sub-folder imports no later one
+FLOORS = {
+    "reduced_model": ("laws", "integrators", "sfb"),
+    "analysis": ("observables", "calibration"),
+    "workflows": ("md", "sweep", "report", "cost", "cli"),
+}
 
 
 def _module_name(path: Path) -> str:
@@ -88,3 +97,69 @@ def test_no_import_cycle():
         if m not in state:
             visit(m)
     assert not cycles, "\n".join(cycles)
+
+
+def _floor(module: str) -> str:
+    """The node of ``module`` with each sub-folder of a layer taken as one:
+    ``filmfriction.workflows.md.runner`` -> ``workflows.md``, a layer's own module
+    (``filmfriction.workflows.study``) stays itself."""
+    parts = module.split(".")[1:]
+    if len(parts) >= 2 and parts[1] in FLOORS.get(parts[0], ()):
+        return ".".join(parts[:2])
+    return ".".join(parts)
+
+
+def test_every_sub_folder_is_a_floor():
+    # a new sub-folder is placed among the floors (or the rules below would skip it)
+    for layer in LAYERS:
+        subs = {p.parent.name for p in (ROOT / layer).glob("*/__init__.py")}
+        assert subs == set(FLOORS.get(layer, ())), (layer, subs)
+
+
+def test_no_sub_folder_imports_a_later_one():
+    upward = []
+    for m, deps in _graph().items():
+        for d in deps:
+            a, b = _floor(m).split("."), _floor(d).split(".")
+            if (len(a) == 2 and len(b) == 2 and a[0] == b[0] and a[1] in FLOORS.get(a[0], ())
+                    and b[1] in FLOORS[b[0]] and FLOORS[a[0]].index(b[1]) > FLOORS[a[0]].index(a[1])):
+                upward.append(f"{m} imports {d}")
+    assert not upward, "\n".join(sorted(upward))
+
+
+def test_no_cycle_between_sub_folders():
+    graph: dict[str, set[str]] = {}
+    for m, deps in _graph().items():
+        if m.endswith(".__init__") or any(m == f"filmfriction.{l}" for l in LAYERS):
+            continue
+        node = _floor(m)
+        if node.count(".") == 1 and node.split(".")[1] in FLOORS.get(node.split(".")[0], ()) \
+                and m == f"filmfriction.{node}":
+            continue  # a sub-folder's __init__ gathers its own modules
+        graph.setdefault(node, set()).update(
+            _floor(d) for d in deps if _floor(d) != node and not node.startswith(_floor(d) + "."))
+    state, stack, cycles = {}, [], []
+
+    def visit(n):
+        state[n] = 1
+        stack.append(n)
+        for d in sorted(graph.get(n, ())):
+            if state.get(d) == 1:
+                cycles.append(" -> ".join(stack[stack.index(d):] + [d]))
+            elif d not in state:
+                visit(d)
+        stack.pop()
+        state[n] = 2
+
+    for n in sorted(graph):
+        if n not in state:
+            visit(n)
+    assert not cycles, "\n".join(cycles)
+
+
+def test_nothing_outside_the_command_line_imports_it():
+    cli = "filmfriction.workflows.cli"
+    users = [f"{m} imports {d}" for m, deps in _graph().items() for d in deps
+             if (d == cli or d.startswith(cli + ".")) and not m.startswith(cli + ".")
+             and m != cli]
+    assert not users, "\n".join(sorted(users))

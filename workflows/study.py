@@ -13,15 +13,10 @@ import time
 import traceback
 from pathlib import Path
 
+from filmfriction.analysis.analyze import analyse_run
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, SFB_FILE
 
-def analyse(run_dir: Path) -> dict:
-    from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.trace import read_trace
-
-    trace = read_trace(run_dir)
-    doc, per_cycle = analyze(trace)
-    write_outputs(doc, per_cycle, run_dir / "analysis.json")
-    return doc
+from .rundir import write_sfb
 
 
 def _step(name: str, failures: dict, fn, *args, **kwargs):
@@ -37,8 +32,6 @@ def _step(name: str, failures: dict, fn, *args, **kwargs):
 
 
 def _write_sfb(run_dir: Path, check) -> Path:
-    from filmfriction.workflows.documents import SFB_FILE, write_sfb
-
     return write_sfb(check, run_dir / SFB_FILE)
 
 
@@ -52,14 +45,14 @@ def finish_study(run_dir: Path) -> int:
     failures: dict = {}
     t0 = time.perf_counter()
 
-    doc = _step("analysis", failures, analyse, run_dir)
+    doc = _step("analysis", failures, analyse_run, run_dir)
     if doc is not None:
         s = doc["slips"]
         fs = s["static_force"]
         force = ("" if fs["mean"] is None else
                  f", static force {fs['mean']:.4g} ± {fs['stderr'] or 0:.2g} {fs['units']}")
         print(f"analysis: {doc['regime']}, {s['count']} slips{force} -> "
-              f"{run_dir / 'analysis.json'}")
+              f"{run_dir / ANALYSIS_FILE}")
 
     from filmfriction.analysis import calibrate, write_calibration
     cal = _step("calibration", failures, calibrate, [run_dir])
@@ -85,8 +78,8 @@ def finish_study(run_dir: Path) -> int:
         print(f"sfb check: {len(check.rows)} rows ({n_md} md-calibrated, {n_sim} similarity) "
               f"-> {path}")
 
-    from filmfriction.workflows.report import render as report
-    path = _step("report", failures, lambda: report.build_report([run_dir], failures=dict(failures)))
+    from .report.render import build_report
+    path = _step("report", failures, lambda: build_report([run_dir], failures=dict(failures)))
     print(f"post-MD steps took {time.perf_counter() - t0:.1f} s"
           + (f"; failed: {', '.join(failures)}" if failures else ""))
     if path is None:

@@ -20,6 +20,7 @@ import math
 from pathlib import Path
 
 from filmfriction.reduced_model.sfb.similarity import SlidingContact
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE
 
 from ..util import read_json_object
 
@@ -90,5 +91,5 @@ def contact_from_analysis(analysis: dict, run: dict) -> SlidingContact:
 def contact_from_run(run_dir) -> SlidingContact:
     """:func:`contact_from_analysis` of ``run_dir/analysis.json`` and ``run_dir/run.json``."""
     run_dir = Path(run_dir)
-    return contact_from_analysis(read_json_object(run_dir / "analysis.json"),
-                                 read_json_object(run_dir / "run.json"))
+    return contact_from_analysis(read_json_object(run_dir / ANALYSIS_FILE),
+                                 read_json_object(run_dir / RUN_FILE))

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 
 from filmfriction.reduced_model.sfb.user_setup import MeasuredSlip
+from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
 __all__ = ["measured_slip"]
 
@@ -40,7 +41,7 @@ def _entry(doc: dict, section: str, key: str, where: str) -> tuple[float, float]
     return float(mean), float(err) if err is not None and math.isfinite(float(err)) else 0.0
 
 
-def measured_slip(doc: dict, where: str = "analysis.json") -> MeasuredSlip:
+def measured_slip(doc: dict, where: str = ANALYSIS_FILE) -> MeasuredSlip:
     """The :class:`MeasuredSlip` of an SI trace's ``analysis.json`` document.
 
     Raises

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.md_inputs.contract import ANALYSIS_FILE
+
 __all__ = ["RunData", "load_run"]
 
 
@@ -88,7 +90,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise ValueError(f"{run_dir}: not a run directory")
-    apath = run_dir / "analysis.json"
+    apath = run_dir / ANALYSIS_FILE
     cpath = run_dir / "analysis_cycles.csv"
     if apath.exists() and cpath.exists():
         try:

@@ -225,7 +225,7 @@ def test_cli_with_calibration_file(tmp_path, capsys):
 
 
 def test_cli_reads_a_calibration_json_and_writes_what_the_report_reads(tmp_path, capsys):
-    from filmfriction.workflows.documents import read_sfb
+    from filmfriction.workflows.rundir import read_sfb
 
     md = {"yield_stress": 0.5, "restick_stress": 0.25, "eta_zero": 50.0}
     cal = tmp_path / "calibration.json"

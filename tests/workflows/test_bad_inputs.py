@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from filmfriction.workflows.inputs import check_writable, UserError
+
 
 def _csv(path: Path, header: str, rows) -> Path:
     path.write_text(header + "\n" + "".join(",".join(repr(float(v)) for v in r) + "\n"
@@ -308,8 +310,6 @@ def _patched(parser, func):
 
 def test_umask_is_not_the_check(tmp_path):
     """check_writable probes with a real file (root passes os.access everywhere)."""
-    from filmfriction.workflows.cli.main import UserError, check_writable
-
     check_writable(tmp_path / "new" / "x.json", "--out")
     assert not (tmp_path / "new").exists() and os.listdir(tmp_path) == []
     with pytest.raises(UserError, match="cannot write in /proc"):

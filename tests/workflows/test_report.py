@@ -108,7 +108,7 @@ def test_report_without_calibration_says_so_and_does_not_calibrate(tmp_path, mon
 def test_the_study_writes_what_the_report_renders(tmp_path):
     """The post-MD study on a synthetic run (no LAMMPS): files first, then the report reads them."""
     from filmfriction.analysis.synthetic import run_directory
-    from filmfriction.workflows.documents import read_calibration, read_sfb
+    from filmfriction.workflows.rundir import read_calibration, read_sfb
     from filmfriction.workflows.study import finish_study
 
     d = run_directory(tmp_path / "run", trajectory=False)

@@ -5,6 +5,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from filmfriction.workflows.inputs import check_run_json, check_writable, UserError
+from filmfriction.md_inputs.contract import ANALYSIS_FILE
+
 
 def _positive(text: str) -> float:
     try:
@@ -79,8 +82,6 @@ def register(subparsers) -> None:
 def run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from filmfriction.workflows.cli.main import UserError, check_run_json, check_writable
-
     from filmfriction.analysis.analyze import analyze, to_json, write_outputs
     from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
                                              write_binary_copy)
@@ -145,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
             raise UserError(f"{where}: column {name} has {int(big.sum())} values beyond "
                             f"±{MAX_MAGNITUDE:g} (first {float(column[first]):g} at data row "
                             f"{first + 2}): arithmetic on them overflows; rescale the trace")
-    out = args.output or ((trace.run_dir or trace.path.parent) / "analysis.json")
+    out = args.output or ((trace.run_dir or trace.path.parent) / ANALYSIS_FILE)
     check_writable(out, "output")
     try:
         doc, per_cycle = analyze(trace, skip=args.skip,

@@ -13,6 +13,8 @@ import math
 import sys
 from pathlib import Path
 
+from filmfriction.workflows.inputs import check_run_source, UserError
+
 __all__ = ["register", "run", "format_calibration"]
 
 
@@ -79,16 +81,15 @@ def format_calibration(cal) -> str:
 def run(args) -> int:
     """Entry point; returns the exit code."""
     from filmfriction.analysis import calibrate, write_calibration
-    from filmfriction.workflows.cli.main import UserError, check_run_source
 
-    from filmfriction.workflows.report.render import _split_sweeps
+    from filmfriction.workflows.rundir import split_sweeps
 
     for d in args.run_dirs:
         if not d.is_dir():
             raise UserError(f"{d}: not a directory")
         check_run_source(d)
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
-    run_dirs, _ = _split_sweeps(list(args.run_dirs))
+    run_dirs, _ = split_sweeps(list(args.run_dirs))
     try:
         cal = calibrate(run_dirs)
     except ValueError as exc:

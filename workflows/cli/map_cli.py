@@ -14,6 +14,9 @@ import argparse
 import math
 from pathlib import Path
 
+from filmfriction.workflows.inputs import check_writable, UserError
+
+
 KINDS = ("lambda-zeta", "velocity-stiffness")
 
 
@@ -37,7 +40,6 @@ def register(subparsers) -> argparse.ArgumentParser:
 
 
 def _user_error(message):
-    from filmfriction.workflows.cli.main import UserError
     return UserError(message)
 
 
@@ -51,7 +53,6 @@ def run(args) -> int:
         raise _user_error(f"--resolution {n}: allowed range is [2, 1000] grid points per axis")
     if args.processes < 1:
         raise _user_error(f"--processes {args.processes}: allowed range is [1, inf)")
-    from filmfriction.workflows.cli.main import check_writable
 
     check_writable(out, "--out", directory=True)
     out.mkdir(parents=True, exist_ok=True)

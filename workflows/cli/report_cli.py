@@ -12,6 +12,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from filmfriction.workflows.inputs import check_run_source, check_writable, UserError
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE
+
 __all__ = ["register", "run"]
 
 
@@ -43,11 +46,10 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Entry point; returns the exit code."""
-    from filmfriction.workflows.cli.main import UserError, check_run_source, check_writable
     from filmfriction.workflows.report.render import build_report
 
     for d in args.compare:
-        if not (d / "analysis.json").is_file() or not (d / "run.json").is_file():
+        if not (d / ANALYSIS_FILE).is_file() or not (d / RUN_FILE).is_file():
             raise UserError(f"--compare {d}: not an analysed run directory (analysis.json and "
                             "run.json; 'filmfriction analyze RUN_DIR' writes the first)")
     for d in args.run_dirs:

@@ -5,6 +5,11 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..inputs import check_ranks, check_writable, parse_overrides, UserError
+
+from filmfriction.md_inputs.contract import RUN_FILE
+
+
 DEFAULT_SCENE = "stick-slip"
 
 
@@ -110,41 +115,10 @@ def parameter_table(meaning: bool = False) -> str:
 
 
 def _overrides(args) -> dict:
-    return overrides(args.overrides)
-
-
-def overrides(texts) -> dict:
-    """``--set KEY=VALUE`` texts as a dict; a key given twice is refused."""
-    from ..md.scene import SceneError, parse_assignment
-
-    values: dict = {}
-    for text in texts:
-        key, value = parse_assignment(text)
-        if key in values:
-            raise SceneError(f"--set {key} given twice ({values[key]!r} and {value!r}): "
-                             "give each key once")
-        values[key] = value
-    return values
-
-
-def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
-    """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
-    oversubscribe, or fail after the setup).  ``more``: where more ranks are
-    accepted, appended to the message."""
-    import os
-
-    from .main import UserError
-
-    if nprocs is None:
-        return
-    cpus = os.cpu_count() or 1
-    if not 1 <= nprocs <= cpus:
-        raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
-                        f"(the CPUs of this machine){more}")
+    return parse_overrides(args.overrides)
 
 
 def run(args: argparse.Namespace) -> int:
-    from .main import UserError
     from ..md.runner import RunFailed, execute, resume
     from ..md.scene import SceneError
 
@@ -152,7 +126,6 @@ def run(args: argparse.Namespace) -> int:
     if args.resume and (args.overrides or args.fidelity or args.out):
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
-    from .main import check_writable
 
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
@@ -189,7 +162,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _scene(args: argparse.Namespace):
     """The scene of ``args.scene`` with ``--fidelity`` and ``--set`` applied."""
-    from .main import UserError
     from ..md.scene import load
 
     user = _overrides(args)
@@ -210,7 +182,6 @@ def _scene(args: argparse.Namespace):
 def write_geometry(args: argparse.Namespace) -> int:
     from filmfriction.analysis.util import write_atomic
 
-    from .main import UserError, check_writable
     from ..md.scene import SceneError
 
     try:
@@ -237,7 +208,7 @@ def write_geometry(args: argparse.Namespace) -> int:
 def _print_warnings(run_dir: Path) -> None:
     import json
 
-    record = json.loads((Path(run_dir) / "run.json").read_text())
+    record = json.loads((Path(run_dir) / RUN_FILE).read_text())
     for line in record.get("warnings") or []:
         print(f"filmfriction run: warning: {line}", file=sys.stderr)
     if record.get("warnings"):

@@ -27,6 +27,8 @@ import sys
 from pathlib import Path
 
 from filmfriction.reduced_model.units import OMCTS, LJUnits
+from filmfriction.workflows.inputs import check_writable, UserError
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE, SWEEP_FILE
 
 __all__ = ["register", "run", "format_table"]
 
@@ -70,7 +72,6 @@ def register(subparsers) -> None:
 
 def _units(args) -> LJUnits:
     if getattr(args, "time_unit", "mass") == "viscosity":
-        from filmfriction.workflows.cli.main import UserError
         if args.sigma_nm is not None or args.epsilon_K is not None:
             raise UserError("--time-unit viscosity: the matched mapping keeps OMCTS's sigma and "
                             "epsilon; --sigma-nm/--epsilon-K are accepted with --time-unit mass only")
@@ -78,7 +79,6 @@ def _units(args) -> LJUnits:
         return OMCTS_VISCOSITY_MATCHED
     if args.sigma_nm is None and args.epsilon_K is None:
         return OMCTS
-    from filmfriction.workflows.cli.main import UserError
     try:
         return LJUnits.from_molecule(
             sigma_nm=OMCTS.sigma * 1e9 if args.sigma_nm is None else args.sigma_nm,
@@ -93,7 +93,6 @@ def _calibration(path: Path | None):
     if path is None:
         return None, False
     from filmfriction.reduced_model import MDCalibration
-    from filmfriction.workflows.cli.main import UserError
     from filmfriction.analysis.util import read_json_object
 
     if path.is_dir():
@@ -126,7 +125,6 @@ def _setup(args):
     """The set-up (--setup) and the measured slip (--measured), or (None, None)."""
     if args.setup is None and args.measured is None:
         return None, None
-    from filmfriction.workflows.cli.main import UserError
     if args.setup is None or args.measured is None:
         raise UserError("--setup FILE.toml and --measured DIR go together: the set-up of your "
                         "SFB and the analysed trace whose slip it measured")
@@ -138,7 +136,7 @@ def _setup(args):
         setup = load_setup(args.setup)
     except ValueError as exc:
         raise UserError(f"--setup {exc}") from None
-    doc_path = args.measured / "analysis.json" if args.measured.is_dir() else args.measured
+    doc_path = args.measured / ANALYSIS_FILE if args.measured.is_dir() else args.measured
     if not doc_path.is_file():
         raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
                         "analyze TRACE_FILE --units si ...' first)")
@@ -187,13 +185,10 @@ def format_table(rows, notes=(), measured: str = "Klein") -> str:
 def run(args) -> int:
     """Entry point of ``filmfriction sfb``; returns the exit code."""
     from filmfriction.reduced_model import sfb_check
-    from filmfriction.workflows.cli.main import UserError
 
     if args.out is not None and not args.out.parent.is_dir():
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     if args.out is not None:
-        from filmfriction.workflows.cli.main import check_writable
-
         check_writable(args.out, "--out")
     units = _units(args)
     setup, slip = _setup(args)
@@ -209,12 +204,12 @@ def run(args) -> int:
     contact = None
     if args.run is not None:
         from filmfriction.analysis.calibration.contact import contact_from_run
-        if not (args.run / "run.json").is_file():
-            sweep = (args.run / "sweep.json").is_file()
+        if not (args.run / RUN_FILE).is_file():
+            sweep = (args.run / SWEEP_FILE).is_file()
             raise UserError(f"--run {args.run}: not a run directory of 'filmfriction run' (no "
                             "run.json)" + (f"; a sweep's runs are {args.run}/points/<point>"
                                            if sweep else ""))
-        if not (args.run / "analysis.json").is_file():
+        if not (args.run / ANALYSIS_FILE).is_file():
             raise UserError(f"--run {args.run}: no analysis.json there (run 'filmfriction "
                             f"analyze {args.run}' first)")
         try:
@@ -234,7 +229,7 @@ def run(args) -> int:
         raise UserError(str(exc)) from None
     path = None
     if args.out is not None:
-        from filmfriction.workflows.documents import write_sfb
+        from filmfriction.workflows.rundir import write_sfb
         extra = None if setup is None else {"setup": setup.as_dict(),
                                             "measured": dataclasses.asdict(slip)}
         path = write_sfb(check, args.out, extra)

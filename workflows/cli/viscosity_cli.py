@@ -39,7 +39,9 @@ from filmfriction import md_inputs
 from filmfriction.analysis import green_kubo as gk
 from filmfriction.analysis.util import write_atomic
 from filmfriction.reduced_model import units as U
+from filmfriction.md_inputs.contract import COMMAND_FILE, LOG_FILE
 from ..md import engine
+from ..inputs import check_ranks, check_writable, UserError
 
 __all__ = ["register", "Settings", "settings_from_args", "run", "main", "DEFAULTS"]
 
@@ -151,8 +153,6 @@ def register(subparsers) -> None:
 
 
 def _fail(message: str):
-    from filmfriction.workflows.cli.main import UserError
-
     raise UserError(message)
 
 
@@ -233,8 +233,8 @@ def run(settings: Settings, run_dir: Path, progress=_progress) -> dict:
     script = md_inputs.script(SCRIPT)
     # LAMMPS runs in run_dir: a relative path (the default runs/...) would not be found there
     cmd = engine.lmp_command(settings.np, script, settings.lammps_variables(),
-                             log=Path(run_dir).resolve() / "lammps.log")
-    write_atomic(run_dir / "command.txt", " ".join(cmd) + "\n")
+                             log=Path(run_dir).resolve() / LOG_FILE)
+    write_atomic(run_dir / COMMAND_FILE, " ".join(cmd) + "\n")
     total = settings.melt_steps + settings.equilibrate_steps + settings.steps
     progress(f"viscosity: {settings.n_atoms} atoms, T = {settings.temperature:g}, "
              f"rho = {settings.density:g}, rc = {settings.cutoff:g}; {total} steps on "
@@ -397,8 +397,6 @@ def main(args: argparse.Namespace) -> int:
     if args.out is not None and Path(args.out).exists():
         _fail(f"--out {args.out}: already exists; a run never overwrites another, "
               "choose a new directory")
-    from .main import check_writable
-    from .run_cli import check_ranks
 
     check_ranks(args.np)
     check_writable(args.out if args.out is not None else Path("runs"),

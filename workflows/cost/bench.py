@@ -18,7 +18,6 @@ lower bounds.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import resource
@@ -29,30 +28,9 @@ import time
 from pathlib import Path
 
 from filmfriction import md_inputs
+from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 from ..md import engine
 from ..md.runner import loop_totals
-
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "bench", help="the scene's MD throughput as 'run' runs it, beside bulk LJ",
-        description="Time a scene as 'filmfriction run --md-only' runs it, on 1 core and on "
-                    "--np cores, beside a bulk LJ liquid with the same atoms, cutoff, steps "
-                    "and ranks. Runs alternate; prints median, spread and best in "
-                    "Matom-step/s, the film/bulk ratio and the scaling from 1 core.")
-    p.add_argument("scene", nargs="?", default="stick-slip",
-                   help="scene name or TOML file (default: stick-slip)")
-    p.add_argument("--np", type=int, default=2,
-                   help="cores of the parallel runs (default 2); 1 core is always timed too")
-    p.add_argument("--steps", type=int, default=None,
-                   help="slide steps (default: the scene's own; equilibration as the scene)")
-    p.add_argument("--repeat", type=int, default=3,
-                   help="repetitions of each configuration, alternating (default 3)")
-    p.add_argument("--omp", action="store_true",
-                   help="also time the film on 1 MPI rank x NP OpenMP threads (-sf omp)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scene parameter, as for 'run'")
-    p.add_argument("--json", action="store_true", help="print the figures as JSON")
-    p.set_defaults(func=main)
 
 
 def bulk_cells(n_atoms: int) -> tuple[int, int, int]:
@@ -87,8 +65,8 @@ def time_film(scene, cores: int, threads: int, where: Path) -> dict:
                           threads=threads)
     except RunFailed as exc:
         raise RuntimeError(f"the film run failed: {exc}") from None
-    record = json.loads((run_dir / "run.json").read_text())
-    atoms, steps, loop = loop_totals((run_dir / "lammps.log").read_text())
+    record = json.loads((run_dir / RUN_FILE).read_text())
+    atoms, steps, loop = loop_totals((run_dir / LOG_FILE).read_text())
     return {"atoms": atoms, "steps": steps, "wall": record["wall_time"],
             "rate": atoms * steps / record["wall_time"], "loop_rate": atoms * steps / loop}
 
@@ -100,14 +78,14 @@ def time_bulk(atoms: int, steps: int, cores: int, cutoff: float, timestep: float
     where.mkdir()
     cmd = engine.lmp_command(cores, md_inputs.script("bulk_lj.lmp"), {
         "cells_x": str(nx), "cells_y": str(ny), "cells_z": str(nz), "cutoff": repr(cutoff),
-        "steps": str(steps), "timestep": repr(timestep)}, log=Path("lammps.log"))
+        "steps": str(steps), "timestep": repr(timestep)}, log=Path(LOG_FILE))
     t0 = time.perf_counter()
     out = subprocess.run(cmd, cwd=where, env=engine.engine_env(), capture_output=True, text=True)
     wall = time.perf_counter() - t0
     if out.returncode != 0 or "ERROR" in out.stdout:
         err = [l for l in out.stdout.splitlines() if "ERROR" in l] or [out.stderr.strip()]
         raise RuntimeError(f"the bulk LJ run failed: {err[0]}")
-    n, s, loop = loop_totals((where / "lammps.log").read_text())
+    n, s, loop = loop_totals((where / LOG_FILE).read_text())
     return {"atoms": n, "steps": s, "wall": wall, "rate": n * s / wall,
             "loop_rate": n * s / loop}
 
@@ -135,64 +113,39 @@ def summary(values: list[float]) -> dict:
             "best": max(values), "n": len(values)}
 
 
-def main(args: argparse.Namespace) -> int:
-    from ..cli.main import UserError
-    from ..cli.run_cli import check_ranks, overrides as parse_overrides
-    from ..md.scene import SceneError, load
-
-    if args.steps is not None and args.steps < 1:
-        raise UserError(f"--steps {args.steps}: need at least 1 slide step")
-    if args.repeat < 1:
-        raise UserError(f"--repeat {args.repeat}: need at least 1 repetition")
-    check_ranks(args.np)
-    try:
-        overrides = parse_overrides(args.overrides)
-        if args.steps is not None:
-            overrides["slide_steps"] = args.steps
-        scene = load(args.scene, overrides)
-        from ..md.lammps_build import resolve
-
-        resolve(None)            # a $FILMFRICTION_LMP that is no executable: before any run
-    except SceneError as exc:
-        raise UserError(str(exc)) from None
+def run_bench(scene, nprocs: int, repeat: int, omp: bool = False, progress=None) -> dict:
+    """Time ``scene`` on 1 core and on ``nprocs`` cores beside bulk LJ, ``repeat`` times,
+    alternating; ``progress(text)`` is told of each run.  Returns the figures (:func:`_report`);
+    RuntimeError when a run fails."""
     cutoff, timestep = scene.parameters["cutoff"], scene.parameters["timestep"]
     layouts = [("film", 1, 1), ("bulk", 1, 1)]
-    if args.np > 1:
-        layouts += [("film", args.np, 1), ("bulk", args.np, 1)]
-        if args.omp:
-            layouts.append(("film", args.np, args.np))
+    if nprocs > 1:
+        layouts += [("film", nprocs, 1), ("bulk", nprocs, 1)]
+        if omp:
+            layouts.append(("film", nprocs, nprocs))
     runs: dict[str, list[dict]] = {}
     busy0, own0, t0 = busy_cpu_seconds(), own_cpu_seconds(), time.perf_counter()
-    total = len(layouts) * args.repeat
+    total = len(layouts) * repeat
     with tempfile.TemporaryDirectory(prefix="filmfriction-bench-") as tmp:
         tmp = Path(tmp)
         done = 0
-        for i in range(args.repeat):
+        for i in range(repeat):
             film_atoms = film_steps = None
             for kind, cores, threads in layouts:
                 key = _key(kind, cores, threads)
                 where = tmp / f"{key.replace(' ', '_')}-{i}"
                 done += 1
-                if not args.json:
-                    print(f"[{done}/{total}] {key} ...", flush=True)
-                try:
-                    if kind == "film":
-                        res = time_film(scene, cores, threads, where)
-                        film_atoms, film_steps = res["atoms"], res["steps"]
-                    else:
-                        res = time_bulk(film_atoms, film_steps, cores, cutoff, timestep, where)
-                except RuntimeError as exc:
-                    print(f"filmfriction bench: {exc}")
-                    return 1
+                if progress is not None:
+                    progress(f"[{done}/{total}] {key} ...")
+                if kind == "film":
+                    res = time_film(scene, cores, threads, where)
+                    film_atoms, film_steps = res["atoms"], res["steps"]
+                else:
+                    res = time_bulk(film_atoms, film_steps, cores, cutoff, timestep, where)
                 runs.setdefault(key, []).append(res)
     busy1, own1, elapsed = busy_cpu_seconds(), own_cpu_seconds(), time.perf_counter() - t0
     other = None if busy0 is None or busy1 is None else max(0.0, (busy1 - busy0) - (own1 - own0))
-    report = _report(scene.name, args, runs, other, elapsed)
-    if args.json:
-        print(json.dumps(report, indent=2))
-    else:
-        print(_text(report))
-    return 0
+    return _report(scene.name, nprocs, repeat, runs, other, elapsed)
 
 
 def _key(kind: str, cores: int, threads: int) -> str:
@@ -209,12 +162,12 @@ def _paired(runs, a: str, b: str) -> dict | None:
     return {"median": statistics.median(ratios), "min": min(ratios), "max": max(ratios)}
 
 
-def _report(name, args, runs, other_cpu, elapsed) -> dict:
+def _report(name, nprocs, repeat, runs, other_cpu, elapsed) -> dict:
     film1, bulk1 = _key("film", 1, 1), _key("bulk", 1, 1)
-    filmn, bulkn = _key("film", args.np, 1), _key("bulk", args.np, 1)
+    filmn, bulkn = _key("film", nprocs, 1), _key("bulk", nprocs, 1)
     first = runs[film1][0]
     out = {
-        "scene": name, "cores": args.np, "repeat": args.repeat,
+        "scene": name, "cores": nprocs, "repeat": repeat,
         "film_atoms": first["atoms"], "steps": first["steps"],
         "bulk_atoms": runs[bulk1][0]["atoms"],
         "elapsed_seconds": elapsed, "other_cpu_seconds": other_cpu, "cpus": os.cpu_count(),
@@ -224,18 +177,18 @@ def _report(name, args, runs, other_cpu, elapsed) -> dict:
         "wall_time": {k: summary([r["wall"] for r in v]) for k, v in runs.items()},
         "ratios": {},
     }
-    if args.np > 1:
-        out["ratios"][f"film / bulk, {args.np} cores"] = _paired(runs, filmn, bulkn)
-        out["ratios"][f"film {args.np} cores / film 1 core"] = _paired(runs, filmn, film1)
-        out["ratios"][f"bulk {args.np} cores / bulk 1 core"] = _paired(runs, bulkn, bulk1)
-        omp = _key("film", args.np, args.np)
+    if nprocs > 1:
+        out["ratios"][f"film / bulk, {nprocs} cores"] = _paired(runs, filmn, bulkn)
+        out["ratios"][f"film {nprocs} cores / film 1 core"] = _paired(runs, filmn, film1)
+        out["ratios"][f"bulk {nprocs} cores / bulk 1 core"] = _paired(runs, bulkn, bulk1)
+        omp = _key("film", nprocs, nprocs)
         if omp in runs:
-            out["ratios"][f"film {args.np} threads / film {args.np} ranks"] = _paired(runs, omp, filmn)
+            out["ratios"][f"film {nprocs} threads / film {nprocs} ranks"] = _paired(runs, omp, filmn)
     out["ratios"]["film / bulk, 1 core"] = _paired(runs, film1, bulk1)
     return out
 
 
-def _text(r: dict) -> str:
+def as_text(r: dict) -> str:
     cores = os.cpu_count() or 1
     lines = [
         f"scene '{r['scene']}' as 'filmfriction run --md-only' runs it: {r['film_atoms']} atoms, "

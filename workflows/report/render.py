@@ -36,7 +36,11 @@ from filmfriction.analysis.observables import Observable, registered as register
 from filmfriction.analysis.trace import unit as _unit
 from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
+from filmfriction.analysis.util import write_atomic as _write_atomic
 from filmfriction.reduced_model.units import OMCTS
+from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
+
+from ..rundir import read_report_inputs, split_sweeps
 
 __all__ = ["build_report", "Section", "Figure", "Table", "PARAMETER_QUANTITIES"]
 
@@ -417,7 +421,7 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
 
 
 def _sfb_section(check, why_none: str, remarks: list, failures) -> Section:
-    """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.documents.SFBDocument`)."""
+    """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.rundir.SFBDocument`)."""
     from filmfriction.reduced_model.sfb.klein import BRAUN_TOSATTI_NOTE
 
     ref = _sfb_reference(check) if check is not None else None
@@ -462,7 +466,7 @@ def _observable_section(obs: Observable, run, failures) -> Section:
         why = run.analysis.get("skipped", {}).get(obs.key)
         if why is None and obs.key in run.analysis:
             why = "nothing to show for this run"
-        elif why is None and not (run.run_dir / "run.json").is_file():
+        elif why is None and not (run.run_dir / RUN_FILE).is_file():
             why = "a trace file has none: it is not an MD run"
         elif why is None:
             why = f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)"
@@ -483,7 +487,7 @@ def _observable_section(obs: Observable, run, failures) -> Section:
 
 def _similarity_rows(run_dir: Path) -> list[dict]:
     """The ``similarity`` rows of ``run_dir/sfb.json`` (what the study wrote)."""
-    doc = json.loads((Path(run_dir) / "sfb.json").read_text())
+    doc = json.loads((Path(run_dir) / SFB_FILE).read_text())
     rows = doc["rows"] if isinstance(doc, dict) else doc
     return [r for r in rows if r["source"] == "similarity"]
 
@@ -521,7 +525,7 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
                              "–" if not r.get("uncertainty") else
                              f"{_fmt(r['uncertainty'][0], 2)} … {_fmt(r['uncertainty'][1], 2)}",
                              r["note"]) for r in rows)))
-    elif (Path(run_dirs[0]) / "run.json").is_file():
+    elif (Path(run_dirs[0]) / RUN_FILE).is_file():
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
     else:
@@ -551,7 +555,7 @@ def _similarity_section(check, run_dirs, failures, compare=()) -> Section:
 
     def scene_of(d):
         try:
-            return json.loads((Path(d) / "run.json").read_text()).get("scene", {}).get("name", "")
+            return json.loads((Path(d) / RUN_FILE).read_text()).get("scene", {}).get("name", "")
         except (OSError, ValueError, AttributeError):
             return ""
     n = similarity_numbers(klein_contact())
@@ -694,38 +698,11 @@ def _render_md(title: str, intro: list, sections: list, stem: str) -> tuple[str,
     return text, files
 
 
-from filmfriction.analysis.util import write_atomic as _write_atomic  # noqa: E402
 
 
 # ---------------------------------------------------------------------------
 # entry point
 # ---------------------------------------------------------------------------
-def _split_sweeps(paths: list) -> tuple[list, list]:
-    """Run directories, and sweeps (directories with ``aggregate.json``).
-
-    A sweep contributes its stick-slip runs (its ``calibration_runs``, else all
-    its runs) to the calibration, after the run directories given directly.
-    """
-    from filmfriction.workflows.sweep.aggregate import load_aggregate
-
-    runs, sweeps, seen = [], [], set()
-
-    def add(d):
-        # each run once, however it is written (r1, ./r1/, /abs/r1, or within a sweep)
-        if Path(d).resolve() not in seen:
-            seen.add(Path(d).resolve())
-            runs.append(d)
-    for p in paths:
-        if (p / "aggregate.json").exists():
-            agg = load_aggregate(p)
-            sweeps.append(agg)
-            for d in agg.calibration_runs or agg.run_dirs:
-                add(d)
-        else:
-            add(p)
-    return runs, sweeps
-
-
 def _sweep_section(sweeps) -> Section:
     sec = Section("Sweeps")
     for agg in sweeps:
@@ -794,12 +771,11 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
         No run directory, or the main run has no analysis (``filmfriction analyze``).
     """
     from filmfriction.analysis.calibration.rundata import load_run
-    from filmfriction.workflows.documents import read_report_inputs
 
     if isinstance(run_dirs, (str, os.PathLike)):
         run_dirs = [run_dirs]
     given = [Path(d) for d in run_dirs]
-    run_dirs, sweeps = _split_sweeps(given)
+    run_dirs, sweeps = split_sweeps(given)
     if out is None and sweeps and given[0] == sweeps[0].sweep_dir:
         out = sweeps[0].sweep_dir / "report.html"   # a sweep's report lives with the sweep
     if not run_dirs:

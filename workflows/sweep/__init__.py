@@ -35,29 +35,26 @@ given.  :func:`load_aggregate` is what the report and the calibration read.
 """
 from __future__ import annotations
 
-import argparse
-import signal
-import sys
 from pathlib import Path
 
-# The sweep is split by purpose; this module is the command line and the one
-# place the rest of the project imports from.
+# The sweep is split by purpose; this module is the one place the rest of the
+# project imports from.
 from .aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, Aggregate, CriticalVelocity,
                         build_aggregate, critical_velocity, load_aggregate, reduced_model_boundary,
                         write_aggregate)
 from filmfriction.analysis.stickslip import STEADY_VELOCITY_TOLERANCE
 
 from .figures import _numeric_axes, fig_velocity_map, fig_vk_map
-from .jobs import (PROFILES, SNAKEFILE, _interrupt, analyse_point, profile_path, run_point,
+from .jobs import (PROFILES, SNAKEFILE, analyse_point, profile_path, run_point,
                    run_sweep, snakemake_command)
-from .plan import (GridAxis, SweepLock, SweepPlan, SweepPoint, _user_error, format_value,
+from .plan import (GridAxis, SweepLock, SweepPlan, SweepPoint, format_value,
                    parse_grid, plan_sweep, write_plan)
 
 __all__ = ["GridAxis", "SweepPoint", "SweepPlan", "CriticalVelocity", "Aggregate",
            "parse_grid", "plan_sweep", "write_plan", "SweepLock", "snakemake_command",
            "run_sweep", "run_point", "analyse_point", "critical_velocity",
-           "reduced_model_boundary", "aggregate", "load_aggregate", "register", "SNAKEFILE",
-           "PROFILES", "format_value", "fig_velocity_map", "fig_vk_map", "_numeric_axes"]
+           "reduced_model_boundary", "aggregate", "load_aggregate", "summary", "SNAKEFILE",
+           "PROFILES", "profile_path", "format_value", "fig_velocity_map", "fig_vk_map", "_numeric_axes"]
 
 
 def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
@@ -82,119 +79,6 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
             write_atomic(sweep_dir / "vk_map.png", fig_vk_map(doc))
             doc["outputs"].append("vk_map.png")
     return write_aggregate(sweep_dir, doc, rows)
-
-
-# ---------------------------------------------------------------------------
-# command line
-# ---------------------------------------------------------------------------
-def register(subparsers) -> None:
-    """Add the ``sweep`` sub-command."""
-    p = subparsers.add_parser(
-        "sweep", help="run a scene over a parameter grid (Snakemake; local or Slurm)",
-        description="Fan a scene out over a grid of parameters, run every point as an MPI "
-                    "LAMMPS job, analyse it, and aggregate: friction vs V, regime per point, "
-                    "critical velocity, eta_eff vs shear rate, (V, K) map. Snakemake "
-                    "schedules the jobs; re-running the same command re-does only what "
-                    "changed and resumes an interrupted sweep.")
-    p.add_argument("scene", help="scene name or TOML file (see 'filmfriction scenes')")
-    p.add_argument("--grid", action="append", default=[], metavar="KEY=START:STOP:N[:log]",
-                   help="a swept parameter: N values from START to STOP (evenly, or in log "
-                        "with :log), or KEY=V1,V2,...; repeat for a full product")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="fixed override for every point, e.g. --set slide_steps=20000")
-    p.add_argument("--np", type=int, default=2,
-                   help="MPI ranks per point (default 2): at most the CPUs of this machine, "
-                        "any number with a Slurm profile (--profile slurm)")
-    p.add_argument("--cores", type=int, default=2,
-                   help="cores Snakemake may use at once on this machine (default 2)")
-    p.add_argument("--out", type=Path, default=None,
-                   help="sweep directory (default sweeps/<scene>-<swept keys>); re-use it to "
-                        "resume or extend a sweep")
-    p.add_argument("--profile", default=None,
-                   help="Snakemake profile: 'slurm', 'local' (shipped) or a directory")
-    p.add_argument("--calibration", type=Path, default=None, metavar="FILE",
-                   help="calibration.json: overlay the reduced model's boundary on the "
-                        "(V, K) map")
-    p.add_argument("--dry-run", action="store_true",
-                   help="list the jobs Snakemake would run, run nothing")
-    p.set_defaults(func=main_sweep)
-
-
-def default_out(plan: SweepPlan) -> Path:
-    return Path("sweeps") / f"{plan.scene}-{'-'.join(a.key for a in plan.grid)}"
-
-
-def uses_slurm(profile: Path | None) -> bool:
-    """True when the Snakemake profile sends the jobs to Slurm (``executor: slurm``)."""
-    import re
-
-    return profile is not None and bool(
-        re.search(r"^executor:\s*slurm\b", (profile / "config.yaml").read_text(), re.M))
-
-
-def check_installed(profile: Path | None) -> None:
-    """Snakemake (and the Slurm executor plugin for a Slurm profile) must be importable."""
-    import importlib.util
-
-    if importlib.util.find_spec("snakemake") is None:
-        raise _user_error("Snakemake is not installed: pip install -e '.[sweep]'")
-    if profile is not None:
-        if (uses_slurm(profile)
-                and importlib.util.find_spec("snakemake_executor_plugin_slurm") is None):
-            raise _user_error(f"profile {profile} uses the Slurm executor, which is not "
-                              "installed: pip install snakemake-executor-plugin-slurm")
-
-
-def check_sweep_dir(out: Path) -> None:
-    """``out`` must be new, empty or a sweep's own directory (``sweep.json`` or its lock):
-    a sweep never writes into a run directory or any other folder."""
-    out = Path(out)
-    if (out.is_dir() and any(out.iterdir()) and not (out / "sweep.json").exists()
-            and not (out / ".sweep.lock").exists()):
-        what = "a run directory" if (out / "run.json").exists() else "not a sweep directory"
-        raise _user_error(f"--out {out}: exists and is {what} (no sweep.json); a sweep writes "
-                          "only into a new or empty directory or its own, to resume or extend "
-                          "it: choose a new --out")
-
-
-def main_sweep(args: argparse.Namespace) -> int:
-    from ..md.scene import SceneError
-
-    if args.cores < 1:
-        raise _user_error(f"--cores {args.cores}: need at least 1")
-    profile = profile_path(args.profile) if args.profile else None
-    if not uses_slurm(profile):
-        # the points run here: no more ranks than CPUs; on Slurm each point gets its own
-        # allocation of --np tasks
-        from ..cli.run_cli import check_ranks
-
-        check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
-    try:
-        plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
-        from ..md.lammps_build import resolve
-
-        resolve(None)            # every point would fail on a $FILMFRICTION_LMP that is none
-    except SceneError as exc:
-        raise _user_error(str(exc)) from None
-    check_installed(profile)
-    out = args.out if args.out is not None else default_out(plan)
-    from ..cli.main import check_writable
-
-    check_writable(out, "--out", directory=True)
-    check_sweep_dir(out)
-    grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
-    print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
-          f"each -> {out}", file=sys.stderr)
-    rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
-    if rc != 0 or args.dry_run:
-        if rc not in (0, 130):
-            print(f"filmfriction sweep: Snakemake exited with code {rc}; completed points are "
-                  f"kept, run the same command again to retry the rest", file=sys.stderr)
-        return rc
-    if profile is not None and not (Path(out) / "aggregate.json").exists():
-        return 0         # remote executor still owns the jobs
-    print(summary(load_aggregate(out)))
-    return 0
 
 
 def summary(agg: Aggregate) -> str:

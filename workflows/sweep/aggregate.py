@@ -16,6 +16,7 @@ import numpy as np
 
 from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime, sliding_steadily
+from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, SWEEP_FILE
 
 from .plan import _dumps, format_value
 
@@ -134,7 +135,7 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
     run_dir = sweep_dir / "points" / name
     inputs = json.loads((sweep_dir / "inputs" / f"{name}.json").read_text())
     p = inputs["parameters"]
-    doc = json.loads((run_dir / "analysis.json").read_text())
+    doc = json.loads((run_dir / ANALYSIS_FILE).read_text())
     row = {"point": name, **{f"grid.{k}": v for k, v in point["values"].items()},
            "drive_velocity": p["drive_velocity"], "spring_constant": p["spring_constant"],
            "normal_pressure": p["normal_pressure"], "temperature": p["temperature"],
@@ -260,7 +261,7 @@ def build_aggregate(sweep_dir: Path) -> tuple[dict, list[dict]]:
     from filmfriction.analysis.viscosity import power_law_fit
 
     sweep_dir = Path(sweep_dir)
-    plan = json.loads((sweep_dir / "sweep.json").read_text())
+    plan = json.loads((sweep_dir / SWEEP_FILE).read_text())
     rows = [point_summary(sweep_dir, p) for p in plan["points"]]
     keys = [a["key"] for a in plan["grid"]]
     doc: dict = {"schema": AGGREGATE_SCHEMA, "units": "lj", "scene": plan["scene"],
@@ -333,7 +334,7 @@ def write_aggregate(sweep_dir: Path, doc: dict, rows: list[dict]) -> dict:
     """Write ``aggregate.csv`` and ``aggregate.json`` atomically; returns the document."""
     sweep_dir = Path(sweep_dir)
     write_atomic(sweep_dir / "aggregate.csv", _csv(rows).encode())
-    write_atomic(sweep_dir / "aggregate.json", _dumps(json_safe(doc)).encode())
+    write_atomic(sweep_dir / AGGREGATE_FILE, _dumps(json_safe(doc)).encode())
     return doc
 
 
@@ -398,7 +399,7 @@ def load_aggregate(sweep_dir) -> Aggregate:
         The sweep has not finished (no ``aggregate.json``).
     """
     sweep_dir = Path(sweep_dir)
-    path = sweep_dir / "aggregate.json"
+    path = sweep_dir / AGGREGATE_FILE
     if not path.exists():
         raise FileNotFoundError(f"{path}: no aggregate; run (or resume) the sweep first")
     doc = json.loads(path.read_text())

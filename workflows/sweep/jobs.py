@@ -197,7 +197,7 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
 
 def analyse_point(run_dir: Path) -> dict:
     """Write ``analysis.json`` (and ``analysis_cycles.csv``) into a completed run."""
-    from ..study import analyse
+    from filmfriction.analysis.analyze import analyse_run as analyse
 
     return analyse(Path(run_dir))
 

@@ -13,8 +13,11 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.util import json_default, read_json_object, write_atomic
+from filmfriction.md_inputs.contract import SWEEP_FILE
 
 from ..md.locks import DirectoryLock
+from ..inputs import UserError
+
 
 PLAN_SCHEMA = "filmfriction.sweep/1"
 POINT_SCHEMA = "filmfriction.sweep-point/1"
@@ -33,8 +36,6 @@ def max_points() -> int:
 
 
 def _user_error(message: str) -> Exception:
-    from ..cli.main import UserError
-
     return UserError(message)
 
 
@@ -326,7 +327,7 @@ def write_plan(plan: SweepPlan, out: Path) -> list[str]:
                "overrides": {**plan.fixed, **p.values}, "parameters": plan.parameters[p.name]}
         if _write_if_changed(out / "inputs" / f"{p.name}.json", _dumps(doc)):
             changed.append(p.name)
-    _write_if_changed(out / "sweep.json", _dumps(plan.as_dict()))
+    _write_if_changed(out / SWEEP_FILE, _dumps(plan.as_dict()))
     return changed
 
 

@@ -20,14 +20,15 @@ import numpy as np
 
 from filmfriction.analysis.util import write_atomic
 from filmfriction.analysis.analyze import to_json
+from filmfriction.md_inputs.contract import AGGREGATE_FILE, CALIBRATION_FILE, SFB_FILE
 from filmfriction.reduced_model.sfb.rows import find_row
+
+from .sweep.aggregate import load_aggregate
 
 __all__ = ["CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
            "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",
-           "read_report_inputs"]
+           "read_report_inputs", "split_sweeps"]
 
-CALIBRATION_FILE = "calibration.json"
-SFB_FILE = "sfb.json"
 #: The slips' traces go to ``<stem><suffix>`` beside ``sfb.json``.
 SFB_TRACES_SUFFIX = "_slips.csv"
 #: The traces kept run from y to this many slip times.
@@ -279,3 +280,27 @@ def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dic
                                f"`calibration.json`; `{sfb_cmd}` recomputes it.")
         got.missing.append((f"{sfb_path} for this calibration.json", sfb_cmd))
     return got
+
+
+def split_sweeps(paths: list) -> tuple[list, list]:
+    """Run directories, and sweeps (directories with ``aggregate.json``).
+
+    A sweep contributes its stick-slip runs (its ``calibration_runs``, else all
+    its runs) to the calibration, after the run directories given directly.
+    """
+    runs, sweeps, seen = [], [], set()
+
+    def add(d):
+        # each run once, however it is written (r1, ./r1/, /abs/r1, or within a sweep)
+        if Path(d).resolve() not in seen:
+            seen.add(Path(d).resolve())
+            runs.append(d)
+    for p in paths:
+        if (p / AGGREGATE_FILE).exists():
+            agg = load_aggregate(p)
+            sweeps.append(agg)
+            for d in agg.calibration_runs or agg.run_dirs:
+                add(d)
+        else:
+            add(p)
+    return runs, sweeps
