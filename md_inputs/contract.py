@@ -30,7 +30,7 @@ from enum import IntEnum
 
 __all__ = ["DATA_FILE", "RUN_FILE", "SCENE_FILE", "COMMAND_FILE", "LOG_FILE", "TRACE_DAT_FILE",
            "TRACE_FILE", "RESTARTS_FILE", "ANALYSIS_FILE", "CALIBRATION_FILE", "SFB_FILE",
-           "SWEEP_FILE", "AGGREGATE_FILE", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
+           "SWEEP_FILE", "AGGREGATE_FILE", "SLIDE_ORIGIN_FILE", "RESUME_OFFSETS", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
            "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
            "column", "fix_print_text", "fix_print_title", "check_head"]
 
@@ -54,6 +54,12 @@ CALIBRATION_FILE = "calibration.json"  #: the reduced model calibrated on the ru
 SFB_FILE = "sfb.json"                  #: the SFB check (``sfb_slips.csv`` beside it)
 SWEEP_FILE = "sweep.json"              #: a sweep directory's plan
 AGGREGATE_FILE = "aggregate.json"      #: a finished sweep's aggregate
+SLIDE_ORIGIN_FILE = "slide_origin.txt"  #: the wall's x and z at the slide's start (for a resume)
+
+#: The energy ledger's running sums a resumed run continues from: the trace column at the
+#: restart step -> the script's variable that starts the sum there.
+RESUME_OFFSETS = {"drive_work": "drive_work0", "thermostat_heat": "heat0",
+                  "mount_heat": "mount_heat0"}
 
 
 # ---------------------------------------------------------------- atom types

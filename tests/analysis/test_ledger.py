@@ -4,7 +4,7 @@ import pytest
 
 from filmfriction.analysis import energy
 from filmfriction.md_inputs import contract
-from filmfriction.workflows.md import runner
+from filmfriction.workflows.md import sanity
 from filmfriction.workflows.md.scene import load
 
 
@@ -45,12 +45,12 @@ def test_the_ledger_counts_every_sink():
 
 def test_the_runner_fails_a_run_whose_ledger_does_not_close():
     scene = load("stick-slip")
-    assert runner.ledger_problem(_dat(0.0), scene) is None
-    assert runner.ledger_problem(_dat(0.4), scene) is None          # 4 %: within the limit
-    msg = runner.ledger_problem(_dat(0.6), scene)                   # 6 %
+    assert sanity.ledger_problem(_dat(0.0), scene) is None
+    assert sanity.ledger_problem(_dat(0.4), scene) is None          # 4 %: within the limit
+    msg = sanity.ledger_problem(_dat(0.6), scene)                   # 6 %
     assert msg.startswith("energy ledger does not close: residual 0.6 epsilon is 6 % of "
                           "the energy turned over (10 epsilon; limit 5 %)")
-    assert runner.trace_problem(_dat(0.6), scene) == msg
+    assert sanity.trace_problem(_dat(0.6), scene) == msg
 
 
 def test_the_runner_has_no_ledger_of_its_own(monkeypatch):
@@ -63,5 +63,5 @@ def test_the_runner_has_no_ledger_of_its_own(monkeypatch):
 
     scene = load("stick-slip")
     monkeypatch.setattr(energy, "ledger", inflated)
-    assert runner.ledger_problem(_dat(0.1), scene).startswith(
+    assert sanity.ledger_problem(_dat(0.1), scene).startswith(
         "energy ledger does not close: residual 2 epsilon")

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from filmfriction.md_inputs.contract import RESUME_OFFSETS
 from filmfriction.workflows.md import runner
 from filmfriction.workflows.md.scene import SceneError
 
@@ -155,7 +156,7 @@ def test_ledger_carried_across_a_cut_off_resume(tmp_path, md, monkeypatch):
     runner.resume(out, nprocs=1, progress=False)
     after = runner.read_trace_dat(out / "trace.dat")
     again = after[after[:, 0] == 2000][0]
-    for name in runner.LEDGER_SUMS:
+    for name in RESUME_OFFSETS:
         assert again[col(name)] == pytest.approx(at_restart[col(name)], rel=1e-9, abs=1e-9), name
     assert md.ledger_closure(md.trace(out)) < 0.02
 

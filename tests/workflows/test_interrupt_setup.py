@@ -92,7 +92,7 @@ def _locked(run_dir: Path) -> bool:
     return False
 
 
-@pytest.mark.parametrize("where", ["_rewrite_trace_dat", "run_engine"],
+@pytest.mark.parametrize("where", ["rewrite_trace_dat", "run_engine"],
                          ids=["run.json set to running", "engine not started"])
 def test_signal_during_setup_of_a_resume(tmp_path, where, interrupted_run):
     run_dir = interrupted_run(tmp_path / "run")

@@ -46,12 +46,12 @@ def test_every_figure_loads_in_headless_chromium(synthetic_study, report_checks)
 
 def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
     from filmfriction.analysis.observables.structure_section import Structure, fig_film
-    from filmfriction.workflows.report import render as report
+    from filmfriction.workflows.report import sections
 
     assert fig_film(tmp_path) == (None, "")
     run = SimpleNamespace(run_dir=tmp_path, analysis={"skipped": {
         "structure": "no trajectory.dcd + topology.data in the run directory"}})
-    sec = report._observable_section(Structure(), run, {})
+    sec = sections.observable_section(Structure(), run, {})
     assert sec.title == "The film: density profile and picture"
     text = [b for b in sec.blocks if isinstance(b, str)]
     assert any("`film-structure` scene" in b and "no trajectory.dcd" in b for b in text), text
@@ -212,7 +212,7 @@ def test_the_lambda_zeta_legend_is_off_the_plane(monkeypatch):
     """A contact in the lower right of the plane (a compared run, Klein's) was under the legend."""
     from matplotlib.figure import Figure
 
-    from filmfriction.workflows.report.render import fig_lambda_zeta
+    from filmfriction.workflows.report.plots import fig_lambda_zeta
 
     clear, savefig = [], Figure.savefig
 

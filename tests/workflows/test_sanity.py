@@ -1,4 +1,4 @@
-"""Physics sanity of a finished run (runner.sanity_warnings) and the lost-atoms
+"""Physics sanity of a finished run (sanity.sanity_warnings) and the lost-atoms
 hint, on synthetic traces and parameters: fast, no LAMMPS."""
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from filmfriction.workflows.md import runner
+from filmfriction.workflows.md import lammps_output, sanity, trace_dat
 from filmfriction.workflows.md.scene import load
 
 
@@ -31,7 +32,7 @@ def _dat(scene, n=400, **change):
 
 def test_a_sane_run_has_no_warnings():
     s = _scene()
-    assert runner.sanity_warnings(_dat(s), s) == []
+    assert sanity.sanity_warnings(_dat(s), s) == []
 
 
 @pytest.mark.parametrize("column, values, check", [
@@ -52,7 +53,7 @@ def test_each_check_names_itself_and_the_values(column, values, check):
         check = "wall speed: 0.01 sigma/tau in steady sliding against the drive V = 0.02"
     else:
         dat = _dat(s, n, **{column: values(n, s)})
-    warnings = runner.sanity_warnings(dat, s)
+    warnings = sanity.sanity_warnings(dat, s)
     assert len(warnings) == 1 and check in warnings[0], warnings
 
 
@@ -60,17 +61,17 @@ def test_stick_slip_is_not_taken_for_a_slow_wall():
     s = _scene()
     n = 400
     v = np.where(np.arange(n) % 50 < 40, 0.0, 5 * s.parameters["drive_velocity"])
-    assert runner.sanity_warnings(_dat(s, n, wall_velocity=v), s) == []
+    assert sanity.sanity_warnings(_dat(s, n, wall_velocity=v), s) == []
 
 
 def test_finish_records_completed_with_warnings(tmp_path):
     s = _scene()
     dat = _dat(s, 400, film_temperature=np.full(400, 1.4))
-    runner._rewrite_trace_dat(tmp_path / "trace.dat", dat)
+    trace_dat.rewrite_trace_dat(tmp_path / "trace.dat", dat)
     record = {"segments": [], "trace_parameters": {}}
     runner._finish(tmp_path, record, replace(s, parameters={**s.parameters,
                                                               "slide_steps": 399 * 50}),
-                   runner.EngineOutcome(returncode=0, error=None), None)
+                   lammps_output.EngineOutcome(returncode=0, error=None), None)
     saved = json.loads((tmp_path / "run.json").read_text())
     assert saved["status"] == "completed_with_warnings"
     assert saved["warnings"][0].startswith("film temperature")
@@ -87,11 +88,11 @@ def test_finish_records_completed_with_warnings(tmp_path):
 def test_lost_atoms_hint_names_the_cause_from_the_parameters(params, cause):
     s = _scene()
     s = replace(s, parameters={**s.parameters, **params})
-    hint = runner.lost_atoms_hint(s)
+    hint = sanity.lost_atoms_hint(s)
     # the named cause comes first: the most likely one
     assert hint.startswith(" (atoms left the box; likely cause: ") and cause in hint, hint
     assert hint.index(cause) < 80, hint
 
 
 def test_lost_atoms_hint_for_default_parameters_blames_nothing_in_particular():
-    assert "none of" in runner.lost_atoms_hint(_scene())
+    assert "none of" in sanity.lost_atoms_hint(_scene())

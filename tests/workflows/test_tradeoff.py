@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 from filmfriction.workflows.md import fidelity
-from filmfriction.workflows.cost import tradeoff
+from filmfriction.workflows.cost import tradeoff, tradeoff_figures, tradeoff_reduced, tradeoff_table
 from filmfriction.workflows.md.scene import SceneError, load
 
 
 def test_pareto_front_keeps_only_undominated_points():
     cost = [1.0, 2.0, 3.0, 4.0, 0.5, math.nan]
     error = [5.0, -1.0, 2.0, 0.5, 9.0, 0.0]      # |error| counts; NaN cost is left out
-    front = tradeoff.pareto_front(cost, error)
+    front = tradeoff_figures.pareto_front(cost, error)
     assert [int(i) for i in front] == [4, 0, 1, 3]
 
 
@@ -24,20 +24,20 @@ def test_drift_recovers_a_slope_and_its_noise():
     t = np.linspace(0.0, 100.0, 5001)
     rng = np.random.default_rng(3)
     r = 0.02 * t + np.cumsum(rng.normal(0.0, 0.05, t.size))
-    slope, se = tradeoff.drift(t, r)
+    slope, se = tradeoff_table.drift(t, r)
     assert slope == pytest.approx((r[-1] - r[0]) / 100.0)
     assert 0 < se < 0.05
     assert abs(slope - 0.02) < 4 * se + 0.01
 
 
 def test_compare_combines_standard_errors_and_zeroes_the_reference():
-    names = list(tradeoff.OBSERVABLES)
-    a = tradeoff.Measurement({n: (10.0, 3.0) for n in names}, 5, "stick-slip", 1.0)
-    b = tradeoff.Measurement({n: (7.0, 4.0) for n in names}, 5, "stick-slip", 1.0)
-    row = tradeoff.compare(a, b, is_reference=False)
+    names = list(tradeoff_table.OBSERVABLES)
+    a = tradeoff_table.Measurement({n: (10.0, 3.0) for n in names}, 5, "stick-slip", 1.0)
+    b = tradeoff_table.Measurement({n: (7.0, 4.0) for n in names}, 5, "stick-slip", 1.0)
+    row = tradeoff_table.compare(a, b, is_reference=False)
     assert row["error_static_force"] == 3.0
     assert row["error_static_force_uncertainty"] == 5.0
-    ref = tradeoff.compare(b, b, is_reference=True)
+    ref = tradeoff_table.compare(b, b, is_reference=True)
     assert ref["error_period"] == 0.0 and ref["error_period_uncertainty"] == 0.0
 
 
@@ -66,7 +66,7 @@ def test_every_planned_setting_is_a_valid_scene_with_one_reference_per_knob(quic
 
 
 def test_reduced_integrators_agree_with_the_closed_form():
-    rows = {r["value"]: r for r in tradeoff.reduced_rows(repeat=1)}
+    rows = {r["value"]: r for r in tradeoff_reduced.reduced_rows(repeat=1)}
     assert rows["closed_form"]["reference"]
     assert rows["closed_form"]["cycles"] >= 20
     for label, r in rows.items():
@@ -132,7 +132,7 @@ def test_tiny_study_writes_table_json_and_figures(tmp_path, monkeypatch, run_cli
     for r in rows:
         assert r["cost_seconds"] > 0 and r["cost_seconds_per_tau"] > 0
         assert r["atom_steps_per_second"] > 0 and r["memory_peak_rss_mb"] > 1
-        for name in tradeoff.OBSERVABLES:
+        for name in tradeoff_table.OBSERVABLES:
             assert f"error_{name}" in r and f"error_{name}_uncertainty" in r
     assert rows[0]["error_static_force"] == 0.0
     # the same trajectory traced every 40 steps instead of 20: identical dynamics (20 tau,
@@ -147,24 +147,24 @@ def test_tiny_study_writes_table_json_and_figures(tmp_path, monkeypatch, run_cli
     with open(out / "tradeoff.csv") as fh:
         table = list(csv.DictReader(fh))
     assert len(table) == len(rows) and "error_period_uncertainty" in table[0]
-    for name in tradeoff.OBSERVABLES:
+    for name in tradeoff_table.OBSERVABLES:
         assert (out / f"pareto_{name}.png").stat().st_size > 1000
 
 
 def test_figures_are_written_atomically(tmp_path, monkeypatch):
-    written, write_atomic = [], tradeoff.write_atomic
+    written, write_atomic = [], tradeoff_figures.write_atomic
 
     def record(path, data):
         written.append(path.name)
         return write_atomic(path, data)
 
-    monkeypatch.setattr(tradeoff, "write_atomic", record)
+    monkeypatch.setattr(tradeoff_figures, "write_atomic", record)
     row = {"knob": "timestep", "value": "0.01", "reference": False, "cost_seconds": 2.0,
-           **{f"error_{n}": 0.1 for n in tradeoff.OBSERVABLES},
-           **{f"error_{n}_uncertainty": 0.01 for n in tradeoff.OBSERVABLES}}
-    paths = tradeoff.plot([row, {**row, "value": "0.005", "reference": True}], tmp_path)
+           **{f"error_{n}": 0.1 for n in tradeoff_table.OBSERVABLES},
+           **{f"error_{n}_uncertainty": 0.01 for n in tradeoff_table.OBSERVABLES}}
+    paths = tradeoff_figures.plot([row, {**row, "value": "0.005", "reference": True}], tmp_path)
     assert sorted(written) == sorted(p.name for p in paths) == sorted(
-        f"pareto_{n}.png" for n in tradeoff.OBSERVABLES)
+        f"pareto_{n}.png" for n in tradeoff_table.OBSERVABLES)
 
 
 def test_point_labels_do_not_overlap_each_other_or_the_markers():
@@ -181,7 +181,7 @@ def test_point_labels_do_not_overlap_each_other_or_the_markers():
     ax.set_xscale("log")
     ax.set_ylim(0, 25)
     fig.tight_layout()
-    anns = tradeoff.place_labels(ax, points)
+    anns = tradeoff_figures.place_labels(ax, points)
     renderer = fig.canvas.get_renderer()
     boxes = [a.get_window_extent(renderer) for a in anns]
     assert [a.get_text() for a in anns] == [p[0] for p in points]
@@ -195,15 +195,15 @@ def test_point_labels_do_not_overlap_each_other_or_the_markers():
 
 
 def test_seeds_combine_into_the_mean_and_its_scatter():
-    runs = [tradeoff.Measurement(values={"static_force": (m, 0.1)}, cycles=6, regime=r, area=58.7)
+    runs = [tradeoff_table.Measurement(values={"static_force": (m, 0.1)}, cycles=6, regime=r, area=58.7)
             for m, r in ((90.0, "stick-slip"), (96.0, "stick-slip"), (99.0, "irregular"))]
-    both = tradeoff.combine(runs)
+    both = tradeoff_table.combine(runs)
     mean, se = both.values["static_force"]
     assert mean == pytest.approx(95.0)
     # the scatter over the runs (std 4.58), not the runs' own 0.1
     assert se == pytest.approx(np.std([90.0, 96.0, 99.0], ddof=1) / np.sqrt(3))
     assert both.cycles == 18 and both.regime == "mixed: irregular, stick-slip"
-    assert tradeoff.combine(runs[:1]) is runs[0]
+    assert tradeoff_table.combine(runs[:1]) is runs[0]
 
 
 @pytest.mark.parametrize("value", ["0", "101", "-2"])

@@ -6,6 +6,7 @@ import pytest
 
 from filmfriction.analysis import green_kubo as gk
 from filmfriction.workflows.cli import viscosity_cli
+from filmfriction.workflows.md import viscosity_run
 from filmfriction.workflows.cli.main import main
 
 STATE = ["viscosity", "--temperature", "0.722", "--density", "0.8442"]
@@ -82,7 +83,7 @@ def test_the_default_relative_run_directory_reaches_lammps(monkeypatch, tmp_path
         raise Stop
 
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(viscosity_cli.subprocess, "Popen", popen)
+    monkeypatch.setattr(viscosity_run.subprocess, "Popen", popen)
     run_dir = Path("runs") / "viscosity-relative"
     run_dir.mkdir(parents=True)
     settings = viscosity_cli.settings_from_args(viscosity_cli.argparse.Namespace(

@@ -8,7 +8,8 @@ import sys
 from datetime import datetime
 from pathlib import Path
 
-from ..cost.tradeoff import study, summary
+from ..cost.tradeoff import study
+from ..cost.tradeoff_table import summary
 from ..inputs import check_ranks, check_writable, UserError
 
 

@@ -39,8 +39,6 @@ its numerics: their "errors" are what the cheaper model changes in the answer.
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import multiprocessing
@@ -57,23 +55,12 @@ from filmfriction.analysis.util import json_safe, write_atomic
 from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 
 from ..md.scene import WCA_CUTOFF as WCA
+from .tradeoff_figures import plot
+from .tradeoff_reduced import reduced_rows
+from .tradeoff_table import (EXTENSIVE, Measurement, combine, compare, drift, value_and_error,
+                             write_csv)
 
 SCENE = "stick-slip"
-
-# name -> unit; the order is the order of the table's columns
-OBSERVABLES = {
-    "static_force": "epsilon/sigma",
-    "slip_distance": "sigma",
-    "period": "tau",
-    "eta_eff": "epsilon tau/sigma^3",
-    "ledger_closure": "1",
-    "energy_drift": "epsilon/tau",
-}
-# observables whose value grows with the contact area: scaled to the base area
-EXTENSIVE = {"static_force", "energy_drift"}
-COST_FIELDS = ("cost_seconds", "cost_seconds_per_tau", "cost_seconds_per_cycle",
-               "atom_steps_per_second", "memory_peak_rss_mb", "memory_lammps_mb_per_rank",
-               "atoms", "steps", "simulated_tau", "cycles")
 
 
 # ----------------------------------------------------------------- the plan
@@ -266,51 +253,6 @@ def run_setting(overrides: dict, out: Path, nprocs: int = 2,
                    lammps_mb_per_rank=max(memory) if memory else math.nan)
 
 
-# ----------------------------------------------------------------- measuring
-@dataclass(frozen=True)
-class Measurement:
-    """Observables of one setting: name -> (mean, standard error)."""
-
-    values: dict
-    cycles: int
-    regime: str
-    area: float
-
-
-def _pair(entry) -> tuple[float, float]:
-    if not entry:
-        return math.nan, math.nan
-    mean, se = entry.get("mean"), entry.get("stderr")
-    return (math.nan if mean is None else float(mean)), (math.nan if se is None else float(se))
-
-
-def drift(time_, residual, blocks: int = 5) -> tuple[float, float]:
-    """Slope of the ledger residual with its standard error from block slopes.
-
-    Parameters
-    ----------
-    time_, residual : array
-        Time and the cumulative ledger residual (zero at the start).
-    blocks : int
-        Equal-time blocks; the spread of their mean slopes gives the error.
-
-    Returns
-    -------
-    (slope, stderr) : tuple of float
-    """
-    t = np.asarray(time_, float)
-    r = np.asarray(residual, float)
-    if t.size < 2 or t[-1] <= t[0]:
-        return math.nan, math.nan
-    slope = (r[-1] - r[0]) / (t[-1] - t[0])
-    edges = np.linspace(t[0], t[-1], blocks + 1)
-    idx = np.searchsorted(t, edges)
-    idx[-1] = t.size - 1
-    slopes = [(r[b] - r[a]) / (t[b] - t[a]) for a, b in zip(idx[:-1], idx[1:]) if t[b] > t[a]]
-    se = float(np.std(slopes, ddof=1) / math.sqrt(len(slopes))) if len(slopes) > 1 else math.nan
-    return float(slope), se
-
-
 def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0,
             trace_stride: int = 1) -> Measurement:
     """Analyse a run (or the first ``prefix`` of it) into the study's observables.
@@ -339,10 +281,10 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     scale = (area_ref / area) if area_ref else 1.0
     slips = doc["slips"]
     values = {
-        "static_force": _pair(slips["static_force"]),
-        "slip_distance": _pair(slips["slip_distance"]),
-        "period": _pair(slips["period"]),
-        "eta_eff": _pair(doc["viscosity"].get("from_slip", {}).get("eta_eff")),
+        "static_force": value_and_error(slips["static_force"]),
+        "slip_distance": value_and_error(slips["slip_distance"]),
+        "period": value_and_error(slips["period"]),
+        "eta_eff": value_and_error(doc["viscosity"].get("from_slip", {}).get("eta_eff")),
     }
     led = energy.ledger({c: trace.columns[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)
                          if trace.has(c)})
@@ -358,25 +300,6 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
                        area=area)
 
 
-def combine(measurements: list[Measurement]) -> Measurement:
-    """One setting's runs with different seeds as one measurement: each observable's mean
-    over the runs, with the standard error of that mean over the runs (the runs' own
-    standard errors for a single run).  Cycles add up; the regime is the runs' regimes."""
-    if len(measurements) == 1:
-        return measurements[0]
-    values = {}
-    for name in measurements[0].values:
-        means = np.array([m.values[name][0] for m in measurements], float)
-        ok = means[np.isfinite(means)]
-        values[name] = ((float(ok.mean()), float(ok.std(ddof=1) / math.sqrt(ok.size)))
-                        if ok.size > 1 else
-                        (float(ok[0]) if ok.size else math.nan, math.nan))
-    regimes = sorted({m.regime for m in measurements})
-    return Measurement(values=values, cycles=sum(m.cycles for m in measurements),
-                       regime=regimes[0] if len(regimes) == 1 else "mixed: " + ", ".join(regimes),
-                       area=measurements[0].area)
-
-
 def _seeded(params: dict, k: int) -> dict:
     """The scene's parameters for the k-th seed of a setting (k = 0: as they are)."""
     if k == 0:
@@ -388,119 +311,6 @@ def _seeded(params: dict, k: int) -> dict:
 
 def _dirname(label: str) -> str:
     return label.replace("=", "-").replace(" ", "-")
-
-
-def compare(setting: Measurement, reference: Measurement, is_reference: bool) -> dict:
-    """``error_<obs>`` = setting − reference with ``error_<obs>_uncertainty``.
-
-    The uncertainty combines both standard errors in quadrature; for a run
-    compared with itself both are zero.  A missing standard error (fewer
-    than two cycles) gives a NaN uncertainty: the error is then not tested.
-    """
-    row = {}
-    for name in OBSERVABLES:
-        m, s = setting.values[name]
-        mr, sr = reference.values[name]
-        row[f"value_{name}"] = m
-        if is_reference:
-            row[f"error_{name}"], row[f"error_{name}_uncertainty"] = 0.0, 0.0
-        else:
-            row[f"error_{name}"] = m - mr
-            row[f"error_{name}_uncertainty"] = math.hypot(s, sr)
-    return row
-
-
-# ----------------------------------------------------------------- the reduced model
-# The reduced model stands in for the default MD run: M, K and V of the default
-# scene, Coulomb friction with the measured Fs and a kinetic force (Fs + Fb)/2,
-# so that an undamped slip re-sticks at the measured Fb = 2 Fk - Fs; a light
-# viscous term (damping ratio 0.045) keeps the slip dynamics non-trivial.  The
-# MD mount dashpot acts on v - V and has no counterpart in SpringBlock's
-# ground damper, so it is left out.  1100 tau hold 24 cycles.
-REDUCED = {"mass": 500.0, "stiffness": 100.0, "drive_velocity": 0.02, "damping": 0.0,
-           "static": 98.7, "kinetic": 61.2, "viscous": 20.0, "duration": 1100.0}
-#: the knob of the reduced model's rows
-REDUCED_KNOB = "reduced_integrator"
-
-
-def _reduced_block():
-    from filmfriction.reduced_model import SpringBlock, laws
-
-    r = REDUCED
-    return SpringBlock(mass=r["mass"], stiffness=r["stiffness"],
-                       drive_velocity=r["drive_velocity"], damping=r["damping"],
-                       law=laws.Coulomb(static=r["static"], kinetic=r["kinetic"],
-                                        viscous=r["viscous"]))
-
-
-def _reduced_measure(t, f, x, yields, sticks) -> dict:
-    from filmfriction.analysis.stickslip import cycle_table
-
-    table = cycle_table(t, f, yields, sticks, spring_constant=REDUCED["stiffness"],
-                        wall_position=x)
-    summ = table.summary(skip=1)
-    out = {}
-    for name in ("static_force", "slip_distance", "period"):
-        s = summ[name]
-        out[name] = (float(s["mean"]), 0.0)  # deterministic: no sampling error
-    return out
-
-
-def reduced_rows(repeat: int = 3) -> list[dict]:
-    """Cost and error of the reduced model's integrators against the closed form.
-
-    The closed form and the event-driven ODE path at several tolerances
-    (:meth:`SpringBlock.simulate <filmfriction.reduced_model.SpringBlock.simulate>`), and a
-    plain ``solve_ivp`` RK45 loop as a user writes it
-    (:func:`filmfriction.reduced_model.integrators.rk45.rk45_stick_slip`).
-    """
-    from filmfriction.reduced_model.integrators.rk45 import rk45_stick_slip
-
-    block = _reduced_block()
-    T = REDUCED["duration"]
-    variants = [("closed_form", {"method": "closed_form"}),
-                ("ode_rtol_1e-4", {"method": "ode", "rtol": 1e-4}),
-                ("ode_rtol_1e-7", {"method": "ode", "rtol": 1e-7}),
-                ("ode_rtol_1e-10", {"method": "ode", "rtol": 1e-10}),
-                ("solve_ivp_rk45_rtol_1e-3", {"rk45": 1e-3}),
-                ("solve_ivp_rk45_rtol_1e-6", {"rk45": 1e-6}),
-                ("solve_ivp_rk45_rtol_1e-9", {"rk45": 1e-9})]
-    results = {}
-    for label, kw in variants:
-        best = math.inf
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            if "rk45" in kw:
-                t, f, x, kinds = rk45_stick_slip(block, T, rtol=kw["rk45"])
-                yi = np.array([i for i, k in enumerate(kinds) if k == "slip"])
-                si = np.array([i for i, k in enumerate(kinds) if k == "stick"])
-                n = min(len(yi), len(si))
-                values = _reduced_measure(t, f, x, yi[:n], si[:n])
-                values["ledger_closure"] = (math.nan, math.nan)
-            else:
-                res = block.simulate(T, **kw)
-                yi, si = res.slip_pairs()
-                values = _reduced_measure(res.t, res.spring_force, res.x, yi, si)
-                values["ledger_closure"] = (float(res.energy.closure), 0.0)
-            best = min(best, time.perf_counter() - t0)
-        values["eta_eff"] = (math.nan, math.nan)
-        values["energy_drift"] = (math.nan, math.nan)
-        results[label] = (Measurement(values, len(yi), "stick-slip", 1.0), best)
-    ref = results["closed_form"][0]
-    rows = []
-    for label, (meas, seconds) in results.items():
-        row = {"knob": REDUCED_KNOB, "value": label, "reference": label == "closed_form",
-               "cost_seconds": seconds, "cost_seconds_per_tau": seconds / T,
-               "cost_seconds_per_cycle": seconds / T * meas.values["period"][0],
-               "atom_steps_per_second": math.nan, "memory_peak_rss_mb": math.nan,
-               "memory_lammps_mb_per_rank": math.nan, "atoms": 1, "steps": math.nan,
-               "simulated_tau": T, "cycles": meas.cycles, "regime": meas.regime}
-        row.update(compare(meas, ref, label == "closed_form"))
-        # ledger closure is the model's own check, not a difference: report it as is
-        row["error_ledger_closure"] = meas.values["ledger_closure"][0]
-        row["error_ledger_closure_uncertainty"] = 0.0
-        rows.append(row)
-    return rows
 
 
 # ----------------------------------------------------------------- the study
@@ -599,171 +409,6 @@ def md_rows(study: Plan, out: Path, nprocs: int = 2, log=print, seeds: int = 1) 
     return rows
 
 
-def columns() -> list[str]:
-    cols = ["knob", "value", "reference", *COST_FIELDS, "regime", "seeds"]
-    for name in OBSERVABLES:
-        cols += [f"value_{name}", f"error_{name}", f"error_{name}_uncertainty"]
-    return cols + ["run_dir"]
-
-
-def write_csv(rows: list[dict], path: Path) -> Path:
-    cols = columns()
-    buf = io.StringIO(newline="")
-    w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore")
-    w.writeheader()
-    for row in rows:
-        w.writerow({c: _fmt(row.get(c)) for c in cols})
-    return write_atomic(path, buf.getvalue())
-
-
-def _fmt(v):
-    if isinstance(v, float):
-        return "" if not math.isfinite(v) else f"{v:.6g}"
-    return "" if v is None else v
-
-
-def pareto_front(cost, error) -> np.ndarray:
-    """Indices of the points no other point beats in both cost and |error|, by cost."""
-    cost, error = np.asarray(cost, float), np.abs(np.asarray(error, float))
-    ok = np.flatnonzero(np.isfinite(cost) & np.isfinite(error))
-    order = ok[np.lexsort((error[ok], cost[ok]))]
-    front, best = [], math.inf
-    for i in order:
-        if error[i] < best:
-            front.append(i)
-            best = error[i]
-    return np.array(front, dtype=int)
-
-
-#: where a point's label may go, in points from the point (tried in this order)
-LABEL_OFFSETS = ((4, 3), (4, -9), (-4, 3), (-4, -9), (6, -3), (-6, -3), (0, 6), (0, -12),
-                 (10, 8), (10, -14), (-10, 8), (-10, -14), (14, -3), (-14, -3))
-
-
-def place_labels(ax, labels) -> list:
-    """Annotate each (text, x, y) next to its point where it covers no other label, no
-    marker and stays inside the axes: the first free offset of :data:`LABEL_OFFSETS`,
-    else the one that overlaps least.  Returns the annotations."""
-    fig = ax.figure
-    renderer = fig.canvas.get_renderer()
-    to_display = ax.transData.transform
-    frame = ax.get_window_extent(renderer)
-    pad = 3.5 * fig.dpi / 72.0                                  # a marker's radius, in pixels
-    markers = [to_display((x, y)) for _, x, y in labels]
-    placed, out = [], []
-    for text, x, y in labels:
-        best = None
-        for dx, dy in LABEL_OFFSETS:
-            ann = ax.annotate(text, (x, y), fontsize=7, xytext=(dx, dy), textcoords="offset points",
-                              ha="left" if dx >= 0 else "right")
-            box = ann.get_window_extent(renderer)
-            cost = sum(_area(box, other) for other in placed)
-            cost += sum(_area(box, (mx - pad, my - pad, mx + pad, my + pad)) for mx, my in markers)
-            cost += box.width * box.height - _area(box, frame)    # the part outside the axes
-            if best is None or cost < best[0]:
-                if best is not None:
-                    best[1].remove()
-                best = (cost, ann, box)
-            else:
-                ann.remove()
-            if cost == 0.0:
-                break
-        placed.append(best[2])
-        out.append(best[1])
-    return out
-
-
-def _area(box, other) -> float:
-    """Area of the intersection of a display-space bbox with a bbox or (x0, y0, x1, y1)."""
-    x0, y0, x1, y1 = other.extents if hasattr(other, "extents") else other
-    w = min(box.x1, x1) - max(box.x0, x0)
-    h = min(box.y1, y1) - max(box.y0, y0)
-    return w * h if w > 0 and h > 0 else 0.0
-
-
-def plot(rows: list[dict], out: Path) -> list[Path]:
-    """One cost–error PNG per observable: the MD settings, and beside them on their own
-    cost axis the reduced model's integrators (milliseconds against the MD's seconds)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter, MaxNLocator
-
-    paths = []
-    knobs = sorted({r["knob"] for r in rows})
-    colors = dict(zip(knobs, plt.cm.tab10.colors))
-    for name, unit in OBSERVABLES.items():
-        # references are the zero of their knob's errors: shown, not part of the front
-        pts = [r for r in rows if not r["reference"]
-               and r.get(f"error_{name}") is not None and math.isfinite(r[f"error_{name}"])]
-        reduced = any(r["knob"] == REDUCED_KNOB for r in pts)
-        fig, axes = plt.subplots(1, 2 if reduced else 1, figsize=(9, 4.5) if reduced else (7.5, 4.5),
-                                 sharey=True, squeeze=False,
-                                 gridspec_kw={"width_ratios": [3, 1]} if reduced else None)
-        ax, ax_reduced = axes[0, 0], (axes[0, 1] if reduced else None)
-        labels = []
-        for knob in knobs:
-            sel = [r for r in pts if r["knob"] == knob]
-            if not sel:
-                continue
-            x = [r["cost_seconds"] for r in sel]
-            y = [abs(r[f"error_{name}"]) for r in sel]
-            e = [r[f"error_{name}_uncertainty"] for r in sel]
-            known = [v is not None and math.isfinite(v) for v in e]
-            e = [v if k else 0.0 for v, k in zip(e, known)]
-            target = ax_reduced if knob == REDUCED_KNOB else ax
-            if knob == REDUCED_KNOB:
-                x = [1e3 * xi for xi in x]                   # milliseconds
-            target.errorbar(x, y, yerr=e, fmt="o", color=colors[knob], label=knob, capsize=3)
-            # hollow: no uncertainty (a single cycle), so no measured error
-            target.scatter([xi for xi, k in zip(x, known) if not k],
-                           [yi for yi, k in zip(y, known) if not k], s=60, color="white",
-                           edgecolors=colors[knob], zorder=3)
-            if knob != REDUCED_KNOB:      # the integrators sit on one spot; the table names them
-                labels += [(r["value"], xi, yi) for xi, yi, r in zip(x, y, sel)]
-        # the front is over the MD settings with a measured error: the reduced model
-        # answers another question (the spring-block ODE) and would dominate any MD
-        # setting trivially
-        md = [r for r in pts if r["knob"] != REDUCED_KNOB
-              and r.get(f"error_{name}_uncertainty") is not None
-              and math.isfinite(r[f"error_{name}_uncertainty"])]
-        if md:
-            idx = pareto_front([r["cost_seconds"] for r in md],
-                               [r[f"error_{name}"] for r in md])
-            if idx.size:
-                ax.step([md[i]["cost_seconds"] for i in idx],
-                        [abs(md[i][f"error_{name}"]) for i in idx], where="post",
-                        color="k", lw=1, alpha=0.6, label="Pareto front (MD)")
-        ax.set_xscale("log")
-        # plain numbers at 1, 2, 3, 5 x 10^k: the MD costs span about one decade
-        plain = FuncFormatter(lambda v, _: f"{v:g}" if f"{v:.0e}"[0] in "1235" else "")
-        ax.xaxis.set_major_formatter(plain)
-        ax.xaxis.set_minor_formatter(plain)
-        ax.set_ylim(bottom=0.0)
-        ax.set_xlabel("cost: wall seconds of the MD run (--np ranks)")
-        ax.set_ylabel(f"|error of {name}| [{unit}]")
-        if reduced:
-            ax_reduced.set_xlim(left=0.0)
-            ax_reduced.xaxis.set_major_locator(MaxNLocator(4))
-            ax_reduced.set_xlabel("cost: ms, reduced model (1 core)")
-        fig.suptitle(f"{name}: error against each knob's reference (bars: 1 s.e.)", fontsize=11)
-        handles = [h for a in axes[0] for h in zip(*a.get_legend_handles_labels())]
-        if handles:
-            # beside the axes: inside, it would sit on points or their labels
-            axes[0, -1].legend(*zip(*handles), fontsize=7, loc="upper left",
-                               bbox_to_anchor=(1.03, 1.0), borderaxespad=0.0)
-        fig.tight_layout()
-        place_labels(ax, labels)
-        path = out / f"pareto_{name}.png"
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=110)
-        plt.close(fig)
-        write_atomic(path, buf.getvalue())
-        paths.append(path)
-    return paths
-
-
 def study(quick: bool, out: Path, nprocs: int = 2, log=print, seeds: int = 1) -> list[dict]:
     """Run the study; write ``tradeoff.csv``, ``tradeoff.json`` and the PNGs under ``out``."""
     out.mkdir(parents=True, exist_ok=False)
@@ -778,23 +423,3 @@ def study(quick: bool, out: Path, nprocs: int = 2, log=print, seeds: int = 1) ->
     return rows
 
 
-def summary(rows: list[dict]) -> str:
-    """A text table: cost and the relative error ± uncertainty of Fs, slip, period, eta."""
-    head = f"{'knob':20s} {'value':26s} {'s':>7s} {'s/tau':>7s} {'MB':>6s}"
-    names = ("static_force", "slip_distance", "period", "eta_eff", "energy_drift")
-    head += "".join(f" {n[:12]:>19s}" for n in names)
-    lines = [head]
-    for r in rows:
-        line = (f"{r['knob']:20s} {r['value'] + (' (ref)' if r['reference'] else ''):26s} "
-                f"{_g(r.get('cost_seconds'), 7)} {_g(r.get('cost_seconds_per_tau'), 7)} "
-                f"{_g(r.get('memory_peak_rss_mb'), 6)}")
-        for n in names:
-            e, u = r.get(f"error_{n}"), r.get(f"error_{n}_uncertainty")
-            line += f" {_g(e, 9)}±{_g(u, 9, left=True)}"
-        lines.append(line)
-    return "\n".join(lines)
-
-
-def _g(v, width, left=False):
-    text = "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.3g}"
-    return f"{text:<{width}s}" if left else f"{text:>{width}s}"

