@@ -17,7 +17,8 @@ Lengths are in the trajectory's units (σ for an LJ run).
 Atom types of a filmfriction run are the script's contract
 (:mod:`filmfriction.md_inputs.contract`): the film, and each wall as all of
 its types (its rigid part and, with ``wall_model = flexible``, its mobile
-planes facing the film).
+planes facing the film).  The structure section of ``analysis.json`` is built
+from these by :mod:`filmfriction.analysis.observables.structure_section`.
 """
 from __future__ import annotations
 
@@ -28,11 +29,9 @@ from MDAnalysis.analysis.base import AnalysisBase
 from scipy.signal import find_peaks
 from scipy.spatial import cKDTree
 
-from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
-
 __all__ = ["DensityProfile", "HexaticOrder", "LayerNeighbours", "psi6_per_layer",
            "FilmThickness", "find_layers",
-           "frame_steps", "lammps_frame_interval", "open_trajectory", "summarize_run"]
+           "frame_steps", "lammps_frame_interval", "open_trajectory", "select_types"]
 
 
 def find_layers(centers, density, *, min_spacing: float = 0.5,
@@ -441,7 +440,7 @@ def _facing_plane(depth, step: float) -> np.ndarray:
     return order[:gaps[0] + 1] if gaps.size else order
 
 
-def _select_types(universe, types):
+def select_types(universe, types):
     return universe.select_atoms("type " + " ".join(str(int(t)) for t in types))
 
 
@@ -501,52 +500,3 @@ def open_trajectory(topology, trajectory, dt: float | None = None):
         return mda.Universe(str(topology), str(trajectory), format="DCD",
                             topology_format="DATA", atom_style="id type x y z",
                             **({"dt": dt} if dt else {}))
-
-
-def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
-                  film_types=FILM_TYPES, bottom_types=BOTTOM_WALL_TYPES,
-                  top_types=TOP_WALL_TYPES, step: int = 1) -> dict:
-    """Structure section of ``analysis.json`` for one run.
-
-    Layers from the mean density profile; ψ6 per layer and the gap per
-    frame; with a trace that has a ``step`` column and a slip table, frames
-    are split into stick and slip (t(y) <= t <= t(s)) and the means of ψ6
-    and gap are reported for each.  The film and each wall are the atoms of
-    the given types (default: the script's contract, either wall model).
-    """
-    u = open_trajectory(topology, trajectory)
-    film = _select_types(u, film_types)
-    if film.n_atoms == 0:
-        raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "
-                         f"in {topology}")
-    prof = DensityProfile(film).run(step=step)
-    layers = prof.results.layers
-    out = {"frames": int(prof.n_frames), "units": units,
-           "layers": {"count": layers["count"],
-                      "positions": layers["positions"].tolist(),
-                      "spacing": {"mean": layers["spacing"], "std": layers["spacing_std"]}}}
-    hex_ = HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
-    bottom = _select_types(u, bottom_types)
-    top = _select_types(u, top_types)
-    gap = FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
-    if hex_ is not None:
-        out["psi6"] = {"per_layer_mean": np.nanmean(hex_.results.psi6, axis=0).tolist()}
-    if gap is not None:
-        out["gap"] = {"mean": float(np.mean(gap.results.gap)),
-                      "std": float(np.std(gap.results.gap))}
-    steps = frame_steps(u)
-    if (trace is not None and table is not None and len(table) and steps is not None
-            and trace.has("step")):
-        frames = np.arange(u.trajectory.n_frames)[slice(None, None, step)]
-        t_frame = np.interp(steps[frames], trace.columns["step"], trace.time)
-        slipping = np.zeros(frames.size, bool)
-        for ty, ts in zip(table.yield_time, table.stick_time):
-            slipping |= (t_frame >= ty) & (t_frame <= ts)
-        for name, mask in (("stick", ~slipping), ("slip", slipping)):
-            sec = {"frames": int(mask.sum())}
-            if mask.any() and hex_ is not None:
-                sec["psi6_per_layer"] = np.nanmean(hex_.results.psi6[mask], axis=0).tolist()
-            if mask.any() and gap is not None:
-                sec["gap"] = float(np.mean(gap.results.gap[mask]))
-            out[name] = sec
-    return out

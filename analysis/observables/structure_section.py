@@ -12,10 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
+
 from ..trace import unit
 from .observable import Context, Observable, format_value, png_bytes, pyplot, shade_slips
 
-__all__ = ["Structure", "universe", "fig_film"]
+__all__ = ["Structure", "summarize_run", "universe", "fig_film"]
 
 TRAJECTORY, TOPOLOGY = "trajectory.dcd", "topology.data"
 
@@ -25,6 +27,57 @@ def universe(run_dir: Path):
     from ..structure import open_trajectory
 
     return open_trajectory(run_dir / TOPOLOGY, run_dir / TRAJECTORY)
+
+
+def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
+                  film_types=FILM_TYPES, bottom_types=BOTTOM_WALL_TYPES,
+                  top_types=TOP_WALL_TYPES, step: int = 1) -> dict:
+    """Structure section of ``analysis.json`` for one run.
+
+    Layers from the mean density profile; ψ6 per layer and the gap per
+    frame; with a trace that has a ``step`` column and a slip table, frames
+    are split into stick and slip (t(y) <= t <= t(s)) and the means of ψ6
+    and gap are reported for each.  The film and each wall are the atoms of
+    the given types (default: the script's contract, either wall model).
+    """
+    from .. import structure as st
+
+    u = st.open_trajectory(topology, trajectory)
+    film = st.select_types(u, film_types)
+    if film.n_atoms == 0:
+        raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "
+                         f"in {topology}")
+    prof = st.DensityProfile(film).run(step=step)
+    layers = prof.results.layers
+    out = {"frames": int(prof.n_frames), "units": units,
+           "layers": {"count": layers["count"],
+                      "positions": layers["positions"].tolist(),
+                      "spacing": {"mean": layers["spacing"], "std": layers["spacing_std"]}}}
+    hex_ = st.HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
+    bottom = st.select_types(u, bottom_types)
+    top = st.select_types(u, top_types)
+    gap = st.FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
+    if hex_ is not None:
+        out["psi6"] = {"per_layer_mean": np.nanmean(hex_.results.psi6, axis=0).tolist()}
+    if gap is not None:
+        out["gap"] = {"mean": float(np.mean(gap.results.gap)),
+                      "std": float(np.std(gap.results.gap))}
+    steps = st.frame_steps(u)
+    if (trace is not None and table is not None and len(table) and steps is not None
+            and trace.has("step")):
+        frames = np.arange(u.trajectory.n_frames)[slice(None, None, step)]
+        t_frame = np.interp(steps[frames], trace.columns["step"], trace.time)
+        slipping = np.zeros(frames.size, bool)
+        for ty, ts in zip(table.yield_time, table.stick_time):
+            slipping |= (t_frame >= ty) & (t_frame <= ts)
+        for name, mask in (("stick", ~slipping), ("slip", slipping)):
+            sec = {"frames": int(mask.sum())}
+            if mask.any() and hex_ is not None:
+                sec["psi6_per_layer"] = np.nanmean(hex_.results.psi6[mask], axis=0).tolist()
+            if mask.any() and gap is not None:
+                sec["gap"] = float(np.mean(gap.results.gap[mask]))
+            out[name] = sec
+    return out
 
 
 class Structure(Observable):
@@ -45,10 +98,8 @@ class Structure(Observable):
         if not (traj and topo):
             ctx.skip_part(self.key, f"no {TRAJECTORY} + {TOPOLOGY} in the run directory")
             return None, {}
-        from .. import structure
-
         try:
-            return structure.summarize_run(topo, traj, trace=trace, table=ctx.all_slips,
+            return summarize_run(topo, traj, trace=trace, table=ctx.all_slips,
                                            units=ctx.units), {}
         except (ValueError, OSError) as exc:
             ctx.skip_part(self.key, f"{traj}: {exc}")

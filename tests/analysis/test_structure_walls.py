@@ -6,7 +6,8 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from filmfriction.analysis.structure import FilmThickness, frame_steps, summarize_run
+from filmfriction.analysis.observables.structure_section import summarize_run
+from filmfriction.analysis.structure import FilmThickness, frame_steps
 from filmfriction.analysis.synthetic import layered_film
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, TOP_WALL_TYPES
 from filmfriction.md_inputs.geometry import plane_spacing
