@@ -10,6 +10,10 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -c constraints.txt -e '.[test,sweep]'
+	# mypy and pyright resolve filmfriction.* from the checkout: a folder on the venv's
+	# path (a .pth file) holds a link named filmfriction to this checkout
+	mkdir -p $(VENV)/src && ln -sfn "$(CURDIR)" $(VENV)/src/filmfriction
+	$(BIN)/python -c 'import pathlib, site; pathlib.Path(site.getsitepackages()[0], "filmfriction-src.pth").write_text("$(CURDIR)/$(VENV)/src\n")'
 	touch $(STAMP)
 
 # The main job: the default study, then a preview of the Klein-similar scene (about 1.5 min

@@ -25,9 +25,20 @@ from __future__ import annotations
 
 import importlib
 import pkgutil
+from typing import TYPE_CHECKING
 
 from .base import REGISTRY, FrictionLaw, registered
 from .films import carreau_viscosity, newtonian_damping
+
+if TYPE_CHECKING:
+    # the laws by name for type checkers, which do not run the registration below
+    # (tests/reduced_model/test_law_contract.py checks this list is every law)
+    from .contact_age import ContactAge
+    from .coulomb import Coulomb
+    from .films import NewtonianFilm, ShearThinningFilm, ThinningFilmWithSliding
+    from .lubricated import LubricatedFilm
+    from .rate_state import RateState
+    from .stribeck import ExponentialWeakening, StribeckExponential, StribeckSchnelle
 
 
 def _import_every_module() -> dict[str, type[FrictionLaw]]:

@@ -245,3 +245,18 @@ def test_the_contract_catches_broken_laws():
         check_friction_curve(FeedsEnergy)
     with pytest.raises(pytest.fail.Exception):
         check_refused(AcceptsAnything, {"kinetic": -0.1})
+
+
+def test_type_checkers_see_every_law():
+    """``laws/__init__.py`` names every registered law for type checkers (which do
+    not run the registration): its ``if TYPE_CHECKING`` block lists exactly the laws."""
+    import ast
+    from pathlib import Path
+
+    from filmfriction.reduced_model import laws as laws_package
+
+    tree = ast.parse(Path(laws_package.__file__).read_text())
+    block = next(n for n in tree.body if isinstance(n, ast.If)
+                 and getattr(n.test, "id", None) == "TYPE_CHECKING")
+    named = {a.name for n in block.body for a in n.names}
+    assert named == set(laws_package._LAWS), named ^ set(laws_package._LAWS)
