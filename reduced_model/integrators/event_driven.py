@@ -26,9 +26,11 @@ DOP853 with a right-hand side on plain Python floats, the displacement counted
 from the slip's start, and the re-stick located by Newton's method on the RK
 step map (see its docstring).
 
-Laws with a state (and stiff ones) run on LSODA whose step cap follows the
-local damping ratio (:class:`_LocalCapLSODA`): a creeping hold of a light block
-no longer crawls at a sixteenth of the natural period.
+Laws with a state (and stiff ones) run on LSODA; where a slip starts
+overdamped (the local damping ratio above :data:`OVERDAMPED`, e.g. a creeping
+hold of a light block) the step cap follows that ratio, on Radau
+(:class:`_LocalCapRadau`), so the hold does not crawl at a sixteenth of the
+natural period.
 
 Smooth laws (rate-and-state, films without a yield force) are one ODE; their
 ``slip``/``stick`` events mark the maxima/minima of the spring force.  Those with
@@ -58,48 +60,26 @@ __all__ = ["run_ode"]
 MAX_STEPS = 20_000_000
 
 
-class _LocalCapLSODA(LSODA):
-    """LSODA whose largest step follows the local damping of the slip.
+class _WatchedLSODA(LSODA):
+    """LSODA with a fixed step cap that gives up when it stalls.
 
-    The step cap (a sixteenth of the natural period) only has to resolve an
-    oscillation, and a slip damped by its own friction (rate-and-state near
-    rest: dF/dv = a N / v) does not oscillate: it relaxes over (d + dF/dv)/K.
-    A fixed cap there forces LSODA through ~10^6 tiny steps of a creeping hold
-    (a light, stiff block) even after it has switched to BDF.  Before each step
-    the cap becomes ``cap(t, y)`` -- the period/16 scaled by the local damping
-    ratio where that exceeds :data:`OVERDAMPED` -- and is handed to the
-    integrator as a changed optional input (ISTATE = 3, the documented way to
-    change HMAX mid-run).  scipy's C port of LSODA restarts its history on
-    ISTATE = 3, so the cap changes only when it moves by more than 10x.  Should scipy's
-    internals differ, the constructor's fixed cap stays (the old behaviour).
-
-    A stick-slip run of a light block can still trap LSODA in steps far below any
+    A stick-slip run of a light block can trap LSODA in steps far below any
     time scale of the motion (10^5 steps per natural period where 10^2 do).  More
     than :data:`STEPS_PER_PERIOD` steps per natural period elapsed (plus as many
-    to start) count as a failure, and the caller redoes the segment with Radau.
+    to start) count as a failure, and the caller redoes the segment with
+    :class:`_LocalCapRadau`.  ``cap`` is accepted for the same call as Radau's and
+    not used: scipy's LSODA takes its step cap once, at the start.
     """
 
     def __init__(self, fun, t0, y0, t_bound, *, cap=None, period=math.inf, **kwargs):
         super().__init__(fun, t0, y0, t_bound, **kwargs)
-        self._cap, self._t_start, self._period = cap, t0, period
+        self._t_start, self._period, self._count = t0, period, 0
 
     def _step_impl(self):
-        self._count = getattr(self, "_count", 0) + 1
+        self._count += 1
         if self._count > STEPS_PER_PERIOD * (1.0 + (self.t - self._t_start) / self._period):
             return False, (f"LSODA took more than {STEPS_PER_PERIOD} steps per natural period "
                            f"by t = {self.t:.6g}")
-        if self._count % 4 != 1:                # the cap is a slow variable: look every 4 steps
-            return super()._step_impl()
-        try:
-            integ = self._lsoda_solver._integrator
-            old = float(integ.rwork[5])
-            new = float(self._cap(self.t, self.y))
-            # ISTATE = 3 restarts LSODA's history (scipy's C port): change the cap rarely
-            if integ.call_args[3] == 2 and not 0.1 * old <= new <= 10.0 * old:
-                integ.rwork[5] = new
-                integ.call_args[3] = 3          # ISTATE = 3: optional inputs changed
-        except (AttributeError, IndexError, TypeError):
-            pass
         return super()._step_impl()
 
 
@@ -281,16 +261,21 @@ def run_ode(p: Problem, rtol: float = 1e-10):
         y0 = np.concatenate(([x, v, 0.0, 0.0, 0.0], state))
         solver, extra = method, {}
         if method == "LSODA":
-            solver = _LocalCapLSODA
-            extra = {"cap": _local_cap(friction, u, d, M, K, p.period, max_step), "period": p.period}
+            # the step cap follows the local damping ratio (a creeping hold of a light
+            # block does not crawl at a sixteenth of the natural period): a segment that
+            # starts overdamped runs on Radau, whose cap may change at every step; the
+            # others on LSODA with the fixed cap, Radau redoing the segment if it stalls
+            cap = _local_cap(friction, u, d, M, K, p.period, max_step)
+            solver = _LocalCapRadau if cap(0.0, y0) > max_step else _WatchedLSODA
+            extra = {"cap": cap, "period": p.period}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
                             max_step=max_step, events=events, dense_output=not has_stick, **extra)
-        if not (sol.status == -1 and solver is _LocalCapLSODA):   # else Radau takes over below
+        if not (sol.status == -1 and solver is _WatchedLSODA):   # else Radau takes over below
             for w in caught:
                 warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        if sol.status == -1 and solver is _LocalCapLSODA:
+        if sol.status == -1 and solver is _WatchedLSODA:
             rec.nfev += sol.nfev
             # scipy's finite-difference Jacobian may overflow while it grows an increment;
             # it recovers, and the RuntimeWarning would only alarm the user

@@ -35,7 +35,7 @@ def test_light_block_stick_slip_no_stall(monkeypatch):
     block = SpringBlock(mass=0.1, stiffness=0.05, drive_velocity=0.1, law=law)
     r = block.simulate(80.0, initial_velocity=0.05)
     assert r.success and r.nfev < 400_000
-    monkeypatch.setattr(hybrid, "_LocalCapLSODA", hybrid._LocalCapRadau)   # Radau throughout
+    monkeypatch.setattr(hybrid, "_WatchedLSODA", hybrid._LocalCapRadau)   # Radau throughout
     with np.errstate(over="ignore"):
         radau = block.simulate(80.0, initial_velocity=0.05)
     assert [e.kind for e in r.events] == [e.kind for e in radau.events] and len(r.events) >= 6
