@@ -81,7 +81,7 @@ def test_a_lammps_trajectory_time_is_the_trace_time(tmp_path):
 
     p = resolve({"timestep": 0.004, "equilibrate_steps": 0, "slide_steps": 60,
                  "dump_every": 20, "trace_every": 10, "restart_every": 0})
-    scene = Scene(name="time", description="", models="", observables=("structure",),
+    scene = Scene(name="time", description="", models="", outputs=("structure",),
                   expected_cost="", parameters=p)
     (tmp_path / DATA_FILE).write_text(scene.geometry().lammps_data())
     cmd = engine.lmp_command(1, md_inputs.script("film_slide.lmp"), scene.lammps_variables())

@@ -121,7 +121,7 @@ def test_the_script_reads_the_contract_types():
 def test_the_data_file_has_the_contract_types():
     from filmfriction.md_inputs.geometry import TYPE_SYMBOLS
 
-    text = Scene(name="types", description="", models="", observables=(), expected_cost="",
+    text = Scene(name="types", description="", models="", outputs=(), expected_cost="",
                  parameters=resolve({"wall_model": "flexible"})).geometry().lammps_data()
     assert f"{len(AtomType)} atom types" in text
     atoms = text[text.index("Atoms # atomic"):].splitlines()[2:]
@@ -143,7 +143,7 @@ ASKED_FOR = {"dump_every": 0, "profile_every": 0}
 def _default_variables() -> dict[str, str]:
     """What the runner passes to LAMMPS for a scene of default parameters that asks
     for no trajectory and no profiles."""
-    scene = Scene(name="defaults", description="", models="", observables=(),
+    scene = Scene(name="defaults", description="", models="", outputs=(),
                   expected_cost="", parameters=resolve({}))
     return scene.lammps_variables()
 

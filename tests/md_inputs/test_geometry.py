@@ -230,7 +230,7 @@ def test_the_script_reads_the_geometry(tmp_path, wall_model):
     its topology.data (written before any step) holds the same atoms, and the gap is
     measured between the walls' facing planes."""
     p = resolve({"wall_model": wall_model})
-    scene = Scene(name="geometry", description="", models="", observables=(),
+    scene = Scene(name="geometry", description="", models="", outputs=(),
                   expected_cost="", parameters=p)
     g = scene.geometry()
     (tmp_path / DATA_FILE).write_text(g.lammps_data())
@@ -253,7 +253,7 @@ def test_the_script_reads_the_geometry(tmp_path, wall_model):
 @pytest.mark.md
 def test_the_script_refuses_a_data_file_of_other_parameters(tmp_path):
     p = resolve({})
-    scene = Scene(name="geometry", description="", models="", observables=(),
+    scene = Scene(name="geometry", description="", models="", outputs=(),
                   expected_cost="", parameters=p)
     (tmp_path / DATA_FILE).write_text(_geometry(film_layers=4).lammps_data())
     variables = {**scene.lammps_variables(), "equilibrate_steps": "0", "slide_steps": "0"}

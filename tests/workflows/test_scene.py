@@ -24,7 +24,7 @@ def test_contract_names_exist():
         assert name in PARAMETERS
 
 
-def test_outputs_follow_observables():
+def test_the_engine_writes_what_the_outputs_ask():
     plain = load("stick-slip")
     assert not plain.writes_trajectory and not plain.writes_profiles
     v = plain.lammps_variables()
@@ -32,6 +32,15 @@ def test_outputs_follow_observables():
     rich = load("film-structure")
     assert rich.writes_trajectory and rich.writes_profiles
     assert int(rich.lammps_variables()["dump_every"]) > 0
+
+
+def test_the_key_observables_is_refused_naming_outputs(tmp_path):
+    path = tmp_path / "old.toml"
+    path.write_text('name = "old"\ndescription = ""\nmodels = ""\nexpected_cost = ""\n'
+                    'observables = ["stick_slip"]\n')
+    with pytest.raises(SceneError, match=r"'observables' is not a scene key.*outputs = \[") as exc:
+        load(str(path))
+    assert "\n" not in str(exc.value)
 
 
 @pytest.mark.parametrize("key,value,fragment", [

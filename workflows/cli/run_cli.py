@@ -58,7 +58,7 @@ def register(subparsers) -> None:
     s = subparsers.add_parser(
         "scenes", help="list the scenes with what they model and cost",
         description="List the shipped scenes: what each one models, its main parameters, "
-                    "its observables and its cost. A scene is a TOML file; give its name or "
+                    "its outputs and its cost. A scene is a TOML file; give its name or "
                     "the path of your own to 'filmfriction run'.")
     s.add_argument("--parameters", action="store_true",
                    help="list every scene parameter instead: unit, default, allowed range "
@@ -235,5 +235,5 @@ def list_scenes(args: argparse.Namespace) -> int:
         print(f"{name:18s} {scene.description}")
         print(f"{'':18s} V={p['drive_velocity']:g} K={p['spring_constant']:g} "
               f"P={p['normal_pressure']:g} T={p['temperature']:g} n={p['film_layers']}; "
-              f"observables: {', '.join(scene.observables)}; cost: {scene.expected_cost}")
+              f"outputs: {', '.join(scene.outputs)}; cost: {scene.expected_cost}")
     return 0

@@ -65,7 +65,7 @@ def scene_toml(scene: Scene) -> str:
              f"name = {json.dumps(scene.name)}",
              f"description = {json.dumps(scene.description)}",
              f"models = {json.dumps(scene.models)}",
-             f"observables = {json.dumps(list(scene.observables))}",
+             f"outputs = {json.dumps(list(scene.outputs))}",
              f"expected_cost = {json.dumps(scene.expected_cost)}",
              "", "[parameters]"]
     from .scene import PARAMETERS

@@ -397,7 +397,9 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],
-        models=record["scene"]["models"], observables=tuple(record["scene"]["observables"]),
+        models=record["scene"]["models"],
+        # a run directory of a version that called the outputs "observables"
+        outputs=tuple(record["scene"].get("outputs", record["scene"].get("observables", ()))),
         expected_cost=record["scene"]["expected_cost"],
         parameters=scene_mod.resolve(params), source=record["scene"].get("source", ""),
         script=record["scene"].get("script", ""),

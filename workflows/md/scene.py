@@ -5,7 +5,7 @@ A scene is a TOML file (see ``workflows/md/scenes/``)::
     name = "stick-slip"
     description = "one line"
     models = "a paragraph: what physics this scene stands for"
-    observables = ["stick_slip", "energy", "viscosity_from_slip"]
+    outputs = ["stick_slip", "energy", "viscosity_from_slip"]
     expected_cost = "about 1 minute on 2 cores"
 
     [parameters]          # LJ reduced units, names as in PARAMETERS below
@@ -168,8 +168,9 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
 ]}
 del P
 
-# What each observable needs from the engine beyond the trace.
-OBSERVABLES = {
+# The scene's outputs: what each asks of the engine beyond the trace (the trace's own
+# quantities, or a trajectory, or profiles); a scene lists the ones it needs.
+OUTPUTS = {
     "stick_slip": "stick-slip events from the spring force (trace)",
     "energy": "energy partition and ledger (trace)",
     "viscosity_from_slip": "effective viscosity from the slip dynamics (trace)",
@@ -195,7 +196,7 @@ class Scene:
     name: str
     description: str
     models: str
-    observables: tuple[str, ...]
+    outputs: tuple[str, ...]
     expected_cost: str
     parameters: dict[str, float | int] = field(hash=False)
     source: str = ""
@@ -204,11 +205,11 @@ class Scene:
 
     @property
     def writes_trajectory(self) -> bool:
-        return bool(NEEDS_TRAJECTORY & set(self.observables))
+        return bool(NEEDS_TRAJECTORY & set(self.outputs))
 
     @property
     def writes_profiles(self) -> bool:
-        return bool(NEEDS_PROFILES & set(self.observables))
+        return bool(NEEDS_PROFILES & set(self.outputs))
 
     def derived(self) -> dict[str, float]:
         return derived_quantities(self.parameters)
@@ -240,7 +241,7 @@ class Scene:
 
     def as_dict(self) -> dict:
         return {"name": self.name, "description": self.description, "models": self.models,
-                "observables": list(self.observables), "expected_cost": self.expected_cost,
+                "outputs": list(self.outputs), "expected_cost": self.expected_cost,
                 "parameters": dict(self.parameters), "source": self.source,
                 "script": self.script, "lammps_packages": list(self.lammps_packages)}
 
@@ -424,17 +425,20 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
                          "a scene is a UTF-8 TOML file") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    allowed = {"name", "description", "models", "observables", "expected_cost", "parameters",
+    if "observables" in data:
+        raise SceneError(f"{path}: 'observables' is not a scene key: the engine's outputs are "
+                         f"listed as outputs = [...] ({', '.join(OUTPUTS)}); rename the key")
+    allowed = {"name", "description", "models", "outputs", "expected_cost", "parameters",
                "script", "lammps_packages"}
     unknown = set(data) - allowed
     if unknown:
         raise SceneError(f"{path}: unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}")
-    observables = data.get("observables", ["stick_slip", "energy"])
-    if not isinstance(observables, list) or not all(isinstance(o, str) for o in observables):
-        raise SceneError(f"{path}: observables must be a list of names")
-    bad = [o for o in observables if o not in OBSERVABLES]
+    outputs = data.get("outputs", ["stick_slip", "energy"])
+    if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
+        raise SceneError(f"{path}: outputs must be a list of names")
+    bad = [o for o in outputs if o not in OUTPUTS]
     if bad:
-        raise SceneError(f"{path}: unknown observables {bad}; known: {sorted(OBSERVABLES)}")
+        raise SceneError(f"{path}: unknown outputs {bad}; known: {sorted(OUTPUTS)}")
     params = data.get("parameters", {})
     if not isinstance(params, dict):
         raise SceneError(f"{path}: [parameters] must be a table")
@@ -450,7 +454,7 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
     return Scene(name=name,
                  description=str(data.get("description", "")),
                  models=str(data.get("models", "")),
-                 observables=tuple(observables),
+                 outputs=tuple(outputs),
                  expected_cost=str(data.get("expected_cost", "")),
                  parameters=resolved, source=str(path),
                  script=_own_script(path, data.get("script")),
