@@ -1,3 +1,6 @@
+# Over 500 lines as one module: the three kinds of trace (run directory, plain file,
+# analysed file) share the reader, the column mapping and the units; split, each part would
+# import the others.
 """Read a stick-slip trace: a run directory, a plain trace file, or an analysed one.
 
 A plain trace file has a header line naming its columns (``time`` and

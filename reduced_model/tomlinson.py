@@ -29,7 +29,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ._checks import finite, non_negative, positive
-from .integrators.event_driven import _force_extrema
+from .integrators.event_driven import force_extrema
 from .result import SimulationResult, ledger_from_series
 from .integrators.trajectory import Recorder
 
@@ -158,7 +158,7 @@ class PrandtlTomlinson:
                          1e-12 * energy, 1e-12 * energy])
         sol = solve_ivp(rhs, (0.0, T), [0.0, 0.0, 0.0, 0.0], method="DOP853", rtol=1e-10,
                         atol=atol, max_step=max_step, dense_output=True)
-        ts, ys, marks = _force_extrema(sol.t, sol.y, sol.sol, lambda t, y: y[1] - V,
+        ts, ys, marks = force_extrema(sol.t, sol.y, sol.sol, lambda t, y: y[1] - V,
                                        lambda t, y: K * (V * t - y[0]))
         result = self._result(ts, ys[0], ys[1], ys[2], ys[3], np.zeros_like(ts), marks, sol.nfev)
         if sol.status == -1:

@@ -6,7 +6,8 @@
   cycle in closed form (the damped oscillator of
   :mod:`~filmfriction.reduced_model.integrators.oscillator`);
 * :mod:`~filmfriction.reduced_model.integrators.event_driven` — any law: an ODE solver
-  between exact stick/slip events;
+  between exact stick/slip events; its fast path for stateless laws with static
+  friction is :mod:`~filmfriction.reduced_model.integrators.dop853_slip`;
 * :mod:`~filmfriction.reduced_model.integrators.limit_cycle` and
   :mod:`~filmfriction.reduced_model.integrators.smooth_steps` — the rate-and-state fast
   path (compiled steps to the limit cycle);

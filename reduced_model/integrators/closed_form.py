@@ -75,7 +75,7 @@ def _freeze_time(osc: DampedOscillator, e0: float, ed0: float, level: float, sig
         t0, e, ed = t0 + tau, e_next, target
 
 
-def _tile_cycles(rec, cycle, sigma, t, x, xa, T):
+def tile_cycles(rec, cycle, sigma, t, x, xa, T):
     """At a yield: if the run since the previous yield was one slip and one stick the same
     way, the rest of the run repeats it exactly, so tile it (all but the last cycle).
 
@@ -163,7 +163,7 @@ def run_closed_form(p: Problem, static, kinetic: float, viscous: float,
             sigma = math.copysign(1.0, rate)
             mode = "slip"
             rec.event("slip", t, K * (xa - x))
-            t, x, xa, cycle = _tile_cycles(rec, cycle, sigma, t, x, xa, T)
+            t, x, xa, cycle = tile_cycles(rec, cycle, sigma, t, x, xa, T)
             continue
 
         f_kin = 0.0 if smooth else sigma * kinetic

@@ -21,7 +21,7 @@ spanning a whole oscillation could miss two crossings.
 
 Stateless laws with static friction (Coulomb via ``method="ode"``, the
 Stribeck curves, exponential weakening, films with a yield force unless
-heavily damped) take a fast path, :func:`_slip_dop853`: Hairer's Fortran
+heavily damped) take a fast path, :func:`~filmfriction.reduced_model.integrators.dop853_slip.slip_dop853`: Hairer's Fortran
 DOP853 with a right-hand side on plain Python floats, the displacement counted
 from the slip's start, and the re-stick located by Newton's method on the RK
 step map (see its docstring).
@@ -52,7 +52,8 @@ from scipy.integrate import LSODA, Radau, solve_ivp
 from scipy.optimize import brentq
 
 from .._checks import SimulationLimitError
-from .closed_form import _tile_cycles, settle, stick_break_time
+from .closed_form import settle, stick_break_time, tile_cycles
+from .dop853_slip import slip_dop853
 from .trajectory import Problem
 
 __all__ = ["run_ode"]
@@ -200,102 +201,97 @@ def run_ode(p: Problem, rtol: float = 1e-10):
             rec.event("slip", t, K * (xa - x))
             if not state.size:
                 # stateless: every slip starts from the same relative state, the run is periodic
-                t, x, xa, cycle = _tile_cycles(rec, cycle, sigma, t, x, xa, T)
+                t, x, xa, cycle = tile_cycles(rec, cycle, sigma, t, x, xa, T)
             continue
 
+        marks, failure = [], None
         if has_stick and method == "DOP853":
             # stateless law: the slip runs on plain floats with the displacement counted
             # from the slip's start (rtol then applies to the slip, not to the whole run)
-            ts, ys, ended, nfev = _slip_dop853(law, N, M, K, d, u, va, K * (xa - x), v, sigma,
+            ts, ys, ended, nfev = slip_dop853(law, N, M, K, d, u, va, K * (xa - x), v, sigma,
                                                remaining, rtol, atol, max_step)
             ys[0] += x
             rec.nfev += nfev
-            rec.append(t + ts, ys[0], ys[1], xa + va * ts, ys[5:], ys[2], ys[3], ys[4])
-            x, v, xa, state = ys[0, -1], ys[1, -1], xa + va * ts[-1], ys[5:, -1].copy()
-            if not ended:
-                break
-            t += ts[-1]
-            mode, sigma = settle(K * (xa - x) - d * u, law.static_force(state, N))
-            rec.event("stick" if mode == "stick" else "reversal", t, K * (xa - x))
-            continue
-
-        xa_seg, sig = xa, sigma
-        if has_stick:
-            def friction(s, st):
-                return sig * law.sliding_force(max(sig * s, 0.0), st, N)
         else:
-            def friction(s, st):
-                return law.friction(s, st, N)
+            xa_seg, sig = xa, sigma
+            if has_stick:
+                def friction(s, st):
+                    return sig * law.sliding_force(max(sig * s, 0.0), st, N)
+            else:
+                def friction(s, st):
+                    return law.friction(s, st, N)
 
-        if rates is not None:
-            # a smooth law with a plain-float form (rate-and-state): the hot loop on floats
-            def rhs(tau, y):
-                x_, v_ = float(y[0]), float(y[1])
-                f_spring = K * (xa_seg + va * tau - x_)
-                s = v_ - u
-                fr, r = rates(s, y[5:].tolist())
-                return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s,
-                                 d * v_ * v_, *r))
-        elif law.state_names:
-            def rhs(tau, y):
-                f_spring = K * (xa_seg + va * tau - y[0])
-                s = y[1] - u
-                fr = friction(s, y[5:])
-                return np.concatenate(([y[1], (f_spring - d * y[1] - fr) / M, f_spring * va - fr * u,
-                                        fr * s, d * y[1] * y[1]], law.state_rate(abs(s), y[5:])))
-        else:
-            # stateless law: the same equations on plain floats (this is the hot loop)
-            def rhs(tau, y):
-                x_, v_ = float(y[0]), float(y[1])
-                f_spring = K * (xa_seg + va * tau - x_)
-                s = v_ - u
-                fr = float(friction(s, ()))
-                return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s, d * v_ * v_))
+            if rates is not None:
+                # a smooth law with a plain-float form (rate-and-state): the hot loop on floats
+                def rhs(tau, y):
+                    x_, v_ = float(y[0]), float(y[1])
+                    f_spring = K * (xa_seg + va * tau - x_)
+                    s = v_ - u
+                    fr, r = rates(s, y[5:].tolist())
+                    return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s,
+                                     d * v_ * v_, *r))
+            elif law.state_names:
+                def rhs(tau, y):
+                    f_spring = K * (xa_seg + va * tau - y[0])
+                    s = y[1] - u
+                    fr = friction(s, y[5:])
+                    return np.concatenate(([y[1], (f_spring - d * y[1] - fr) / M, f_spring * va - fr * u,
+                                            fr * s, d * y[1] * y[1]], law.state_rate(abs(s), y[5:])))
+            else:
+                # stateless law: the same equations on plain floats (this is the hot loop)
+                def rhs(tau, y):
+                    x_, v_ = float(y[0]), float(y[1])
+                    f_spring = K * (xa_seg + va * tau - x_)
+                    s = v_ - u
+                    fr = float(friction(s, ()))
+                    return np.array((v_, (f_spring - d * v_ - fr) / M, f_spring * va - fr * u, fr * s, d * v_ * v_))
 
-        events = []
-        if has_stick:
-            def stop(tau, y):
-                return y[1] - u
-            stop.terminal, stop.direction = True, -sig
-            events = [stop]
-        y0 = np.concatenate(([x, v, 0.0, 0.0, 0.0], state))
-        solver, extra = method, {}
-        if method == "LSODA":
-            # the step cap follows the local damping ratio (a creeping hold of a light
-            # block does not crawl at a sixteenth of the natural period): a segment that
-            # starts overdamped runs on Radau, whose cap may change at every step; the
-            # others on LSODA with the fixed cap, Radau redoing the segment if it stalls
-            cap = _local_cap(friction, u, d, M, K, p.period, max_step)
-            solver = _LocalCapRadau if cap(0.0, y0) > max_step else _WatchedLSODA
-            extra = {"cap": cap, "period": p.period}
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
-                            max_step=max_step, events=events, dense_output=not has_stick, **extra)
-        if not (sol.status == -1 and solver is _WatchedLSODA):   # else Radau takes over below
-            for w in caught:
-                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        if sol.status == -1 and solver is _WatchedLSODA:
+            events = []
+            if has_stick:
+                def stop(tau, y):
+                    return y[1] - u
+                stop.terminal, stop.direction = True, -sig
+                events = [stop]
+            y0 = np.concatenate(([x, v, 0.0, 0.0, 0.0], state))
+            solver, extra = method, {}
+            if method == "LSODA":
+                # the step cap follows the local damping ratio (a creeping hold of a light
+                # block does not crawl at a sixteenth of the natural period): a segment that
+                # starts overdamped runs on Radau, whose cap may change at every step; the
+                # others on LSODA with the fixed cap, Radau redoing the segment if it stalls
+                cap = _local_cap(friction, u, d, M, K, p.period, max_step)
+                solver = _LocalCapRadau if cap(0.0, y0) > max_step else _WatchedLSODA
+                extra = {"cap": cap, "period": p.period}
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                sol = solve_ivp(rhs, (0.0, remaining), y0, method=solver, rtol=rtol, atol=atol,
+                                max_step=max_step, events=events, dense_output=not has_stick, **extra)
+            if not (sol.status == -1 and solver is _WatchedLSODA):   # else Radau takes over below
+                for w in caught:
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            if sol.status == -1 and solver is _WatchedLSODA:
+                rec.nfev += sol.nfev
+                # scipy's finite-difference Jacobian may overflow while it grows an increment;
+                # it recovers, and the RuntimeWarning would only alarm the user
+                with np.errstate(over="ignore"):
+                    sol = solve_ivp(rhs, (0.0, remaining), y0, method=_LocalCapRadau, rtol=rtol,
+                                    atol=atol, max_step=max_step, events=events,
+                                    dense_output=not has_stick, **extra)
             rec.nfev += sol.nfev
-            # scipy's finite-difference Jacobian may overflow while it grows an increment;
-            # it recovers, and the RuntimeWarning would only alarm the user
-            with np.errstate(over="ignore"):
-                sol = solve_ivp(rhs, (0.0, remaining), y0, method=_LocalCapRadau, rtol=rtol,
-                                atol=atol, max_step=max_step, events=events,
-                                dense_output=not has_stick, **extra)
-        rec.nfev += sol.nfev
-        ts, ys = sol.t, sol.y
-        if not has_stick:
-            ts, ys, marks = _force_extrema(ts, ys, sol.sol, lambda tau, y: y[1] - va,
-                                           lambda tau, y: K * (xa_seg + va * tau - y[0]))
-        ended = has_stick and sol.status == 1
-        if ended:
-            ys[1, -1] = u                      # the root: slip velocity exactly zero
+            ts, ys = sol.t, sol.y
+            if not has_stick:
+                ts, ys, marks = force_extrema(ts, ys, sol.sol, lambda tau, y: y[1] - va,
+                                               lambda tau, y: K * (xa_seg + va * tau - y[0]))
+            ended = has_stick and sol.status == 1
+            if ended:
+                ys[1, -1] = u                      # the root: slip velocity exactly zero
+            if sol.status == -1:
+                failure = f"solve_ivp failed at t = {t + ts[-1]:.6g}: {sol.message}"
         rec.append(t + ts, ys[0], ys[1], xa + va * ts, ys[5:], ys[2], ys[3], ys[4])
-        if not has_stick:
+        if marks:
             rec.insert_events([t + tm for tm, _ in marks], [k for _, k in marks])
-        if sol.status == -1:
-            return rec.finish(status=-1, message=f"solve_ivp failed at t = {t + ts[-1]:.6g}: {sol.message}")
+        if failure is not None:
+            return rec.finish(status=-1, message=failure)
         x, v, xa, state = ys[0, -1], ys[1, -1], xa + va * ts[-1], ys[5:, -1].copy()
         if not ended:
             break
@@ -312,9 +308,10 @@ STEPS_PER_PERIOD = 5_000
 
 
 class _LocalCapRadau(Radau):
-    """Radau with the same local step cap (a plain attribute here: no restart); the
-    fallback when LSODA fails, e.g. starting a hold deep in creep, where the
-    relaxation rate a N / (M v) reaches 10^12 /s."""
+    """Radau whose step cap follows the local damping (``cap(t, y)`` before each step):
+    the route of a segment that starts overdamped, and the one that redoes a segment
+    LSODA stalled on, e.g. a hold deep in creep, where the relaxation rate a N / (M v)
+    reaches 10^12 /s."""
 
     def __init__(self, fun, t0, y0, t_bound, *, cap=None, period=None, **kwargs):
         super().__init__(fun, t0, y0, t_bound, **kwargs)
@@ -351,141 +348,7 @@ def _local_cap(friction, u, d, M, K, period, floor):
     return cap
 
 
-def _slip_dop853(law, N, M, K, d, u, va, f0, v0, sigma, t_end, rtol, atol, max_step):
-    """One slip of a stateless law with static friction, ended at s = 0.
-
-    Hairer's Fortran DOP853 (scipy.integrate.ode): the step loop runs in
-    Fortran; the right-hand side is a closure on plain floats (no NumPy in the
-    per-evaluation path) and a Python callback per accepted step watches the
-    sign of the slip velocity.  The state is (displacement since the slip began,
-    velocity, drive work, friction and damper dissipation), all starting at 0
-    but the velocity; ``f0`` is the spring force at the start.
-
-    The re-stick is the root of the slip velocity of the RK solution itself
-    (not of an interpolant): bracketed between two accepted steps, first guessed
-    by a cubic Hermite fit, then refined by Newton's method on the map "one
-    DOP853 step from the last accepted point to t" (its derivative is the
-    acceleration, known from the right-hand side), falling back to brentq on the
-    same map should Newton leave the bracket.
-    Returns (times, states, ended_at_restick, n_evaluations).
-    """
-    from scipy.integrate import ode
-
-    # scipy's dop853 wrapper takes a scalar atol: integrate z = y / scale with the
-    # per-component tolerances folded into the scale
-    scale = np.asarray(atol, dtype=float) / 1e-12
-    s0, s1, s2, s3, s4 = (float(c) for c in scale)
-    i0, i1, i2, i3, i4 = 1.0 / s0, 1.0 / s1, 1.0 / s2, 1.0 / s3, 1.0 / s4
-    # plain Python floats throughout: NumPy scalars would cost ~10x per operation
-    N, M, K, d, u, va, f0, sig = (float(c) for c in (N, M, K, d, u, va, f0, sigma))
-    sliding, Kva = law.scalar_sliding(N), K * va
-    ks0, a1, v0_scale, u_i2, dv_i4 = K * s0, i1 / M, s1 * i0, u * i2, d * i4
-    count = [0]
-
-    def f(tau, z):
-        count[0] += 1
-        z0, z1, _, _, _ = z.tolist()
-        vb = z1 * s1
-        f_spring = f0 + Kva * tau - ks0 * z0
-        s = vb - u
-        ss = sig * s
-        fr = sig * sliding(ss if ss > 0.0 else 0.0)
-        return [z1 * v0_scale, (f_spring - d * vb - fr) * a1, f_spring * va * i2 - fr * u_i2,
-                fr * s * i3, dv_i4 * vb * vb]
-
-    def slip_of(z):
-        return sig * (float(z[1]) * s1 - u)
-
-    ts, zs = [0.0], [np.array([0.0, v0 * i1, 0.0, 0.0, 0.0])]
-
-    def watch(tau, z):
-        if tau > ts[-1]:
-            ts.append(tau)
-            zs.append(np.array(z))
-            if slip_of(z) < 0.0:
-                return -1                       # crossed s = 0: stop and bracket
-        return 0
-
-    def solver(first_step=0.0):
-        return ode(f).set_integrator("dop853", rtol=rtol, atol=1e-12, nsteps=10 ** 8,
-                                     max_step=max_step, first_step=first_step)
-
-    main = solver()
-    main.set_solout(watch)
-    main.set_initial_value(zs[0], 0.0)
-    main.integrate(t_end)
-    if not slip_of(zs[-1]) < 0.0:
-        return np.array(ts), (np.array(zs) * scale).T, False, count[0]
-    t_a, z_a, t_b = ts[-2], zs[-2], ts[-1]
-
-    last = {t_a: z_a}
-
-    def state_at(tau):
-        if tau not in last:
-            sub = solver(first_step=tau - t_a)  # one step (if its error test passes)
-            sub.set_initial_value(z_a, t_a)
-            last.clear()
-            last[t_a], last[tau] = z_a, sub.integrate(tau)
-        return last[tau]
-
-    def slip_rate(tau, z):
-        return sig * f(tau, z)[1] * s1
-
-    t_root = _restick_root(state_at, slip_of, slip_rate, t_a, z_a, t_b, zs[-1])
-    y_root = state_at(t_root) * scale
-    y_root[1] = u                               # the root: slip velocity exactly zero
-    ys = np.array(zs) * scale
-    ts[-1], ys[-1] = t_root, y_root
-    return np.array(ts), ys.T, True, count[0]
-
-
-def _restick_root(state_at, slip_of, slip_rate, t_a, z_a, t_b, z_b):
-    """Root of ``slip_of(state_at(t))`` in [t_a, t_b] (slip >= 0 at t_a, < 0 at t_b)."""
-    g_a, g_b = slip_of(z_a), slip_of(z_b)
-    if g_a <= 0.0:
-        return t_a
-    h = t_b - t_a
-    xtol = max(1e-15 * abs(t_b), 1e-300)
-    # cubic Hermite guess from values and slopes at both ends, solved by Newton from
-    # the secant guess (the cubic is monotone enough on a bracket this short)
-    d_a, d_b = slip_rate(t_a, z_a) * h, slip_rate(t_b, z_b) * h
-    c2, c3 = 3.0 * (g_b - g_a) - 2.0 * d_a - d_b, 2.0 * (g_a - g_b) + d_a + d_b
-    theta = g_a / (g_a - g_b)
-    for _ in range(6):
-        slope = d_a + theta * (2.0 * c2 + 3.0 * c3 * theta)
-        if not slope < 0.0:
-            theta = g_a / (g_a - g_b)
-            break
-        theta -= (g_a + theta * (d_a + theta * (c2 + theta * c3))) / slope
-        if not 0.0 < theta < 1.0:
-            theta = g_a / (g_a - g_b)
-            break
-    lo, hi = t_a, t_b
-    t = t_a + theta * h
-    for _ in range(8):
-        t = min(max(t, lo), hi)
-        z = state_at(t)
-        g = slip_of(z)
-        if g == 0.0:
-            return t
-        if g > 0.0:
-            lo = t
-        else:
-            hi = t
-        rate = slip_rate(t, z)
-        step = -g / rate if rate != 0.0 else math.inf
-        if abs(step) <= xtol:
-            return t
-        t_new = t + step
-        if not lo < t_new < hi:
-            break                               # Newton left the bracket: bisect the rest
-        t = t_new
-    if hi == t_b and not slip_of(state_at(t_b)) < 0.0:
-        return t_b      # re-integrating the last step lands on s = 0 within round-off
-    return brentq(lambda tt: slip_of(state_at(tt)), lo, hi, xtol=xtol, rtol=8.9e-16)
-
-
-def _force_extrema(ts, ys, dense, rate, force, rel_tol=1e-6):
+def force_extrema(ts, ys, dense, rate, force, rel_tol=1e-6):
     """Maxima ("slip") and minima ("stick") of the spring force of a smooth run.
 
     Candidates are sign changes of ``rate`` (v - v_drive) between steps, refined
@@ -545,7 +408,7 @@ def _run_massless(p: Problem, rtol: float):
     y0 = np.concatenate(([p.x0, 0.0, 0.0], p.state0))
     sol = solve_ivp(rhs, (0.0, p.duration), y0, method="DOP853", rtol=rtol, atol=atol,
                     max_step=p.duration / 200.0, dense_output=True)
-    ts, ys, marks = _force_extrema(sol.t, sol.y, sol.sol, lambda tau, y: speed(tau, y) - va,
+    ts, ys, marks = force_extrema(sol.t, sol.y, sol.sol, lambda tau, y: speed(tau, y) - va,
                                    lambda tau, y: K * (p.xa0 + va * tau - y[0]))
     p.v0 = float(speed(0.0, y0))          # the massless block starts at its equilibrium speed
     v = np.array([speed(tt, ys[:, i]) for i, tt in enumerate(ts)])

@@ -190,7 +190,7 @@ def test_scalar_sliding_agrees_with_sliding_force(law):
 
 
 def test_restick_root_newton_and_brentq_fallback():
-    from filmfriction.reduced_model.integrators.event_driven import _restick_root
+    from filmfriction.reduced_model.integrators.dop853_slip import restick_root
 
     def state_at(t):
         return np.array([0.0, math.cos(t) - 0.5])
@@ -200,14 +200,14 @@ def test_restick_root_newton_and_brentq_fallback():
 
     root = math.pi / 3
     exact_rate = (lambda t, z: -math.sin(t))
-    assert _restick_root(state_at, slip_of, exact_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
+    assert restick_root(state_at, slip_of, exact_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
         pytest.approx(root, rel=0, abs=4e-16)
     # a rate that sends Newton out of the bracket: brentq on the same map finishes the job
     wrong_rate = (lambda t, z: 1.0)
-    assert _restick_root(state_at, slip_of, wrong_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
+    assert restick_root(state_at, slip_of, wrong_rate, 0.9, state_at(0.9), 1.2, state_at(1.2)) == \
         pytest.approx(root, rel=0, abs=4e-16)
     # zero slip at the start of the bracket: the slip ends at once
-    assert _restick_root(state_at, slip_of, exact_rate, root, np.array([0.0, 0.0]), 1.2, state_at(1.2)) == root
+    assert restick_root(state_at, slip_of, exact_rate, root, np.array([0.0, 0.0]), 1.2, state_at(1.2)) == root
 
 
 def test_stribeck_ode_events_converge_over_many_cycles():
