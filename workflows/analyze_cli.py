@@ -266,6 +266,8 @@ def run(args: argparse.Namespace) -> int:
             write_binary_copy(trace)
         except (OSError, ValueError):
             pass
+    for warning in (doc.get("units_check") or {}).get("warnings", []):
+        print(f"warning: {warning}", file=sys.stderr)
     if args.json:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))
     else:
