@@ -194,7 +194,8 @@ def read_log_table(path, runs: str | None = None,
     if lost:
         dropped = {"count": len(lost), "lines": lost[:20]}
         notes.append(f"dropped {len(lost)} thermo row{'s' if len(lost) > 1 else ''} with NaN "
-                     f"or infinite values (lines {_lines(lost)}); not interpolated")
+                     f"or infinite values (line{'s' if len(lost) > 1 else ''} {_lines(lost)}); "
+                     "not interpolated")
     return names, data, notes, dropped
 
 

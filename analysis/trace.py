@@ -573,8 +573,10 @@ def map_columns(names, mapping: dict | None, where="", aliases: dict | None = No
             raise ValueError(f"--column {target}={src}: unknown name {target!r}; the analysis "
                              f"reads {', '.join(known)}")
         if src not in names:
+            lost = not any(s in names for s in mapping.values())
             raise ValueError(f"{where}--column {target}={src}: no column {src!r} in the header "
-                             f"(columns: {', '.join(names)})")
+                             f"(columns: {', '.join(names)}"
+                             + (f"; {_SKIP_HINT})" if lost and len(mapping) > 1 else ")"))
         renames[src] = target
     targets = list(renames.values())
     for target in set(targets):
