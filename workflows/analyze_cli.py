@@ -31,42 +31,39 @@ def _count(text: str) -> int:
 MAX_MAGNITUDE = 1e100
 
 
-def _mapping(text: str) -> tuple[str, str, str | None]:
+def _reading_options(args) -> None:
+    """Check --column, --skip-rows, --comment and --log-run (one-line errors naming the
+    option, its value and what is accepted); ``args`` gets their parsed values."""
     from filmfriction.analysis.column_spec import parse_column
-
-    try:
-        return parse_column(text, where=repr(text))
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _rows(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r} (lines to skip before "
-                                         "the header)") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"{v}: must be 0 or more (lines to skip before the "
-                                         "header)")
-    return v
-
-
-def _prefix(text: str) -> str:
-    if not text.strip() or text != text.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: give the text a comment line starts with, "
-                                         "e.g. '#' or '%' (no blanks)")
-    return text
-
-
-def _log_run(text: str) -> str:
     from filmfriction.analysis.lammps_log import parse_runs
+    from filmfriction.workflows.cli import UserError
 
-    try:
-        parse_runs(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc).removeprefix(f"--log-run {text}: ")) from None
-    return text.strip()
+    parsed = []
+    for text in args.column:
+        try:
+            parsed.append(parse_column(text))
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+    args.column = parsed
+    if args.skip_rows is not None:
+        try:
+            n = int(args.skip_rows)
+        except ValueError:
+            n = -1
+        if n < 0:
+            raise UserError(f"--skip-rows {args.skip_rows}: give a whole number, 0 or more "
+                            "(lines skipped before the header)")
+        args.skip_rows = n
+    for prefix in args.comment or ():
+        if not prefix.strip() or prefix != prefix.strip():
+            raise UserError(f"--comment {prefix!r}: give the text a comment line starts with, "
+                            "e.g. '#' or '%' (no blanks)")
+    if args.log_run is not None:
+        try:
+            parse_runs(args.log_run)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+        args.log_run = args.log_run.strip()
 
 
 def register(subparsers) -> None:
@@ -83,19 +80,19 @@ def register(subparsers) -> None:
                     "with its slips) next to the trace.")
     p.add_argument("path", type=Path, help="run directory, trace file, or the directory of an "
                                            "analysed trace file (its analysis.json)")
-    p.add_argument("--column", type=_mapping, action="append", default=[],
+    p.add_argument("--column", action="append", default=[],
                    metavar="NAME=COLUMN[:UNIT]",
                    help="read the file's column COLUMN as NAME (time, spring_force, "
                         "drive_position, wall_position, wall_velocity, gap, ...), in UNIT when "
                         "given (SI with a prefix: uN, nm, ms, ...; Å, eV, kcal/mol; LJ: "
                         "epsilon/sigma, sigma, tau); repeat per column, e.g. --column "
                         "time=t:ms --column spring_force=F:uN")
-    p.add_argument("--skip-rows", type=_rows, default=None, metavar="N",
+    p.add_argument("--skip-rows", default=None, metavar="N",
                    help="skip the first N lines of the file (an instrument's metadata) before "
                         "the header")
-    p.add_argument("--comment", type=_prefix, action="append", default=None, metavar="TEXT",
+    p.add_argument("--comment", action="append", default=None, metavar="TEXT",
                    help="lines starting with TEXT are comments (default '#'); repeat for more")
-    p.add_argument("--log-run", type=_log_run, default=None, metavar="N",
+    p.add_argument("--log-run", default=None, metavar="N",
                    help="a LAMMPS log: read its thermo run N (counted from 1), or N-M to join "
                         "runs N to M (a run in segments), N- to the last")
     p.add_argument("--json", action="store_true", help="also print the document")
@@ -130,6 +127,7 @@ def run(args: argparse.Namespace) -> int:
     from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
                                              write_binary_copy)
 
+    _reading_options(args)
     record = check_run_json(args.path) if args.path.is_dir() else None
     recorded = (record or {}).get("trace_parameters") or {}
     if recorded:
@@ -197,8 +195,8 @@ def run(args: argparse.Namespace) -> int:
                               "--units lj (the others are converted with the OMCTS mapping)")
         args.units = systems.pop()
     if args.path.is_dir() and (args.skip_rows is not None or args.comment or args.log_run):
-        flag = ("--skip-rows" if args.skip_rows is not None else
-                "--comment" if args.comment else "--log-run")
+        flag = (f"--skip-rows {args.skip_rows}" if args.skip_rows is not None else
+                f"--comment {args.comment[0]}" if args.comment else f"--log-run {args.log_run}")
         if record:
             raise UserError(f"{flag}: {args.path} is a run directory (its trace.csv is read "
                             "as written); give the file itself, e.g. "
