@@ -6,8 +6,14 @@ A plain trace file has a header line naming its columns (``time`` and
 commas, tabs, semicolons or whitespace (detected from the header,
 :func:`detect_delimiter`).  A file with its own column names is read through a
 mapping, analysis name → the file's name (:func:`map_columns`; ``filmfriction
-analyze --column time=t_s``).  Lines starting with ``#`` before the header are
-ignored.  The parameters a trace needs (spring constant, wall mass, contact
+analyze --column time=t_s``), a column in its own unit converted into the trace's unit
+system (``column_units``, ``--column spring_force=F:uN``; the conversion is
+:func:`filmfriction.reduced_model.units.column_factor`).  Comment lines (``#``, or the
+``comments`` given) and the first ``skip_rows`` lines are skipped; when the first other
+line is numbers, the header is the comment line before it (LAMMPS's ``fix print`` and
+``fix ave/time`` files).  A LAMMPS log is read by its thermo runs
+(:mod:`filmfriction.analysis.lammps_log`).  Rows with an empty, NaN or infinite cell in a
+column the analysis reads are dropped and said, never interpolated.  The parameters a trace needs (spring constant, wall mass, contact
 area, film thickness, drive velocity) and the unit system come from the
 command line or, for a run directory, from ``run.json``'s ``trace_parameters``
 (the command line wins).  A directory holding the ``analysis.json`` of a plain
@@ -26,7 +32,8 @@ by ``filmfriction analyze`` for traces of :data:`BINARY_MIN_ROWS` rows or more) 
 read instead while it is at least as new as the text (~0.01 s; see
 ``benchmarks/bench_analysis.py``).
 
-The unit system is only reported, never converted: ``lj`` or ``si``.
+The unit system, ``lj`` or ``si``, labels the outputs; only columns given with a unit of
+their own are converted into it.
 """
 from __future__ import annotations
 

@@ -14,8 +14,8 @@ The check
   s and the creep before y left out) fitted by a straight line; the median of the
   slopes over K·V.  It agrees when it lies within :data:`RAMP_BAND`, 0.1 to 3:
   no stick rises faster than K·V beyond its noise, a film ten times softer than
-  the spring still passes (the default MD scene gives 0.61, a film about 1.5
-  times as stiff as its spring; the SFB example 1.00), and a unit's prefix moves
+  the spring still passes (the default MD scene on the tests' small box gives
+  0.61, a film about 1.5 times as stiff as its spring; the SFB example 1.00), and a unit's prefix moves
   the ratio by 10³ or more;
 * the drive column: its straight-line slope over ``--drive-velocity`` (when both
   are given), agreeing within :data:`DRIVE_BAND` (±10 %: a drive is prescribed);
@@ -93,9 +93,11 @@ def _factor(unit_text: str) -> float:
     return parse_unit(unit_text).factor
 
 
-def likely_units(ratios: dict, current: dict, bands: dict) -> list[dict]:
+def likely_units(ratios: dict, current: dict, bands: dict,
+                 named: dict | None = None) -> list[dict]:
     """The units of ``spring_force``, ``time`` and ``drive_position`` that would bring
-    every ratio into its band, fewest changes from ``current`` first (at most three).
+    every ratio into its band, fewest changes from ``current`` first (at most three);
+    those that agree with the units the columns' names suggest (``named``) before all.
 
     Parameters
     ----------
@@ -105,6 +107,8 @@ def likely_units(ratios: dict, current: dict, bands: dict) -> list[dict]:
         The unit each of the three columns was read in.
     bands : dict
         The band of each ratio.
+    named : dict, optional
+        Column -> the unit its name ends in (:func:`name_hint`).
 
     Examples
     --------
@@ -126,12 +130,16 @@ def likely_units(ratios: dict, current: dict, bands: dict) -> list[dict]:
             changed = {c: units[c] for c in columns if _factor(units[c]) != _factor(current[c])}
             if changed:
                 misfit = sum(abs(math.log10(v)) for v in new.values())
-                found.append((len(changed), misfit, changed))
+                as_named = all(_factor(units[c]) == _factor(u)
+                               for c, u in (named or {}).items() if c in units)
+                found.append((len(changed), misfit, changed, bool(named) and as_named))
     found.sort(key=lambda x: (x[0], x[1]))
     if not found:
         return []
     fewest = found[0][0]
-    return [c for n, _, c in found if n <= fewest + 1][:3]
+    chosen = [f for f in found if f[0] <= fewest + 1 or f[3]]
+    chosen.sort(key=lambda f: not f[3])
+    return [f[2] for f in chosen][:3]
 
 
 def _say(change: dict, where: dict) -> str:
@@ -219,12 +227,13 @@ class UnitsCheck(Observable):
         bad = {k: v for k, v in ratios.items()
                if not section["band"][k][0] <= v <= section["band"][k][1]}
         if bad:
+            named = {h["column"]: h["named"] for h in hints}
             section["warnings"].append(self._warning(trace, ratios, bad, given_units, file_names,
-                                                     K, V, rate))
+                                                     K, V, rate, named))
         return section, {}
 
     @staticmethod
-    def _warning(trace, ratios, bad, given_units, file_names, K, V, rate) -> str:
+    def _warning(trace, ratios, bad, given_units, file_names, K, V, rate, named) -> str:
         said = []
         if "stick_ramp" in bad:
             said.append(f"the stick ramps rise at {_times(bad['stick_ramp'])} × K·V "
@@ -238,7 +247,8 @@ class UnitsCheck(Observable):
             return (text + ": check K and V (run.json, --spring-constant, --drive-velocity) "
                            "and the columns' units")
         current = {c: given_units.get(c, _SI_BASE[c]) for c in _CANDIDATES}
-        guesses = likely_units(ratios, current, {"stick_ramp": RAMP_BAND, "drive": DRIVE_BAND})
+        guesses = likely_units(ratios, current, {"stick_ramp": RAMP_BAND, "drive": DRIVE_BAND},
+                               named)
         if guesses:
             alternatives = "; or ".join(_say(g, file_names) for g in guesses)
             example = next(iter(guesses[0].items()))
