@@ -724,8 +724,11 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
                              "thermo blocks (choose them with --log-run); leave --skip-rows out")
 
         def usable(keys):
-            names = map_columns(keys, {k: v for k, v in (columns or {}).items() if v in keys},
-                                aliases=LAMMPS_NAMES).values()
+            try:
+                names = map_columns(keys, {k: v for k, v in (columns or {}).items()
+                                           if v in keys}, aliases=LAMMPS_NAMES).values()
+            except ValueError:
+                return False
             return all(r in names for r in REQUIRED_COLUMNS)
 
         names, data, notes, dropped = read_log_table(path, log_run, usable)
@@ -733,7 +736,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
         cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
         delimiter, kind = "whitespace", "lammps-log"
     else:
-        raw_head = path.open("rb").read(65536)
+        raw_head = path.read_bytes() if skip_rows else path.open("rb").read(65536)
         start, header, sep = _header(raw_head, path, skip_rows, comments)
         renames = map_columns(_split(header, sep), columns, str(path))
         cols = _read_binary_copy(path, list(renames))

@@ -151,3 +151,23 @@ def test_log_options_where_they_do_not_belong(tmp_path, run_cli, synthetic_run):
     shutil.copy(LOG, synthetic_run / "log.lammps")
     r = run_cli("analyze", synthetic_run / "log.lammps", "--log-run", "2-3")
     assert r.code == 2 and "give --output FILE.json" in r.err
+
+
+def test_nan_and_overflowing_cells_are_dropped_not_refused(tmp_path, run_cli):
+    """A value beyond a double (1e400 reads as inf) and a column with gaps (every third
+    wall position NaN): the rows go, the note says which, the rest is analysed."""
+    t = [0.1 * i for i in range(400)]
+    lines = ["time,spring_force,wall_position"]
+    for i, ti in enumerate(t):
+        force = "1e400" if i == 4 else f"{(ti % 5.0) * 2:.6g}"
+        wall = "nan" if i % 3 == 0 else f"{ti * 0.1:.6g}"
+        lines.append(f"{ti:.6g},{force},{wall}")
+    path = tmp_path / "gaps.csv"
+    path.write_text("\n".join(lines) + "\n")
+    r = run_cli("analyze", path, "--json", "--no-figure")
+    assert r.code == 0, r.err
+    source = r.json()["source"]
+    assert source["samples"] == 400 - 134 - 1
+    assert source["dropped_rows"]["count"] == 135
+    assert source["dropped_rows"]["columns"] == {"spring_force": 1, "wall_position": 134}
+    assert source["dropped_rows"]["lines"][:3] == [2, 5, 6]
