@@ -871,11 +871,14 @@ def read_trace(path, *, columns: dict | None = None, column_units: dict | None =
             params = TraceParameters(**base).updated(**overrides)
             mapping = dict(source.get("columns") or {})
             mapping.update(columns or {})
-            recorded = {"column_units": source.get("column_units") or {},
+            recorded = {"column_units": dict(source.get("column_units") or {}),
                         "skip_rows": int(source.get("skip_rows") or 0),
                         "comments": tuple(source.get("comments") or COMMENTS),
                         "log_run": source.get("log_run")}
-            recorded.update({k: v for k, v in reading.items() if v is not None})
+            # what is given wins: units name by name, as the mapping
+            recorded["column_units"].update(column_units or {})
+            recorded.update({k: v for k, v in reading.items()
+                             if v is not None and k != "column_units"})
             tr = read_csv_trace(file, params, mapping, **recorded)
             return Trace(tr.columns, params, tr.path, None, _run_record(file.parent), tr.notes,
                          tr.layout)

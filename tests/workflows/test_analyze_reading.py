@@ -171,3 +171,16 @@ def test_nan_and_overflowing_cells_are_dropped_not_refused(tmp_path, run_cli):
     assert source["dropped_rows"]["count"] == 135
     assert source["dropped_rows"]["columns"] == {"spring_force": 1, "wall_position": 134}
     assert source["dropped_rows"]["lines"][:3] == [2, 5, 6]
+
+
+def test_analysing_the_directory_again_keeps_the_recorded_reading(example, run_cli):
+    d = example
+    (d / "trace.tsv").write_text("exported by SFB-3\n" + (d / "trace.tsv").read_text())
+    first = run_cli("analyze", d / "trace.tsv", "--setup", d / "my_sfb.toml", "--skip-rows", "1",
+                    *UNITS, "--json", "--no-figure")
+    assert first.code == 0, first.err
+    again = run_cli("analyze", d, "--json", "--no-figure")
+    assert again.code == 0, again.err
+    assert again.json()["slips"] == first.json()["slips"]
+    for key in ("column_units", "skip_rows", "columns"):
+        assert again.json()["source"][key] == first.json()["source"][key]
