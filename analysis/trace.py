@@ -420,11 +420,16 @@ def _parse_rows(lines: list[str], numbers: np.ndarray, sep: str | None, names: l
     return data
 
 
-def _plain(text: str, comments) -> bool:
-    """Whether ``text`` (the data rows) has no blank and no comment line."""
-    body = text.rstrip("\r\n")
-    return (bool(body) and "\n\n" not in body and "\n\r\n" not in body
-            and not any(body.startswith(c) or ("\n" + c) in body for c in comments))
+def _row_lines(body: bytes, start: int, comments) -> tuple[np.ndarray, int]:
+    """The file's line number of each data row of ``body`` (the text after the header,
+    which starts at line index ``start``), and how many comment lines lie among them."""
+    numbers, n_comments = [], 0
+    for i, line in enumerate(body.decode("utf-8", errors="replace").splitlines()):
+        if _is_comment(line, comments):
+            n_comments += 1
+        elif line.strip():
+            numbers.append(start + 1 + i)
+    return np.asarray(numbers, dtype=int), n_comments
 
 
 def _read_table(path: Path, skip_rows: int = 0, comments=COMMENTS):
@@ -438,27 +443,34 @@ def _read_table(path: Path, skip_rows: int = 0, comments=COMMENTS):
         raise ValueError(f"{path}: bad header {header!r} (need unique column names separated "
                          f"by commas, tabs, semicolons or spaces; {_SKIP_HINT})")
     body = raw.split(b"\n", start)[-1] if raw.count(b"\n") >= start else b""
-    text = body.decode("utf-8-sig" if start == 0 else "utf-8", errors="replace")
-    if sep == ";" and "," in text:
+    decimal_commas = sep == ";" and b"," in body
+    if not decimal_commas and body.strip():
+        # the common case, parsed by NumPy's C reader from the file (comment and blank
+        # lines skipped); anything it refuses goes the slow way below
+        import warnings
+
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                data = np.loadtxt(path, delimiter=sep, skiprows=start, ndmin=2, dtype=float,
+                                  comments=list(comments), encoding="utf-8")
+        except ValueError:
+            data = None
+        if data is not None and data.shape[0] and data.shape[1] == len(names):
+            n_lines = body.count(b"\n") + (not body.endswith(b"\n"))
+            if data.shape[0] == n_lines:
+                return names, data, np.arange(start + 1, start + 1 + n_lines), notes, sep
+            numbers, n_comments = _row_lines(body, start, comments)
+            if numbers.size == data.shape[0]:
+                if n_comments:
+                    notes.append(f"skipped {n_comments} comment line"
+                                 f"{'s' if n_comments > 1 else ''} among the data rows")
+                return names, data, numbers, notes, sep
+    text = body.decode("utf-8", errors="replace")
+    if decimal_commas:
         # a semicolon-separated table may write decimal commas (1,5;2,25)
         text = text.replace(",", ".")
         notes.append("decimal commas read as decimal points")
-    if _plain(text, comments):
-        # the common case, parsed by NumPy's C reader: no blank or comment lines
-        n_lines = text.count("\n") + (not text.endswith("\n"))
-        last = text.rstrip("\r\n").rsplit("\n", 1)[-1]
-        fields = last.split(sep) if sep is not None else last.split()
-        if not raw.endswith(b"\n") and (len(fields) != len(names) or not fields[-1].strip()):
-            notes.append(f"dropped truncated last line {start + n_lines}")
-            n_lines -= 1
-        if n_lines <= 0:
-            raise ValueError(f"{path}: no data rows after the header")
-        try:
-            data = np.loadtxt(io.StringIO(text), delimiter=sep, ndmin=2, dtype=float,
-                              comments=None, max_rows=n_lines)
-            return names, data, np.arange(start + 1, start + 1 + n_lines), notes, sep
-        except ValueError:
-            notes = [n for n in notes if not n.startswith("dropped truncated")]
     lines = text.splitlines()
     numbers = np.arange(start + 1, start + 1 + len(lines))
     keep = [i for i, line in enumerate(lines) if line.strip() and not _is_comment(line, comments)]
