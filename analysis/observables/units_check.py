@@ -36,7 +36,7 @@ import re
 import numpy as np
 
 from ..trace import MissingInput
-from .base import Context, Observable, format_value, parameter
+from .base import Context, Observable, format_value
 
 __all__ = ["UnitsCheck", "RAMP_BAND", "DRIVE_BAND", "stick_ramp_slopes", "likely_units",
            "name_hint"]
@@ -162,8 +162,8 @@ class UnitsCheck(Observable):
     key = "units_check"
     title = "Units: the stick ramps against K·V"
     order = 90
-    needs = (parameter("spring_constant", "the stick ramps' expected slope K·V"),)
     table_header = ("check", "value")
+    absent = "No units check"
 
     def compute(self, ctx: Context) -> tuple[dict, dict]:
         trace = ctx.trace
@@ -177,10 +177,16 @@ class UnitsCheck(Observable):
         section = {"band": {"stick_ramp": list(RAMP_BAND), "drive": list(DRIVE_BAND)},
                    "warnings": []}
         ratios = {}
-        if V is None or not V > 0:
+        if K is None:
+            ctx.skip_part("units_check.stick_ramp",
+                          MissingInput("--spring-constant", "the stick ramps' expected slope K·V"))
+        elif V is None:
             ctx.skip_part("units_check.stick_ramp",
                           MissingInput("--drive-velocity (or a drive_position column)",
                                        "the stick ramps' expected slope K·V"))
+        elif not V > 0:
+            ctx.skip_part("units_check.stick_ramp", f"the drive's velocity V = {V:g} ({v_from}) "
+                                                    "is not positive")
         else:
             table = ctx.all_slips
             slopes = stick_ramp_slopes(trace.time, trace.spring_force, table.yield_index,
@@ -230,6 +236,11 @@ class UnitsCheck(Observable):
             named = {h["column"]: h["named"] for h in hints}
             section["warnings"].append(self._warning(trace, ratios, bad, given_units, file_names,
                                                      K, V, rate, named))
+        if not (section.get("stick_ramp") or section.get("drive") or section["warnings"]):
+            why = ctx.skipped.pop("units_check.stick_ramp", "nothing to check")
+            ctx.skipped.pop("units_check.drive", None)
+            ctx.skip_part("units_check", why)
+            return None, {}
         return section, {}
 
     @staticmethod
@@ -255,7 +266,13 @@ class UnitsCheck(Observable):
             return (text + f": is {alternatives}? Give a column's unit with --column "
                            f"{example[0]}={file_names.get(example[0], example[0])}:{example[1]} "
                            "(or is K or V off by that factor?)")
+        if any(v < 0 for v in bad.values()):
+            return text + (": a negative ratio: the force or the drive counts the other way "
+                           "(a sign convention), or the columns are not what they are named")
         return text + ": no change of the force, time or drive units explains it; check K and V"
+
+    def shown(self, section: dict) -> bool:
+        return bool(section.get("stick_ramp") or section.get("drive") or section.get("warnings"))
 
     def rows(self, section: dict) -> list[tuple[str, str]]:
         rows = []

@@ -1,6 +1,9 @@
-"""Trace files as instruments write them: the delimiter detected, the user's own
-column names mapped (with clear errors), the binary copy read only while it is fresh,
-and the figure of the trace with its events, labelled in the trace's units."""
+"""Trace files as instruments and LAMMPS write them: the delimiter detected, the user's
+own column names mapped (with clear errors) and their units converted and checked against
+K and V, LAMMPS's fix print / fix ave/time files and logs (real files of a small run,
+tests/analysis/data/lammps), metadata lines skipped, rows with missing values dropped and
+said, the binary copy read only while it is fresh, and the figure of the trace with its
+events, labelled in the trace's units."""
 from __future__ import annotations
 
 import os
