@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["parse_column", "TraceTable", "trace_table", "TRACE_KEYS"]
+__all__ = ["parse_column", "trace_table", "TRACE_KEYS"]
 
 #: The keys of a set-up file's ``[trace]`` table.
 TRACE_KEYS = ("columns", "skip_rows", "comments")
@@ -78,14 +78,10 @@ def parse_column(text: str, where: str | None = None) -> tuple[str, str, str | N
     return name, column, unit
 
 
-class TraceTable(dict):
-    """A set-up file's ``[trace]`` table, checked: ``columns`` (name -> (column,
-    unit or None)), ``skip_rows`` (int), ``comments`` (tuple of str); keys absent
-    from the file are absent here."""
-
-
-def trace_table(path) -> TraceTable:
-    """The ``[trace]`` table of the set-up file ``path`` (empty when it has none).
+def trace_table(path) -> dict:
+    """The ``[trace]`` table of the set-up file ``path``, checked: ``columns`` (name ->
+    (column, unit or None)), ``skip_rows`` (int), ``comments`` (tuple of str); keys
+    absent from the file are absent here (an empty dict for a file without the table).
 
     Raises
     ------
@@ -104,7 +100,7 @@ def trace_table(path) -> TraceTable:
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
     table = data.get("trace", {})
-    out = TraceTable()
+    out = {}
     if not isinstance(table, dict):
         raise ValueError(f"{path}: trace = {table!r}: give a table [trace] with "
                          f"{', '.join(TRACE_KEYS)}")

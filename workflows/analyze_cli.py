@@ -91,7 +91,8 @@ def register(subparsers) -> None:
                    help="skip the first N lines of the file (an instrument's metadata) before "
                         "the header")
     p.add_argument("--comment", action="append", default=None, metavar="TEXT",
-                   help="lines starting with TEXT are comments (default '#'); repeat for more")
+                   help="lines starting with TEXT are comments (default '#'; given, only those "
+                        "given); repeat for more, e.g. --comment '#' --comment '%%'")
     p.add_argument("--log-run", default=None, metavar="N",
                    help="a LAMMPS log: read its thermo run N (counted from 1), or N-M to join "
                         "runs N to M (a run in segments), N- to the last")
