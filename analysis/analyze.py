@@ -50,6 +50,11 @@ def _source(trace: Trace) -> dict:
               "parameters": {k: getattr(p, k) for k in
                              ("spring_constant", "mass", "area", "thickness", "drive_velocity")},
               "notes": list(trace.notes)}
+    if trace.layout is not None and trace.run_dir is None:
+        # how the file was read, so that it is read again the same way
+        source.update(trace.layout.source())
+    elif trace.layout is not None and trace.layout.dropped:
+        source["dropped_rows"] = dict(trace.layout.dropped)
     if trace.run:
         source["run_status"] = trace.run.get("status")
     return source

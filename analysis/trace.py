@@ -9,8 +9,14 @@ A plain trace file has a header line naming its columns (``time`` and
 commas, tabs, semicolons or whitespace (detected from the header,
 :func:`detect_delimiter`).  A file with its own column names is read through a
 mapping, analysis name → the file's name (:func:`map_columns`; ``filmfriction
-analyze --column time=t_s``).  Lines starting with ``#`` before the header are
-ignored.  The parameters a trace needs (spring constant, wall mass, contact
+analyze --column time=t_s``), a column in its own unit converted into the trace's unit
+system (``column_units``, ``--column spring_force=F:uN``; the conversion is
+:func:`filmfriction.reduced_model.units.column_factor`).  Comment lines (``#``, or the
+``comments`` given) and the first ``skip_rows`` lines are skipped; when the first other
+line is numbers, the header is the comment line before it (LAMMPS's ``fix print`` and
+``fix ave/time`` files).  A LAMMPS log is read by its thermo runs
+(:mod:`filmfriction.analysis.lammps_log`).  Rows with an empty, NaN or infinite cell in a
+column the analysis reads are dropped and said, never interpolated.  The parameters a trace needs (spring constant, wall mass, contact
 area, film thickness, drive velocity) and the unit system come from the
 command line or, for a run directory, from ``run.json``'s ``trace_parameters``
 (the command line wins).  A directory holding the ``analysis.json`` of a plain
@@ -29,10 +35,12 @@ by ``filmfriction analyze`` for traces of :data:`BINARY_MIN_ROWS` rows or more) 
 read instead while it is at least as new as the text (~0.01 s; see
 ``benchmarks/bench_analysis.py``).
 
-The unit system is only reported, never converted: ``lj`` or ``si``.
+The unit system, ``lj`` or ``si``, labels the outputs; only columns given with a unit of
+their own are converted into it.
 """
 from __future__ import annotations
 
+import io
 import json
 import math
 from dataclasses import dataclass, field
@@ -147,11 +155,49 @@ class TraceLayout:
         Analysis name → the file's column name, for the columns renamed.
     binary : bool
         Read from the binary copy beside the text (:func:`write_binary_copy`).
+    kind : str
+        ``"table"`` (a text table, LAMMPS's ``fix print`` and ``fix ave/time`` files
+        among them) or ``"lammps-log"`` (a log's thermo output).
+    column_units : dict
+        Analysis name → the unit its column was given in (converted on reading).
+    skip_rows : int
+        Lines skipped before the header.
+    comments : tuple of str
+        The comment prefixes.
+    log_run : str or None
+        The log's thermo run(s) read (``--log-run``).
+    dropped : dict
+        The rows dropped for empty, NaN or infinite cells: ``count``, ``lines`` (the
+        file's line numbers, at most 20) or ``rows``, and per column ``columns``
+        (empty: none).
     """
 
     delimiter: str = "comma"
     columns: dict = field(default_factory=dict)
     binary: bool = False
+    kind: str = "table"
+    column_units: dict = field(default_factory=dict)
+    skip_rows: int = 0
+    comments: tuple = ("#",)
+    log_run: str | None = None
+    dropped: dict = field(default_factory=dict)
+
+    def source(self) -> dict:
+        """What ``analysis.json``'s ``source`` records to read the file again so."""
+        out = {"delimiter": self.delimiter, "columns": dict(self.columns)}
+        if self.kind != "table":
+            out["format"] = self.kind
+        if self.column_units:
+            out["column_units"] = dict(self.column_units)
+        if self.skip_rows:
+            out["skip_rows"] = self.skip_rows
+        if tuple(self.comments) != COMMENTS:
+            out["comments"] = list(self.comments)
+        if self.log_run is not None:
+            out["log_run"] = self.log_run
+        if self.dropped:
+            out["dropped_rows"] = dict(self.dropped)
+        return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -280,8 +326,36 @@ def _split(line: str, sep: str | None) -> list[str]:
             (line.split(sep) if sep is not None else line.split())]
 
 
-def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
-    """Index of the header line (after blank and ``#`` lines), its text, the delimiter."""
+#: What starts a comment line by default (``--comment`` gives others).
+COMMENTS = ("#",)
+_SKIP_HINT = ("instrument lines before the header? skip them with --skip-rows N or a "
+              "comment prefix --comment TEXT")
+
+
+def _is_comment(line: str, comments) -> bool:
+    stripped = line.lstrip()
+    return any(stripped.startswith(c) for c in comments)
+
+
+def _numbers(line: str, sep: str | None) -> bool:
+    """Whether every field of ``line`` is a number (a data row, not a header)."""
+    fields = line.split(sep) if sep is not None else line.split()
+    try:
+        [float(f) for f in fields]
+    except ValueError:
+        return False
+    return bool(fields)
+
+
+def _header(raw: bytes, path: Path, skip_rows: int = 0,
+            comments=COMMENTS) -> tuple[int, str, str | None]:
+    """Where the data rows start (line index), the header's text and the delimiter.
+
+    The header is the first line after ``skip_rows`` lines, blank lines and comment
+    lines; when that line is a row of numbers, it is the last comment line before it,
+    its prefix removed: LAMMPS's convention (``fix print``'s ``title "# step time
+    ..."``, ``fix ave/time``'s ``# TimeStep v_a v_b``).
+    """
     if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
         raise ValueError(f"{path}: UTF-16 text (a spreadsheet's 'Unicode text' export): save it "
                          "as UTF-8 or plain CSV")
@@ -290,62 +364,142 @@ def _header(raw: bytes, path: Path) -> tuple[int, str, str | None]:
                          "trace: give a header line, then rows of numbers (decompress or export "
                          "it as text first)")
     # utf-8-sig: a spreadsheet's CSV export may start with a byte-order mark
-    head = raw[:65536].decode("utf-8-sig", errors="replace").splitlines()
-    start = 0
-    while start < len(head) and (not head[start].strip() or head[start].lstrip().startswith("#")):
+    head_bytes = raw[:65536] if raw[:65536].count(b"\n") > skip_rows + 64 else raw
+    head = head_bytes.decode("utf-8-sig", errors="replace").splitlines()
+    if skip_rows and skip_rows >= len(head):
+        raise ValueError(f"--skip-rows {skip_rows}: {path} has {len(head)} lines")
+    start, last_comment = skip_rows, None
+    while start < len(head) and (not head[start].strip() or _is_comment(head[start], comments)):
+        if head[start].strip():
+            last_comment = head[start]
         start += 1
     if start == len(head):
-        raise ValueError(f"{path}: empty file (no header line)")
+        raise ValueError(f"{path}: empty file (no header line" +
+                         (f" after the {skip_rows} rows skipped)" if skip_rows else ")"))
+    first = head[start]
+    plain = detect_delimiter(first)
+    if _numbers(first, plain):
+        if last_comment is None:
+            raise ValueError(f"{path}: line {start + 1} is a row of numbers, not a header: give "
+                             "a line naming the columns before the data (or LAMMPS's '# name "
+                             "name ...' comment line)")
+        text = last_comment.lstrip()
+        text = text[next(len(c) for c in comments if text.startswith(c)):].strip()
+        sep = detect_delimiter(text, first)
+        return start, text, sep
     first_row = head[start + 1] if start + 1 < len(head) else None
-    sep = detect_delimiter(head[start], first_row)
-    named = next((s for s in (",", "\t", ";") if s in head[start]), None)
+    sep = detect_delimiter(first, first_row)
+    named = next((s for s in (",", "\t", ";") if s in first), None)
     if sep is None and named is not None and first_row is not None and named in first_row:
-        raise ValueError(f"{path}: the header has {len(head[start].split(named))} "
+        raise ValueError(f"{path}: the header has {len(first.split(named))} "
                          f"{_DELIMITER_NAMES[named]}-separated columns, the first data row (line "
                          f"{start + 2}) {len(first_row.split(named))}: every row needs one value "
-                         "per column")
-    return start, head[start], sep
+                         f"per column ({_SKIP_HINT})")
+    return start + 1, first, sep
 
 
-def _read_table(path: Path) -> tuple[list[str], np.ndarray, list[str], str | None]:
-    """The header's names, the data rows (2-D), remarks, and the delimiter of a text trace."""
+def _cell(text: str) -> float:
+    """One cell: a number; an empty cell is NaN (a missing value)."""
+    text = text.strip().strip('"')
+    return float(text) if text else math.nan
+
+
+def _parse_rows(lines: list[str], numbers: np.ndarray, sep: str | None, names: list[str],
+                path: Path) -> np.ndarray:
+    """Rows parsed one by one: empty cells are NaN; a cell that is neither a number nor
+    empty, or a row of the wrong length, is an error naming its line."""
+    data = np.empty((len(lines), len(names)))
+    for i, line in enumerate(lines):
+        fields = line.split(sep) if sep is not None else line.split()
+        if len(fields) != len(names):
+            raise ValueError(f"{path}: line {numbers[i]} has {len(fields)} "
+                             f"{_DELIMITER_NAMES[sep]}-separated values, the header "
+                             f"{len(names)} ({_SKIP_HINT})")
+        for j, field_ in enumerate(fields):
+            try:
+                data[i, j] = _cell(field_)
+            except ValueError:
+                raise ValueError(f"{path}: line {numbers[i]}, column {names[j]}: "
+                                 f"{field_.strip()!r} is not a number (a missing value is an "
+                                 "empty cell or NaN)") from None
+    return data
+
+
+def _row_lines(body: bytes, start: int, comments) -> tuple[np.ndarray, int]:
+    """The file's line number of each data row of ``body`` (the text after the header,
+    which starts at line index ``start``), and how many comment lines lie among them."""
+    numbers, n_comments = [], 0
+    for i, line in enumerate(body.decode("utf-8", errors="replace").splitlines()):
+        if _is_comment(line, comments):
+            n_comments += 1
+        elif line.strip():
+            numbers.append(start + 1 + i)
+    return np.asarray(numbers, dtype=int), n_comments
+
+
+def _read_table(path: Path, skip_rows: int = 0, comments=COMMENTS):
+    """The header's names, the data rows (2-D), each row's line number in the file,
+    remarks, and the delimiter of a text trace."""
     notes = []
     raw = path.read_bytes()
-    start, header, sep = _header(raw, path)
+    start, header, sep = _header(raw, path, skip_rows, comments)
     names = _split(header, sep)
     if any(not n for n in names) or len(set(names)) != len(names):
         raise ValueError(f"{path}: bad header {header!r} (need unique column names separated "
-                         "by commas, tabs, semicolons or spaces)")
-    body = raw.rstrip(b"\n\r\t ")
-    n_lines = body.count(b"\n") + 1 if body else 0
-    n_rows = n_lines - start - 1
-    if n_rows > 0 and not raw.endswith(b"\n"):
-        last = body[body.rfind(b"\n") + 1:].decode("utf-8", errors="replace")
-        fields = last.split(sep) if sep is not None else last.split()
-        if len(fields) != len(names) or not fields[-1].strip():
-            n_rows -= 1
-            notes.append(f"dropped truncated last line {n_lines}")
-    if n_rows <= 0:
-        raise ValueError(f"{path}: no data rows after the header")
-    source = path
-    if sep == ";":
+                         f"by commas, tabs, semicolons or spaces; {_SKIP_HINT})")
+    body = raw.split(b"\n", start)[-1] if raw.count(b"\n") >= start else b""
+    decimal_commas = sep == ";" and b"," in body
+    if not decimal_commas and body.strip():
+        # the common case, parsed by NumPy's C reader from the file (comment and blank
+        # lines skipped); anything it refuses goes the slow way below
+        import warnings
+
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                data = np.loadtxt(path, delimiter=sep, skiprows=start, ndmin=2, dtype=float,
+                                  comments=list(comments), encoding="utf-8")
+        except ValueError:
+            data = None
+        if data is not None and data.shape[0] and data.shape[1] == len(names):
+            n_lines = body.count(b"\n") + (not body.endswith(b"\n"))
+            if data.shape[0] == n_lines:
+                return names, data, np.arange(start + 1, start + 1 + n_lines), notes, sep
+            numbers, n_comments = _row_lines(body, start, comments)
+            if numbers.size == data.shape[0]:
+                if n_comments:
+                    notes.append(f"skipped {n_comments} comment line"
+                                 f"{'s' if n_comments > 1 else ''} among the data rows")
+                return names, data, numbers, notes, sep
+    text = body.decode("utf-8", errors="replace")
+    if decimal_commas:
         # a semicolon-separated table may write decimal commas (1,5;2,25)
-        rows = raw.split(b"\n", start + 1)[-1]
-        if b"," in rows:
-            import io
-            source = io.StringIO(rows.decode("utf-8").replace(",", "."))
-            start = -1
-            notes.append("decimal commas read as decimal points")
+        text = text.replace(",", ".")
+        notes.append("decimal commas read as decimal points")
+    lines = text.splitlines()
+    numbers = np.arange(start + 1, start + 1 + len(lines))
+    keep = [i for i, line in enumerate(lines) if line.strip() and not _is_comment(line, comments)]
+    if len(keep) != len(lines):
+        n_comments = sum(1 for line in lines if line.strip() and _is_comment(line, comments))
+        if n_comments:
+            notes.append(f"skipped {n_comments} comment line{'s' if n_comments > 1 else ''} "
+                         "among the data rows")
+        lines, numbers = [lines[i] for i in keep], numbers[keep]
+    if lines and not raw.endswith(b"\n"):
+        fields = lines[-1].split(sep) if sep is not None else lines[-1].split()
+        if len(fields) != len(names) or not fields[-1].strip():
+            notes.append(f"dropped truncated last line {numbers[-1]}")
+            lines, numbers = lines[:-1], numbers[:-1]
+    if not lines:
+        raise ValueError(f"{path}: no data rows after the header")
     try:
-        data = np.loadtxt(source, delimiter=sep, skiprows=start + 1, max_rows=n_rows,
-                          ndmin=2, dtype=float, comments=None)
-    except ValueError as exc:
-        raise ValueError(f"{path}: cannot parse data rows "
-                         f"({_DELIMITER_NAMES[sep]}-separated): {exc}") from None
+        data = np.loadtxt(lines, delimiter=sep, ndmin=2, dtype=float, comments=None)
+    except ValueError:
+        data = _parse_rows(lines, numbers, sep, names, path)
     if data.shape[1] != len(names):
         raise ValueError(f"{path}: header has {len(names)} columns ({_DELIMITER_NAMES[sep]}-"
-                         f"separated), rows have {data.shape[1]}")
-    return names, data, notes, sep
+                         f"separated), rows have {data.shape[1]} ({_SKIP_HINT})")
+    return names, data, numbers, notes, sep
 
 
 _DELIMITER_NAMES = {",": "comma", "\t": "tab", ";": "semicolon", None: "whitespace"}
@@ -372,6 +526,10 @@ def write_binary_copy(trace: "Trace") -> Path:
     from .util import write_atomic
 
     layout = trace.layout or TraceLayout()
+    if layout.column_units or layout.dropped or layout.kind != "table" or trace.notes:
+        raise ValueError(f"{trace.path}: read with unit conversions, dropped rows or notes "
+                         f"({'; '.join(trace.notes)}): a binary copy holds a text table's "
+                         "columns as written, so none is made")
     names = [layout.columns.get(name, name) for name in trace.columns]
     table = np.empty(len(trace), dtype=[(name, "<f8") for name in names])
     for name, values in zip(names, trace.columns.values()):
@@ -398,8 +556,12 @@ def _read_binary_copy(path: Path, names: list[str]) -> dict | None:
     return {name: np.ascontiguousarray(table[name], dtype=float) for name in names}
 
 
-def map_columns(names, mapping: dict | None, where="") -> dict:
+def map_columns(names, mapping: dict | None, where="", aliases: dict | None = None) -> dict:
     """Check a column mapping (analysis name → the file's column name) against a header.
+
+    ``aliases`` (the file's name → an analysis name, e.g. a LAMMPS log's thermo
+    keywords, :data:`~filmfriction.analysis.lammps_log.LAMMPS_NAMES`) name the
+    columns that the mapping leaves and the header does not name itself.
 
     Returns
     -------
@@ -425,13 +587,20 @@ def map_columns(names, mapping: dict | None, where="") -> dict:
     known = trace_column_names()
     where = f"{where}: " if where else ""
     renames = {n: n for n in names}
-    for target, src in (mapping or {}).items():
+    mapping = mapping or {}
+    for src, target in (aliases or {}).items():
+        if (src in renames and target not in names and target not in mapping
+                and src not in mapping.values()):
+            renames[src] = target
+    for target, src in mapping.items():
         if target not in known:
             raise ValueError(f"--column {target}={src}: unknown name {target!r}; the analysis "
                              f"reads {', '.join(known)}")
         if src not in names:
+            lost = not any(s in names for s in mapping.values())
             raise ValueError(f"{where}--column {target}={src}: no column {src!r} in the header "
-                             f"(columns: {', '.join(names)})")
+                             f"(columns: {', '.join(names)}"
+                             + (f"; {_SKIP_HINT})" if lost and len(mapping) > 1 else ")"))
         renames[src] = target
     targets = list(renames.values())
     for target in set(targets):
@@ -442,9 +611,91 @@ def map_columns(names, mapping: dict | None, where="") -> dict:
     return renames
 
 
+def _lines(numbers, most: int = 8) -> str:
+    numbers = [int(n) for n in numbers]
+    shown = ", ".join(str(n) for n in numbers[:most])
+    return shown + (f", ... ({len(numbers) - most} more)" if len(numbers) > most else "")
+
+
+def _drop_missing(cols: dict, numbers, notes: list) -> tuple[dict, object, dict]:
+    """``cols`` (and their line ``numbers``) without the rows where a column the analysis
+    reads is NaN, infinite or empty; what was dropped (``{"count", "lines" or "rows",
+    "columns"}``) is noted."""
+    known = [n for n in cols if n in trace_column_names()]
+    bad_by = {n: ~np.isfinite(cols[n]) for n in known}
+    bad = np.logical_or.reduce(list(bad_by.values())) if known else None
+    if bad is None or not bad.any():
+        return cols, numbers, {}
+    idx = np.flatnonzero(bad)
+    per_column = {n: int(b.sum()) for n, b in bad_by.items() if b.any()}
+    dropped = {"count": int(idx.size), "columns": per_column}
+    if numbers is not None:
+        dropped["lines"] = [int(n) for n in np.asarray(numbers)[idx[:20]]]
+        at = f"line{'s' if idx.size > 1 else ''} {_lines(np.asarray(numbers)[idx])}"
+    else:
+        dropped["rows"] = [int(i) + 1 for i in idx[:20]]
+        at = f"data row{'s' if idx.size > 1 else ''} {_lines(idx + 1)}"
+    notes.append(f"dropped {idx.size} row{'s' if idx.size > 1 else ''} with empty, NaN or "
+                 f"infinite cells ({at}; " + ", ".join(f"{n} {k}" for n, k in per_column.items())
+                 + "); not interpolated")
+    keep = ~bad
+    return ({n: np.ascontiguousarray(v[keep]) for n, v in cols.items()},
+            None if numbers is None else np.asarray(numbers)[keep], dropped)
+
+
+def _drop_repeated_steps(cols: dict, numbers, notes: list) -> tuple[dict, object]:
+    """A LAMMPS run in segments prints a segment's first step twice (the last row of one,
+    the first of the next): of rows with equal ``step``, the later is kept."""
+    if "step" not in cols or cols["step"].size < 2:
+        return cols, numbers
+    step = cols["step"]
+    later = np.append(step[1:] != step[:-1], True)
+    if later.all():
+        return cols, numbers
+    n = int((~later).sum())
+    notes.append(f"{n} row{'s' if n > 1 else ''} repeating the next row's step (a LAMMPS run's "
+                 "segment boundary) dropped, the later kept")
+    return ({k: np.ascontiguousarray(v[later]) for k, v in cols.items()},
+            None if numbers is None else np.asarray(numbers)[later])
+
+
+def _convert_units(cols: dict, column_units: dict, system: str, notes: list) -> dict:
+    """Columns given in their own units, brought into the trace's unit system."""
+    from filmfriction.md_inputs.contract import column as contract_column
+    from filmfriction.reduced_model.units import OMCTS, column_factor
+
+    out = dict(cols)
+    for name, text in (column_units or {}).items():
+        if name not in out:
+            continue
+        quantity = contract_column(name).quantity
+        if quantity == "1":
+            raise ValueError(f"--column {name}=...:{text}: {name} is a count, it has no unit")
+        try:
+            factor = column_factor(text, quantity, system, OMCTS)
+        except ValueError as exc:
+            raise ValueError(f"--column {name}=...:{text}: {exc}") from None
+        target = UNITS[system][quantity]
+        via = (" with the OMCTS mapping (filmfriction.reduced_model.units.OMCTS)"
+               if _unit_system(text) != system else "")
+        if factor != 1.0:
+            out[name] = out[name] * factor
+        notes.append(f"{name} read in {text}: x {factor:.6g} to {target}{via}")
+    return out
+
+
+def _unit_system(text: str) -> str:
+    from filmfriction.reduced_model.units import parse_unit
+
+    return parse_unit(text).system
+
+
 def read_csv_trace(path, parameters: TraceParameters | None = None,
-                   columns: dict | None = None) -> Trace:
-    """Read a plain trace file (comma-, tab-, semicolon- or whitespace-separated).
+                   columns: dict | None = None, *, column_units: dict | None = None,
+                   skip_rows: int = 0, comments=COMMENTS, log_run: str | None = None) -> Trace:
+    """Read a plain trace file (comma-, tab-, semicolon- or whitespace-separated), a
+    LAMMPS ``fix print`` / ``fix ave/time`` file (the header in the comment line before
+    the data) or a LAMMPS log's thermo output.
 
     Parameters
     ----------
@@ -453,36 +704,104 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
     columns : dict, optional
         Analysis name → the file's column name, e.g. ``{"time": "t_s",
         "spring_force": "F_N"}`` (:func:`map_columns`).
+    column_units : dict, optional
+        Analysis name → the unit its column is in (``{"spring_force": "uN", "time":
+        "ms"}``): the column is converted into the trace's unit system
+        (``parameters.units``) by :func:`filmfriction.reduced_model.units.column_factor`.
+    skip_rows : int
+        Lines skipped at the top before the header is looked for (an instrument's
+        metadata).
+    comments : tuple of str
+        What starts a comment line (skipped before the header and among the rows).
+    log_run : str, optional
+        The thermo run(s) of a LAMMPS log to read: ``N``, ``N-M``, ``N-``
+        (:func:`filmfriction.analysis.lammps_log.read_log_table`); a log is
+        recognised by its first line, ``LAMMPS (...)``.
+
+    Rows where a column the analysis reads is empty, NaN or infinite are dropped
+    (never interpolated), as are rows repeating the next row's ``step``; the trace's
+    ``notes`` and ``layout.dropped`` say which.
 
     Raises
     ------
     ValueError
-        Unreadable file, a bad mapping, missing ``time``/``spring_force``,
+        Unreadable file, a bad mapping or unit, missing ``time``/``spring_force``,
         non-increasing time.
     """
+    from .lammps_log import LAMMPS_NAMES, is_lammps_log, read_log_table
+
     path = Path(path)
-    raw_head = path.open("rb").read(65536)
-    start, header, sep = _header(raw_head, path)
-    renames = map_columns(_split(header, sep), columns, str(path))
-    cols = _read_binary_copy(path, list(renames))
-    notes, from_binary = [], cols is not None
-    if cols is None:
-        names, data, notes, sep = _read_table(path)
+    params = parameters or TraceParameters()
+    comments = tuple(comments) or COMMENTS
+    column_units = dict(column_units or {})
+    numbers, from_binary, dropped = None, False, {}
+    if log_run is not None or is_lammps_log(path):
+        if skip_rows:
+            raise ValueError(f"--skip-rows {skip_rows}: {path} is a LAMMPS log, read by its "
+                             "thermo blocks (choose them with --log-run); leave --skip-rows out")
+
+        def usable(keys):
+            try:
+                names = map_columns(keys, {k: v for k, v in (columns or {}).items()
+                                           if v in keys}, aliases=LAMMPS_NAMES).values()
+            except ValueError:
+                return False
+            return all(r in names for r in REQUIRED_COLUMNS)
+
+        names, data, notes, dropped = read_log_table(path, log_run, usable)
+        renames = map_columns(names, columns, str(path), aliases=LAMMPS_NAMES)
         cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
+        delimiter, kind = "whitespace", "lammps-log"
+    else:
+        raw_head = path.read_bytes() if skip_rows else path.open("rb").read(65536)
+        start, header, sep = _header(raw_head, path, skip_rows, comments)
+        renames = map_columns(_split(header, sep), columns, str(path))
+        cols = _read_binary_copy(path, list(renames))
+        notes, from_binary = [], cols is not None
+        if cols is None:
+            names, data, numbers, notes, sep = _read_table(path, skip_rows, comments)
+            cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
+        delimiter, kind = _DELIMITER_NAMES[sep], "table"
     cols = {renames[n]: v for n, v in cols.items()}
     for req in REQUIRED_COLUMNS:
         if req not in cols:
-            raise ValueError(f"{path}: required column '{req}' missing (header: "
+            what = "thermo keywords" if kind == "lammps-log" else "header"
+            raise ValueError(f"{path}: required column '{req}' missing ({what}: "
                              f"{', '.join(renames)}); name it with --column {req}=NAME")
+    for name in column_units:
+        if name not in cols:
+            raise ValueError(f"--column {name}=...:{column_units[name]}: {path} has no column "
+                             f"read as {name}")
+    notes = list(notes)
+    cols, numbers, more = _drop_missing(cols, numbers, notes)
+    dropped = _merge_dropped(dropped, more)
+    cols, numbers = _drop_repeated_steps(cols, numbers, notes)
+    cols = _convert_units(cols, column_units, params.units, notes)
     t = cols["time"]
-    if not np.all(np.isfinite(t)):
-        raise ValueError(f"{path}: column 'time' has non-finite values")
+    if t.size == 0:
+        raise ValueError(f"{path}: no data rows left once the rows with missing values are "
+                         "dropped")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         i = int(np.flatnonzero(np.diff(t) <= 0)[0])
-        raise ValueError(f"{path}: time not increasing at data row {i + 2}")
+        at = (f"line {numbers[i + 1]}" if numbers is not None else
+              f"row {i + 2}" + (f" (step {cols['step'][i + 1]:g})" if "step" in cols else ""))
+        raise ValueError(f"{path}: time not increasing at {at} ({t[i]:g} then {t[i + 1]:g})")
     mapped = {renames[s]: s for s in renames if renames[s] != s}
-    return Trace(cols, parameters or TraceParameters(), path, notes=tuple(notes),
-                 layout=TraceLayout(_DELIMITER_NAMES[sep], mapped, from_binary))
+    layout = TraceLayout(delimiter, mapped, from_binary, kind=kind, column_units=column_units,
+                         skip_rows=skip_rows, comments=comments, log_run=log_run,
+                         dropped=dropped)
+    return Trace(cols, params, path, notes=tuple(notes), layout=layout)
+
+
+def _merge_dropped(a: dict, b: dict) -> dict:
+    if not a:
+        return b
+    if not b:
+        return a
+    out = dict(b)
+    out["count"] = a["count"] + b["count"]
+    out["lines"] = (a.get("lines", []) + b.get("lines", []))[:20]
+    return out
 
 
 def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
@@ -505,17 +824,42 @@ def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
                      f"(nor in {directory})")
 
 
-def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
-    """Read a run directory, a plain trace file, or the directory of an analysed trace.
+def _run_record(directory: Path) -> dict:
+    """``run.json`` of a run directory (empty when there is none)."""
+    if not (directory / RUN_FILE).exists():
+        return {}
+    try:
+        return json.loads((directory / RUN_FILE).read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{directory / RUN_FILE}: not valid JSON: {exc}") from None
+
+
+def _run_parameters(run: dict) -> dict:
+    given = dict(run.get("trace_parameters") or {})
+    base = {k: given.get(k) for k in PARAMETERS}
+    base["units"] = given.get("units", "lj")
+    return base
+
+
+def read_trace(path, *, columns: dict | None = None, column_units: dict | None = None,
+               skip_rows: int | None = None, comments=None, log_run: str | None = None,
+               **overrides) -> Trace:
+    """Read a run directory, a trace file, or the directory of an analysed trace.
 
     Parameters
     ----------
     path : path-like
-        A run directory (with ``trace.csv`` and ``run.json``), a trace file, or a
-        directory with the ``analysis.json`` of a trace file (``filmfriction analyze``
-        records the file, its column mapping, units and parameters there).
+        A run directory (with ``trace.csv`` and ``run.json``), a trace file (a text
+        table, a LAMMPS ``fix print``/``fix ave/time`` file or log), or a directory
+        with the ``analysis.json`` of a trace file (``filmfriction analyze`` records
+        the file, how it was read, its units and parameters there).  A file beside a
+        ``run.json`` (a run's ``trace.dat`` or LAMMPS log) is read with that run's
+        parameters and units.
     columns : dict, optional
         Analysis name → the file's column name (:func:`map_columns`).
+    column_units, skip_rows, comments, log_run
+        As for :func:`read_csv_trace` (for a file; an analysed file's directory
+        reads them from its ``analysis.json`` unless given).
     **overrides
         ``spring_constant``, ``mass``, ``area``, ``thickness``,
         ``drive_velocity``, ``units``; ``None`` values are ignored.
@@ -525,6 +869,8 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
     >>> tr = read_trace("runs/default", spring_constant=10.0)  # doctest: +SKIP
     """
     path = Path(path)
+    reading = {"column_units": column_units, "skip_rows": skip_rows, "comments": comments,
+               "log_run": log_run}
     if path.is_dir():
         csv_path = path / TRACE_FILE
         if not csv_path.exists():
@@ -542,19 +888,30 @@ def read_trace(path, *, columns: dict | None = None, **overrides) -> Trace:
             params = TraceParameters(**base).updated(**overrides)
             mapping = dict(source.get("columns") or {})
             mapping.update(columns or {})
-            return read_csv_trace(file, params, mapping)
-        run = {}
-        if (path / RUN_FILE).exists():
-            try:
-                run = json.loads((path / RUN_FILE).read_text())
-            except json.JSONDecodeError as exc:
-                raise ValueError(f"{path / 'run.json'}: not valid JSON: {exc}") from None
-        given = dict(run.get("trace_parameters") or {})
-        base = {k: given.get(k) for k in PARAMETERS}
-        base["units"] = given.get("units", "lj")
-        params = TraceParameters(**base).updated(**overrides)
+            recorded = {"column_units": dict(source.get("column_units") or {}),
+                        "skip_rows": int(source.get("skip_rows") or 0),
+                        "comments": tuple(source.get("comments") or COMMENTS),
+                        "log_run": source.get("log_run")}
+            # what is given wins: units name by name, as the mapping
+            recorded["column_units"].update(column_units or {})
+            recorded.update({k: v for k, v in reading.items()
+                             if v is not None and k != "column_units"})
+            tr = read_csv_trace(file, params, mapping, **recorded)
+            return Trace(tr.columns, params, tr.path, None, _run_record(file.parent), tr.notes,
+                         tr.layout)
+        run = _run_record(path)
+        params = TraceParameters(**_run_parameters(run)).updated(**overrides)
         tr = read_csv_trace(csv_path, params, columns)
         return Trace(tr.columns, params, csv_path, path, run, tr.notes, tr.layout)
     if not path.exists():
         raise ValueError(f"{path}: no such file or directory")
-    return read_csv_trace(path, TraceParameters().updated(**overrides), columns)
+    run = _run_record(path.parent)
+    base, notes = {}, ()
+    if run.get("trace_parameters"):
+        base = _run_parameters(run)
+        notes = (f"parameters and units from {path.parent / 'run.json'} (the run that wrote "
+                 "the file)",)
+    params = TraceParameters(**base).updated(**overrides)
+    tr = read_csv_trace(path, params, columns,
+                        **{k: v for k, v in reading.items() if v is not None})
+    return Trace(tr.columns, params, tr.path, None, run, notes + tr.notes, tr.layout)

@@ -416,3 +416,189 @@ OMCTS_VISCOSITY_MATCHED = viscosity_matched(
 
 __all__ += ["OMCTS_BULK_VISCOSITY", "viscosity_time_unit", "viscosity_matched",
             "LJ_ETA_FILM", "LJ_ETA_FILM_STDERR", "OMCTS_VISCOSITY_MATCHED"]
+
+
+# ---------------------------------------------------------------------------
+# Units of a measured column
+# ---------------------------------------------------------------------------
+# A trace file's column may be in any unit: µN, nm, ms (an SFB), Å and fs (LAMMPS
+# metal units), ε/σ and τ (LJ).  :func:`column_factor` turns a unit's text into
+# the factor that brings the column's numbers into the trace's unit system (SI
+# base units, or LJ units): SI to SI is the prefixes' arithmetic; LJ to SI and SI
+# to LJ go through an :class:`LJUnits` mapping (default :data:`OMCTS`).
+#
+# A unit's text is a product of symbols, each with an optional SI prefix and
+# power, divided by more: ``uN``, ``µm/s``, ``N/m``, ``kcal/mol/Å``,
+# ``epsilon/sigma``, ``ε/k_B``.  SI symbols carry dimensions as exponents of
+# (kg, m, s, K, mol); LJ symbols as exponents of (σ, ε, m) as in _DIMENSIONS, plus
+# one of k_B for ε/k_B (a temperature).
+
+#: The SI prefixes accepted before a symbol (``u`` and ``µ``/``μ`` are micro).
+SI_PREFIXES: dict[str, float] = {
+    "G": 1e9, "M": 1e6, "k": 1e3, "c": 1e-2, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6,
+    "n": 1e-9, "p": 1e-12, "f": 1e-15, "a": 1e-18}
+
+# symbol -> (SI factor, exponents of kg, m, s, K, mol, prefix allowed)
+_SI_SYMBOLS: dict[str, tuple[float, tuple[int, ...], bool]] = {
+    "m": (1.0, (0, 1, 0, 0, 0), True),
+    "s": (1.0, (0, 0, 1, 0, 0), True),
+    "g": (1e-3, (1, 0, 0, 0, 0), True),
+    "N": (1.0, (1, 1, -2, 0, 0), True),
+    "J": (1.0, (1, 2, -2, 0, 0), True),
+    "Pa": (1.0, (1, -1, -2, 0, 0), True),
+    "K": (1.0, (0, 0, 0, 1, 0), False),
+    "eV": (constants.eV, (1, 2, -2, 0, 0), True),
+    "cal": (constants.calorie, (1, 2, -2, 0, 0), True),
+    "mol": (1.0, (0, 0, 0, 0, 1), False),
+    "Å": (1e-10, (0, 1, 0, 0, 0), False),
+    "angstrom": (1e-10, (0, 1, 0, 0, 0), False),
+    "min": (60.0, (0, 0, 1, 0, 0), False),
+    "h": (3600.0, (0, 0, 1, 0, 0), False),
+}
+# symbol -> exponents of sigma, epsilon, m, k_B (LJ units take no prefix)
+_LJ_SYMBOLS: dict[str, tuple[float, ...]] = {
+    "σ": (1, 0, 0, 0), "sigma": (1, 0, 0, 0),
+    "ε": (0, 1, 0, 0), "epsilon": (0, 1, 0, 0),
+    "τ": (1, -0.5, 0.5, 0), "tau": (1, -0.5, 0.5, 0),
+    "k_B": (0, 0, 0, 1), "kB": (0, 0, 0, 1),
+}
+
+#: Example units of each quantity a trace column has, for messages.
+UNIT_EXAMPLES: dict[str, tuple[str, ...]] = {
+    "time": ("s", "ms", "us", "ns", "ps", "fs", "min", "tau"),
+    "length": ("m", "mm", "um", "nm", "Å", "sigma"),
+    "force": ("N", "mN", "uN", "nN", "pN", "eV/Å", "kcal/mol/Å", "epsilon/sigma"),
+    "velocity": ("m/s", "um/s", "nm/s", "Å/fs", "sigma/tau"),
+    "energy": ("J", "nJ", "eV", "kcal/mol", "epsilon"),
+    "temperature": ("K", "epsilon/k_B"),
+}
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A parsed unit: its system (``si`` or ``lj``), its SI factor (SI units: the SI
+    value of 1 of it; LJ units: 1) and its dimensions (SI: exponents of kg, m, s, K,
+    mol; LJ: of σ, ε, m, k_B)."""
+
+    text: str
+    system: str
+    factor: float
+    dimensions: tuple
+
+    def dimension_of(self, quantity: str) -> bool:
+        """Whether this unit measures ``quantity`` (a key of :data:`QUANTITIES`)."""
+        return self.dimensions == _quantity_dimensions(quantity, self.system)
+
+
+def _quantity_dimensions(quantity: str, system: str) -> tuple:
+    if quantity not in _DIMENSIONS:
+        raise ValueError(f"unknown quantity {quantity!r}; allowed: {', '.join(QUANTITIES)}")
+    if quantity == "temperature":
+        return (0, 0, 0, 1, 0) if system == "si" else (0, 1, 0, -1)
+    a, b, c = _DIMENSIONS[quantity]
+    if system == "lj":
+        return (a, b, c, 0)
+    # sigma -> m, epsilon -> kg m^2 s^-2, mass -> kg
+    return (b + c, a + 2 * b, -2 * b, 0, 0)
+
+
+def _symbol(token: str, text: str):
+    """(system, factor, dimensions) of one symbol with its prefix and power."""
+    power = 1
+    for sup, p in (("²", 2), ("³", 3)):
+        if token.endswith(sup):
+            token, power = token[:-1], p
+    if "^" in token:
+        token, _, exp = token.partition("^")
+        try:
+            power = int(exp)
+        except ValueError:
+            raise ValueError(f"unit {text!r}: bad power {exp!r} (give e.g. m^2)") from None
+    if token in _LJ_SYMBOLS:
+        return "lj", 1.0, tuple(power * e for e in _LJ_SYMBOLS[token])
+    if token in _SI_SYMBOLS:
+        factor, dims, _ = _SI_SYMBOLS[token]
+        return "si", factor ** power, tuple(power * e for e in dims)
+    for symbol, (factor, dims, prefixable) in _SI_SYMBOLS.items():
+        prefix = token[:-len(symbol)]
+        if prefixable and token.endswith(symbol) and prefix in SI_PREFIXES:
+            return "si", (SI_PREFIXES[prefix] * factor) ** power, tuple(power * e for e in dims)
+    raise ValueError(f"unit {text!r}: unknown symbol {token!r} (SI symbols m, s, g, N, J, Pa, "
+                     f"K, eV, cal, mol, Å, min, h with a prefix {', '.join(SI_PREFIXES)}; "
+                     "LJ: sigma σ, epsilon ε, tau τ, k_B)")
+
+
+def parse_unit(text: str) -> Unit:
+    """The :class:`Unit` of ``text``: symbols with optional SI prefix and power, joined
+    by ``*`` or ``·`` and divided by ``/``.
+
+    Raises
+    ------
+    ValueError
+        An empty unit, an unknown symbol, or SI and LJ symbols mixed.
+
+    Examples
+    --------
+    >>> parse_unit("uN").factor, parse_unit("kcal/mol").dimensions
+    (1e-06, (1.0, 2.0, -2.0, 0.0, 0.0))
+    >>> parse_unit("epsilon/sigma").system, parse_unit("µN").dimension_of("force")
+    ('lj', True)
+    """
+    raw = str(text).strip()
+    if not raw:
+        raise ValueError("empty unit")
+    symbols = []
+    for i, part in enumerate(raw.split("/")):
+        tokens = part.replace("·", "*").split("*")
+        if any(not t.strip() for t in tokens):
+            raise ValueError(f"unit {raw!r}: an empty symbol (write e.g. N/m, kcal/mol/Å)")
+        symbols += [(1 if i == 0 else -1, *_symbol(t.strip(), raw)) for t in tokens]
+    systems = {system for _, system, _, _ in symbols}
+    if len(systems) > 1:
+        raise ValueError(f"unit {raw!r}: mixes SI and LJ symbols")
+    system = systems.pop()
+    factor, dims = 1.0, [0.0] * len(symbols[0][3])
+    for sign, _, f, d in symbols:
+        factor *= f ** sign
+        dims = [x + sign * e for x, e in zip(dims, d)]
+    if system == "si":
+        # a mole counts particles: per mole is per N_A of them (kcal/mol is an energy)
+        factor *= constants.N_A ** dims[4]
+        dims[4] = 0.0
+    return Unit(raw, system, factor, tuple(float(e) for e in dims))
+
+
+def column_factor(text: str, quantity: str, system: str,
+                  units: LJUnits = OMCTS) -> float:
+    """The factor that turns numbers in unit ``text`` of ``quantity`` into the unit
+    system ``system`` (``"si"``: SI base units; ``"lj"``: LJ units), through
+    ``units`` when the unit is of the other system.
+
+    Raises
+    ------
+    ValueError
+        An unreadable unit, or one that does not measure ``quantity``; the message
+        lists units that do.
+
+    Examples
+    --------
+    >>> column_factor("uN", "force", "si"), column_factor("ms", "time", "si")
+    (1e-06, 0.001)
+    >>> column_factor("tau", "time", "lj"), round(column_factor("ps", "time", "lj", OMCTS), 4)
+    (1.0, 0.1324)
+    """
+    if system not in ("si", "lj"):
+        raise ValueError(f"unit system {system!r}: 'si' or 'lj'")
+    unit_ = parse_unit(text)
+    if not unit_.dimension_of(quantity):
+        examples = ", ".join(UNIT_EXAMPLES.get(quantity, ()))
+        raise ValueError(f"unit {text!r} is not a {quantity.replace('_', ' ')} unit"
+                         + (f" (e.g. {examples})" if examples else ""))
+    if unit_.system == system:
+        return unit_.factor
+    if unit_.system == "lj":                      # LJ -> SI
+        return units.scale(quantity)
+    return unit_.factor / units.scale(quantity)   # SI -> LJ
+
+
+__all__ += ["SI_PREFIXES", "UNIT_EXAMPLES", "Unit", "parse_unit", "column_factor"]

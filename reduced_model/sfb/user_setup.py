@@ -162,7 +162,9 @@ class SFBSetup:
 
 def load_setup(path) -> SFBSetup:
     """The :class:`SFBSetup` in the TOML file ``path`` (named after the file unless it
-    says ``name``).
+    says ``name``).  A ``[trace]`` table, how the instrument writes its traces, is not
+    part of the set-up: ``filmfriction analyze`` reads it
+    (:func:`filmfriction.analysis.column_spec.trace_table`).
 
     Raises
     ------
@@ -180,6 +182,7 @@ def load_setup(path) -> SFBSetup:
         raise ValueError(f"{path}: no such file") from None
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
+    data.pop("trace", None)
     try:
         return SFBSetup.from_dict(data, name=path.stem)
     except ValueError as exc:

@@ -42,7 +42,7 @@ def test_truncated_file(tmp_path):
     tr = read_trace(p)
     assert len(tr) == 2 and "truncated" in tr.notes[0]
     p.write_text("time,spring_force\n0,1\n1\n2,3\n")          # damaged inside
-    with pytest.raises(ValueError, match="cannot parse"):
+    with pytest.raises(ValueError, match="line 3 has 1 comma-separated values, the header 2"):
         read_trace(p)
     p.write_text("time,spring_force\n")
     with pytest.raises(ValueError, match="no data rows"):
@@ -112,8 +112,14 @@ def test_user_errors(tmp_path, run_cli):
     assert missing.code == 2 and "nope.csv" in missing.err
     p = tmp_path / "nan.csv"
     p.write_text("time,spring_force\n0,1\n1,nan\n2,1\n3,2\n")
-    r = run_cli("analyze", p)
-    assert r.code == 2 and "non-finite" in r.err
+    r = run_cli("analyze", p, "--json")
+    # the row is dropped, said and recorded; never interpolated
+    assert r.code == 0, r.err
+    source = r.json()["source"]
+    assert source["samples"] == 3
+    assert source["dropped_rows"] == {"count": 1, "columns": {"spring_force": 1}, "lines": [3]}
+    assert any("dropped 1 row with empty, NaN or infinite cells (line 3; spring_force 1)" in n
+               for n in source["notes"])
 
 
 def test_analyze_run_directory(synthetic_run, run_cli):

@@ -85,22 +85,6 @@ def _analysed_file_dir(tmp: Path) -> Path:
     return d
 
 
-def _nan_wall(tmp: Path) -> Path:
-    wall = np.arange(400) * 0.1
-    wall[::3] = np.nan
-    return _trace(tmp, wall=wall, name="nanwall.csv")
-
-
-def _overflow(tmp: Path) -> Path:
-    p = _trace(tmp, name="overflow.csv")
-    lines = p.read_text().splitlines()
-    parts = lines[5].split(",")
-    parts[3] = "1e400"                      # overflows a double: inf
-    lines[5] = ",".join(parts)
-    p.write_text("\n".join(lines) + "\n")
-    return p
-
-
 def _huge(tmp: Path) -> Path:
     t = np.arange(400) * 0.5
     force = (10 * np.sin(t) + t % 20) * 1e306     # finite, but its square is not
@@ -130,7 +114,6 @@ CASES = {
     "calibration not UTF-8": (lambda t: ["sfb", "--calibration",
                                          _latin1(t, "c.json", '{"a": "caf\xe9"}')],
                               "not UTF-8", 2),
-    "trace that overflows": (lambda t: ["analyze", _overflow(t)], "non-finite", 2),
     "trace whose arithmetic overflows": (lambda t: ["analyze", _huge(t)], "beyond ±1e+100", 2),
     "run.json not an object (analyze)": (lambda t: ["analyze", _list_run(t)],
                                          "JSON object", 2),
@@ -140,7 +123,6 @@ CASES = {
     "bench --steps 0": (lambda t: ["bench", "--steps", "0"], "--steps 0", 2),
     "bench --repeat 0": (lambda t: ["bench", "--repeat", "0"], "--repeat 0", 2),
     # -- were accepted
-    "NaN in wall_position": (lambda t: ["analyze", _nan_wall(t)], "column wall_position", 2),
     "--skip negative": (lambda t: ["analyze", _trace(t), "--skip", "-1"], "--skip", 2),
     "--skip beyond the slips": (lambda t: ["analyze", _trace(t), "--skip", "100000"],
                                 "--skip 100000", 2),

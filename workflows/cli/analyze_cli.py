@@ -34,28 +34,70 @@ def _count(text: str) -> int:
 MAX_MAGNITUDE = 1e100
 
 
-def _mapping(text: str) -> tuple[str, str]:
-    name, sep, column = text.partition("=")
-    if not sep or not name.strip() or not column.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: give NAME=COLUMN, e.g. time=t_s")
-    return name.strip(), column.strip()
+def _reading_options(args) -> None:
+    """Check --column, --skip-rows, --comment and --log-run (one-line errors naming the
+    option, its value and what is accepted); ``args`` gets their parsed values."""
+    from filmfriction.analysis.column_spec import parse_column
+    from filmfriction.analysis.lammps_log import parse_runs
+
+    parsed = []
+    for text in args.column:
+        try:
+            parsed.append(parse_column(text))
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+    args.column = parsed
+    if args.skip_rows is not None:
+        try:
+            n = int(args.skip_rows)
+        except ValueError:
+            n = -1
+        if n < 0:
+            raise UserError(f"--skip-rows {args.skip_rows}: give a whole number, 0 or more "
+                            "(lines skipped before the header)")
+        args.skip_rows = n
+    for prefix in args.comment or ():
+        if not prefix.strip() or prefix != prefix.strip():
+            raise UserError(f"--comment {prefix!r}: give the text a comment line starts with, "
+                            "e.g. '#' or '%' (no blanks)")
+    if args.log_run is not None:
+        try:
+            parse_runs(args.log_run)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+        args.log_run = args.log_run.strip()
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "analyze", help="stick-slip events, energy partition, viscosity, structure",
-        description="Analyse a run directory (trace.csv + run.json) or a trace file "
+        description="Analyse a run directory (trace.csv + run.json), a trace file "
                     "(a header line, then rows separated by commas, tabs, semicolons or "
                     "spaces; columns time, spring_force, optional drive_position, "
                     "wall_position, wall_velocity, gap, or the file's own names mapped with "
-                    "--column). Writes analysis.json, analysis_cycles.csv and "
-                    "analysis_trace.png (the trace with its slips) next to the trace.")
+                    "--column, in their own units), a LAMMPS fix print / fix ave/time file "
+                    "('# name ...' header) or a LAMMPS log (its thermo output, --log-run). "
+                    "Rows with empty or NaN cells are dropped with a note. Writes "
+                    "analysis.json, analysis_cycles.csv and analysis_trace.png (the trace "
+                    "with its slips) next to the trace.")
     p.add_argument("path", type=Path, help="run directory, trace file, or the directory of an "
                                            "analysed trace file (its analysis.json)")
-    p.add_argument("--column", type=_mapping, action="append", default=[], metavar="NAME=COLUMN",
+    p.add_argument("--column", action="append", default=[],
+                   metavar="NAME=COLUMN[:UNIT]",
                    help="read the file's column COLUMN as NAME (time, spring_force, "
-                        "drive_position, wall_position, wall_velocity, gap, ...); repeat per "
-                        "column, e.g. --column time=t_s --column spring_force=F_N")
+                        "drive_position, wall_position, wall_velocity, gap, ...), in UNIT when "
+                        "given (SI with a prefix: uN, nm, ms, ...; Å, eV, kcal/mol; LJ: "
+                        "epsilon/sigma, sigma, tau); repeat per column, e.g. --column "
+                        "time=t:ms --column spring_force=F:uN")
+    p.add_argument("--skip-rows", default=None, metavar="N",
+                   help="skip the first N lines of the file (an instrument's metadata) before "
+                        "the header")
+    p.add_argument("--comment", action="append", default=None, metavar="TEXT",
+                   help="lines starting with TEXT are comments (default '#'; given, only those "
+                        "given); repeat for more, e.g. --comment '#' --comment '%%'")
+    p.add_argument("--log-run", default=None, metavar="N",
+                   help="a LAMMPS log: read its thermo run N (counted from 1), or N-M to join "
+                        "runs N to M (a run in segments), N- to the last")
     p.add_argument("--json", action="store_true", help="also print the document")
     p.add_argument("--setup", type=Path, default=None, metavar="FILE.toml",
                    help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
@@ -86,6 +128,7 @@ def run(args: argparse.Namespace) -> int:
     from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
                                              write_binary_copy)
 
+    _reading_options(args)
     record = check_run_json(args.path) if args.path.is_dir() else None
     recorded = (record or {}).get("trace_parameters") or {}
     if recorded:
@@ -104,11 +147,14 @@ def run(args: argparse.Namespace) -> int:
                                 f"run.json), and is analysed with it; leave {flag} out")
     if args.output is not None:
         check_writable(args.output, "--output")
+    table = {}
     if args.setup is not None:
+        from filmfriction.analysis.column_spec import trace_table
         from filmfriction.reduced_model.sfb.user_setup import load_setup
 
         try:
             setup = load_setup(args.setup)
+            table = trace_table(args.setup)
         except ValueError as exc:
             raise UserError(f"--setup {exc}") from None
         if args.units == "lj":
@@ -119,27 +165,64 @@ def run(args: argparse.Namespace) -> int:
                             ("drive_velocity", setup.drive_velocity)):
             if getattr(args, flag) is None:
                 setattr(args, flag, value)
-    columns = {}
-    for name, column in args.column:
-        if name in columns and columns[name] != column:
-            raise UserError(f"--column {name}={column}: {name} is already read from "
-                            f"{columns[name]!r}; give each name once")
+    # the set-up's [trace] table, then the command line (which wins, name by name)
+    columns, units_of = {}, {}
+    for name, (column, unit_) in (table.get("columns") or {}).items():
         columns[name] = column
+        if unit_:
+            units_of[name] = unit_
+    given = {}
+    for name, column, unit_ in args.column:
+        shown = f"--column {name}={column}" + (f":{unit_}" if unit_ else "")
+        if name in given and given[name] != (column, unit_):
+            raise UserError(f"{shown}: {name} is already read from {given[name][0]!r}; give "
+                            "each name once")
+        given[name] = (column, unit_)
+        columns[name] = column
+        units_of.pop(name, None)
+        if unit_:
+            units_of[name] = unit_
+    skip_rows = args.skip_rows if args.skip_rows is not None else table.get("skip_rows")
+    comments = tuple(args.comment) if args.comment else table.get("comments")
+    if units_of and args.units is None and not recorded:
+        # the columns' units say the system: SI units -> si, LJ units -> lj
+        from filmfriction.reduced_model.units import parse_unit
+
+        systems = {parse_unit(u).system for u in units_of.values()}
+        if len(systems) > 1:
+            raise UserError("--column: units of SI and of LJ mixed ("
+                            + ", ".join(f"{n}:{u}" for n, u in units_of.items())
+                            + "); say which system the analysis is in with --units si or "
+                              "--units lj (the others are converted with the OMCTS mapping)")
+        args.units = systems.pop()
+    if args.path.is_dir() and (args.skip_rows is not None or args.comment or args.log_run):
+        flag = (f"--skip-rows {args.skip_rows}" if args.skip_rows is not None else
+                f"--comment {args.comment[0]}" if args.comment else f"--log-run {args.log_run}")
+        if record:
+            raise UserError(f"{flag}: {args.path} is a run directory (its trace.csv is read "
+                            "as written); give the file itself, e.g. "
+                            f"{args.path / 'lammps.log'}")
+    if not args.path.is_dir() and args.path.exists():
+        beside = args.path.parent
+        if (args.output is None and (beside / "run.json").is_file()
+                and args.path.name != "trace.csv"):
+            raise UserError(f"{args.path}: a file of the run directory {beside}, whose "
+                            "analysis.json is of its trace.csv; give --output FILE.json for "
+                            "this file's analysis")
     try:
-        trace = read_trace(args.path, columns=columns, spring_constant=args.spring_constant,
+        trace = read_trace(args.path, columns=columns, column_units=units_of,
+                           skip_rows=skip_rows, comments=comments, log_run=args.log_run,
+                           spring_constant=args.spring_constant,
                            mass=args.mass, area=args.area, thickness=args.thickness,
                            drive_velocity=args.drive_velocity, units=args.units)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     where = trace.path
+    from filmfriction.analysis.trace import trace_column_names
+
     for name, column in trace.columns.items():
-        bad = ~np.isfinite(np.asarray(column, dtype=float))
-        if bad.any():
-            first = int(np.flatnonzero(bad)[0])
-            raise UserError(f"{where}: column {name} has {int(bad.sum())} non-finite (NaN or "
-                            f"infinite) values (first at data row {first + 2}); every value must be a "
-                            f"finite number (drop the column to skip what needs it)")
-    for name, column in trace.columns.items():
+        if name not in trace_column_names():
+            continue            # a column the analysis does not read
         big = np.abs(np.asarray(column, dtype=float)) > MAX_MAGNITUDE
         if big.any():
             first = int(np.flatnonzero(big)[0])
@@ -160,9 +243,6 @@ def run(args: argparse.Namespace) -> int:
                         f"--skip {args.skip}: the trace has no slips; give --skip 0")
     layout = trace.layout
     if trace.run_dir is None and layout is not None:
-        # how the file was read: `calibrate`, `report` and `analyze DIR` read it again so
-        doc["source"]["delimiter"] = layout.delimiter
-        doc["source"]["columns"] = dict(layout.columns)
         # the file as seen from analysis.json (not from this working directory), so that
         # `calibrate`/`report` of its directory find it from anywhere, --output elsewhere too
         import os
@@ -183,8 +263,10 @@ def run(args: argparse.Namespace) -> int:
         # long text traces: later reads (calibrate, report, analyze again) take the copy
         try:
             write_binary_copy(trace)
-        except OSError:
+        except (OSError, ValueError):
             pass
+    for warning in (doc.get("units_check") or {}).get("warnings", []):
+        print(f"warning: {warning}", file=sys.stderr)
     if args.json:
         print(to_json(dict(doc, cycles_csv=csv_path.name)))
     else:
