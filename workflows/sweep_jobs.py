@@ -144,7 +144,8 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
     np_ : int
         MPI ranks.
     launcher : str
-        ``mpiexec`` (the venv's) or a command such as ``srun`` (Slurm's ``mpi`` resource).
+        ``mpiexec`` (the venv's) or a command such as ``srun --mpi=pmi2`` (the Snakefile's
+        ``launcher`` resource, set by the profile).
     """
     import shutil
 
