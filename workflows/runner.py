@@ -194,16 +194,17 @@ def loop_atoms(line: str) -> int | None:
     return int(m.group(3)) if m else None
 
 
-_PROCS = re.compile(r"^Loop time of \S+ on (\d+) procs", re.M)
+_TASKS = re.compile(r"CPU use with (\d+) MPI tasks x \d+ OpenMP threads")
 
 
 def ranks_problem(log: Path, ranks: int) -> str | None:
     """Why a run's LAMMPS did not run on the ``ranks`` MPI ranks asked (None when it did,
-    or when its log has no "Loop time" line): a launcher whose ranks do not join one MPI
-    job (e.g. ``srun`` without the PMI the MPI library needs) starts ``ranks`` separate
-    one-rank copies of the run, which write over each other's files."""
+    or when its log does not say, e.g. "98.5% CPU use with 2 MPI tasks x 1 OpenMP
+    threads"): a launcher whose ranks do not join one MPI job (e.g. ``srun`` without the
+    PMI the MPI library needs) starts ``ranks`` separate one-rank copies of the run,
+    which write over each other's files."""
     try:
-        used = {int(n) for n in _PROCS.findall(log.read_text(errors="replace"))}
+        used = {int(n) for n in _TASKS.findall(log.read_text(errors="replace"))}
     except OSError:
         return None
     if not used or used == {ranks}:

