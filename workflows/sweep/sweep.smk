@@ -5,8 +5,8 @@
 #     python -m snakemake --snakefile workflows/sweep/sweep.smk --directory SWEEP_DIR ...
 # It can be run by hand the same way on a directory that holds a sweep.json.
 #
-# point job      an MPI LAMMPS run through workflows.runner (mpiexec locally, `srun` on Slurm:
-#                the `mpi` resource names the launcher, `tasks` the ranks)
+# point job      an MPI LAMMPS run through workflows.runner (mpiexec locally, srun on Slurm:
+#                the `launcher` resource names the launcher, `tasks` the ranks)
 # analyse job    analysis.json of the run (serial)
 # aggregate job  aggregate.json/.csv, velocity_map.png, vk_map.png when V x K are swept
 import json
@@ -23,6 +23,13 @@ CALIBRATION = [SPEC["calibration"]] if SPEC.get("calibration") else []
 AGGREGATE = ["aggregate.json", "aggregate.csv", "velocity_map.png"]
 if "drive_velocity" in KEYS and "spring_constant" in KEYS:
     AGGREGATE.append("vk_map.png")
+# Slurm's executor takes a job with an `mpi` resource for one MPI job of `tasks` ranks
+# (sbatch --ntasks; the command runs in the batch step, where the launcher starts the ranks),
+# and refuses one with a single task.  A one-rank point is a plain one-task job: the executor
+# runs it inside a job step (srun -n 1), so the Slurm profile's launcher carries --overlap
+# to start LAMMPS's own step beside it.  The value of `mpi` is not read; locally it means
+# nothing.
+MPI_JOB = {"mpi": "yes"} if NP > 1 else {}
 
 wildcard_constraints:
     point="[^/]+",
@@ -47,14 +54,15 @@ rule point:
         "logs/{point}.run.log",
     threads: NP  # local scheduling: a point occupies its ranks' cores
     resources:
-        mpi="mpiexec",  # the launcher; the Slurm profile sets "srun"
+        launcher="mpiexec",  # what starts the ranks; the Slurm profile sets srun
         tasks=NP,  # MPI ranks (Slurm: --ntasks)
         cpus_per_task=1,  # one core per rank (Slurm would otherwise take `threads`)
         mem_mb=2000,
         runtime=60,  # minutes; raise it in the profile for production-length runs
+        **MPI_JOB,
     shell:
         "{PYTHON:q} -m filmfriction.workflows.sweep point {input:q} points/{wildcards.point:q} "
-        "--np {resources.tasks} --launcher {resources.mpi:q} > {log:q} 2>&1"
+        "--np {resources.tasks} --launcher {resources.launcher:q} > {log:q} 2>&1"
 
 
 rule analyse:
