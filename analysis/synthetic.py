@@ -6,7 +6,12 @@
   (``solve_ivp``, independent of the closed form in :mod:`.viscosity`), and
   which re-sticks when the force has fallen to Fb;
 * :func:`smooth_trace` — steady sliding: constant mean force plus
-  correlated (AR(1)) noise.
+  correlated (AR(1)) noise;
+* :func:`block_trace` — a reduced-model spring-block (any friction law) sampled
+  at a uniform step, as an MD trace is;
+* :func:`with_wall_noise` — an MD wall's noise added to a trace: thermal
+  velocity noise on the sampled wall velocity and a correlated random force in
+  the film.
 
 All return a dict of columns named as in a trace CSV.
 """
@@ -19,7 +24,8 @@ from scipy.signal import lfilter
 from filmfriction.md_inputs.contract import AtomType
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 
-__all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
+__all__ = ["sawtooth", "klein_trace", "smooth_trace", "block_trace", "with_wall_noise",
+           "write_csv"]
 
 
 def _ar1(n: int, sigma: float, rho: float, rng) -> np.ndarray:
@@ -118,6 +124,67 @@ def smooth_trace(*, mean_force=1.0, noise=0.05, rho=0.9, n=20000, dt=0.5,
     return {"time": t, "spring_force": f, "drive_position": velocity * t,
             "wall_velocity": velocity + _ar1(n, 0.1 * velocity, rho, rng),
             "gap": gap + _ar1(n, 0.01 * gap, rho, rng)}
+
+
+def block_trace(block, duration: float, dt: float, **simulate) -> dict:
+    """A :class:`~filmfriction.reduced_model.SpringBlock` run sampled every ``dt``.
+
+    The run is integrated once at its own samples and interpolated linearly to
+    the grid when those are at least as fine as ``dt`` during the slips; else it
+    is integrated again to every grid time (``t_eval``: exact, slower).
+    ``simulate`` goes to :meth:`SpringBlock.simulate`.
+
+    Returns columns ``time, spring_force, drive_position, wall_position,
+    wall_velocity``.
+
+    Example
+    -------
+    >>> from filmfriction.reduced_model import SpringBlock, laws
+    >>> b = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
+    ...                 law=laws.Coulomb(static=1.0, kinetic=0.5))
+    >>> tr = block_trace(b, 30.0, 0.5)
+    >>> tr["time"][:3].tolist(), round(float(tr["spring_force"][20]), 12)   # K·V·t in the stick
+    ([0.0, 0.5, 1.0], 1.0)
+    """
+    grid = np.arange(0.0, duration, dt)
+    r = block.simulate(duration, samples_per_segment=512, **simulate)
+    fast = r.v[1:] > 0.2 * max(float(np.max(np.abs(r.v))), 1e-300)
+    step = np.diff(r.t)
+    if fast.any() and float(np.max(step[fast])) > dt:
+        r = block.simulate(duration, t_eval=grid, **simulate)
+        pick = r.eval_index
+        cols = (r.spring_force[pick], r.drive_position[pick], r.x[pick], r.v[pick])
+    else:
+        cols = tuple(np.interp(grid, r.t, c) for c in (r.spring_force, r.drive_position, r.x,
+                                                      r.v))
+    return dict(zip(("time", "spring_force", "drive_position", "wall_position",
+                     "wall_velocity"), (grid,) + cols))
+
+
+def with_wall_noise(columns: dict, *, velocity_noise: float, velocity_correlation: float = 0.0,
+                    rattle: float = 0.0, force_noise: float = 0.0,
+                    force_correlation: float = 0.0, seed: int = 0) -> dict:
+    """``columns`` with an MD wall's noise added to what is measured, not to the motion.
+
+    * ``wall_velocity`` + AR(1) noise of rms ``velocity_noise`` and lag-one
+      correlation ``velocity_correlation`` (the wall's bursts and pauses about the
+      law's motion) + white noise of rms ``rattle`` (its thermal rattling);
+    * ``spring_force`` + AR(1) noise of rms ``force_noise`` and lag-one correlation
+      ``force_correlation`` (a random force of the film, carried as it is by the
+      film force F_spring − M·a).
+
+    The position and the motion are left as they are: the law sees the true
+    velocity, a fit the noisy one.
+    """
+    rng = np.random.default_rng(seed)
+    out = dict(columns)
+    n = len(columns["time"])
+    out["wall_velocity"] = (np.asarray(columns["wall_velocity"], float)
+                            + _ar1(n, velocity_noise, velocity_correlation, rng)
+                            + rng.normal(0.0, rattle, n))
+    out["spring_force"] = np.asarray(columns["spring_force"], float) + _ar1(
+        n, force_noise, force_correlation, rng)
+    return out
 
 
 def write_csv(path, columns: dict) -> None:
