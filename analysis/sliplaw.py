@@ -116,7 +116,7 @@ class BranchFit:
     Attributes
     ----------
     branch : str
-        ``decelerating``, ``accelerating`` or ``both``.
+        ``decelerating``, ``accelerating`` or ``whole``.
     kinetic_force, kinetic_force_stderr : float
         F_k and its standard error (force units).
     damping, damping_stderr : float
@@ -182,6 +182,9 @@ class FilmForceFit:
     ----------
     decelerating, accelerating : BranchFit
         The two branches (see the module text).
+    whole : BranchFit
+        The whole slip in one fit (both branches: a loop makes it a compromise; with
+        the co-moving mass, the term where the acceleration takes both signs).
     verdict, reason : str
         The decelerating branch's.
     loop_area, loop_area_stderr : float
@@ -200,6 +203,7 @@ class FilmForceFit:
 
     decelerating: BranchFit
     accelerating: BranchFit
+    whole: BranchFit
     verdict: str
     reason: str
     loop_area: float
@@ -538,14 +542,14 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     else:
         guide = savgol_filter(v, w, 2) if w else v
     impulse = cumulative_trapezoid(f, t, initial=0.0)
-    segs = {name: [] for name in BRANCHES}
+    segs = {name: [] for name in BRANCHES + ("whole",)}
     ranges = []
     edge = w // 2 + 1
     for y, s in zip(table.yield_index, table.stick_index):
         y, s = int(y), int(s)
         g = guide[y:s + 1]
         if g.size < 3 or not np.max(g) > 0:
-            for name in BRANCHES:
+            for name in segs:
                 segs[name].append(None)
             ranges.append((math.nan, math.nan))
             continue
@@ -554,7 +558,8 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         fast = g > min_velocity_fraction * peak
         fast[:edge] = False
         fast[max(g.size - edge, 0):] = False
-        for name, (lo, hi) in (("accelerating", (0, p + 1)), ("decelerating", (p, g.size))):
+        for name, (lo, hi) in (("accelerating", (0, p + 1)), ("decelerating", (p, g.size)),
+                               ("whole", (0, g.size))):
             k = np.flatnonzero(fast[lo:hi]) + lo
             if k.size == 0:
                 segs[name].append(None)
@@ -565,7 +570,7 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
                     - (0.0 if comoving_mass else mass) * v[i])
             segs[name].append(_Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
         ranges.append((min_velocity_fraction * peak, peak))
-    fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in BRANCHES}
+    fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in segs}
     acc, dec = fits["accelerating"], fits["decelerating"]
     lo, hi = np.array(ranges, float).reshape(-1, 2).T
     # the loop between the two branches' lines, over the velocities both cover
@@ -575,8 +580,8 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     with np.errstate(invalid="ignore", divide="ignore"):
         gap = area / (hi - lo)
     la, lf = _mean_se(area), _mean_se(gap)
-    return FilmForceFit(dec, acc, dec.verdict, dec.reason, la[0], la[1], lf[0], lf[1], area, w,
-                        comoving_mass)
+    return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
+                        lf[1], area, w, comoving_mass)
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
