@@ -330,13 +330,13 @@ def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
 # ---------------------------------------------------------------------------
 # fitting
 # ---------------------------------------------------------------------------
-def _ols(X: np.ndarray, y: np.ndarray):
+def _ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
     """Least squares y = X·c: (coef, stderr, residuals); the errors widened by the
-    residuals' integrated autocorrelation time."""
+    residuals' integrated autocorrelation time (NaN with ``errors=False``)."""
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     dof = y.size - X.shape[1]
-    if dof <= 0:
+    if dof <= 0 or not errors:
         return coef, np.full(X.shape[1], math.nan), resid
     s2 = float(resid @ resid) / dof
     try:
@@ -389,12 +389,13 @@ def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) ->
     """Per-slip fits on one branch, their mean, errors, power and verdict."""
     nterms = 4 if comoving else 3
     per = []                       # (fk, b, mc, vbar) per slip
-    used = []
+    used, resids = [], []
     for seg in segments:
         if seg is None or seg.y.size < nterms + 3:
             per.append((math.nan,) * 4)
             continue
-        coef, _, _ = _ols(np.column_stack(seg.design(comoving)), seg.y)
+        coef, _, res = _ols(np.column_stack(seg.design(comoving)), seg.y, errors=False)
+        resids.append(res)
         # with m_c, the coefficient of v − v0 is M + m_c
         per.append((float(coef[1]), float(coef[2]),
                     float(coef[3]) - seg.mass if comoving else math.nan, seg.mean_velocity))
@@ -407,10 +408,6 @@ def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) ->
                          f"no slip with {nterms + 3} or more samples on the {branch} branch "
                          "above the velocity floor", per[:, 0], per[:, 1], per[:, 0] * nan,
                          0, 0, nan)
-    # pooled: one intercept per slip, common F_k, B (, m_c)
-    X = np.vstack([np.column_stack(s.design(comoving, len(used), k)) for k, s in enumerate(used)])
-    y = np.concatenate([s.y for s in used])
-    coef, pse, resid = _ols(X, y)
     m = len(used)
     ok = np.isfinite(per[:, 0]) & np.isfinite(per[:, 1])
     n = int(ok.sum())
@@ -422,8 +419,12 @@ def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) ->
         se = per[ok, :3].std(axis=0, ddof=1) / math.sqrt(n)
         dof = n - 1
     else:
-        # too few slips for a scatter: the pooled fit, its errors widened for the
-        # residuals' correlation, with the degrees of freedom of its independent samples
+        # too few slips for a scatter: the pooled fit (one intercept per slip, common
+        # F_k, B (, m_c)), its errors widened for the residuals' correlation, with the
+        # degrees of freedom of its independent samples
+        X = np.vstack([np.column_stack(s.design(comoving, m, k)) for k, s in enumerate(used)])
+        y = np.concatenate([s.y for s in used])
+        coef, pse, resid = _ols(X, y)
         est = np.array([coef[m], coef[m + 1], coef[m + 2] - used[0].mass if comoving else nan])
         se = np.array([pse[m], pse[m + 1], pse[m + 2] if comoving else nan])
         dof = max(int(y.size / _correlation_time(resid)) - (m + nterms - 1), 1)
@@ -436,13 +437,14 @@ def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) ->
     fbar = fk + b * vbar
     share = b * vbar / fbar if fbar > 0 else nan
     # the residual as the error of the law's wall velocity: (response residual) / M
-    vres = float(np.sqrt(np.mean(resid ** 2))) / used[0].mass
+    allres = np.concatenate(resids)
+    vres = float(np.sqrt(np.mean(allres ** 2))) / used[0].mass
     z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
     det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
     verdict, reason = _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n)
     return BranchFit(branch, fk, se_fk, b, se_b, mc, se_mc, vbar,
                      fbar, share, n_mean, n_se, z_fk, z_b, det_b, det_fk, dof, verdict, reason,
-                     per[:, 0], per[:, 1], expo, int(y.size), n, vres)
+                     per[:, 0], per[:, 1], expo, int(allres.size), n, vres)
 
 
 def _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
