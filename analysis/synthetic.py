@@ -58,12 +58,13 @@ def sawtooth(*, static_force=3.0, backward_force=1.0, period=2.0, cycles=10,
 def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
                 drive_velocity=100e-9, static_force=9.7e-6, backward_force=3.0e-6,
                 cycles=4, dt=2e-4, noise=0.0, seed=0, ringing=0.0,
-                ringing_frequency=45.0, ringing_decay=0.02) -> dict:
+                ringing_frequency=45.0, ringing_decay=0.02, kinetic_force=0.0) -> dict:
     """A driven spring-block with Klein-type slips, sampled every ``dt``.
 
     Stick: wall at rest until K(x_d − x) reaches Fs.  Slip: M x'' + B x' =
-    K(x_d − x) from rest until the force falls to Fb; the wall then stops
-    (the film solidifies).  Defaults are Klein's SFB numbers (SI).  With
+    K(x_d − x) − F_k (``kinetic_force``, 0: Klein's Eq. 1) from rest until the
+    force falls to Fb or the wall comes to rest; the wall then stops (the film
+    solidifies).  Defaults are Klein's SFB numbers (SI).  With
     ``ringing`` > 0 a decaying oscillation of that force amplitude is added
     after each re-stick (energy ringing²/(2K)).
 
@@ -81,16 +82,20 @@ def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
         t = t_yield
 
         def rhs(tt, s):
-            return [s[1], (k * (xd0 + v * tt - s[0]) - b * s[1]) / m]
+            return [s[1], (k * (xd0 + v * tt - s[0]) - b * s[1] - kinetic_force) / m]
 
         def stick(tt, s):
             return k * (xd0 + v * tt - s[0]) - backward_force
         stick.terminal, stick.direction = True, -1
+
+        def rest(tt, s):
+            return s[1] if tt > t else 1.0
+        rest.terminal, rest.direction = True, -1
         horizon = 100.0 * (b / k + np.sqrt(m / k))
-        sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=stick,
+        sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=(stick, rest),
                         dense_output=True, rtol=1e-10, atol=1e-16,
                         first_step=1e-6 * horizon, max_step=1e-3 * horizon)
-        t_s = float(sol.t_events[0][0])
+        t_s = float(min(e[0] for e in sol.t_events if e.size))
         segments.append((t, t_s, "slip", sol.sol))
         t, x = t_s, float(sol.sol(t_s)[0])
     t_end = t + 0.5 * (segments[-2][1] - segments[-2][0])
