@@ -76,15 +76,16 @@ def coulomb_viscous(share: float, *, slips: int = 8, film_force: float = 28.0,
                     slip_velocity: float = 0.55) -> dict:
     """Slips resisted by F_k + B·v whose viscous part is ``share`` of ``film_force`` at
     ``slip_velocity`` (the MD's mean film force and slip velocity), re-sticking at
-    F_b = 20 ε/σ (the MD's) or at rest, noise-free, ``slips`` + 1 slips."""
+    F_b = 20 ε/σ (the MD's) or once slowed to 0.15 σ/τ (a law with F_k would
+    otherwise slide on), noise-free, ``slips`` + 1 slips."""
     if not 0 <= share <= 1:
         raise ValueError(f"share = {share!r}: must be in [0, 1]")
     s = SCALE
     return klein_trace(spring_constant=s["spring_constant"], mass=s["mass"],
                        damping=share * film_force / slip_velocity,
                        kinetic_force=(1 - share) * film_force, drive_velocity=0.1,
-                       static_force=s["static_force"], backward_force=20.0, cycles=slips + 1,
-                       dt=s["dt"])
+                       static_force=s["static_force"], backward_force=20.0,
+                       restick_velocity=0.15, cycles=slips + 1, dt=s["dt"])
 
 
 @lru_cache(maxsize=16)

@@ -58,13 +58,15 @@ def sawtooth(*, static_force=3.0, backward_force=1.0, period=2.0, cycles=10,
 def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
                 drive_velocity=100e-9, static_force=9.7e-6, backward_force=3.0e-6,
                 cycles=4, dt=2e-4, noise=0.0, seed=0, ringing=0.0,
-                ringing_frequency=45.0, ringing_decay=0.02, kinetic_force=0.0) -> dict:
+                ringing_frequency=45.0, ringing_decay=0.02, kinetic_force=0.0,
+                restick_velocity=0.0) -> dict:
     """A driven spring-block with Klein-type slips, sampled every ``dt``.
 
     Stick: wall at rest until K(x_d − x) reaches Fs.  Slip: M x'' + B x' =
     K(x_d − x) − F_k (``kinetic_force``, 0: Klein's Eq. 1) from rest until the
-    force falls to Fb or the wall comes to rest; the wall then stops (the film
-    solidifies).  Defaults are Klein's SFB numbers (SI).  With
+    force falls to Fb or the wall slows to ``restick_velocity`` (0: comes to
+    rest); the wall then stops (the film solidifies).  Defaults are Klein's SFB
+    numbers (SI).  With
     ``ringing`` > 0 a decaying oscillation of that force amplitude is added
     after each re-stick (energy ringing²/(2K)).
 
@@ -88,8 +90,8 @@ def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
             return k * (xd0 + v * tt - s[0]) - backward_force
         stick.terminal, stick.direction = True, -1
 
-        def rest(tt, s):
-            return s[1] if tt > t else 1.0
+        def rest(tt, s):            # v falls through the re-stick velocity (not v = 0 at y)
+            return s[1] - restick_velocity if restick_velocity > 0 or tt > t else 1.0
         rest.terminal, rest.direction = True, -1
         horizon = 100.0 * (b / k + np.sqrt(m / k))
         sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=(stick, rest),
