@@ -526,10 +526,11 @@ def _bingham_reading(rows) -> str:
             f"no-slip film of bulk viscosity, this run's {_fmt(bi['model'], 3)} "
             f"({_fmt(lo, 2)} … {_fmt(hi, 2)}). ")
     if hi < 10:
-        text += ("Here Eq. (1) asks for no more damping than a bulk film would give, so a fit of "
-                 "Eq. (1) cannot by itself show a viscous film, and the run does not reproduce "
-                 "the regime of Klein's film: a verdict on his film needs Bi ≫ 1. What the run's "
-                 "slips do say is the slip law's verdict (its own section), with its power.")
+        text += ("Here Eq. (1) asks for less than ten times the damping a bulk film would "
+                 "give, so a fit of Eq. (1) cannot by itself show a viscous film, and the run "
+                 "does not reproduce the regime of Klein's film: a verdict on his film needs "
+                 "Bi ≫ 1. What the run's slips do say is the slip law's verdict (its own "
+                 "section), with its power.")
     else:
         text += ("Bi ≫ 1 here as in Klein's film: the slip law's verdict (its own section) says "
                  "whether the large damping is viscous.")
