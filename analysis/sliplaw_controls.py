@@ -89,7 +89,7 @@ def coulomb_viscous(share: float, *, slips: int = 8, film_force: float = 28.0,
 
 
 @lru_cache(maxsize=16)
-def _clean(name: str, slips: int):
+def _noise_free(name: str, slips: int):
     s, v = SCALE, _DRIVE.get(name)
     duration = (slips + 2.5) * _PERIOD.get(name, 0.0)
     if name == "coulomb":
@@ -115,7 +115,7 @@ def _clean(name: str, slips: int):
 def control_trace(name: str, slips: int = 8) -> dict:
     """The noise-free trace of control ``name`` (one of :data:`CONTROLS`), with at least
     ``slips`` slips after the start-up one."""
-    return dict(_clean(name, int(slips)))
+    return dict(_noise_free(name, int(slips)))
 
 
 def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,

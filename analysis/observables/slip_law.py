@@ -24,6 +24,7 @@ from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
 
 from ..sliplaw import BRANCHES, film_force, fit_film_force
 from ..trace import unit
+from ..util import finite_or_none
 from .base import (Context, MissingInput, Observable, column, format_estimate, format_value,
                    parameter, png_bytes, pyplot)
 
@@ -78,15 +79,15 @@ class SlipLaw(Observable):
                "samples": dec.samples, "slips": dec.slips,
                "branches": {b.branch: self._branch(ctx, b)
                             for b in (fit.decelerating, fit.accelerating, fit.whole)},
-               "loop": {"area": {"mean": _num(fit.loop_area), "stderr": _num(fit.loop_area_stderr),
+               "loop": {"area": {"mean": finite_or_none(fit.loop_area), "stderr": finite_or_none(fit.loop_area_stderr),
                                  "units": force_velocity},
                         "force_gap": ctx.value(fit.loop_force, fit.loop_force_stderr, "force")},
                "comoving_mass": ctx.value(with_mass.whole.comoving_mass,
                                           with_mass.whole.comoving_mass_stderr, "mass",
                                           branch="whole slip",
-                                          damping=_num(with_mass.whole.damping),
-                                          damping_stderr=_num(with_mass.whole.damping_stderr),
-                                          kinetic_force=_num(with_mass.whole.kinetic_force)),
+                                          damping=finite_or_none(with_mass.whole.damping),
+                                          damping_stderr=finite_or_none(with_mass.whole.damping_stderr),
+                                          kinetic_force=finite_or_none(with_mass.whole.kinetic_force)),
                "smoothing_window": fit.smoothing_window,
                "law": "F_film = kinetic_force + damping * v on each branch, F_film = "
                       "F_spring - M a - mount_damping (v - V), fitted in the integrated "
@@ -114,14 +115,14 @@ class SlipLaw(Observable):
     @staticmethod
     def _branch(ctx, b) -> dict:
         return {"kinetic_force": ctx.value(b.kinetic_force, b.kinetic_force_stderr, "force",
-                                           sigmas=_num(b.kinetic_sigmas)),
+                                           sigmas=finite_or_none(b.kinetic_sigmas)),
                 "damping": ctx.value(b.damping, b.damping_stderr, "damping",
-                                     sigmas=_num(b.damping_sigmas)),
+                                     sigmas=finite_or_none(b.damping_sigmas)),
                 "detectable_damping": ctx.value(b.detectable_damping, None, "damping"),
                 "detectable_kinetic_force": ctx.value(b.detectable_kinetic_force, None, "force"),
                 "mean_velocity": ctx.value(b.mean_velocity, None, "velocity"),
                 "mean_force": ctx.value(b.mean_force, None, "force"),
-                "viscous_share": _num(b.viscous_share),
+                "viscous_share": finite_or_none(b.viscous_share),
                 "exponent": ctx.value(b.exponent, b.exponent_stderr, "1"),
                 "velocity_residual": ctx.value(b.velocity_residual, None, "velocity"),
                 "dof": b.dof, "samples": b.samples, "slips": b.slips,
@@ -135,8 +136,8 @@ class SlipLaw(Observable):
                                            **BULK_VISCOSITY_SOURCE),
                "bulk_film_damping": ctx.value(bulk, LJ_ETA_FILM_STDERR * area / d, "damping",
                                               form="eta_bulk·A/D", thickness=d),
-               "damping_over_bulk": _num(b / bulk),
-               "damping_over_bulk_stderr": _num(b_err / bulk)}
+               "damping_over_bulk": finite_or_none(b / bulk),
+               "damping_over_bulk_stderr": finite_or_none(b_err / bulk)}
         tr = ctx.trace
         if tr.has("film_temperature"):
             temp = float(np.mean(tr.columns["film_temperature"]))
@@ -228,9 +229,3 @@ class SlipLaw(Observable):
         # above the axes: inside, it hid slips' points (the loops fill the plane)
         ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         return png_bytes(fig)
-
-
-def _num(x):
-    """A JSON number or None (NaN, inf)."""
-    x = float(x)
-    return x if math.isfinite(x) else None
