@@ -1,33 +1,68 @@
-"""Klein's slip equation tested on the slips themselves: viscous flow or kinetic friction?
+"""Klein's slip equation tested on the slips themselves: viscous, kinetic, mixed or weakening?
 
 Klein (PRL 98, 056101) writes the slip as ``M x'' + B x' = K(x0 − x)``: the film
 resists with a viscous force B·v only.  Braun & Tosatti (EPL 88, 48003, 2009)
-read the same slips as a kinetic friction stress F_k with a bulk-like viscosity.
-The slip alone cannot tell the two apart in an SFB trace, but a trace that has
-the wall's velocity can: during a slip, the wall's equation of motion gives the
-film's own shear force sample by sample,
+read the same slips as a kinetic friction stress with a bulk-like viscosity.
+An SFB trace cannot tell the two apart; a trace that has the wall's velocity can
+(Klein's note 27): the wall's equation of motion gives the film's own shear force
+sample by sample,
 
-    F_film(t) = F_spring − M·a − γM·(v − V),
+    F_film(t) = F_spring − M·a − γM·(v − V)
 
 (spring, minus the wall's inertia, minus the mount dashpot of an MD run, which
 acts on the wall's velocity relative to the drive), and the law
 
-    F_film = F_k + B·v
+    F_film = F_k + B·v  [+ m_c·a]
 
-is fitted to (v, F_film) over each slip, by least squares, and over all slips.
+is fitted to (v, F_film) over each slip by least squares; the optional term m_c·a
+is a mass moving with the wall that the equation of motion left out (film
+atoms carried along).
 
-The verdict compares the two terms at the mean slip velocity v̄ of the fitted
-samples, with the viscous share s = B·v̄ / (F_k + B·v̄):
+Branches.  A slip is a loop in the (v, F_film) plane, not a line: the force on
+the *accelerating* branch (yield → peak velocity) is the breaking of the pinned
+film, the force on the *decelerating* branch (peak velocity → re-stick) is that
+of the film while it slides and re-solidifies.  The two are fitted separately;
+the verdict is the decelerating branch's (the sliding law), the accelerating
+one is reported beside it, and the loop's area between the two branches'
+lines (and the mean force gap, area over the velocity range) says how far from
+one law F(v) the slip is.  (∮F_film dv over the samples themselves is no
+measure: the noise of M·a is correlated with that of dv.)
 
-* ``viscous`` — B is resolved (B > 2 σ_B) and s ≥ 0.8 (Klein's reading);
-* ``kinetic`` — B is not resolved, or s ≤ 0.2 (Braun–Tosatti's reading);
-* ``mixed`` — both terms resolved and each carries more than a fifth.
+Smoothing.  The sampled wall velocity of an MD run carries the wall's thermal
+vibration; differentiated for M·a it swamps the film force.  A Savitzky–Golay
+filter (order 2, a window of ``smoothing`` × the median slip duration) is
+applied to the spring force, the velocity and the acceleration alike; a linear
+law F_k + B·v + m_c·a survives any such filter unchanged (the filter is linear
+and keeps constants), so the smoothing removes noise, not the law.
 
-σ_B and σ_Fk are the standard errors over the slips (their scatter) when there
-are 2 or more, never below the pooled least-squares fit's own (which carries the
-error of differentiating the sampled velocity).  Only samples where the wall moves faster than
-``min_velocity_fraction`` of the slip's peak velocity are fitted: near v = 0 the
-film is re-solidifying (or has not yet shear-melted), which is not the law.
+Verdict (one of :data:`VERDICTS`).  Each term is *resolved* when it exceeds
+2 σ — at the coverage of a normal 2 σ (97.7 % one-sided) with the Student t of
+the errors' degrees of freedom — and *ruled out as dominant* when the run had
+95 % power to resolve it at half the film force F̄ (the power analysis, on the
+run's own errors: :func:`detectable`):
+
+* ``velocity-weakening`` — B resolved negative;
+* ``mixed`` — B and F_k both resolved positive;
+* ``viscous`` — B resolved, F_k not, and a kinetic force of F̄/2 would have been
+  resolved (Klein's reading);
+* ``kinetic`` — F_k resolved, B not, and a viscous force of F̄/2 at v̄ would have
+  been resolved (Braun–Tosatti's reading);
+* ``inconclusive`` — anything else: nothing resolved, or the missing term could
+  carry half the force unseen.
+
+``detectable_damping`` is the smallest B the run resolves at 2 σ in 95 % of
+repeats; B, it and the B of a no-slip film of bulk viscosity (η_bulk·A/D,
+computed by the caller) belong side by side.  σ_B and σ_Fk are the standard
+errors of the per-slip fits' mean over the slips (their scatter, n − 1 degrees
+of freedom), never below the pooled least-squares errors widened for the
+residuals' correlation.  Only samples faster than ``min_velocity_fraction`` of
+the slip's peak are fitted: near v = 0 the film is re-solidifying (or has not
+yet shear-melted), which is not the law; nor are the samples whose derivative or
+smoothing window reaches across the yield or the re-stick (half a window and one
+sample at each end of the slip).
+
+The local exponent n = d ln F/d ln v is fitted per slip as F = c·(v/v̄)^n on the
+same branch: 1 for a viscous film, 0 for a kinetic force, < 0 for weakening.
 
 Example
 -------
@@ -46,61 +81,171 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats as sps
+from scipy.integrate import cumulative_trapezoid
+from scipy.optimize import brentq
+from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
 
-__all__ = ["FilmForceFit", "film_force", "fit_film_force", "VISCOUS_SHARE", "RESOLVED_SIGMAS"]
+__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
+           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE"]
 
-#: Viscous share s = B·v̄/(F_k + B·v̄) at or above which a slip is ``viscous`` (and at or
-#: below 1 − VISCOUS_SHARE, ``kinetic``).
-VISCOUS_SHARE = 0.8
-#: A fitted term counts as resolved when it exceeds this many standard errors.
+#: The verdicts, in the order the rules are tried.
+VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
+#: The branches of a slip; the verdict is the first one's.
+BRANCHES = ("decelerating", "accelerating")
+#: A fitted term is resolved when it exceeds this many standard errors (at a normal's coverage).
 RESOLVED_SIGMAS = 2.0
+#: The power at which a term the run did not resolve is ruled out.
+POWER = 0.95
+#: A term not resolved is ruled out as dominant when the run would have resolved it (at
+#: :data:`POWER`) carrying this share of the mean film force.
+DOMINANT_SHARE = 0.5
+#: Default window of the velocity that picks the fitted samples, as a share of the median
+#: slip duration.
+SMOOTHING = 0.1
+#: With this many slips or more, the errors are the scatter of the per-slip fits.
+MIN_SLIPS_FOR_SCATTER = 3
 
 
 @dataclass(frozen=True)
-class FilmForceFit:
-    """F_film = F_k + B·v fitted over the slips (see the module text).
+class BranchFit:
+    """F_film = F_k + B·v [+ m_c·a] fitted on one branch of the slips (see the module text).
 
     Attributes
     ----------
+    branch : str
+        ``decelerating``, ``accelerating`` or ``whole``.
     kinetic_force, kinetic_force_stderr : float
         F_k and its standard error (force units).
     damping, damping_stderr : float
         B and its standard error (force per velocity).
-    mean_slip_velocity : float
-        v̄, mean wall velocity of the fitted samples.
+    comoving_mass, comoving_mass_stderr : float
+        m_c and its standard error (NaN when the term was not fitted).
+    mean_velocity, mean_force : float
+        v̄ and F̄, the means of the fitted samples.
     viscous_share : float
-        B·v̄ / (F_k + B·v̄).
-    verdict : str
-        ``viscous``, ``kinetic``, ``mixed``, or ``none`` (nothing to fit).
-    reason : str
-        Why the verdict (the numbers it rests on).
-    per_slip_kinetic_force, per_slip_damping : ndarray
-        The per-slip fits (NaN where a slip had fewer than 4 samples to fit).
-    samples : int
-        Samples fitted over all slips.
-    residual_rms : float
-        Root-mean-square residual of the pooled fit (force units).
-    r_squared : float
-        Share of the variance of F_film that the pooled line explains: how well
-        a straight line in v describes the film force at all (a wall hopping
-        one registry site feels the film's corrugation, not F_k + B·v).
+        B·v̄ / F̄.
+    exponent, exponent_stderr : float
+        n = d ln F/d ln v of the fitted law at each slip's mean velocity, mean and
+        standard error over the slips.
+    kinetic_sigmas, damping_sigmas : float
+        F_k and B in normal-equivalent standard errors (signed).
+    detectable_damping, detectable_kinetic_force : float
+        The smallest B and F_k the run resolves at 2 σ with 95 % power.
+    dof : int
+        Degrees of freedom of the errors.
+    verdict, reason : str
+        One of :data:`VERDICTS`, and the numbers it rests on.
+    per_slip_kinetic_force, per_slip_damping, per_slip_exponent : ndarray
+        Per-slip fits (NaN where a slip had too few samples on this branch).
+    samples, slips : int
+        Samples and slips fitted.
+    velocity_residual : float
+        Root-mean-square residual of the pooled integral fit over M: how far the
+        wall's velocity strays from the law's (velocity units).
     """
 
+    branch: str
     kinetic_force: float
     kinetic_force_stderr: float
     damping: float
     damping_stderr: float
-    mean_slip_velocity: float
+    comoving_mass: float
+    comoving_mass_stderr: float
+    mean_velocity: float
+    mean_force: float
     viscous_share: float
+    exponent: float
+    exponent_stderr: float
+    kinetic_sigmas: float
+    damping_sigmas: float
+    detectable_damping: float
+    detectable_kinetic_force: float
+    dof: int
     verdict: str
     reason: str
     per_slip_kinetic_force: np.ndarray
     per_slip_damping: np.ndarray
+    per_slip_exponent: np.ndarray
     samples: int
-    residual_rms: float
-    r_squared: float = float("nan")
+    slips: int
+    velocity_residual: float
+
+
+@dataclass(frozen=True)
+class FilmForceFit:
+    """The slip law on both branches, the loop, and the verdict (the decelerating branch's).
+
+    Attributes
+    ----------
+    decelerating, accelerating : BranchFit
+        The two branches (see the module text).
+    whole : BranchFit
+        The whole slip in one fit (both branches: a loop makes it a compromise; with
+        the co-moving mass, the term where the acceleration takes both signs).
+    verdict, reason : str
+        The decelerating branch's.
+    loop_area, loop_area_stderr : float
+        The area between the two branches' fitted lines over the velocities both
+        cover (the floor to the peak), ∫(F_acc − F_dec) dv (force × velocity;
+        positive when the accelerating branch lies above), mean and standard
+        error over the slips.
+    loop_force, loop_force_stderr : float
+        Loop area / that velocity range: the mean force gap between the branches.
+    per_slip_loop_area : ndarray
+    smoothing_window : int
+        Window of the guiding velocity in samples (0: not smoothed).
+    comoving_mass : bool
+        Whether the m_c·a term was fitted.
+    """
+
+    decelerating: BranchFit
+    accelerating: BranchFit
+    whole: BranchFit
+    verdict: str
+    reason: str
+    loop_area: float
+    loop_area_stderr: float
+    loop_force: float
+    loop_force_stderr: float
+    per_slip_loop_area: np.ndarray
+    smoothing_window: int
+    comoving_mass: bool
+
+    # the verdict's branch, as the single law the callers quote
+    @property
+    def kinetic_force(self) -> float:
+        return self.decelerating.kinetic_force
+
+    @property
+    def kinetic_force_stderr(self) -> float:
+        return self.decelerating.kinetic_force_stderr
+
+    @property
+    def damping(self) -> float:
+        return self.decelerating.damping
+
+    @property
+    def damping_stderr(self) -> float:
+        return self.decelerating.damping_stderr
+
+    @property
+    def detectable_damping(self) -> float:
+        return self.decelerating.detectable_damping
+
+    @property
+    def mean_slip_velocity(self) -> float:
+        return self.decelerating.mean_velocity
+
+    @property
+    def viscous_share(self) -> float:
+        return self.decelerating.viscous_share
+
+    @property
+    def samples(self) -> int:
+        return self.decelerating.samples
 
 
 def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity: float = 0.0,
@@ -126,6 +271,11 @@ def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity
     >>> film_force(t, np.full(5, 3.0), v, mass=0.5).tolist()   # 3 − 0.5·2
     [2.0, 2.0, 2.0, 2.0, 2.0]
     """
+    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    return f - mass * np.gradient(v, t) - mount_damping * (v - drive_velocity)
+
+
+def _checked(time, spring_force, wall_velocity, mass):
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
     v = np.asarray(wall_velocity, float)
@@ -136,50 +286,221 @@ def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity
         raise ValueError(f"mass = {mass!r}: must be positive")
     if t.size < 2:
         raise ValueError("need at least 2 samples")
-    accel = np.gradient(v, t)
-    return f - mass * accel - mount_damping * (v - drive_velocity)
+    return t, f, v
 
 
-def _line_fit(v: np.ndarray, f: np.ndarray):
-    """Least-squares f = a + b v: (a, b, se_a, se_b, rms)."""
-    n = v.size
-    A = np.column_stack([np.ones(n), v])
-    coef, *_ = np.linalg.lstsq(A, f, rcond=None)
-    resid = f - A @ coef
-    dof = n - 2
-    s2 = float(resid @ resid) / dof if dof > 0 else math.nan
+# ---------------------------------------------------------------------------
+# significance and power
+# ---------------------------------------------------------------------------
+def sigmas(estimate: float, stderr: float, dof: int) -> float:
+    """``estimate/stderr`` as normal-equivalent standard errors (signed): the t of ``dof``
+    degrees of freedom mapped to the normal quantile of the same tail probability.
+
+    >>> round(sigmas(2.0, 1.0, 10**6), 3), round(sigmas(2.0, 1.0, 4), 2)
+    (2.0, 1.57)
+    """
+    if not (math.isfinite(estimate) and math.isfinite(stderr) and stderr >= 0 and dof >= 1):
+        return math.nan
+    if stderr == 0:
+        return math.copysign(38.0, estimate) if estimate else 0.0
+    t = estimate / stderr
+    z = float(sps.norm.isf(sps.t.sf(abs(t), dof)))
+    return math.copysign(min(z, 38.0), t)
+
+
+def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
+               power: float = POWER) -> float:
+    """The smallest true value resolved at ``resolved`` σ (normal-equivalent) in a share
+    ``power`` of repeats, for an estimate with standard error ``stderr`` whose own
+    error has ``dof`` degrees of freedom: δ·stderr with δ the noncentrality at
+    which a noncentral t exceeds the critical t with probability ``power``.
+
+    >>> round(detectable(1.0, 10**6), 2), round(detectable(1.0, 6), 2)   # 2 + 1.645; 6 dof
+    (3.64, 4.45)
+    """
+    if not (math.isfinite(stderr) and stderr >= 0 and dof >= 1):
+        return math.nan
+    crit = sps.t.isf(sps.norm.sf(resolved), dof)
+    if dof > 1000:
+        return float((crit + sps.norm.ppf(power)) * stderr)
+    delta = brentq(lambda d: sps.nct.sf(crit, dof, d) - power, 0.0, 10 * crit + 50)
+    return float(delta * stderr)
+
+
+# ---------------------------------------------------------------------------
+# fitting
+# ---------------------------------------------------------------------------
+def _ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
+    """Least squares y = X·c: (coef, stderr, residuals); the errors widened by the
+    residuals' integrated autocorrelation time (NaN with ``errors=False``)."""
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    resid = y - X @ coef
+    dof = y.size - X.shape[1]
+    if dof <= 0 or not errors:
+        return coef, np.full(X.shape[1], math.nan), resid
+    s2 = float(resid @ resid) / dof
     try:
-        cov = s2 * np.linalg.inv(A.T @ A)
-        se = np.sqrt(np.diag(cov))
+        se = np.sqrt(np.diag(s2 * np.linalg.inv(X.T @ X)) * _correlation_time(resid))
     except np.linalg.LinAlgError:
-        se = np.array([math.nan, math.nan])
-    rms = float(np.sqrt(np.mean(resid ** 2)))
-    return float(coef[0]), float(coef[1]), float(se[0]), float(se[1]), rms
+        se = np.full(X.shape[1], math.nan)
+    return coef, se, resid
 
 
-def _verdict(fk, se_fk, b, se_b, vbar):
-    if not (math.isfinite(b) and math.isfinite(fk)):
-        return "none", math.nan, "no slip could be fitted"
-    total = fk + b * vbar
-    share = b * vbar / total if total != 0 else math.nan
-    b_ok = math.isfinite(se_b) and b > RESOLVED_SIGMAS * se_b
-    fk_ok = math.isfinite(se_fk) and abs(fk) > RESOLVED_SIGMAS * se_fk
-    nums = (f"F_k = {fk:.4g} ± {se_fk:.2g}, B = {b:.4g} ± {se_b:.2g}, "
-            f"B·v̄ = {b * vbar:.4g} at v̄ = {vbar:.4g} (viscous share {share:.2f})")
-    if not b_ok:
-        return "kinetic", share, f"B not resolved (< {RESOLVED_SIGMAS:g} σ): {nums}"
-    if share >= VISCOUS_SHARE or not fk_ok:
-        why = "F_k not resolved" if not fk_ok else f"share ≥ {VISCOUS_SHARE:g}"
-        return "viscous", share, f"{why}: {nums}"
-    if share <= 1 - VISCOUS_SHARE:
-        return "kinetic", share, f"share ≤ {1 - VISCOUS_SHARE:.1f}: {nums}"
-    return "mixed", share, f"both terms resolved: {nums}"
+def _correlation_time(r: np.ndarray) -> float:
+    """Integrated autocorrelation time of ``r`` in samples, 1 + 2 Σ ρ_k summed up to
+    the first lag where ρ_k ≤ 0 (1 for uncorrelated samples)."""
+    r = r - r.mean()
+    den = float(r @ r)
+    if r.size < 3 or den <= 0:
+        return 1.0
+    tau = 1.0
+    for k in range(1, r.size // 2):
+        rho = float(r[k:] @ r[:-k]) / den
+        if rho <= 0:
+            break
+        tau += 2 * rho
+    return tau
+
+
+@dataclass(frozen=True)
+class _Segment:
+    """One branch of one slip in integral form (module text): the response y, the
+    regressors Δt, Δx and v − v0, and the branch's mean velocity."""
+
+    y: np.ndarray           # ∫F_spring dt − γM(Δx − VΔt) − M v
+    dt: np.ndarray
+    dx: np.ndarray
+    dv: np.ndarray          # v − v0 of the smoothed velocity (the m_c term)
+    mass: float
+
+    @property
+    def mean_velocity(self) -> float:
+        return float(self.dx[-1] / self.dt[-1]) if self.dt[-1] > 0 else math.nan
+
+    def design(self, comoving: bool, intercepts: int = 1, which: int = 0):
+        """Columns [intercepts…, Δt, Δx (, v − v0)] and the response (with m_c, the
+        response without the −M·v it would otherwise hold: M·v joins m_c·v)."""
+        cols = [np.full(self.y.size, float(k == which)) for k in range(intercepts)]
+        cols += [self.dt, self.dx]
+        return cols + ([self.dv] if comoving else [])
+
+
+def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) -> BranchFit:
+    """Per-slip fits on one branch, their mean, errors, power and verdict."""
+    nterms = 4 if comoving else 3
+    per = []                       # (fk, b, mc, vbar) per slip
+    used, resids = [], []
+    for seg in segments:
+        if seg is None or seg.y.size < nterms + 3:
+            per.append((math.nan,) * 4)
+            continue
+        coef, _, res = _ols(np.column_stack(seg.design(comoving)), seg.y, errors=False)
+        resids.append(res)
+        # with m_c, the coefficient of v − v0 is M + m_c
+        per.append((float(coef[1]), float(coef[2]),
+                    float(coef[3]) - seg.mass if comoving else math.nan, seg.mean_velocity))
+        used.append(seg)
+    per = np.array(per, float).reshape(-1, 4)
+    nan = math.nan
+    if not used:
+        return BranchFit(branch, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan,
+                         nan, nan, nan, 0, "inconclusive",
+                         f"no slip with {nterms + 3} or more samples on the {branch} branch "
+                         "above the velocity floor", per[:, 0], per[:, 1], per[:, 0] * nan,
+                         0, 0, nan)
+    m = len(used)
+    ok = np.isfinite(per[:, 0]) & np.isfinite(per[:, 1])
+    n = int(ok.sum())
+    with np.errstate(invalid="ignore", divide="ignore"):
+        expo = per[:, 1] * per[:, 3] / (per[:, 0] + per[:, 1] * per[:, 3])
+    if n >= MIN_SLIPS_FOR_SCATTER:
+        # the slips are the replicas: the standard error of their mean
+        est = per[ok, :3].mean(axis=0)
+        se = per[ok, :3].std(axis=0, ddof=1) / math.sqrt(n)
+        dof = n - 1
+    else:
+        # too few slips for a scatter: the pooled fit (one intercept per slip, common
+        # F_k, B (, m_c)), its errors widened for the residuals' correlation, with the
+        # degrees of freedom of its independent samples
+        X = np.vstack([np.column_stack(s.design(comoving, m, k)) for k, s in enumerate(used)])
+        y = np.concatenate([s.y for s in used])
+        coef, pse, resid = _ols(X, y)
+        est = np.array([coef[m], coef[m + 1], coef[m + 2] - used[0].mass if comoving else nan])
+        se = np.array([pse[m], pse[m + 1], pse[m + 2] if comoving else nan])
+        dof = max(int(y.size / _correlation_time(resid)) - (m + nterms - 1), 1)
+    fk, b, mc = (float(x) for x in est)
+    se_fk, se_b, se_mc = (float(x) for x in se)
+    ex = expo[ok][np.isfinite(expo[ok])]
+    n_mean = float(ex.mean()) if ex.size else nan
+    n_se = float(ex.std(ddof=1) / math.sqrt(ex.size)) if ex.size >= 2 else nan
+    vbar = float(np.nanmean(per[ok, 3])) if n else nan
+    fbar = fk + b * vbar
+    share = b * vbar / fbar if fbar > 0 else nan
+    # the residual as the error of the law's wall velocity: (response residual) / M
+    allres = np.concatenate(resids)
+    vres = float(np.sqrt(np.mean(allres ** 2))) / used[0].mass
+    z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
+    det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
+    verdict, reason = _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n)
+    return BranchFit(branch, fk, se_fk, b, se_b, mc, se_mc, vbar,
+                     fbar, share, n_mean, n_se, z_fk, z_b, det_b, det_fk, dof, verdict, reason,
+                     per[:, 0], per[:, 1], expo, int(allres.size), n, vres)
+
+
+def _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
+    """The verdict of one branch and the numbers it rests on (module text)."""
+    r = RESOLVED_SIGMAS
+    nums = (f"F_k = {fk:.4g} ± {se_fk:.2g} ({z_fk:+.1f} σ), B = {b:.4g} ± {se_b:.2g} "
+            f"({z_b:+.1f} σ) over {n} slip(s); F̄ = {fbar:.4g} at v̄ = {vbar:.4g}; "
+            f"95 % power at 2 σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
+    if not all(math.isfinite(x) for x in (z_fk, z_b, fbar, vbar)):
+        return "inconclusive", f"errors not defined: {nums}"
+    if z_b <= -r:
+        return "velocity-weakening", f"B resolved negative: {nums}"
+    b_res, fk_res = z_b >= r, z_fk >= r
+    if b_res and fk_res:
+        return "mixed", f"both terms resolved (viscous share {b * vbar / fbar:.2f}): {nums}"
+    if fbar <= 0:
+        return "inconclusive", f"mean film force not positive: {nums}"
+    hidden_visc = det_b * vbar / fbar       # share a viscous term could carry unseen
+    hidden_kin = det_fk / fbar
+    if b_res:
+        if hidden_kin < DOMINANT_SHARE:
+            return "viscous", (f"B resolved, F_k not; a kinetic force of {hidden_kin:.2f} F̄ "
+                               f"would have been resolved: {nums}")
+        return "inconclusive", (f"B resolved, F_k not, but a kinetic force up to "
+                                f"{hidden_kin:.2f} F̄ could go unresolved: {nums}")
+    if fk_res:
+        if hidden_visc < DOMINANT_SHARE:
+            return "kinetic", (f"F_k resolved, B not; a viscous force of {hidden_visc:.2f} F̄ "
+                               f"would have been resolved: {nums}")
+        return "inconclusive", (f"F_k resolved, B not, but a viscous force up to "
+                                f"{hidden_visc:.2f} F̄ could go unresolved: {nums}")
+    return "inconclusive", f"neither term resolved: {nums}"
+
+
+def _window(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
+    """Savitzky–Golay window (odd, ≥ 5 samples) for ``smoothing`` × median slip duration;
+    0 when the sampling is not uniform or the window would be under 5 samples."""
+    if smoothing <= 0 or t.size < 7:
+        return 0
+    dt = np.diff(t)
+    if not np.allclose(dt, dt[0], rtol=1e-6, atol=0):
+        return 0
+    dur = np.asarray(table.slip_duration, float)
+    dur = dur[np.isfinite(dur)]
+    if dur.size == 0:
+        return 0
+    w = int(round(smoothing * float(np.median(dur)) / dt[0]))
+    w += 1 - w % 2
+    return w if 5 <= w < t.size else 0
 
 
 def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass: float,
-                 drive_velocity: float = 0.0, mount_damping: float = 0.0,
-                 min_velocity_fraction: float = 0.2) -> FilmForceFit:
-    """Fit F_film = F_k + B·v over each slip of ``table`` and over all of them.
+                   drive_velocity: float = 0.0, mount_damping: float = 0.0,
+                   wall_position=None, min_velocity_fraction: float = 0.2,
+                   smoothing: float = SMOOTHING, comoving_mass: bool = False) -> FilmForceFit:
+    """Fit F_film = F_k + B·v [+ m_c·a] on each branch of each slip of ``table``.
 
     Parameters
     ----------
@@ -190,56 +511,83 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         passing it (``table[skip:]``).
     mass, drive_velocity, mount_damping : float
         See :func:`film_force`.
+    wall_position : array_like, shape (n,), optional
+        The wall's position (else the integrated velocity).
     min_velocity_fraction : float
         Fit only samples with v above this fraction of the slip's peak velocity.
+    smoothing : float
+        Window of the velocity that picks the peak, the branches and the fitted
+        samples, as a share of the median slip duration (0: the samples' own).
+    comoving_mass : bool
+        Fit the term m_c·a too.
 
     Returns
     -------
     FilmForceFit
-        The pooled F_k and B are the means of the per-slip fits, with the
-        standard error of their scatter (2 or more slips, floored at the pooled
-        least-squares errors); with one slip, that slip's fit and its errors.
     """
     if not 0 <= min_velocity_fraction < 1:
         raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
-    t = np.asarray(time, float)
-    v = np.asarray(wall_velocity, float)
-    ff = film_force(t, spring_force, v, mass=mass, drive_velocity=drive_velocity,
-                    mount_damping=mount_damping)
-    fks, bs, vs, fs, ses = [], [], [], [], []
-    for y, s in zip(table.yield_index, table.stick_index):
-        seg = slice(int(y), int(s) + 1)
-        vv, fff = v[seg], ff[seg]
-        peak = float(np.max(vv)) if vv.size else 0.0
-        keep = (vv > min_velocity_fraction * peak) & np.isfinite(fff) if peak > 0 else \
-            np.zeros(vv.size, bool)
-        if keep.sum() < 4:
-            fks.append(math.nan), bs.append(math.nan), ses.append((math.nan, math.nan))
-            continue
-        a, b, se_a, se_b, _ = _line_fit(vv[keep], fff[keep])
-        fks.append(a), bs.append(b), ses.append((se_a, se_b))
-        vs.append(vv[keep]), fs.append(fff[keep])
-    fks, bs = np.array(fks, float), np.array(bs, float)
-    ok = np.isfinite(fks) & np.isfinite(bs)
-    nan = math.nan
-    if not ok.any():
-        return FilmForceFit(nan, nan, nan, nan, nan, nan, "none",
-                          "no slip with 4 or more samples above the velocity floor",
-                          fks, bs, 0, nan)
-    vall, fall = np.concatenate(vs), np.concatenate(fs)
-    _, _, pooled_se_fk, pooled_se_b, rms = _line_fit(vall, fall)
-    if ok.sum() >= 2:
-        fk, b = float(fks[ok].mean()), float(bs[ok].mean())
-        se_fk = max(float(fks[ok].std(ddof=1) / math.sqrt(ok.sum())), pooled_se_fk)
-        se_b = max(float(bs[ok].std(ddof=1) / math.sqrt(ok.sum())), pooled_se_b)
+    if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
+        raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
+    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    if wall_position is None:
+        x = cumulative_trapezoid(v, t, initial=0.0)
     else:
-        i = int(np.flatnonzero(ok)[0])
-        fk, b = float(fks[i]), float(bs[i])
-        se_fk, se_b = ses[i]
-    vbar = float(vall.mean())
-    var = float(np.var(fall))
-    r2 = 1.0 - rms ** 2 / var if var > 0 else math.nan
-    verdict, share, reason = _verdict(fk, se_fk, b, se_b, vbar)
-    reason += f"; the line explains {r2:.0%} of the film force's variance"
-    return FilmForceFit(fk, se_fk, b, se_b, vbar, share, verdict, reason, fks, bs,
-                      int(vall.size), rms, r2)
+        x = np.asarray(wall_position, float)
+        if x.shape != t.shape:
+            raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
+    w = _window(t, table, smoothing)
+    # the velocity that picks the samples: from the position, whose noise is not the
+    # response's (selecting on the response's own noise would bias the fit)
+    if w and wall_position is not None:
+        guide = savgol_filter(x, w, 2, deriv=1, delta=float(t[1] - t[0]))
+    else:
+        guide = savgol_filter(v, w, 2) if w else v
+    impulse = cumulative_trapezoid(f, t, initial=0.0)
+    segs = {name: [] for name in BRANCHES + ("whole",)}
+    ranges = []
+    edge = w // 2 + 1
+    for y, s in zip(table.yield_index, table.stick_index):
+        y, s = int(y), int(s)
+        g = guide[y:s + 1]
+        if g.size < 3 or not np.max(g) > 0:
+            for name in segs:
+                segs[name].append(None)
+            ranges.append((math.nan, math.nan))
+            continue
+        p = int(np.argmax(g))
+        peak = float(g[p])
+        fast = g > min_velocity_fraction * peak
+        fast[:edge] = False
+        fast[max(g.size - edge, 0):] = False
+        for name, (lo, hi) in (("accelerating", (0, p + 1)), ("decelerating", (p, g.size)),
+                               ("whole", (0, g.size))):
+            k = np.flatnonzero(fast[lo:hi]) + lo
+            if k.size == 0:
+                segs[name].append(None)
+                continue
+            i = np.arange(k[0], k[-1] + 1) + y          # contiguous: the integral needs it
+            dt_, dx = t[i] - t[i[0]], x[i] - x[i[0]]
+            resp = (impulse[i] - impulse[i[0]] - mount_damping * (dx - drive_velocity * dt_)
+                    - (0.0 if comoving_mass else mass) * v[i])
+            segs[name].append(_Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
+        ranges.append((min_velocity_fraction * peak, peak))
+    fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in segs}
+    acc, dec = fits["accelerating"], fits["decelerating"]
+    lo, hi = np.array(ranges, float).reshape(-1, 2).T
+    # the loop between the two branches' lines, over the velocities both cover
+    gap_fk = acc.per_slip_kinetic_force - dec.per_slip_kinetic_force
+    gap_b = acc.per_slip_damping - dec.per_slip_damping
+    area = gap_fk * (hi - lo) + gap_b * (hi ** 2 - lo ** 2) / 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gap = area / (hi - lo)
+    la, lf = _mean_se(area), _mean_se(gap)
+    return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
+                        lf[1], area, w, comoving_mass)
+
+
+def _mean_se(x: np.ndarray) -> tuple[float, float]:
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return math.nan, math.nan
+    return float(x.mean()), (float(x.std(ddof=1) / math.sqrt(x.size)) if x.size > 1 else math.nan)

@@ -6,7 +6,12 @@
   (``solve_ivp``, independent of the closed form in :mod:`.viscosity`), and
   which re-sticks when the force has fallen to Fb;
 * :func:`smooth_trace` — steady sliding: constant mean force plus
-  correlated (AR(1)) noise.
+  correlated (AR(1)) noise;
+* :func:`block_trace` — a reduced-model spring-block (any friction law) sampled
+  at a uniform step, as an MD trace is;
+* :func:`with_wall_noise` — an MD wall's noise added to a trace: thermal
+  velocity noise on the sampled wall velocity and a correlated random force in
+  the film.
 
 All return a dict of columns named as in a trace CSV.
 """
@@ -14,12 +19,14 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.interpolate import CubicHermiteSpline
 from scipy.signal import lfilter
 
 from filmfriction.md_inputs.contract import AtomType, RUN_FILE, TRACE_FILE
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 
-__all__ = ["sawtooth", "klein_trace", "smooth_trace", "write_csv"]
+__all__ = ["sawtooth", "klein_trace", "smooth_trace", "block_trace", "with_wall_noise",
+           "write_csv"]
 
 
 def _ar1(n: int, sigma: float, rho: float, rng) -> np.ndarray:
@@ -51,12 +58,15 @@ def sawtooth(*, static_force=3.0, backward_force=1.0, period=2.0, cycles=10,
 def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
                 drive_velocity=100e-9, static_force=9.7e-6, backward_force=3.0e-6,
                 cycles=4, dt=2e-4, noise=0.0, seed=0, ringing=0.0,
-                ringing_frequency=45.0, ringing_decay=0.02) -> dict:
+                ringing_frequency=45.0, ringing_decay=0.02, kinetic_force=0.0,
+                restick_velocity=0.0) -> dict:
     """A driven spring-block with Klein-type slips, sampled every ``dt``.
 
     Stick: wall at rest until K(x_d − x) reaches Fs.  Slip: M x'' + B x' =
-    K(x_d − x) from rest until the force falls to Fb; the wall then stops
-    (the film solidifies).  Defaults are Klein's SFB numbers (SI).  With
+    K(x_d − x) − F_k (``kinetic_force``, 0: Klein's Eq. 1) from rest until the
+    force falls to Fb or the wall slows to ``restick_velocity`` (0: comes to
+    rest); the wall then stops (the film solidifies).  Defaults are Klein's SFB
+    numbers (SI).  With
     ``ringing`` > 0 a decaying oscillation of that force amplitude is added
     after each re-stick (energy ringing²/(2K)).
 
@@ -74,16 +84,20 @@ def klein_trace(*, spring_constant=97.0, mass=1.47e-3, damping=3.09,
         t = t_yield
 
         def rhs(tt, s):
-            return [s[1], (k * (xd0 + v * tt - s[0]) - b * s[1]) / m]
+            return [s[1], (k * (xd0 + v * tt - s[0]) - b * s[1] - kinetic_force) / m]
 
         def stick(tt, s):
             return k * (xd0 + v * tt - s[0]) - backward_force
         stick.terminal, stick.direction = True, -1
+
+        def rest(tt, s):            # v falls through the re-stick velocity (not v = 0 at y)
+            return s[1] - restick_velocity if restick_velocity > 0 or tt > t else 1.0
+        rest.terminal, rest.direction = True, -1
         horizon = 100.0 * (b / k + np.sqrt(m / k))
-        sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=stick,
+        sol = solve_ivp(rhs, (t, t + horizon), [x, 0.0], events=(stick, rest),
                         dense_output=True, rtol=1e-10, atol=1e-16,
                         first_step=1e-6 * horizon, max_step=1e-3 * horizon)
-        t_s = float(sol.t_events[0][0])
+        t_s = float(min(e[0] for e in sol.t_events if e.size))
         segments.append((t, t_s, "slip", sol.sol))
         t, x = t_s, float(sol.sol(t_s)[0])
     t_end = t + 0.5 * (segments[-2][1] - segments[-2][0])
@@ -118,6 +132,72 @@ def smooth_trace(*, mean_force=1.0, noise=0.05, rho=0.9, n=20000, dt=0.5,
     return {"time": t, "spring_force": f, "drive_position": velocity * t,
             "wall_velocity": velocity + _ar1(n, 0.1 * velocity, rho, rng),
             "gap": gap + _ar1(n, 0.01 * gap, rho, rng)}
+
+
+def block_trace(block, duration: float, dt: float, **simulate) -> dict:
+    """A :class:`~filmfriction.reduced_model.SpringBlock` run sampled every ``dt``.
+
+    The run is integrated once at its own samples; the position and the velocity
+    are carried to the grid by cubic Hermite interpolation with their exact
+    derivatives (the velocity, and the acceleration from the equation of motion
+    with the block's friction law; 0 while stuck).  ``simulate`` goes to
+    :meth:`SpringBlock.simulate`.
+
+    Returns columns ``time, spring_force, drive_position, wall_position,
+    wall_velocity``.
+
+    Example
+    -------
+    >>> from filmfriction.reduced_model import SpringBlock, laws
+    >>> b = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
+    ...                 law=laws.Coulomb(static=1.0, kinetic=0.5))
+    >>> tr = block_trace(b, 30.0, 0.5)
+    >>> tr["time"][:3].tolist(), round(float(tr["spring_force"][20]), 12)   # K·V·t in the stick
+    ([0.0, 0.5, 1.0], 1.0)
+    """
+    grid = np.arange(0.0, duration, dt)
+    r = block.simulate(duration, samples_per_segment=512, **simulate)
+    t, x, v = r.t, r.x, r.v
+    keep = np.concatenate(([True], np.diff(t) > 0))      # an event repeats its time
+    t, x, v = t[keep], x[keep], v[keep]
+    state = r.state[:, keep] if r.state.size else None
+    law, load = block.law, block.normal_load
+    friction = np.array([float(law.friction(float(vi), state[:, i] if state is not None
+                                            else (), load)) for i, vi in enumerate(v)])
+    spring = r.spring_force[keep]
+    accel = np.where(v == 0.0, 0.0, (spring - friction - block.damping * v) / block.mass)
+    wall = CubicHermiteSpline(t, x, v)(grid)
+    vel = CubicHermiteSpline(t, v, accel)(grid)
+    drive = np.interp(grid, t, r.drive_position[keep])
+    force = block.stiffness * (drive - wall)
+    return {"time": grid, "spring_force": force, "drive_position": drive,
+            "wall_position": wall, "wall_velocity": vel}
+
+
+def with_wall_noise(columns: dict, *, velocity_noise: float, velocity_correlation: float = 0.0,
+                    rattle: float = 0.0, force_noise: float = 0.0,
+                    force_correlation: float = 0.0, seed: int = 0) -> dict:
+    """``columns`` with an MD wall's noise added to what is measured, not to the motion.
+
+    * ``wall_velocity`` + AR(1) noise of rms ``velocity_noise`` and lag-one
+      correlation ``velocity_correlation`` (the wall's bursts and pauses about the
+      law's motion) + white noise of rms ``rattle`` (its thermal rattling);
+    * ``spring_force`` + AR(1) noise of rms ``force_noise`` and lag-one correlation
+      ``force_correlation`` (a random force of the film, carried as it is by the
+      film force F_spring − M·a).
+
+    The position and the motion are left as they are: the law sees the true
+    velocity, a fit the noisy one.
+    """
+    rng = np.random.default_rng(seed)
+    out = dict(columns)
+    n = len(columns["time"])
+    out["wall_velocity"] = (np.asarray(columns["wall_velocity"], float)
+                            + _ar1(n, velocity_noise, velocity_correlation, rng)
+                            + rng.normal(0.0, rattle, n))
+    out["spring_force"] = np.asarray(columns["spring_force"], float) + _ar1(
+        n, force_noise, force_correlation, rng)
+    return out
 
 
 def write_csv(path, columns: dict) -> None:

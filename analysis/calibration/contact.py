@@ -12,7 +12,13 @@ and the run's own parameters (``run.json``'s ``trace_parameters`` and scene) int
 * γM — the mount dashpot; k_f — the stick ramps' film stiffness;
 * the viscous fraction — film heat over film heat + ringing, per slip;
 * L = P·A with P the scene's normal pressure and A the wall area; the molecular
-  diameter is the film atom's σ = 1 and ε/σ³ = 1 (LJ units).
+  diameter is the film atom's σ = 1 and ε/σ³ = 1 (LJ units);
+* B_bulk = η_bulk·A/D, the slip law's ``bulk_film_damping`` (η_bulk of the LJ liquid
+  at the film's state point);
+* the film's temperature rise per slip, adiabatic: the film heat over 3 N k_B
+  (Dulong–Petit for N film atoms; k_B = 1), beside the scene's temperature;
+* the mean slip velocity, mean slip distance over mean slip duration, beside the
+  thermal velocity √(kT/m) (m = 1); the contact width √A.
 """
 from __future__ import annotations
 
@@ -71,6 +77,20 @@ def contact_from_analysis(analysis: dict, run: dict) -> SlidingContact:
         b, b_err = _mean(law.get("damping")), _err(law.get("damping"))
     energy = analysis.get("energy") or {}
     pressure = scene.get("normal_pressure")
+    law = analysis.get("slip_law") or {}
+    bulk, bulk_err = _mean(law.get("bulk_film_damping")), _err(law.get("bulk_film_damping"))
+    temp = scene.get("temperature")
+    atoms = (run.get("derived") or {}).get("film_atoms")
+    heat, heat_err = _mean(energy.get("film_heat")), _err(energy.get("film_heat"))
+    rise = rise_err = None
+    if heat is not None and atoms:
+        rise, rise_err = heat / (3.0 * atoms), heat_err / (3.0 * atoms)
+    dist, dur = _mean(slips.get("slip_distance")), _mean(slips.get("slip_duration"))
+    speed = speed_err = None
+    if dist is not None and dur:
+        speed = dist / dur
+        speed_err = speed * math.hypot(_err(slips.get("slip_distance")) / dist if dist else 0.0,
+                                       _err(slips.get("slip_duration")) / dur)
     return SlidingContact(
         spring_constant=float(k), mass=float(m), drive_velocity=float(v),
         static_force=fs, restick_force=fb,
@@ -85,7 +105,13 @@ def contact_from_analysis(analysis: dict, run: dict) -> SlidingContact:
         molecular_diameter=1.0,
         viscous_fraction=_mean(energy.get("viscous_fraction")),
         viscous_fraction_err=_err(energy.get("viscous_fraction")),
-        pressure=None if pressure is None else float(pressure), stress_unit=1.0)
+        pressure=None if pressure is None else float(pressure), stress_unit=1.0,
+        bulk_damping=bulk, bulk_damping_err=bulk_err,
+        temperature=None if temp is None else float(temp),
+        temperature_rise=rise, temperature_rise_err=rise_err or 0.0,
+        slip_velocity=speed, slip_velocity_err=speed_err or 0.0,
+        thermal_velocity=None if temp is None else math.sqrt(float(temp)),
+        contact_width=math.sqrt(float(area)))
 
 
 def contact_from_run(run_dir) -> SlidingContact:

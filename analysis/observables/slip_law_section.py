@@ -2,85 +2,187 @@
 
 The physics is :mod:`filmfriction.analysis.slip_law`; this file says what the
 fit needs, what it writes into ``analysis.json["slip_law"]`` and
-``analysis_cycles.csv`` (``slip_law_kinetic_force``, ``slip_law_damping``), and
-what the report shows: the verdict's table and the film force against the
-wall's velocity with the fitted line.
+``analysis_cycles.csv`` (``slip_law_kinetic_force``, ``slip_law_damping`` of
+the decelerating branch, ``slip_law_accelerating_kinetic_force``,
+``slip_law_accelerating_damping``, ``slip_law_loop_area``), and what the report
+shows: the verdict's table and the film force against the wall's velocity with
+the two branches' lines.
+
+Beside B stand the smallest B the run resolves (``detectable_damping``) and, for
+an LJ run, the B of a no-slip film of bulk viscosity, η_bulk·A/D
+(``bulk_film_damping``), with η_bulk the LJ liquid's measured at the film's
+state point (:data:`filmfriction.reduced_model.units.LJ_ETA_FILM`).
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from scipy.signal import savgol_filter
 
-from ..slip_law import film_force, fit_film_force
+from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
+
+from ..slip_law import BRANCHES, film_force, fit_film_force
 from ..trace import unit
+from ..util import finite_or_none
 from .observable import (Context, MissingInput, Observable, column, format_estimate, format_value,
                          parameter, png_bytes, pyplot)
 
-__all__ = ["SlipLaw"]
+__all__ = ["SlipLaw", "BULK_VISCOSITY_SOURCE"]
+
+#: Where the LJ bulk viscosity of the film's state point comes from.
+BULK_VISCOSITY_SOURCE = {
+    "state_point": "T = 0.71 ε/k_B, ρ = 0.85 σ⁻³ (the film's, rc = 2.5 σ)",
+    "command": "filmfriction viscosity --temperature 0.71 --density 0.85 --steps 800000 "
+               "--blocks 20 --seed 4928459",
+}
+#: Film temperatures (ε/k_B) farther than this from the bulk value's 0.71 get a note.
+_STATE_POINT_TOLERANCE = 0.03
 
 
 class SlipLaw(Observable):
-    """F_film = F_k + B·v fitted over the analysed slips, and its verdict."""
+    """F_film = F_k + B·v fitted on each branch of the analysed slips, and its verdict."""
 
     key = "slip_law"
-    title = "Klein's slip equation on the slips: viscous or kinetic?"
+    title = "Klein's slip equation on the slips: viscous, kinetic or neither resolved?"
     needs = (column("wall_velocity", "the film force during the slip"),
              parameter("mass", "the film force F_spring − M·a"))
     table_header = ("slip law (mean ± stderr over slips)", "value")
     absent = "No slip-law fit"
     caption = ("The film's own shear force during each slip (the spring's force less "
-               "the wall's inertia and the mount dashpot) against the wall's velocity, "
-               "with the fit F_film = F_k + B·v. A line through the origin is Klein's "
-               "viscous film (his Eq. 1); a flat line at F_k is a kinetic friction "
-               "stress (Braun & Tosatti).")
+               "the wall's inertia and the mount dashpot, smoothed over a tenth of a "
+               "slip) against the wall's velocity, with the fitted lines F_k + B·v of the "
+               "accelerating and the decelerating branch. A line through the origin is "
+               "Klein's viscous film (his Eq. 1); a flat line is a kinetic friction force "
+               "(Braun & Tosatti).")
 
     def compute(self, ctx: Context) -> tuple[dict, dict]:
         trace, p = ctx.trace, ctx.trace.parameters
         if len(ctx.table) == 0:
             raise MissingInput("slips", "the slip-law fit")
         v_drive, _ = trace.drive_velocity()
-        fit = fit_film_force(trace.time, trace.spring_force, trace.columns["wall_velocity"],
-                             ctx.table, mass=p.mass, drive_velocity=v_drive or 0.0,
-                             mount_damping=p.mount_damping or 0.0)
-        out = {"kinetic_force": ctx.value(fit.kinetic_force, fit.kinetic_force_stderr, "force"),
-               "damping": ctx.value(fit.damping, fit.damping_stderr, "damping"),
-               "mean_slip_velocity": ctx.value(fit.mean_slip_velocity, None, "velocity"),
-               "viscous_share": fit.viscous_share, "verdict": fit.verdict,
-               "reason": fit.reason, "samples": fit.samples,
-               "residual_rms": ctx.value(fit.residual_rms, None, "force"),
-               "r_squared": fit.r_squared,
-               "law": "F_film = kinetic_force + damping * v, F_film = F_spring - M a - "
-                      "mount_damping (v - V)"}
-        if p.area is not None and math.isfinite(fit.damping) and (
-                trace.has("gap") or p.thickness is not None):
+        args = dict(mass=p.mass, drive_velocity=v_drive or 0.0,
+                    mount_damping=p.mount_damping or 0.0,
+                    wall_position=trace.wall_position())
+        t, f, v = trace.time, trace.spring_force, trace.columns["wall_velocity"]
+        fit = fit_film_force(t, f, v, ctx.table, **args)
+        with_mass = fit_film_force(t, f, v, ctx.table, comoving_mass=True, **args)
+        dec = fit.decelerating
+        force_velocity = f"{ctx.unit('force')}·{ctx.unit('velocity')}"
+        out = {"verdict": fit.verdict, "reason": fit.reason,
+               "kinetic_force": ctx.value(dec.kinetic_force, dec.kinetic_force_stderr, "force"),
+               "damping": ctx.value(dec.damping, dec.damping_stderr, "damping"),
+               "detectable_damping": ctx.value(dec.detectable_damping, None, "damping"),
+               "mean_slip_velocity": ctx.value(dec.mean_velocity, None, "velocity"),
+               "viscous_share": dec.viscous_share,
+               "exponent": ctx.value(dec.exponent, dec.exponent_stderr, "1"),
+               "samples": dec.samples, "slips": dec.slips,
+               "branches": {b.branch: self._branch(ctx, b)
+                            for b in (fit.decelerating, fit.accelerating, fit.whole)},
+               "loop": {"area": {"mean": finite_or_none(fit.loop_area), "stderr": finite_or_none(fit.loop_area_stderr),
+                                 "units": force_velocity},
+                        "force_gap": ctx.value(fit.loop_force, fit.loop_force_stderr, "force")},
+               "comoving_mass": ctx.value(with_mass.whole.comoving_mass,
+                                          with_mass.whole.comoving_mass_stderr, "mass",
+                                          branch="whole slip",
+                                          damping=finite_or_none(with_mass.whole.damping),
+                                          damping_stderr=finite_or_none(with_mass.whole.damping_stderr),
+                                          kinetic_force=finite_or_none(with_mass.whole.kinetic_force)),
+               "smoothing_window": fit.smoothing_window,
+               "law": "F_film = kinetic_force + damping * v on each branch, F_film = "
+                      "F_spring - M a - mount_damping (v - V), fitted in the integrated "
+                      "equation of motion"}
+        if p.area is not None and (trace.has("gap") or p.thickness is not None):
             d, d_src = trace.film_thickness()
-            out["eta_from_damping"] = ctx.value(fit.damping * d / p.area,
-                                                fit.damping_stderr * d / p.area, "viscosity",
-                                                thickness=d, thickness_source=d_src,
-                                                form="B·D/A")
-        per_slip = {"kinetic_force": fit.per_slip_kinetic_force.tolist(),
-                    "damping": fit.per_slip_damping.tolist()}
+            if math.isfinite(dec.damping):
+                out["eta_from_damping"] = ctx.value(dec.damping * d / p.area,
+                                                    dec.damping_stderr * d / p.area,
+                                                    "viscosity", thickness=d,
+                                                    thickness_source=d_src, form="B·D/A")
+            if ctx.units == "lj":
+                out.update(self._bulk(ctx, dec.damping, dec.damping_stderr, d, p.area))
+            else:
+                ctx.skip_part("slip_law.bulk_film_damping",
+                              "no bulk viscosity for a measured (SI) trace")
+        per_slip = {"kinetic_force": fit.decelerating.per_slip_kinetic_force.tolist(),
+                    "damping": fit.decelerating.per_slip_damping.tolist(),
+                    "accelerating_kinetic_force":
+                        fit.accelerating.per_slip_kinetic_force.tolist(),
+                    "accelerating_damping": fit.accelerating.per_slip_damping.tolist(),
+                    "loop_area": fit.per_slip_loop_area.tolist()}
         return out, per_slip
 
+    @staticmethod
+    def _branch(ctx, b) -> dict:
+        return {"kinetic_force": ctx.value(b.kinetic_force, b.kinetic_force_stderr, "force",
+                                           sigmas=finite_or_none(b.kinetic_sigmas)),
+                "damping": ctx.value(b.damping, b.damping_stderr, "damping",
+                                     sigmas=finite_or_none(b.damping_sigmas)),
+                "detectable_damping": ctx.value(b.detectable_damping, None, "damping"),
+                "detectable_kinetic_force": ctx.value(b.detectable_kinetic_force, None, "force"),
+                "mean_velocity": ctx.value(b.mean_velocity, None, "velocity"),
+                "mean_force": ctx.value(b.mean_force, None, "force"),
+                "viscous_share": finite_or_none(b.viscous_share),
+                "exponent": ctx.value(b.exponent, b.exponent_stderr, "1"),
+                "velocity_residual": ctx.value(b.velocity_residual, None, "velocity"),
+                "dof": b.dof, "samples": b.samples, "slips": b.slips,
+                "verdict": b.verdict, "reason": b.reason}
+
+    @staticmethod
+    def _bulk(ctx, b, b_err, d, area) -> dict:
+        """B of a no-slip film of bulk viscosity beside the fitted B (LJ runs)."""
+        bulk = LJ_ETA_FILM * area / d
+        out = {"bulk_viscosity": ctx.value(LJ_ETA_FILM, LJ_ETA_FILM_STDERR, "viscosity",
+                                           **BULK_VISCOSITY_SOURCE),
+               "bulk_film_damping": ctx.value(bulk, LJ_ETA_FILM_STDERR * area / d, "damping",
+                                              form="eta_bulk·A/D", thickness=d),
+               "damping_over_bulk": finite_or_none(b / bulk),
+               "damping_over_bulk_stderr": finite_or_none(b_err / bulk)}
+        tr = ctx.trace
+        if tr.has("film_temperature"):
+            temp = float(np.mean(tr.columns["film_temperature"]))
+            if abs(temp - 0.71) > _STATE_POINT_TOLERANCE:
+                out["bulk_viscosity"]["note"] = (
+                    f"the film's mean temperature {temp:.3g} is not the bulk value's 0.71: "
+                    "measure eta_bulk at the film's own state point")
+        return out
+
     def rows(self, section: dict) -> list[tuple[str, str]]:
-        rows = [("kinetic force F_k", format_estimate(section.get("kinetic_force"))),
-                ("damping B", format_estimate(section.get("damping"))),
-                ("mean slip velocity v̄", format_estimate(section.get("mean_slip_velocity"))),
-                ("viscous share B·v̄/(F_k + B·v̄)", format_value(section.get("viscous_share"), 3)),
-                ("share of F_film's variance the line explains",
-                 format_value(section.get("r_squared"), 3)),
-                ("verdict", f"**{section.get('verdict', '?')}**")]
+        br = section.get("branches") or {}
+        rows = [("verdict (decelerating branch)", f"**{section.get('verdict', '?')}**")]
+        for name in BRANCHES:
+            b = br.get(name) or {}
+            rows += [(f"{name}: kinetic force F_k", format_estimate(b.get("kinetic_force"))),
+                     (f"{name}: damping B", format_estimate(b.get("damping"))),
+                     (f"{name}: smallest B resolved (2 σ, 95 % power)",
+                      format_estimate(b.get("detectable_damping"))),
+                     (f"{name}: exponent n = d ln F/d ln v",
+                      format_estimate(b.get("exponent"))),
+                     (f"{name}: verdict", b.get("verdict", "?"))]
+        loop = section.get("loop") or {}
+        rows.append(("loop: mean force gap, accelerating − decelerating",
+                     format_estimate(loop.get("force_gap"))))
+        if section.get("bulk_film_damping"):
+            rows.append(("B of a no-slip film of bulk viscosity, η_bulk·A/D",
+                         format_estimate(section["bulk_film_damping"])))
+            rows.append(("B / (η_bulk·A/D)", format_value(section.get("damping_over_bulk"), 3)))
+        cm = section.get("comoving_mass") or {}
+        if cm:
+            rows.append(("co-moving mass m_c (fitted with the law over the whole slip)",
+                         format_estimate(cm)))
         if section.get("eta_from_damping"):
             rows.append(("η from B (B·D/A)", format_estimate(section["eta_from_damping"])))
         return rows
 
     def notes(self, section: dict) -> list[str]:
         return [f"Why: {section.get('reason', '')}. Klein himself proposed this test (his note "
-                "27: the friction force against the sliding velocity during the slip)."]
+                "27: the friction force against the sliding velocity during the slip). "
+                "`inconclusive` says that the run's slips are too few or too noisy to tell; "
+                "what the test can resolve at the MD's noise is in docs/results/slip-law.md."]
 
     def figure(self, run) -> bytes | None:
-        """The film's force against the wall's velocity during the slips, with the fitted line."""
+        """The film's force against the wall's velocity during the slips, with the
+        branches' fitted lines."""
         tr = run.trace
         p = tr.parameters
         if not (tr.has("wall_velocity") and p.mass):
@@ -89,8 +191,16 @@ class SlipLaw(Observable):
         plt = pyplot()
         t, f, v = tr.time, tr.spring_force, tr.columns["wall_velocity"]
         v_drive, _ = tr.drive_velocity()   # the same V as the fit's (compute)
-        ff = film_force(t, f, v, mass=p.mass, drive_velocity=v_drive or 0.0,
-                        mount_damping=p.mount_damping or 0.0)
+        w = int(law.get("smoothing_window") or 0)
+        if w >= 5 and t.size > w:
+            dt = float(t[1] - t[0])
+            a = savgol_filter(v, w, 2, deriv=1, delta=dt)
+            vs, fs = savgol_filter(v, w, 2), savgol_filter(f, w, 2)
+            ff = fs - p.mass * a - (p.mount_damping or 0.0) * (vs - (v_drive or 0.0))
+        else:
+            vs = v
+            ff = film_force(t, f, v, mass=p.mass, drive_velocity=v_drive or 0.0,
+                            mount_damping=p.mount_damping or 0.0)
         lab = lambda q: unit(tr.units, q)  # noqa: E731
         yi = np.asarray(run.cycles.get("yield_index", []), int)[run.skip:]
         si = np.asarray(run.cycles.get("stick_index", []), int)[run.skip:]
@@ -99,16 +209,20 @@ class SlipLaw(Observable):
         vmax = 0.0
         for i, (y, s_) in enumerate(zip(yi, si)):
             seg = slice(int(y), int(s_) + 1)
-            ax.plot(v[seg], ff[seg], ".-", lw=0.5, ms=3, color=cmap(i / max(len(yi) - 1, 1)),
-                    alpha=0.8, label="slips (colour: order)" if i == 0 else None)
-            vmax = max(vmax, float(np.max(v[seg])) if v[seg].size else 0.0)
-        fk = (law.get("kinetic_force") or {}).get("mean")
-        b = (law.get("damping") or {}).get("mean")
-        if fk is not None and b is not None and vmax > 0:
+            ax.plot(vs[seg], ff[seg], ".-", lw=0.5, ms=2, color=cmap(i / max(len(yi) - 1, 1)),
+                    alpha=0.6, label="slips (colour: order)" if i == 0 else None)
+            vmax = max(vmax, float(np.max(vs[seg])) if vs[seg].size else 0.0)
+        styles = {"decelerating": "k--", "accelerating": "r:"}
+        for name, b in (law.get("branches") or {}).items():
+            if name not in styles:
+                continue
+            fk = (b.get("kinetic_force") or {}).get("mean")
+            bb = (b.get("damping") or {}).get("mean")
+            if fk is None or bb is None or vmax <= 0:
+                continue
             vv = np.linspace(0.0, vmax, 50)
-            ax.plot(vv, fk + b * vv, "k--", lw=1.5,
-                    label=f"fit F_k + B·v: F_k = {fk:.3g} {lab('force')}, "
-                          f"B = {b:.3g} {lab('damping')}")
+            ax.plot(vv, fk + bb * vv, styles.get(name, "k-"), lw=1.5,
+                    label=f"{name}: F_k = {fk:.3g} {lab('force')}, B = {bb:.3g} {lab('damping')}")
         ax.axhline(0, color="0.6", lw=0.5)
         ax.set_xlabel(f"wall velocity during the slip v [{lab('velocity')}]")
         ax.set_ylabel(f"film force F_spring − M·a − γM(v − V) [{lab('force')}]")

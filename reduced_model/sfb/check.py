@@ -343,8 +343,9 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         slips["md"] = md_run
         notes += md_notes
     if contact is not None:
-        from .similarity import klein_contact, similarity_rows
-        rows += similarity_rows(contact, klein_contact(ex, units))
+        from .similarity import klein_contact, klein_ranges, similarity_rows
+        rows += similarity_rows(contact, klein_contact(ex, units),
+                                klein_ranges(ex, units) if is_klein else {})
         notes.append("similarity rows: dimensionless numbers of the MD run (its own units) beside "
                      "Klein's; his drive velocity is taken as slip distance / cycle time, his "
                      "film compliance as delta/x0, his mount damping from the ringing's decay")

@@ -14,8 +14,12 @@ import math
 
 __all__ = ["ROW_KEYS", "SOURCES", "table_row", "find_row", "spans_decade", "without_unfixed_ratio"]
 
-#: Keys of every table row (``note`` and ``uncertainty`` are extras to the issue's six).
-ROW_KEYS = ("name", "klein", "model", "ratio", "units", "source", "uncertainty", "note")
+#: Keys of every table row (``note`` and ``uncertainty`` are extras to the issue's six;
+#: ``klein_source`` says whether Klein's number is ``printed`` (computed from numbers he
+#: printed) or ``derived`` (it needs one he did not), ``klein_range`` the range a derived
+#: one takes over what its unprinted inputs allow; both None where not assessed).
+ROW_KEYS = ("name", "klein", "model", "ratio", "units", "source", "uncertainty", "note",
+            "klein_source", "klein_range")
 
 #: The values of a row's ``source``.
 SOURCES = ("sfb-parameters", "md-calibrated", "similarity")
@@ -28,16 +32,25 @@ def _finite_or_none(v):
     return v if math.isfinite(v) else None
 
 
-def table_row(name, klein, model, units_, source, note="", uncertainty=None) -> dict:
+def table_row(name, klein, model, units_, source, note="", uncertainty=None,
+              klein_source=None, klein_range=None) -> dict:
     """One row (keys :data:`ROW_KEYS`): non-finite numbers become ``None``, the ratio is
-    model/Klein when both exist, the uncertainty a sorted [low, high] or ``None``."""
+    model/Klein when both exist, the uncertainty and Klein's range a sorted
+    [low, high] or ``None``."""
     klein, model = _finite_or_none(klein), _finite_or_none(model)
     ratio = model / klein if (klein not in (None, 0.0) and model is not None) else None
-    if uncertainty is not None:
-        lo, hi = (_finite_or_none(u) for u in uncertainty)
-        uncertainty = None if lo is None or hi is None else [min(lo, hi), max(lo, hi)]
+    if klein_source not in (None, "printed", "derived"):
+        raise ValueError(f"klein_source = {klein_source!r}: 'printed', 'derived' or None")
     return {"name": name, "klein": klein, "model": model, "ratio": ratio, "units": units_,
-            "source": source, "uncertainty": uncertainty, "note": note}
+            "source": source, "uncertainty": _interval(uncertainty), "note": note,
+            "klein_source": klein_source, "klein_range": _interval(klein_range)}
+
+
+def _interval(pair):
+    if pair is None:
+        return None
+    lo, hi = (_finite_or_none(u) for u in pair)
+    return None if lo is None or hi is None else [min(lo, hi), max(lo, hi)]
 
 
 def find_row(rows, name: str, source: str = "sfb-parameters") -> dict:

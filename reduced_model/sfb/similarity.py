@@ -23,6 +23,17 @@ molecular diameter):
 ``lambda_critical``                  λ_c(ζ) at ζ = ζ_film + ζ_mount
                                      (:func:`.maps.critical_lambda`; ∞ for ζ ≥ 1)
 ``reduced_pressure``                 P σ³/ε (needs ε/σ³)
+``bingham_number``                   Bi = B/B_bulk = η_eff/η_bulk: the film's damping
+                                     (Klein's Eq. 1 fitted to the slips) over that of
+                                     a no-slip film of bulk viscosity, B_bulk = η_bulk·A/D
+                                     — the number Klein and Braun & Tosatti disagree on
+``bulk_film_damping_ratio``          ζ_bulk = B_bulk/(2√(KM))
+``slip_heating``                     ΔT/T, the film's temperature rise per slip
+                                     (adiabatic) over its temperature
+``slip_velocity_over_thermal``       (Δx0/τ_s)/√(kT/m), the mean slip velocity over
+                                     the molecules' thermal velocity
+``contact_width_over_sigma``         √A/a, the contact's width in molecular diameters
+``backward_over_static``             F_b/F_s
 
 Uncertainties are propagated to first order from the inputs' standard errors,
 taken independent (each input moved by its error, the changes added in quadrature).
@@ -41,14 +52,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields, replace
+from itertools import product
 
-from .klein import KLEIN, KleinExperiment, klein_slip_geometry
+from scipy import constants
+
+from .klein import KLEIN, KleinExperiment, klein_slip_geometry, newtonian_damping
 from ..maps import critical_lambda
 from .rows import table_row, without_unfixed_ratio
 from ..units import OMCTS, LJUnits
 
 __all__ = ["SlidingContact", "Number", "similarity_numbers", "NUMBERS", "klein_contact",
-           "similarity_rows", "KLEIN_RINGDOWN_TIME", "SIMILARITY_SOURCE"]
+           "klein_ranges", "similarity_rows", "KLEIN_RINGDOWN_TIME", "KLEIN_UNPRINTED",
+           "KLEIN_ROOM_TEMPERATURE", "SIMILARITY_SOURCE"]
 
 #: ``source`` of the similarity rows of the SFB table.
 SIMILARITY_SOURCE = "similarity"
@@ -60,7 +75,18 @@ KLEIN_RINGDOWN_TIME = 0.08
 NUMBERS = ("static_friction_coefficient", "kinetic_friction_coefficient",
            "extension_over_lattice", "slip_over_extension", "film_damping_ratio",
            "mount_damping_ratio", "compliance_ratio", "viscous_fraction", "lambda",
-           "lambda_critical", "reduced_pressure")
+           "lambda_critical", "reduced_pressure", "bingham_number", "bulk_film_damping_ratio",
+           "slip_heating", "slip_velocity_over_thermal", "contact_width_over_sigma",
+           "backward_over_static")
+
+#: Klein's inputs that he did not print, with the range each can take: his ΔE_f ≈ 1×10⁻¹⁴ J
+#: is one figure (±10 %), and x0, Δx0 and the drive velocity follow from it; the molecular
+#: diameter σ of OMCTS, 0.82 ± 0.02 nm from the force oscillations or 0.875 nm from his
+#: 3.5 nm / 4 layers; "room temperature", 293–298 K.
+KLEIN_UNPRINTED = {"film_energy": (0.9e-14, 1.1e-14), "sigma": (0.80e-9, 0.875e-9),
+                   "temperature": (293.0, 298.0)}
+#: The room temperature taken for Klein's film, K (not printed).
+KLEIN_ROOM_TEMPERATURE = 295.0
 
 
 @dataclass(frozen=True)
@@ -94,6 +120,12 @@ class SlidingContact:
     viscous_fraction: float | None = None
     pressure: float | None = None
     stress_unit: float | None = None        # ε/σ³, for the reduced pressure
+    bulk_damping: float | None = None       # η_bulk·A/D, a no-slip film of bulk viscosity
+    temperature: float | None = None
+    temperature_rise: float | None = None   # of the film per slip, adiabatic
+    slip_velocity: float | None = None      # mean slip velocity Δx0/τ_s
+    thermal_velocity: float | None = None   # √(kT/m) of one molecule
+    contact_width: float | None = None      # √A
     static_force_err: float = 0.0
     restick_force_err: float = 0.0
     slip_distance_err: float = 0.0
@@ -103,6 +135,9 @@ class SlidingContact:
     mass_err: float = 0.0
     spring_constant_err: float = 0.0
     normal_load_err: float = 0.0
+    bulk_damping_err: float = 0.0
+    temperature_rise_err: float = 0.0
+    slip_velocity_err: float = 0.0
 
     def __post_init__(self):
         for name in ("spring_constant", "mass", "drive_velocity"):
@@ -141,6 +176,12 @@ def _values(c: SlidingContact) -> dict:
         "lambda_critical": (float(critical_lambda(zf + zm)) if math.isfinite(zf + zm)
                             and zf + zm >= 0 else nan),
         "reduced_pressure": opt(c.pressure) / opt(c.stress_unit),
+        "bingham_number": opt(c.film_damping) / opt(c.bulk_damping),
+        "bulk_film_damping_ratio": opt(c.bulk_damping) / (2 * root),
+        "slip_heating": opt(c.temperature_rise) / opt(c.temperature),
+        "slip_velocity_over_thermal": opt(c.slip_velocity) / opt(c.thermal_velocity),
+        "contact_width_over_sigma": opt(c.contact_width) / opt(c.molecular_diameter),
+        "backward_over_static": fb / fs,
     }
 
 
@@ -175,7 +216,8 @@ def similarity_numbers(contact: SlidingContact) -> dict[str, Number]:
     return out
 
 
-def klein_contact(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS) -> SlidingContact:
+def klein_contact(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS,
+                  temperature: float = KLEIN_ROOM_TEMPERATURE) -> SlidingContact:
     """Klein's SFB cycle as a :class:`SlidingContact` (SI), from his printed numbers.
 
     * x0 and Δx0 from his energy statements (:func:`.klein.klein_slip_geometry`);
@@ -188,7 +230,13 @@ def klein_contact(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS) -
       so K/k_f = δ/x0;
     * viscous fraction ΔE_spring/(ΔE_spring + ΔE_osc) from his energies (he states
       "of order 90 % or more");
-    * the molecular diameter and ε/σ³ of the OMCTS unit mapping ``units``.
+    * the molecular diameter, the molecule's mass and ε/σ³ of the OMCTS unit mapping
+      ``units``;
+    * B_bulk = A·η_bulk/D with his bulk viscosity (2.5 mPa·s), so that the Bingham
+      number is his η_eff/η_bulk;
+    * the film's temperature rise per slip, his note [29]'s 0.6 K, over the room
+      ``temperature`` (not printed: :data:`KLEIN_UNPRINTED`);
+    * the mean slip velocity Δx0/τ_s over √(k_B T/m) of one OMCTS molecule; √A.
 
     Example
     -------
@@ -212,7 +260,40 @@ def klein_contact(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS) -
         molecular_diameter=units.sigma,
         viscous_fraction=ex.spring_energy_released / (ex.spring_energy_released
                                                       + ex.ringing_energy),
-        pressure=ex.load / ex.contact_area, stress_unit=units.stress)
+        pressure=ex.load / ex.contact_area, stress_unit=units.stress,
+        bulk_damping=newtonian_damping(ex.contact_area, ex.eta_bulk, ex.film_thickness),
+        temperature=temperature, temperature_rise=ex.temperature_rise,
+        slip_velocity=geo.slip_distance / ex.slip_time,
+        thermal_velocity=math.sqrt(constants.k * temperature / units.mass),
+        contact_width=math.sqrt(ex.contact_area))
+
+
+def klein_ranges(experiment: KleinExperiment = KLEIN, units: LJUnits = OMCTS) -> dict:
+    """For each of :data:`NUMBERS`, the range Klein's number takes over what his
+    unprinted inputs allow (:data:`KLEIN_UNPRINTED`, every corner), or ``None`` when it
+    does not depend on them (computed from printed numbers only).
+
+    Example
+    -------
+    >>> r = klein_ranges()
+    >>> [round(x, 3) for x in r["slip_over_extension"]], r["bingham_number"]
+    ([0.401, 0.795], None)
+    """
+    values = {k: [] for k in NUMBERS}
+    fe, sig, temp = (KLEIN_UNPRINTED[k] for k in ("film_energy", "sigma", "temperature"))
+    for e, a, t in product(fe, sig, temp):
+        n = similarity_numbers(klein_contact(replace(experiment, film_energy=e),
+                                             replace(units, sigma=a), temperature=t))
+        for k in NUMBERS:
+            values[k].append(n[k].value)
+    base = similarity_numbers(klein_contact(experiment, units))
+    out = {}
+    for k, vs in values.items():
+        lo, hi = min(vs), max(vs)
+        ref = abs(base[k].value)
+        moves = math.isfinite(lo) and math.isfinite(hi) and hi - lo > 1e-9 * max(ref, 1e-300)
+        out[k] = (lo, hi) if moves else None
+    return out
 
 
 #: What each similarity row compares, for its note.
@@ -229,17 +310,35 @@ _ROW_NOTES = {
     "lambda": "Nakano-Maegawa (F_s - F_k)/(V sqrt(KM)) (Klein: V = slip/cycle time)",
     "lambda_critical": "lambda_c at zeta = film + mount (inf: no stick-slip for a viscous law)",
     "reduced_pressure": "P sigma^3/epsilon",
+    "bingham_number": "eta_eff/eta_bulk = B/(eta_bulk A/D), B from Klein's Eq. (1) fitted to the "
+                      "slips (less the mount's dashpot); the number Klein (~1e4) and Braun & "
+                      "Tosatti (~1) disagree on. Near 1, Eq. (1) needs no more damping than a "
+                      "bulk film gives: a fitted eta_eff cannot show a viscous film there",
+    "bulk_film_damping_ratio": "eta_bulk A/(D 2 sqrt(KM)): the damping ratio a no-slip film of "
+                               "bulk viscosity would give (MD: eta_bulk of the LJ liquid at the "
+                               "film's state point)",
+    "slip_heating": "temperature rise of the film per slip (adiabatic) over its temperature "
+                    "(Klein: his note 29's 0.6 K; MD: film heat / (3 N k_B))",
+    "slip_velocity_over_thermal": "mean slip velocity dx0/tau_s over sqrt(kT/m) of one molecule",
+    "contact_width_over_sigma": "sqrt(A)/a: contact width in molecular diameters (MD: the "
+                                "periodic box; Klein: his JKR area)",
+    "backward_over_static": "F_b/F_s, re-stick over yield force",
 }
 
 
-def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) -> list[dict]:
+def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None,
+                    ranges: dict | None = None) -> list[dict]:
     """Rows of the SFB table (``source = "similarity"``): each number, Klein's beside the model's.
 
     ``uncertainty`` is the model's ±1 standard error interval; a row whose
     interval spans more than a decade (or reaches zero) has no ratio and says so.
+    ``ranges`` (:func:`klein_ranges`; by default those of Klein's own contact when
+    ``klein`` is not given, else none) mark his numbers printed or derived.
     """
     mk = similarity_numbers(model)
     kl = similarity_numbers(klein if klein is not None else klein_contact())
+    if ranges is None:
+        ranges = klein_ranges() if klein is None else {}
     rows = []
     for name in NUMBERS:
         m, k = mk[name], kl[name]
@@ -250,7 +349,13 @@ def similarity_rows(model: SlidingContact, klein: SlidingContact | None = None) 
         for who, n in (("this run", m.note), ("Klein", k.note)):
             if n:
                 note += f"; {who}: {n}"
+        rng = ranges.get(name)
+        if rng is not None:
+            note += (f"; Klein's value is derived, not printed: {rng[0]:.3g} to {rng[1]:.3g} "
+                     "over his unprinted inputs (dE_f +-10 %, sigma, room temperature)")
+        src = (("derived" if rng is not None else "printed") if name in ranges else None)
         # every number here is positive by nature
         rows.append(without_unfixed_ratio(
-            table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc)))
+            table_row(name, k.value, m.value, "1", SIMILARITY_SOURCE, note, unc,
+                      klein_source=src, klein_range=rng)))
     return rows

@@ -63,6 +63,10 @@ def test_analysis_json_validates(lj_analysis, si_analysis):
     lambda d: d["viscosity"].update(guessed={"eta_eff": {"mean": 1.0, "units": "Pa·s"}}),
     # an SI document with an LJ label, deep inside
     lambda d: d["viscosity"]["from_slip"]["eta_eff"].update(units="ετ/σ³"),
+    # the slip law: a verdict outside the five, a branch missing
+    lambda d: d["slip_law"].update(verdict="kinetic-ish"),
+    lambda d: d["slip_law"]["branches"].pop("accelerating"),
+    lambda d: d["slip_law"]["branches"]["decelerating"].update(verdict="none"),
     lambda d: d["slips"]["period"].update(units="τ"),
 ])
 def test_analysis_schema_rejects_a_spoilt_document(si_analysis, spoil):

@@ -189,7 +189,7 @@ def test_columns_in_their_own_units_give_the_si_analysis(tmp_path, columns):
 ])
 def test_a_column_read_in_the_wrong_unit_is_named(tmp_path, columns, scale, says):
     from filmfriction.analysis.report import analyze
-    from filmfriction.analysis.observables.units_check import likely_units
+    from filmfriction.analysis.observables.units_check_section import likely_units
 
     path = _scaled(tmp_path, columns, scale)
     tr = read_trace(path, columns=SI_NAMES, units="si", spring_constant=K, drive_velocity=V)

@@ -5,7 +5,8 @@ import pytest
 
 from filmfriction.reduced_model import sfb_check
 from filmfriction.reduced_model.sfb.similarity import (NUMBERS, SlidingContact, klein_contact,
-                                                       similarity_numbers, similarity_rows)
+                                                       klein_ranges, similarity_numbers,
+                                                       similarity_rows)
 
 
 def test_klein_numbers_by_hand():
@@ -31,6 +32,46 @@ def test_klein_numbers_by_hand():
     assert math.isinf(n["lambda_critical"].value)                                     # zeta > 1
     eps_over_sigma3 = 290.25 / 0.69 * 1.380649e-23 / (0.82e-9) ** 3
     assert n["reduced_pressure"].value == pytest.approx(42e-6 / 4e-10 / eps_over_sigma3, rel=1e-6)
+
+
+def test_klein_dispute_numbers_by_hand():
+    # eta_eff/eta_bulk = 27/2.5e-3 (A and D cancel); a bulk film's B = A eta_bulk/D
+    n = similarity_numbers(klein_contact())
+    assert n["bingham_number"].value == pytest.approx(27 / 2.5e-3)                   # 1.08e4
+    root = math.sqrt(97 * 1.47e-3)
+    assert n["bulk_film_damping_ratio"].value == pytest.approx(
+        4e-10 * 2.5e-3 / 3.5e-9 / (2 * root))                                          # 3.8e-4
+    assert n["slip_heating"].value == pytest.approx(0.6 / 295)                        # 2.0e-3
+    # dx0/tau_s over sqrt(kT/m) of one OMCTS molecule (296.62 g/mol) at 295 K
+    x0 = 1e-14 / (97 * 1e-9)
+    dx0 = x0 - math.sqrt(x0 ** 2 - 2 * 4e-13 / 97)
+    thermal = math.sqrt(1.380649e-23 * 295 / (296.62e-3 / 6.02214076e23))           # 90.9 m/s
+    assert n["slip_velocity_over_thermal"].value == pytest.approx(dx0 / 25e-3 / thermal)  # 2.4e-8
+    assert n["contact_width_over_sigma"].value == pytest.approx(2e-5 / 0.82e-9)       # 2.4e4
+    assert n["backward_over_static"].value == pytest.approx(1 - dx0 / x0)             # 0.47
+
+
+def test_klein_numbers_he_did_not_print_carry_their_range():
+    r = klein_ranges()
+    # dE_f = 0.9 or 1.1e-14 J: dx0/x0 from 0.795 to 0.401 (the 0.40-0.79)
+    for e, want in ((0.9e-14, 0.795), (1.1e-14, 0.401)):
+        x0 = e / (97 * 1e-9)
+        dx0 = x0 - math.sqrt(x0 ** 2 - 2 * 4e-13 / 97)
+        assert dx0 / x0 == pytest.approx(want, abs=1e-3)
+    assert r["slip_over_extension"] == pytest.approx((0.401, 0.795), abs=1e-3)
+    assert r["backward_over_static"] == pytest.approx((1 - 0.795, 1 - 0.401), abs=1e-3)
+    # from printed numbers alone: no range
+    for name in ("bingham_number", "bulk_film_damping_ratio", "film_damping_ratio",
+                 "viscous_fraction", "mount_damping_ratio"):
+        assert r[name] is None, name
+    rows = {row["name"]: row for row in similarity_rows(SlidingContact(
+        spring_constant=2.0, mass=30.0, drive_velocity=0.02, static_force=48.0,
+        restick_force=22.0, film_damping=60.0, bulk_damping=55.0))}
+    assert rows["bingham_number"]["klein_source"] == "printed"
+    assert rows["slip_over_extension"]["klein_source"] == "derived"
+    assert rows["slip_over_extension"]["klein_range"] == pytest.approx([0.401, 0.795], abs=1e-3)
+    assert rows["bingham_number"]["model"] == pytest.approx(60 / 55)
+    assert "derived" in rows["slip_over_extension"]["note"]
 
 
 def test_coulomb_numbers_and_errors():

@@ -293,6 +293,38 @@ def _lambda_zeta_point(label: str, rows: list[dict]) -> tuple:
     return (label, zeta, half_range("film_damping_ratio"), value("lambda"), half_range("lambda"))
 
 
+def _klein_cell(row) -> str:
+    """Klein's number, with † and the range of a derived one."""
+    cell = _fmt(row["klein"], 3)
+    rng = row.get("klein_range")
+    if row.get("klein_source") == "derived" and rng:
+        cell += f" † ({_fmt(rng[0], 2)} … {_fmt(rng[1], 2)})"
+    return cell
+
+
+def _bingham_reading(rows) -> str:
+    """What the Bingham number of the run says about the slip law's reach (no more)."""
+    by = {r["name"]: r for r in rows}
+    bi = by.get("bingham_number")
+    if not bi or bi.get("model") is None or bi.get("klein") is None:
+        return ""
+    lo, hi = bi.get("uncertainty") or (bi["model"], bi["model"])
+    text = (f"The number Klein and Braun & Tosatti disagree on is the Bingham number "
+            f"η_eff/η_bulk: Klein's Eq. (1) needs {_fmt(bi['klein'], 3)} × the damping of a "
+            f"no-slip film of bulk viscosity, this run's {_fmt(bi['model'], 3)} "
+            f"({_fmt(lo, 2)} … {_fmt(hi, 2)}). ")
+    if hi < 10:
+        text += ("Here Eq. (1) asks for less than ten times the damping a bulk film would "
+                 "give, so a fit of Eq. (1) cannot by itself show a viscous film, and the run "
+                 "does not reproduce the regime of Klein's film: a verdict on his film needs "
+                 "Bi ≫ 1. What the run's slips do say is the slip law's verdict (its own "
+                 "section), with its power.")
+    else:
+        text += ("Bi ≫ 1 here as in Klein's film: the slip law's verdict (its own section) says "
+                 "whether the large damping is viscous.")
+    return text
+
+
 def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given: the rows
     each run's ``sfb.json`` holds (Klein's point from his printed parameters)."""
@@ -302,13 +334,18 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     rows = [r for r in (check.rows if check is not None else []) if r["source"] == "similarity"]
     if rows:
         sec.p("An MD film slides ~10⁹ times faster than an SFB contact: what carries over is "
-              "similarity. Each number of this run beside Klein's (model range: ±1 standard error).")
+              "similarity. Each number of this run beside Klein's (model range: ±1 standard "
+              "error; Klein's marked † where it needs an input he did not print, with the range "
+              "those inputs allow).")
         sec.add(Table(("number", "Klein", "this run", "ratio", "run's range", "what it is"),
-                      tuple((r["name"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+                      tuple((r["name"], _klein_cell(r), _fmt(r["model"], 3),
                              "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
                              "–" if not r.get("uncertainty") else
                              f"{_fmt(r['uncertainty'][0], 2)} … {_fmt(r['uncertainty'][1], 2)}",
                              r["note"]) for r in rows)))
+        reading = _bingham_reading(rows)
+        if reading:
+            sec.p(reading)
     elif (Path(run_dirs[0]) / RUN_FILE).is_file():
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")

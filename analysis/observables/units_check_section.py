@@ -36,7 +36,7 @@ import re
 import numpy as np
 
 from ..trace import MissingInput
-from .base import Context, Observable, format_value
+from .observable import Context, Observable, format_value
 
 __all__ = ["UnitsCheck", "RAMP_BAND", "DRIVE_BAND", "stick_ramp_slopes", "likely_units",
            "name_hint"]
