@@ -43,7 +43,8 @@ __all__ = ["FAMILIES", "Case", "Truth", "random_case", "simulate", "truth", "sam
            "Score", "score", "OBSERVABLES"]
 
 #: the friction laws of the suite
-FAMILIES = ("coulomb", "coulomb-viscous", "stribeck", "rate-state", "klein-eq1")
+FAMILIES = ("coulomb", "coulomb-viscous", "coulomb-elastic", "stribeck", "rate-state",
+            "klein-eq1")
 
 #: SI scales of one model unit (length, time, mass): an SFB-like contact,
 #: forces of µN, displacements of 100 nm, slips of ms
@@ -73,6 +74,9 @@ class Case:
         AR(1) coefficient of the noise per sample (0: white).
     units : {"lj", "si"}
     seed : int
+    initial_velocity : float, optional
+        Block velocity at t = 0 (a law without static friction starts from a
+        perturbed steady sliding, which grows into stick-slip).
     """
 
     family: str
@@ -84,6 +88,7 @@ class Case:
     correlation: float = 0.0
     units: str = "lj"
     seed: int = 0
+    initial_velocity: float | None = None
 
     def label(self) -> str:
         return (f"{self.family} {self.units} {self.sampling} n/slip={self.samples_per_slip:g} "
@@ -95,20 +100,46 @@ def _loguniform(rng, lo, hi):
 
 
 def random_case(family: str, rng, **options) -> Case:
+    """A random stick-slip block of ``family`` (model units, forces of order 1): see
+    :func:`_draw`; a draw that does not stick-slip (checked by a short run) is
+    drawn again."""
+    for _ in range(50):
+        try:
+            case = _draw(family, rng, **options)
+            c = _probe(case)
+        except ValueError:
+            continue
+        if len(c) >= 3:
+            return case
+    raise RuntimeError(f"no stick-slip {family} block in 50 draws")
+
+
+def _probe(case: Case):
+    block = case.block
+    return block.simulate(duration=_probe_duration(block), samples_per_segment=64,
+                          initial_velocity=case.initial_velocity).cycles()
+
+
+def _draw(family: str, rng, **options) -> Case:
     """A random stick-slip block of ``family`` (model units, forces of order 1).
 
     λ = (F_s − F_k)/(V √(KM)), the ratio of the slip's speed to the drive's, is
-    drawn in [3, 100]: clean stick-slip whose force extrema sit close to, but
-    not on, the law's breakaway and re-stick.
+    drawn in [1, 100]: clean stick-slip whose force extrema sit close to the
+    law's breakaway and re-stick (λ large) or well after and before them (λ ≈ 1,
+    slips as long as the sticks).
     """
     k = _loguniform(rng, 0.3, 30.0)
     m = _loguniform(rng, 0.3, 300.0)
     fs = _loguniform(rng, 0.5, 5.0)
-    lam = _loguniform(rng, 3.0, 100.0)
+    lam = _loguniform(rng, 1.0, 100.0)
     root = math.sqrt(k * m)
     if family == "coulomb":
         fk = fs * rng.uniform(0.2, 0.8)
         law = laws.Coulomb(static=fs, kinetic=fk)
+    elif family == "coulomb-elastic":
+        # a stuck film that strains before it yields: the ramps rise at K k_f/(K + k_f) V
+        fk = fs * rng.uniform(0.2, 0.8)
+        law = laws.Coulomb(static=fs, kinetic=fk, shear_stiffness=_loguniform(rng, 1.0, 10.0) * k)
     elif family == "coulomb-viscous":
         fk = fs * rng.uniform(0.2, 0.8)
         law = laws.Coulomb(static=fs, kinetic=fk, viscous=rng.uniform(0.05, 0.6) * 2 * root)
@@ -121,9 +152,9 @@ def random_case(family: str, rng, **options) -> Case:
         # velocity weakening, K well below the critical stiffness: relaxation oscillations
         k, m = 10.0 * rng.uniform(0.5, 1.0), _loguniform(rng, 0.2, 2.0)
         law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)
-        block = SpringBlock(mass=m, stiffness=k, drive_velocity=0.1 * rng.uniform(0.5, 2.0),
-                            law=law)
-        return Case(family, block, **options)
+        v = 0.1 * rng.uniform(0.5, 2.0)
+        block = SpringBlock(mass=m, stiffness=k, drive_velocity=v, law=law)
+        return Case(family, block, initial_velocity=0.5 * v, **options)
     elif family == "klein-eq1":
         # M x'' + B x' = K(x0 - x) overdamped (Klein's SFB: ζ ≈ 4), frozen at F_b
         b = rng.uniform(1.5, 5.0) * 2 * root
@@ -173,14 +204,14 @@ class Truth:
 def simulate(case: Case):
     """The model run of ``case``: ``cycles`` slips and half a stick more (model units)."""
     block = case.block
-    probe = block.simulate(duration=_probe_duration(block), samples_per_segment=64)
-    c = probe.cycles()
+    c = _probe(case)
     if len(c) < 2:
         raise ValueError(f"{case.label()}: the block does not stick-slip ({len(c)} slips)")
     period = float(np.nanmedian(c.period))
     first = float(c.yield_time[0])
     duration = first + (case.cycles - 0.5) * period
-    return block.simulate(duration=duration, samples_per_segment=512)
+    return block.simulate(duration=duration, samples_per_segment=512,
+                          initial_velocity=case.initial_velocity)
 
 
 def _probe_duration(block: SpringBlock) -> float:
@@ -268,7 +299,8 @@ def sample(case: Case, result=None, tr: Truth | None = None) -> tuple[dict, dict
     if case.sampling == "events":
         r = block.simulate(duration=float(simulate(case).t[-1]) if result is None
                            else float(result.t[-1]),
-                           samples_per_segment=max(int(case.samples_per_slip), 2))
+                           samples_per_segment=max(int(case.samples_per_slip), 2),
+                           initial_velocity=case.initial_velocity)
         keep = np.concatenate(([True], np.diff(r.t) > 0))
         t, f = r.t[keep], r.spring_force[keep]
         tr = truth(case, r) if tr is None else tr
@@ -348,6 +380,7 @@ def score(case: Case) -> Score:
     """Analyse ``case``'s trace and score every observable against :func:`truth`."""
     from .energy import energy_table
     from .report import context
+    from .stickslip import stick_stiffness
 
     r = simulate(case)
     tr = truth(case, r)
@@ -377,6 +410,16 @@ def score(case: Case) -> Score:
     heat = np.asarray(et.film_dissipation, float)[skip:]
     summary["energy_per_slip"] = _stats(heat)
     errors, ses, cov = {}, {}, {}
+    if tr.film_stiffness is not None:
+        st = stick_stiffness(trace.time, trace.spring_force, table,
+                             spring_constant=params["spring_constant"],
+                             drive_velocity=params["drive_velocity"])
+        kf = tr.film_stiffness * scale["force"] / scale["length"]
+        if st is not None:
+            errors["film_stiffness"] = (st.film_stiffness - kf) / kf
+            ses["film_stiffness"] = st.film_stiffness_stderr / kf
+            cov["film_stiffness"] = (abs(st.film_stiffness - kf) <= st.film_stiffness_stderr
+                                     if math.isfinite(st.film_stiffness_stderr) else None)
     for name, (attr, how) in OBSERVABLES.items():
         true_rows = np.asarray(getattr(tr, attr), float)[rows] * scale[_QUANTITY[name]]
         est_rows = heat if name == "energy_per_slip" else np.asarray(getattr(table, name),

@@ -107,19 +107,34 @@ def _mad_std(x: np.ndarray) -> float:
     return 1.4826 * float(np.median(np.abs(x - np.median(x))))
 
 
-# s(2L)/s(L) beyond what any stationary noise gives (at most 4, for a smooth
-# process): the windows at 2L straddle slips
-STRADDLE_RATIO = 4.5
+# s(2L)/s(L) at which the growth is the slips' own: a smooth curve's residuals grow as
+# L⁴ (a factor 16 per doubling), windows straddling a slip fast too; white noise gives 1,
+# correlated (AR(1)) noise at most √2, an MD wall's thermal motion 2-4
+STRADDLE_RATIO = 8.0
 
 
 def _line_residuals(t, f, lag):
-    """Residuals of f[i] from the straight line through f[i − lag] and f[i + lag], scaled
-    to the noise's standard deviation: zero on a straight ramp however it is sampled,
-    of standard deviation σ for white noise σ (uniform or not)."""
-    t0, t1, t2 = t[:-2 * lag], t[lag:-lag], t[2 * lag:]
-    w = (t1 - t0) / (t2 - t0)
-    r = f[lag:-lag] - (1.0 - w) * f[:-2 * lag] - w * f[2 * lag:]
-    return r / np.sqrt(1.0 + w ** 2 + (1.0 - w) ** 2)
+    """Residuals of f[i] from the cubic through f[i − 2 lag], f[i − lag], f[i + lag] and
+    f[i + 2 lag], scaled to the noise's standard deviation: zero on a straight ramp
+    however it is sampled, ∝ lag⁴ on a smooth curve, of standard deviation σ for
+    white noise σ (uniform sampling or not)."""
+    n = t.size
+    c = slice(2 * lag, n - 2 * lag)
+    if c.stop - c.start <= 0:
+        return np.empty(0)
+    nodes = [slice(0, n - 4 * lag), slice(lag, n - 3 * lag), slice(3 * lag, n - lag),
+             slice(4 * lag, n)]
+    x = t[c]
+    r = f[c].copy()
+    norm = np.ones_like(x)
+    for j, sj in enumerate(nodes):
+        w = np.ones_like(x)
+        for k, sk in enumerate(nodes):
+            if k != j:
+                w *= (x - t[sk]) / (t[sj] - t[sk])
+        r -= w * f[sj]
+        norm += w * w
+    return r / np.sqrt(norm)
 
 
 #: the quantile of |residual| the noise is read from (see :func:`noise_level`)
@@ -132,9 +147,10 @@ def noise_level(spring_force, *, max_lag: int | None = None,
                 plateau: float = 1.15, time=None) -> tuple[float, int]:
     """Robust standard deviation of the fluctuations of a trace.
 
-    Uses the residual of each sample from the straight line through its
-    neighbours at lag L (a second difference, weighted by the sample times when
-    they are not uniform), which vanishes on straight stick ramps of any slope.
+    Uses the residual of each sample from the cubic through its neighbours at
+    lags ±L and ±2L (a fourth difference, weighted by the sample times when they
+    are not uniform), which vanishes on straight stick ramps of any slope and is
+    ∝ L⁴ on the smooth curve of a finely sampled slip.
     s(L) is read from the lower quartile of |residual| (``NOISE_QUANTILE``,
     scaled to a Gaussian's σ): the curved slips, however much of the trace
     they take, give the large residuals, and the straight ramps, as long as
@@ -143,9 +159,11 @@ def noise_level(spring_force, *, max_lag: int | None = None,
     L exceeds the correlation time.  The estimate is s(2L) at the first lag
     with s(2L)/s(L) < ``plateau``.
 
-    A ratio s(2L)/s(L) above 4.5 stops the search at s(L): no stationary
-    process grows that fast (a smooth one at most as L², a factor 4), so at 2L
-    most windows straddle a slip or its ringing.
+    A ratio s(2L)/s(L) above 8 (``STRADDLE_RATIO``) stops the search at s(L):
+    that is the L⁴ growth of a smooth curve -- the slips themselves, sampled
+    finely, or sampled at the model's own event times with a handful of
+    samples per stick -- or windows straddling a slip or its ringing, not
+    noise; s(L) is then an upper bound of the noise.
 
     Parameters
     ----------
@@ -165,7 +183,7 @@ def noise_level(spring_force, *, max_lag: int | None = None,
     """
     f = np.asarray(spring_force, float)
     n = f.size
-    if n < 5:
+    if n < 9:
         return 0.0, 1
     t = np.arange(n, dtype=float) if time is None else np.asarray(time, float)
 
@@ -175,7 +193,7 @@ def noise_level(spring_force, *, max_lag: int | None = None,
 
     max_lag = max(1, n // 20) if max_lag is None else max_lag
     lag, prev = 1, s(1)
-    while 2 * lag <= max_lag and 4 * lag < n:
+    while 2 * lag <= max_lag and 8 * lag < n:
         cur = s(2 * lag)
         if prev == 0.0 or cur < plateau * prev:
             return (cur if prev else 0.0), lag
@@ -419,8 +437,8 @@ def ramp_forces(time, spring_force, table: CycleTable, *, wall_position=None,
     return replace(new, **changes)
 
 
-#: the window of the fit about a noisy extremum reaches where the fitted curve has
-#: fallen by this many noise standard deviations (see :func:`refine_extrema`)
+#: an extreme sample that stands this many noise standard deviations above the chord
+#: of its neighbours is refined as on a noise-free trace (see :func:`refine_extrema`)
 EXTREMUM_WINDOW_SIGMAS = 4.0
 #: a flat extremum's samples lie within this many noise standard deviations of the
 #: extreme sample (see :func:`refine_extrema`)
@@ -438,9 +456,10 @@ def _quadratic(t, g, lo, hi, centre):
 
 
 def _secant_bound(t, g, i, lo, hi):
-    """Highest value a concave curve through the samples can reach next to sample i:
-    where the secants of the neighbouring pairs, extended, meet (inf if unbounded)."""
-    best = g[i]
+    """Highest value a concave curve through the samples can reach next to sample i,
+    and where: the meeting point of the neighbouring pairs' secants, extended
+    ((t[i], g[i]) when none meet above it)."""
+    best = (t[i], g[i])
     for a, b, c, d in ((i - 2, i - 1, i, i + 1), (i - 1, i, i + 1, i + 2)):
         if a < lo or d > hi:
             continue
@@ -449,24 +468,33 @@ def _secant_bound(t, g, i, lo, hi):
         if s1 <= s2:
             continue
         tx = (g[c] - g[b] + s1 * t[b] - s2 * t[c]) / (s1 - s2)
-        best = max(best, g[b] + s1 * (tx - t[b]))
+        if not t[b] <= tx <= t[c]:
+            continue
+        value = g[b] + s1 * (tx - t[b])
+        if value > best[1]:
+            best = (tx, value)
     return best
 
 
 def _ramp_side(t, g, i, lo, hi, step, tol):
     """Indices of the straight (stick-ramp) samples next to the extremum i on the
     side ``step`` (−1: before, +1: after), nearest first (i itself when it lies on
-    the ramp), or [] when that side is curved."""
-    near, mid, far = (i + step * k for k in (1, 2, 3))
-    if min(near, far) < lo or max(near, far) > hi:
+    the ramp), or [] when that side is curved.  Three samples must be collinear;
+    a stick sampled by fewer (the model's own output: a stick is one straight
+    segment between its events) is taken as straight."""
+    pts = [j for j in (i + step * k for k in (1, 2, 3)) if lo <= j <= hi]
+    if not pts:
         return []
+    near, far = pts[0], pts[-1]
 
     def off(j):
         w = (t[j] - t[far]) / (t[near] - t[far])
         return abs(g[j] - (1 - w) * g[far] - w * g[near])
-    if off(mid) > tol:
+    if len(pts) == 3 and off(pts[1]) > tol:
         return []
-    return [i, near, mid, far] if off(i) <= tol else [near, mid, far]
+    if len(pts) == 1:
+        return [i, near]
+    return [i] + pts if off(i) <= tol else pts
 
 
 def _kink_extremum(t, g, i, lo, hi, tol):
@@ -486,6 +514,8 @@ def _kink_extremum(t, g, i, lo, hi, tol):
         return None
     a, b = ramp[-1], ramp[-2]
     slope = (g[b] - g[a]) / (t[b] - t[a])
+    if not slope * step < 0:             # the ramp rises towards the extremum
+        return None
     line = lambda x: g[a] + slope * (x - t[a])  # noqa: E731
     first = ramp[0] - step                     # first slip-side sample
     curved = [first - step * k for k in range(3)]
@@ -591,9 +621,10 @@ def _extremum(t, g, i, lo, hi, sigma, lag):
     a_, b_ = i - 1, i + 1
     coef, cov, _ = _quadratic(t, g, a_, b_, t[i])
     a = coef[0]
-    span = min(t[i] - t[a_], t[b_] - t[i])
-    fall = -a * span * span
-    w = 1 if sigma == 0.0 or fall >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
+    # how far the extreme sample stands above the chord of its neighbours, in σ
+    x = (t[i] - t[a_]) / (t[b_] - t[a_])
+    bump = g[i] - (1.0 - x) * g[a_] - x * g[b_]
+    w = 1 if sigma == 0.0 or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
     if w > 1:      # the noise is comparable to the turn over three samples
         tp, vp, ev = _noisy_extremum(t, g, i, lo, hi, sigma, lag)
         return tp, vp, ev, 0.0, 0.0, 0.0
@@ -611,12 +642,17 @@ def _extremum(t, g, i, lo, hi, sigma, lag):
     if w == 1:
         # noise-free regime: the sampling bounds the peak between the highest
         # sample and where the neighbouring secants meet
-        bound = _secant_bound(t, g, i, lo, hi)
-        value = min(max(value, g[i]), bound) if math.isfinite(bound) else max(value, g[i])
+        t_bound, bound = _secant_bound(t, g, i, lo, hi)
+        value = min(max(value, g[i]), bound)
+        if not t[i - 1] <= t_peak <= t[i + 1]:
+            t_peak = t[i]
         dt = 0.5 * (t[min(i + 1, hi)] - t[max(i - 1, lo)])
         scale = float(np.ptp(g[lo:hi + 1])) if hi > lo else 0.0
         kink = _kink_extremum(t, g, i, lo, hi, 1e-9 * scale + 4.0 * sigma)
-        if kink is not None and g[i] <= kink[1] <= bound:
+        if kink is not None:
+            if not g[i] <= kink[1] <= bound:
+                # a sharp corner the slip-side parabola overshoots: where the secants meet
+                kink = (t_bound, bound)
             dv, dtk = abs(kink[1] - value), abs(kink[0] - t_peak)
             return kink[0], kink[1], 0.0, 0.0, dv / 2.0, dtk / 2.0
         ev = et = 0.0
