@@ -202,14 +202,15 @@ class Truth:
 
 
 def simulate(case: Case):
-    """The model run of ``case``: ``cycles`` slips and half a stick more (model units)."""
+    """The model run of ``case``: ``cycles`` slips and three quarters of a period more
+    (model units)."""
     block = case.block
     c = _probe(case)
     if len(c) < 2:
         raise ValueError(f"{case.label()}: the block does not stick-slip ({len(c)} slips)")
     period = float(np.nanmedian(c.period))
     first = float(c.yield_time[0])
-    duration = first + (case.cycles - 0.5) * period
+    duration = first + (case.cycles - 0.25) * period
     return block.simulate(duration=duration, samples_per_segment=512,
                           initial_velocity=case.initial_velocity)
 
@@ -256,14 +257,23 @@ def truth(case: Case, result=None) -> Truth:
     spline = _spline(r, k, v_drive)
     yi, si = r.slip_pairs()
     t = r.t
+    # a last slip whose re-stick the run does not reach still has its force minimum
+    # when the force rises again before the end (the analysis counts it)
+    slips = [e.index for e in r.events if e.kind == "slip"]
+    last = [i for i in slips if not si.size or i > si[-1]]
+    ends = list(si) + ([t.size - 1] if last else [])
+    starts = list(yi) + ([last[0]] if last else [])
     ty, fy, ts_, fb = [], [], [], []
-    for j, (a, b) in enumerate(zip(yi, si)):
-        prev = t[si[j - 1]] if j else t[0]
-        nxt = t[yi[j + 1]] if j + 1 < len(yi) else t[-1]
+    for j, (a, b) in enumerate(zip(starts, ends)):
+        prev = t[ends[j - 1]] if j else t[0]
+        nxt = t[starts[j + 1]] if j + 1 < len(starts) else t[-1]
         # the maximum lies between the previous re-stick and this slip's re-stick,
         # the minimum between this slip's breakaway and the next breakaway
         tmax, fmax = _extremum(spline, 0.5 * (prev + t[a]), t[b], True)
-        tmin, fmin = _extremum(spline, tmax, 0.5 * (t[b] + nxt), False)
+        tmin, fmin = _extremum(spline, tmax, 0.5 * (t[b] + nxt) if j + 1 < len(starts)
+                               else t[-1], False)
+        if j == len(yi) and not (tmin < t[-1] and spline(t[-1]) > fmin + 1e-3 * (fmax - fmin)):
+            break                       # the last slip's force has not turned up yet
         ty.append(tmax), fy.append(fmax), ts_.append(tmin), fb.append(fmin)
     ty, fy, ts_, fb = map(np.asarray, (ty, fy, ts_, fb))
     nan = np.full(ty.size, math.nan)

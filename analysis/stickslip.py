@@ -107,10 +107,25 @@ def _mad_std(x: np.ndarray) -> float:
     return 1.4826 * float(np.median(np.abs(x - np.median(x))))
 
 
-# s(2L)/s(L) at which the growth is the slips' own: a smooth curve's residuals grow as
-# L⁴ (a factor 16 per doubling), windows straddling a slip fast too; white noise gives 1,
-# correlated (AR(1)) noise at most √2, an MD wall's thermal motion 2-4
-STRADDLE_RATIO = 8.0
+# s(2L)/s(L) beyond what stationary noise gives to second differences (at most 4, for a
+# smooth process): the windows at 2L straddle slips
+STRADDLE_RATIO = 4.5
+# the same for fourth differences, which grow as L⁴ (16 per doubling) on a smooth curve;
+# white noise gives 1, AR(1) noise about √2, an MD wall's thermal motion 2-4
+STRADDLE_RATIO_SMOOTH = 8.0
+# fourth differences below this share of the second differences at lag 1: the trace is
+# smooth at its sampling (a noise-free slip), not noisy
+SMOOTH_RATIO = 0.25
+
+
+def _chord_residuals(t, f, lag):
+    """Residuals of f[i] from the straight line through f[i − lag] and f[i + lag], scaled
+    to the noise's standard deviation: zero on a straight ramp however it is sampled,
+    ∝ lag² on a smooth curve, of standard deviation σ for white noise σ."""
+    t0, t1, t2 = t[:-2 * lag], t[lag:-lag], t[2 * lag:]
+    w = (t1 - t0) / (t2 - t0)
+    r = f[lag:-lag] - (1.0 - w) * f[:-2 * lag] - w * f[2 * lag:]
+    return r / np.sqrt(1.0 + w ** 2 + (1.0 - w) ** 2)
 
 
 def _line_residuals(t, f, lag):
@@ -147,23 +162,27 @@ def noise_level(spring_force, *, max_lag: int | None = None,
                 plateau: float = 1.15, time=None) -> tuple[float, int]:
     """Robust standard deviation of the fluctuations of a trace.
 
-    Uses the residual of each sample from the cubic through its neighbours at
-    lags ±L and ±2L (a fourth difference, weighted by the sample times when they
-    are not uniform), which vanishes on straight stick ramps of any slope and is
-    ∝ L⁴ on the smooth curve of a finely sampled slip.
+    Uses the residual of each sample from the straight line through its
+    neighbours at lag L (a second difference, weighted by the sample times when
+    they are not uniform), which vanishes on straight stick ramps of any slope.
     s(L) is read from the lower quartile of |residual| (``NOISE_QUANTILE``,
-    scaled to a Gaussian's σ): the curved slips, however much of the trace
-    they take, give the large residuals, and the straight ramps, as long as
-    they are a quarter of the trace, set the quartile.  For white noise
-    s(L) = σ at every L; for correlated (thermal) noise s(L) grows with L until
-    L exceeds the correlation time.  The estimate is s(2L) at the first lag
-    with s(2L)/s(L) < ``plateau``.
+    scaled to a Gaussian's σ): the curved slips, however much of the trace they
+    take, give the large residuals, and the straight ramps, as long as they are
+    a quarter of the trace, set the quartile.  For white noise s(L) = σ at every
+    L; for correlated (thermal) noise s(L) grows with L until L exceeds the
+    correlation time.  The estimate is s(2L) at the first lag with
+    s(2L)/s(L) < ``plateau``.  A ratio above 4.5 (``STRADDLE_RATIO``) stops the
+    search at s(L): no stationary noise grows that fast (a smooth process at
+    most as L², 4×), so at 2L most windows straddle a slip or its ringing.
 
-    A ratio s(2L)/s(L) above 8 (``STRADDLE_RATIO``) stops the search at s(L):
-    that is the L⁴ growth of a smooth curve -- the slips themselves, sampled
-    finely, or sampled at the model's own event times with a handful of
-    samples per stick -- or windows straddling a slip or its ringing, not
-    noise; s(L) is then an upper bound of the noise.
+    A trace that is smooth at its sampling (a noise-free slip sampled finely, or
+    by the model's own output with a handful of samples per stick) has fourth
+    differences (the residual from the cubic through the neighbours at ±L and
+    ±2L) far below its second differences at lag 1 (below ``SMOOTH_RATIO``):
+    its second differences are the slip's curvature, not noise.  The same search
+    then runs on the fourth differences, which grow as L⁴ on a smooth curve
+    (stop above ``STRADDLE_RATIO_SMOOTH`` = 8× per doubling; s(L) is then an
+    upper bound of the noise).
 
     Parameters
     ----------
@@ -187,17 +206,22 @@ def noise_level(spring_force, *, max_lag: int | None = None,
         return 0.0, 1
     t = np.arange(n, dtype=float) if time is None else np.asarray(time, float)
 
-    def s(lag):
-        r = np.abs(_line_residuals(t, f, lag))
+    def s(lag, residuals):
+        r = np.abs(residuals(t, f, lag))
         return float(np.quantile(r, NOISE_QUANTILE)) / _Q_NORMAL if r.size else 0.0
 
     max_lag = max(1, n // 20) if max_lag is None else max_lag
-    lag, prev = 1, s(1)
+    # a trace whose second differences at lag 1 are mostly a smooth curve's (a slip
+    # sampled finely, or by the model's own output) has fourth differences far below them
+    smooth = s(1, _line_residuals) < SMOOTH_RATIO * s(1, _chord_residuals)
+    residuals, straddle = ((_line_residuals, STRADDLE_RATIO_SMOOTH) if smooth
+                           else (_chord_residuals, STRADDLE_RATIO))
+    lag, prev = 1, s(1, residuals)
     while 2 * lag <= max_lag and 8 * lag < n:
-        cur = s(2 * lag)
+        cur = s(2 * lag, residuals)
         if prev == 0.0 or cur < plateau * prev:
             return (cur if prev else 0.0), lag
-        if cur > STRADDLE_RATIO * prev:
+        if cur > straddle * prev:
             return prev, lag
         lag, prev = 2 * lag, cur
     return prev, lag
