@@ -514,11 +514,17 @@ def _ramp_side(t, g, i, lo, hi, step, tol):
     def off(j):
         w = (t[j] - t[far]) / (t[near] - t[far])
         return abs(g[j] - (1 - w) * g[far] - w * g[near])
-    if len(pts) == 3 and off(pts[1]) > tol:
-        return []
-    if len(pts) == 1:
-        return [i, near]
-    return [i] + pts if off(i) <= tol else pts
+    if len(pts) == 3:
+        if off(pts[1]) > tol:
+            return []
+        return [i] + pts if off(i) <= tol else pts
+    if len(pts) == 2:
+        # the stick's two events: the steeper rise towards i is the ramp (the other pair
+        # reaches into the previous slip)
+        def rise(a, b):
+            return (g[a] - g[b]) / abs(t[a] - t[b])
+        return [i, near] if rise(i, near) >= rise(near, far) else [near, far]
+    return [i, near]
 
 
 def _kink_extremum(t, g, i, lo, hi, tol):
@@ -648,7 +654,11 @@ def _extremum(t, g, i, lo, hi, sigma, lag):
     # how far the extreme sample stands above the chord of its neighbours, in σ
     x = (t[i] - t[a_]) / (t[b_] - t[a_])
     bump = g[i] - (1.0 - x) * g[a_] - x * g[b_]
-    w = 1 if sigma == 0.0 or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
+    # unevenly spaced samples (a model's output: long sticks, dense slips) are a
+    # noise-free trace's; the noisy fit assumes an even sampling
+    gaps = (t[i] - t[a_], t[b_] - t[i])
+    uneven = max(gaps) > 3.0 * min(gaps)
+    w = 1 if sigma == 0.0 or uneven or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
     if w > 1:      # the noise is comparable to the turn over three samples
         tp, vp, ev = _noisy_extremum(t, g, i, lo, hi, sigma, lag)
         return tp, vp, ev, 0.0, 0.0, 0.0
