@@ -401,6 +401,11 @@ class HeatComparison:
     resolution : float
         threshold × stderr / |film_heat|: the relative error of the film heat
         that the check flags in half of the runs (its power).
+
+    Windows that share their ends (cycles y → next y) share the tally's
+    fluctuation there, which cancels in the mean; the pairs' scatter then
+    overstates its error, the check flags less often than 1 % and the
+    resolution is an upper bound.
     """
 
     status: str
