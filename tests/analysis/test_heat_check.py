@@ -117,3 +117,10 @@ def test_the_quadrature_residual_does_not_see_a_wrong_thermostat(klein):
         assert np.all(np.abs(et.quadrature_residual) < 0.01), et.quadrature_residual
         status = compare_heat(et.film_heat, et.thermostat_heat_slip).status
         assert status == ("disagree" if scale == 0.5 else "agree")
+    # what it does check: the trace against the engine's integrals (here a spring energy
+    # column 10 % off, as with a wrong K)
+    cols["spring_energy"] = 1.1 * cols["spring_energy"]
+    et = energy_table(t, f, tab, KLEIN["spring_constant"], mass=KLEIN["mass"],
+                      wall_velocity=tr["wall_velocity"], drive_position=xd,
+                      drive_velocity=KLEIN["drive_velocity"], ledger_columns=cols)
+    assert np.all(np.abs(et.quadrature_residual) > 0.05), et.quadrature_residual
