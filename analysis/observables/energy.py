@@ -125,8 +125,19 @@ class Energy(Observable):
         return bool(section) and "film_dissipation" in section
 
     def rows(self, section: dict) -> list[tuple[str, str]]:
-        return [(label, format_estimate(section.get(name))) for name, label in _ROWS
+        rows = [(label, format_estimate(section.get(name))) for name, label in _ROWS
                 if (section.get(name) or {}).get("mean") is not None]
+        for key, _, _, what in HEAT_CHECKS:
+            c = (section.get("heat_check") or {}).get(key)
+            if c and c["z"] is not None:
+                res = ("" if c["resolution"] is None
+                       else f"; resolves a {100 * c['resolution']:.0f} % error")
+                rows.append((f"check: film heat vs thermostat's, {what}",
+                             f"{c['status']}: {c['z']:.2f} stderr (limit {c['threshold']:.2f}, "
+                             f"99 %{res})"))
+            elif c:
+                rows.append((f"check: film heat vs thermostat's, {what}", c["status"]))
+        return rows
 
     def notes(self, section: dict) -> list[str]:
         e = section
@@ -159,14 +170,16 @@ class Energy(Observable):
                 "just after s): what is released (spring, drive, the stuck film's elastic "
                 "energy) and where it goes (film heat, which the thermostat measures "
                 "independently; the mount dashpot; the ringing left at s; the dilation). "
-                "Per cycle (y → next y): the thermostat's and the mount dashpot's heat and the "
-                "ledger residual.")]
+                "Per cycle (y → next y): the film heat from the mechanics against the "
+                "thermostat's, the mount dashpot's heat and the ledger residual. The film heat "
+                "and the thermostat's are the independent pair that energy.heat_check tests.")]
         if all(run.trace.has(c) for c in _energy.LEDGER_COLUMNS):
             out.append(("ledger", fig_ledger(run),
                         "The run's energy ledger over time, each term from the start: the work "
                         "done on the system (drive and load) against the energy stored "
                         "(potential, kinetic, spring) and the heat the thermostat and the mount "
-                        "dashpot removed; the residual closes the books. Shaded: the slips."))
+                        "dashpot removed; the residual is what the engine's integrals leave "
+                        "unaccounted (a timestep too long shows here). Shaded: the slips."))
         return out
 
 
