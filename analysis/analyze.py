@@ -72,7 +72,10 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
                                   spring_constant=trace.parameters.spring_constant,
                                   wall_position=wall)
-    table = stickslip.ramp_forces(t, f, table, wall_position=wall)
+    v_drive, _ = trace.drive_velocity()
+    table = stickslip.refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
+                                     spring_constant=trace.parameters.spring_constant,
+                                     drive_velocity=v_drive, wall_position=wall)
     regime = stickslip.classify_regime(table)
     if skip is None:
         skip = 1 if len(table) >= 3 else 0

@@ -45,23 +45,32 @@ Per slip y → s:
 ``dilation_work``
     Work against the normal load, P·A·Δz of the top wall over the slip window
     (from the ``load_work`` column).
-``balance_residual``
+``quadrature_residual``
     Per slip: (released − accounted)/released over the slip window, with
     released = spring energy released + drive work (both ends of the drive:
-    spring and mount) + ``film_elastic_released`` and accounted = film heat
-    + the dashpot's heat along x + ΔKE_wall + ``dilation_work``, the film heat
-    being ``film_dissipation`` + ``film_elastic_released`` − ``dilation_work``
-    (what the film received and released, less the work it did lifting the
-    wall).  It checks the bookkeeping (the trace's sampled forces against the
-    engine's integrated work, the dashpot's reference velocity), not the film:
-    the thermostat's own measure of the film's heat is ``thermostat_heat_slip``.
+    spring and mount, from the engine's columns) + ``film_elastic_released``
+    and accounted = ``film_heat`` + the dashpot's heat along x + ΔKE_wall +
+    ``dilation_work``.  ``film_dissipation`` is itself ∫F v − ΔKE_wall − the
+    dashpot's work, so this is no physics check: it reduces to the engine's
+    integrated power (``drive_work`` − ``spring_energy``) against the trace's
+    sampled ∫F v dt, less V∫γM(v − V) dt.  It tests the sampling and the
+    quadrature (a trace too coarse for its slips shows here), not the film.
 ``film_heat``
     What the film turns into heat in a slip: ``film_dissipation`` +
     ``film_elastic_released`` − ``dilation_work``.
 ``thermostat_heat_slip``
-    Heat the thermostat removed over the slip window (MD): an independent
-    measure of ``film_heat``, noisy by the film's thermal fluctuations (and
-    short of it when the window ends before the film has cooled).
+    Heat the thermostat removed over the slip window (MD, ``fix langevin``'s
+    own tally): an independent measure of ``film_heat``, noisy by the film's
+    thermal fluctuations (and short of it when the window ends before the
+    film has cooled).  :func:`compare_heat` tests the two against each other.
+``film_heat_cycle``
+    The film's heat from the mechanics over a whole cycle (y → next y, the
+    window of ``thermostat_heat_cycle``): ∫F v dt − ΔKE_wall − the mount
+    dashpot's work along x, less its heat along z (the engine's
+    ``mount_heat`` less its x part) and the dilation work.  The film starts
+    and ends the cycle stuck and cool, so no k_f is needed and no heat is
+    still on its way out: :func:`compare_heat` against
+    ``thermostat_heat_cycle`` is the check that does not depend on the window.
 ``dashpot_static_bias``
     γM (V − v̄) at the end of each stick: the mount dashpot's force that the
     film carries at yield besides the spring's (the film's static force is
@@ -84,7 +93,7 @@ from scipy.integrate import trapezoid
 
 from filmfriction.reduced_model.cycles import CycleTable, stats as _stats
 
-__all__ = ["EnergyTable", "energy_table", "ledger"]
+__all__ = ["EnergyTable", "HeatComparison", "compare_heat", "energy_table", "ledger"]
 
 # trace columns (md_inputs/contract.py) the ledger needs; mount_heat is optional
 # (traces written before the mount dashpot lack it)
@@ -113,18 +122,19 @@ class EnergyTable:
     mount_dissipation_slip: np.ndarray | None = None
     film_elastic_released: np.ndarray | None = None
     dilation_work: np.ndarray | None = None
-    balance_residual: np.ndarray | None = None
+    quadrature_residual: np.ndarray | None = None
     thermostat_heat_slip: np.ndarray | None = None
     dashpot_static_bias: np.ndarray | None = None
     film_heat: np.ndarray | None = None
     ringing_method: str = "force-amplitude"
+    film_heat_cycle: np.ndarray | None = None
 
     _NAMES = ("spring_released", "spring_released_exact", "drive_work_slip",
               "film_dissipation", "wall_ke_change", "ringing_energy",
               "viscous_fraction", "at_stick_fraction", "thermostat_heat_cycle",
               "ledger_residual_cycle", "mount_dissipation_slip", "film_elastic_released",
-              "dilation_work", "balance_residual", "thermostat_heat_slip",
-              "dashpot_static_bias", "film_heat")
+              "dilation_work", "quadrature_residual", "thermostat_heat_slip",
+              "dashpot_static_bias", "film_heat", "film_heat_cycle")
 
     def _column(self, name):
         value = getattr(self, name)
@@ -306,7 +316,7 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     if v is not None and mount_damping:
         bias = np.array([mount_damping * (v_drive - np.mean(v[max(y - (y - a) // 10, a):y + 1]))
                          for a, y in zip(starts, yi)])
-    balance, q_slip = nan(), nan()
+    quadrature, q_slip = nan(), nan()
     film_heat = film + np.where(np.isfinite(elastic), elastic, 0.0) \
         - np.where(np.isfinite(dilation), dilation, 0.0)
     # Klein's fractions, with everything the film turns into heat in the slip
@@ -323,12 +333,14 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         into = (es[lo] - es[hi]) + (wd[hi] - wd[lo]) + el
         accounted = (film + el - dil) + mnt + dke + dil
         with np.errstate(invalid="ignore", divide="ignore"):
-            balance = (into - accounted) / into
+            quadrature = (into - accounted) / into
     if "thermostat_heat" in cols:
         q = np.asarray(cols["thermostat_heat"], float)
         q_slip = q[hi] - q[lo]
 
-    heat, resid = nan(), nan()
+    heat, resid, film_cycle = nan(), nan(), nan()
+    if v is not None and m > 1:
+        film_cycle[:-1] = _film_heat_cycle(t, f, v, yi, mass, mount_damping, v_drive, cols)
     if m > 1 and "thermostat_heat" in cols:
         q = np.asarray(cols["thermostat_heat"], float)
         heat[:-1] = np.diff(q[yi])
@@ -336,8 +348,139 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
         r = ledger(cols)["residual"]
         resid[:-1] = np.diff(r[yi])
     return EnergyTable(released, exact, drive, film, dke, ring, visc_frac,
-                       stick_frac, heat, resid, method, mount, elastic, dilation, balance,
-                       q_slip, bias, film_heat, ring_method)
+                       stick_frac, heat, resid, method, mount, elastic, dilation, quadrature,
+                       q_slip, bias, film_heat, ring_method, film_cycle)
+
+
+def _film_heat_cycle(t, f, v, yi, mass, mount_damping, v_drive, cols):
+    """``film_heat_cycle`` of the cycles yi[i] → yi[i + 1] (module text)."""
+    def integral(y, a, b):
+        return trapezoid(y[a:b + 1], t[a:b + 1])
+    out = []
+    for a, b in zip(yi[:-1], yi[1:]):
+        heat = integral(f * v, a, b)
+        if mass:
+            heat -= 0.5 * mass * (v[b] ** 2 - v[a] ** 2)
+        x_heat = 0.0
+        if mount_damping:
+            heat -= integral(mount_damping * (v - v_drive) * v, a, b)
+            x_heat = integral(mount_damping * (v - v_drive) ** 2, a, b)
+        if "mount_heat" in cols:
+            mh = np.asarray(cols["mount_heat"], float)
+            # the engine's dashpot heat beyond its x part is the z dashpot's, fed by the film
+            heat -= (mh[b] - mh[a]) - x_heat if mount_damping else mh[b] - mh[a]
+        if "load_work" in cols:
+            lw = np.asarray(cols["load_work"], float)
+            heat += lw[b] - lw[a]          # the film's work lifting the wall: −ΔW_load
+        out.append(heat)
+    return np.asarray(out, float)
+
+
+@dataclass(frozen=True)
+class HeatComparison:
+    """The film's heat from the mechanics against the thermostat's, slip by slip.
+
+    Attributes
+    ----------
+    status : {"agree", "disagree", "undetermined"}
+        ``disagree`` when the mean paired difference exceeds ``threshold``
+        standard errors; ``undetermined`` with fewer than 3 pairs or no
+        scatter to judge by.
+    message : str
+        One line saying so, with the numbers.
+    film_heat, thermostat_heat : float
+        Means over the ``n`` pairs (both finite).
+    difference, stderr : float
+        Mean of film − thermostat heat, pair by pair, and its standard error
+        (the pairs' scatter: the film's thermal noise and the slips' spread).
+    z : float
+        difference / stderr.
+    threshold : float
+        The two-sided 99 % quantile of Student's t with n − 1 degrees of
+        freedom: a correct film heat is flagged in 1 % of runs.
+    resolution : float
+        threshold × stderr / |film_heat|: the relative error of the film heat
+        that the check flags in half of the runs (its power).
+
+    Windows that share their ends (cycles y → next y) share the tally's
+    fluctuation there, which cancels in the mean; the pairs' scatter then
+    overstates its error, the check flags less often than 1 % and the
+    resolution is an upper bound.
+    """
+
+    status: str
+    message: str
+    n: int
+    film_heat: float
+    thermostat_heat: float
+    difference: float
+    stderr: float
+    z: float
+    threshold: float
+    resolution: float
+
+
+def compare_heat(film_heat, thermostat_heat, *, skip: int = 0,
+                 what: str = "per slip") -> HeatComparison:
+    """Test the film's heat from the mechanics against the thermostat's tally.
+
+    The two are independent measures of the same heat: ``film_heat`` from the
+    wall's equation of motion (the trace's force and velocity), the
+    thermostat's from the atoms (LAMMPS's ``fix langevin … tally yes``).
+    They differ by the film's internal energy still to be removed at the end
+    of the window, the engine's ledger residual and the quadrature of the
+    sampled trace.
+
+    Parameters
+    ----------
+    film_heat, thermostat_heat : array_like
+        Per slip (or per cycle), the same windows; pairs with a NaN are dropped.
+    skip : int
+        Leading pairs left out (start-up slips).
+    what : str
+        Names the windows in the message.
+
+    Returns
+    -------
+    HeatComparison
+
+    Examples
+    --------
+    >>> c = compare_heat([10.2, 9.7, 10.4, 9.9], [10.0, 10.1, 10.3, 9.8])
+    >>> c.status, abs(c.difference) < 1e-12
+    ('agree', True)
+    >>> compare_heat([13.0, 12.4, 13.2, 12.9], [10.0, 10.1, 10.3, 9.8]).status
+    'disagree'
+    """
+    from scipy.stats import t as student_t
+
+    a = np.asarray(film_heat, float)[skip:]
+    b = np.asarray(thermostat_heat, float)[skip:]
+    ok = np.isfinite(a) & np.isfinite(b)
+    a, b = a[ok], b[ok]
+    n = int(a.size)
+    nan = math.nan
+    if n < 3:
+        return HeatComparison("undetermined", f"film heat vs thermostat heat {what}: {n} pair(s) "
+                              "with both values, at least 3 needed", n,
+                              float(a.mean()) if n else nan, float(b.mean()) if n else nan,
+                              nan, nan, nan, nan, nan)
+    d = a - b
+    diff = float(d.mean())
+    err = float(d.std(ddof=1) / math.sqrt(n))
+    q = float(student_t.ppf(0.995, n - 1))
+    fh, th = float(a.mean()), float(b.mean())
+    if not err > 0:
+        return HeatComparison("undetermined", f"film heat vs thermostat heat {what}: the "
+                              "differences do not scatter, no error to judge by", n, fh, th,
+                              diff, err, nan, q, nan)
+    z = diff / err
+    res = q * err / abs(fh) if fh else nan
+    status = "agree" if abs(z) <= q else "disagree"
+    msg = (f"film heat {fh:.4g} vs thermostat heat {th:.4g} {what} ({n} pairs): difference "
+           f"{diff:.3g} ± {err:.2g} = {z:.2f} standard errors, limit {q:.2f} (99 %): {status}; "
+           f"the check resolves a film-heat error of {100 * res:.0f} %")
+    return HeatComparison(status, msg, n, fh, th, diff, err, z, q, res)
 
 
 def ledger(columns: dict) -> dict:

@@ -60,6 +60,10 @@ class CycleTable:
         t(next y) − t(s); NaN for the last slip.
     period : ndarray
         τ_ss = t(next y) − t(y); NaN for the last slip.
+    uncertainty : dict, optional
+        Column name → (noise error, sampling error), per-slip arrays: what each
+        slip's value may be off by (:func:`filmfriction.analysis.stickslip.refine_extrema`);
+        None for exact event samples.
     """
 
     yield_index: np.ndarray
@@ -74,6 +78,7 @@ class CycleTable:
     stick_duration: np.ndarray
     period: np.ndarray
     spring_constant: float | None = field(default=None)
+    uncertainty: dict | None = field(default=None)
 
     def __len__(self) -> int:
         return int(self.yield_index.size)
@@ -88,7 +93,10 @@ class CycleTable:
             rows = rows % n
             rows = slice(rows, rows + 1)
         names = ("yield_index", "stick_index") + CYCLE_COLUMNS
-        return replace(self, **{n: np.asarray(getattr(self, n))[rows] for n in names})
+        unc = None if self.uncertainty is None else {
+            n: (np.asarray(a)[rows], np.asarray(b)[rows]) for n, (a, b) in self.uncertainty.items()}
+        return replace(self, **{n: np.asarray(getattr(self, n))[rows] for n in names},
+                       uncertainty=unc)
 
     @property
     def count(self) -> int:
@@ -105,13 +113,34 @@ class CycleTable:
             Leave out the first ``skip`` slips (e.g. 1 to drop the start-up
             yield from a relaxed spring, which is larger than the rest).
 
+        With per-slip errors (``uncertainty``) the standard error is the
+        scatter's, s/√n, combined in quadrature with the mean sampling error
+        (the same for every slip, it does not average out); for a single slip
+        it is that slip's own error (noise and sampling).  ``resolution`` is the
+        mean sampling error (0 without ``uncertainty``).
+
         Returns
         -------
         dict
-            ``{name: {"mean", "std", "stderr", "n"}}``.
+            ``{name: {"mean", "std", "stderr", "n", "resolution"}}``.
         """
-        return {name: stats(np.asarray(getattr(self, name), float)[skip:])
-                for name in CYCLE_COLUMNS[2:]}
+        out = {}
+        for name in CYCLE_COLUMNS[2:]:
+            values = np.asarray(getattr(self, name), float)[skip:]
+            st = stats(values)
+            st["resolution"] = 0.0
+            if self.uncertainty and name in self.uncertainty:
+                noise, res = (np.asarray(a, float)[skip:] for a in self.uncertainty[name])
+                ok = np.isfinite(values) & np.isfinite(noise) & np.isfinite(res)
+                if ok.any():
+                    r = float(np.mean(res[ok]))
+                    st["resolution"] = r
+                    if st["n"] == 1:
+                        st["stderr"] = float(math.hypot(noise[ok][0], res[ok][0]))
+                    elif st["n"] > 1:
+                        st["stderr"] = float(math.hypot(st["stderr"], r))
+            out[name] = st
+        return out
 
     def as_dict(self) -> dict:
         """Per-cycle columns as lists (JSON-ready; NaN stays NaN)."""

@@ -29,9 +29,13 @@ ENERGY_QUANTITIES = {"spring_released": "energy", "spring_released_exact": "ener
                      "viscous_fraction": "1", "at_stick_fraction": "1",
                      "thermostat_heat_cycle": "energy", "ledger_residual_cycle": "energy",
                      "mount_dissipation_slip": "energy", "film_elastic_released": "energy",
-                     "dilation_work": "energy", "balance_residual": "1",
+                     "dilation_work": "energy", "quadrature_residual": "1",
                      "thermostat_heat_slip": "energy", "dashpot_static_bias": "force",
-                     "film_heat": "energy"}
+                     "film_heat": "energy", "film_heat_cycle": "energy"}
+
+#: the independent checks of the film heat: (key, film heat, the thermostat's, windows)
+HEAT_CHECKS = (("slip", "film_heat", "thermostat_heat_slip", "per slip"),
+               ("cycle", "film_heat_cycle", "thermostat_heat_cycle", "per cycle"))
 
 
 #: the rows of the report's table: (section entry, label)
@@ -41,8 +45,10 @@ _ROWS = (("spring_released_exact", "spring energy released (Fs² − Fb²)/2K"),
          ("film_heat", "film heat"),
          ("thermostat_heat_slip", "thermostat's heat over the slip"),
          ("ringing_energy", "ringing energy after s ΔE_osc"),
+         ("film_heat_cycle", "film heat over the cycle (y → next y)"),
+         ("thermostat_heat_cycle", "thermostat's heat over the cycle"),
          ("viscous_fraction", "viscous fraction E_film/(E_film + ΔE_osc)"),
-         ("balance_residual", "balance residual (released − accounted)/released"))
+         ("quadrature_residual", "quadrature residual (engine's work vs the trace's ∫F·v)"))
 
 
 class Energy(Observable):
@@ -93,6 +99,7 @@ class Energy(Observable):
             section["ringing_method"] = et.ringing_method
             per_slip = {name: values for name, values in et.as_dict().items()
                         if not name.endswith("_method")}
+            section["heat_check"] = heat_checks(et, ctx.skip, ctx.unit("energy"))
             if p.mass is None and et.film_dissipation_method != "klein-eq1":
                 ctx.skip_part("energy.wall_ke_change", MissingInput("--mass", "ΔKE of the wall"))
         except MissingInput as exc:
@@ -118,18 +125,33 @@ class Energy(Observable):
         return bool(section) and "film_dissipation" in section
 
     def rows(self, section: dict) -> list[tuple[str, str]]:
-        return [(label, format_estimate(section.get(name))) for name, label in _ROWS
+        rows = [(label, format_estimate(section.get(name))) for name, label in _ROWS
                 if (section.get(name) or {}).get("mean") is not None]
+        for key, _, _, what in HEAT_CHECKS:
+            c = (section.get("heat_check") or {}).get(key)
+            if c and c["z"] is not None:
+                res = ("" if c["resolution"] is None
+                       else f"; resolves a {100 * c['resolution']:.0f} % error")
+                rows.append((f"check: film heat vs thermostat's, {what}",
+                             f"{c['status']}: {c['z']:.2f} stderr (limit {c['threshold']:.2f}, "
+                             f"99 %{res})"))
+            elif c:
+                rows.append((f"check: film heat vs thermostat's, {what}", c["status"]))
+        return rows
 
     def notes(self, section: dict) -> list[str]:
         e = section
         vf = e.get("viscous_fraction") or {}
         text = (f"Film dissipation method: {e.get('film_dissipation_method', '?')}. Viscous "
                 f"fraction film heat/(film heat + ringing) = {format_estimate(vf)}.")
-        bal = e.get("balance_residual") or {}
-        if bal.get("mean") is not None:
-            text += (f" Per-slip balance (released − accounted)/released = "
-                     f"{format_estimate(bal)} (ringing: {e.get('ringing_method', '?')}).")
+        for check in (e.get("heat_check") or {}).values():
+            text += f" Check: {check['message']}."
+        quad = e.get("quadrature_residual") or {}
+        if quad.get("mean") is not None:
+            text += (" Quadrature residual per slip (the engine's integrated work against the "
+                     f"trace's sampled ∫F·v, a check of the sampling, not of the film) = "
+                     f"{format_estimate(quad)}.")
+        text += f" Ringing: {e.get('ringing_method', '?')}."
         if e.get("film_stiffness"):
             text += (f" Stuck film's shear stiffness k_f = {format_estimate(e['film_stiffness'])}"
                      " (from the stick ramps).")
@@ -148,15 +170,36 @@ class Energy(Observable):
                 "just after s): what is released (spring, drive, the stuck film's elastic "
                 "energy) and where it goes (film heat, which the thermostat measures "
                 "independently; the mount dashpot; the ringing left at s; the dilation). "
-                "Per cycle (y → next y): the thermostat's and the mount dashpot's heat and the "
-                "ledger residual.")]
+                "Per cycle (y → next y): the film heat from the mechanics against the "
+                "thermostat's, the mount dashpot's heat and the ledger residual. The film heat "
+                "and the thermostat's are the independent pair that energy.heat_check tests.")]
         if all(run.trace.has(c) for c in _energy.LEDGER_COLUMNS):
             out.append(("ledger", fig_ledger(run),
                         "The run's energy ledger over time, each term from the start: the work "
                         "done on the system (drive and load) against the energy stored "
                         "(potential, kinetic, spring) and the heat the thermostat and the mount "
-                        "dashpot removed; the residual closes the books. Shaded: the slips."))
+                        "dashpot removed; the residual is what the engine's integrals leave "
+                        "unaccounted (a timestep too long shows here). Shaded: the slips."))
         return out
+
+
+def heat_checks(et, skip: int, energy_unit: str) -> dict:
+    """``energy.heat_check``: the film heat against the thermostat's, per slip and per cycle
+    (:func:`filmfriction.analysis.energy.compare_heat`), for the windows that have both."""
+    out = {}
+    for key, film, thermostat, what in HEAT_CHECKS:
+        c = _energy.compare_heat(et._column(film), et._column(thermostat), skip=skip, what=what)
+        if c.n == 0:
+            continue
+        out[key] = {"status": c.status, "message": c.message, "n": c.n,
+                    "film_heat": {"mean": finite_or_none(c.film_heat), "units": energy_unit},
+                    "thermostat_heat": {"mean": finite_or_none(c.thermostat_heat),
+                                        "units": energy_unit},
+                    "difference": {"mean": finite_or_none(c.difference),
+                                   "stderr": finite_or_none(c.stderr), "units": energy_unit},
+                    "z": finite_or_none(c.z), "threshold": finite_or_none(c.threshold),
+                    "resolution": finite_or_none(c.resolution)}
+    return out
 
 
 def _mount_heat_per_cycle(run) -> float:
@@ -184,7 +227,8 @@ def energy_bars(run) -> list[tuple[str, float, float]]:
             ("mount dashpot (slip)",) + get("mount_dissipation_slip"),
             ("ringing after s",) + get("ringing_energy"),
             ("dilation work P·A·Δz (slip)",) + get("dilation_work"),
-            ("thermostat (cycle)",) + get("thermostat_heat_cycle"),
+            ("film heat (cycle)",) + get("film_heat_cycle"),
+            ("  thermostat's measure of it (cycle)",) + get("thermostat_heat_cycle"),
             ("mount dashpot (cycle)", _mount_heat_per_cycle(run), math.nan),
             ("ledger residual (cycle)",) + get("ledger_residual_cycle")]
     return [(a, float(b), float(c)) for a, b, c in bars]

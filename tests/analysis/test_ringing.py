@@ -77,7 +77,9 @@ def test_the_restick_point_is_where_the_fall_ends_not_halfway_down():
     events = stickslip.detect_slips(t, f)
     table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
                                   spring_constant=k, wall_position=wall)
-    table = stickslip.ramp_forces(t, f, table, wall_position=wall)
+    events_noise = events.noise
+    table = stickslip.refine_extrema(t, f, table, noise=events_noise, lag=events.lag,
+                                     spring_constant=k, drive_velocity=0.02)
     ends = t[table.stick_index] % period
     assert np.all(np.abs(ends - period) % period < 0.3), ends
     # the slip covers the whole drop: (Fs - Fb)/K plus the drive's advance

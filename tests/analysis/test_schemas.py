@@ -109,3 +109,14 @@ def test_sfb_schema_rejects_a_spoilt_document(klein_sfb, spoil):
 def test_an_unknown_schema_is_named():
     with pytest.raises(ValueError, match="the schemas are analysis, sfb"):
         json_schema("calibration")
+
+
+def test_the_heat_check_is_in_the_schema(lj_analysis):
+    # the MD-like run has a thermostat column: its film heat is checked against it
+    check = lj_analysis["energy"]["heat_check"]
+    assert check and set(check) <= {"slip", "cycle"}
+    for spoil in (lambda c: c.update(status="pass"), lambda c: c.pop("resolution"),
+                  lambda c: c["difference"].pop("units")):
+        doc = copy.deepcopy(lj_analysis)
+        spoil(next(iter(doc["energy"]["heat_check"].values())))
+        assert list(_validator("analysis").iter_errors(doc))

@@ -1,0 +1,241 @@
+"""Ground-truth validation of the slip analysis: bias and error-bar coverage on model traces.
+
+Random spring-blocks of every friction law of :mod:`filmfriction.analysis.groundtruth`
+(Coulomb, Coulomb + viscous, Coulomb with an elastic film, Stribeck, rate-and-state,
+Klein's Eq. 1), in LJ and SI numbers, sampled uniformly (5 to 500 samples per slip)
+and at the model's own output times, exact and with white or correlated noise; each
+trace analysed as ``filmfriction analyze`` does (:func:`filmfriction.analysis.report.context`)
+and every observable compared with the model's own answer.
+
+Usage::
+
+    python benchmarks/validate.py                 # the table, printed
+    python benchmarks/validate.py --write docs/results/validation.md
+    python benchmarks/validate.py --quick         # a few cases per cell
+
+Errors: forces in % of the force drop F_s − F_b, everything else in % of the true
+value.  "max |err|" is over the cases of a column; coverage is the share of cases
+whose reported mean ± 1 standard error contains the truth.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from filmfriction.analysis import groundtruth as gt
+
+NAMES = {"static_force": "F_s", "backward_force": "F_b", "slip_distance": "slip distance",
+         "slip_duration": "slip duration", "stick_duration": "stick duration",
+         "period": "period", "energy_per_slip": "energy per slip",
+         "film_stiffness": "k_f (stick ramps)"}
+EXACT_SAMPLING = (("uniform", 5), ("uniform", 20), ("uniform", 100), ("uniform", 500),
+                  ("events", 20), ("events", 100))
+NOISE = (0.003, 0.01, 0.03, 0.1)
+CORRELATION = (0.0, 0.9)
+
+
+def run_cases(cases):
+    out = []
+    for case in cases:
+        try:
+            out.append(gt.score(case))
+        except Exception as exc:      # noqa: BLE001 -- a case that fails is counted, not fatal
+            out.append(gt.Score(case, 0, 0, "error", message=f"{type(exc).__name__}: {exc}"))
+    return out
+
+
+def exact_cases(per_cell, rng):
+    cases = []
+    for family in gt.FAMILIES:
+        for units in ("lj", "si"):
+            for sampling, n in EXACT_SAMPLING:
+                for k in range(per_cell):
+                    cases.append(gt.random_case(family, rng, sampling=sampling, samples_per_slip=n,
+                                                units=units, seed=len(cases)))
+    return cases
+
+
+def noisy_cases(per_cell, rng):
+    cases = []
+    for noise in NOISE:
+        for rho in CORRELATION:
+            for family in gt.FAMILIES:
+                for k in range(per_cell):
+                    cases.append(gt.random_case(family, rng, sampling="uniform",
+                                                samples_per_slip=50, noise=noise,
+                                                correlation=rho, units=("lj", "si")[k % 2],
+                                                seed=len(cases)))
+    return cases
+
+
+def _pct(x):
+    return "–" if x is None or not math.isfinite(x) else f"{100 * x:.2g}"
+
+
+def exact_table(scores):
+    cols = [f"{s} {n}" for s, n in EXACT_SAMPLING]
+    head = "| observable | " + " | ".join(f"{c}/slip" for c in cols) + " |"
+    lines = ["Largest |error| over the exact (noise-free) traces, % (forces: of the drop).",
+             "", head, "|" + "---|" * (len(cols) + 1)]
+    for name in NAMES:
+        row = []
+        for sampling, n in EXACT_SAMPLING:
+            errs = [abs(s.errors[name]) for s in scores
+                    if s.case.sampling == sampling and s.case.samples_per_slip == n
+                    and name in s.errors]
+            row.append(_pct(max(errs)) if errs else "–")
+        lines.append(f"| {NAMES[name]} | " + " | ".join(row) + " |")
+    detected = [s for s in scores if s.detected == s.expected and s.expected]
+    lines += ["", f"Slips found = slips made in {len(detected)} of {len(scores)} exact traces; "
+              "the others: " + (", ".join(sorted({f'{s.case.family} {s.case.sampling} '
+                                                  f'{s.case.samples_per_slip:g}/slip: '
+                                                  f'{s.detected} of {s.expected}'
+                                                  for s in scores if s not in detected}))
+                                or "none") + "."]
+    return lines
+
+
+def noisy_table(scores):
+    lines = ["Noisy traces (50 samples per slip): per noise level σ (% of the drop; white, or "
+             "AR(1) with ρ = 0.9 per sample), the mean error (bias), the rms error, the median "
+             "reported standard error (all %) and the coverage of ±1 s.e.", ""]
+    head = "| observable | " + " | ".join(
+        f"σ {100 * n:g} % {'white' if r == 0 else 'ρ 0.9'}" for n in NOISE for r in CORRELATION) + " |"
+    lines += [head, "|" + "---|" * (len(NOISE) * len(CORRELATION) + 1)]
+    for name in NAMES:
+        row = []
+        for noise in NOISE:
+            for rho in CORRELATION:
+                sel = [s for s in scores if s.case.noise == noise and s.case.correlation == rho
+                       and name in s.errors]
+                if not sel:
+                    row.append("–")
+                    continue
+                e = np.array([s.errors[name] for s in sel])
+                se = np.array([s.stderrs[name] for s in sel])
+                cov = [s.covered[name] for s in sel if s.covered[name] is not None]
+                row.append(f"{_pct(e.mean())} / {_pct(math.sqrt(np.mean(e ** 2)))} / "
+                           f"{_pct(float(np.nanmedian(se)))} / "
+                           f"{(f'{100 * np.mean(cov):.0f} % of {len(cov)}') if cov else '–'}")
+        lines.append(f"| {NAMES[name]} | " + " | ".join(row) + " |")
+    lines.append("")
+    lines.append("Cells: bias / rms / median s.e. (%) / coverage of ±1 s.e. (of n cases).")
+    for noise in NOISE:
+        for rho in CORRELATION:
+            sel = [s for s in scores if s.case.noise == noise and s.case.correlation == rho]
+            ok = sum(s.detected == s.expected for s in sel)
+            lines.append(f"- σ {100 * noise:g} % {'white' if rho == 0 else 'ρ 0.9'}: slips found = "
+                         f"slips made in {ok} of {len(sel)} traces")
+    return lines
+
+
+TARGETS = {"static_force": 0.005, "backward_force": 0.005, "slip_distance": 0.02,
+           "slip_duration": 0.02}
+
+
+def targets(exact, noisy):
+    """The issue's targets, each with the measured figure and met / not met."""
+    lines = ["| target | measured | met |", "|---|---|---|"]
+    fine = [s for s in exact if s.case.samples_per_slip >= 20]
+    for name, limit in TARGETS.items():
+        errs = [abs(s.errors[name]) for s in fine if name in s.errors]
+        worst = max(errs) if errs else math.nan
+        unit = "of the drop" if name.endswith("force") else "relative"
+        lines.append(f"| exact, >= 20 samples/slip: {NAMES[name]} within {100 * limit:g} % "
+                     f"({unit}) | largest {_pct(worst)} % over {len(errs)} traces | "
+                     f"{'yes' if worst <= limit else 'no'} |")
+    for name in ("static_force", "backward_force", "slip_distance", "slip_duration"):
+        cov = [s.covered[name] for s in noisy if s.covered.get(name) is not None]
+        share = float(np.mean(cov)) if cov else math.nan
+        lines.append(f"| noisy: ±1 s.e. of {NAMES[name]} covers the truth in 60-75 % | "
+                     f"{100 * share:.0f} % of {len(cov)} traces (all noise levels) | "
+                     f"{'yes' if 0.6 <= share <= 0.75 else 'no'} |")
+    return lines
+
+
+def readme_example():
+    """The README's block (Coulomb F_s = 1, F_k = 0.5, K = M = 1, V = 0.1) as the model
+    outputs it, analysed: value ± s.e. against the force extrema of its exact trajectory."""
+    from filmfriction.reduced_model import SpringBlock, laws
+
+    block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
+                        law=laws.Coulomb(static=1.0, kinetic=0.5))
+    case = gt.Case("coulomb", block, sampling="events", samples_per_slip=64)
+    from filmfriction.analysis.report import context
+
+    r = gt.simulate(case)
+    tr = gt.truth(case, r)
+    cols, params = gt.sample(case, r, tr)
+    ctx = context(gt.as_trace(cols, params), structure=False)
+    summ = ctx.all_slips.summary(skip=ctx.skip)
+    lines = ["| observable | truth | analysis (mean ± s.e.) |", "|---|---|---|"]
+    for name, attr in (("static_force", "static_force"), ("backward_force", "backward_force"),
+                       ("slip_distance", "slip_distance"), ("slip_duration", "slip_duration"),
+                       ("period", "period")):
+        true = float(np.nanmean(getattr(tr, attr)[1:]))
+        st = summ[name]
+        lines.append(f"| {NAMES[name]} | {true:.6g} | {st['mean']:.6g} ± {st['stderr']:.2g} |")
+    lines += ["", f"Trace: the model's own output ({len(cols['time'])} samples, 64 per slip "
+              f"segment), `drive_velocity` given; {len(ctx.all_slips)} slips, the first left out. "
+              "The law's breakaway is at F = 1; the force keeps rising to its maximum 1.0099 "
+              "until the block has caught up with the drive (docs/analysis.md, Definitions)."]
+    return lines
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--write", type=Path, help="write the table as Markdown to this file")
+    ap.add_argument("--quick", action="store_true", help="one case per exact cell, 4 per noisy")
+    ap.add_argument("--seed", type=int, default=2024)
+    args = ap.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    exact = run_cases(exact_cases(1 if args.quick else 3, rng))
+    noisy = run_cases(noisy_cases(4 if args.quick else 10, rng))
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            cwd=Path(__file__).resolve().parent).stdout.strip() or "?"
+    cmd = "python benchmarks/validate.py" + (" --quick" if args.quick else "") + \
+        (f" --seed {args.seed}" if args.seed != 2024 else "")
+    lines = ["# Ground-truth validation of the slip analysis", "",
+             f"Command: `{cmd}`; commit {commit}; {os.cpu_count()} cores (one used); "
+             f"seed {args.seed}.", "",
+             "Random spring-blocks of six friction laws (Coulomb, Coulomb + viscous, Coulomb "
+             "with an elastic film, Stribeck, rate-and-state, Klein's Eq. 1), half in LJ and "
+             "half in SI numbers, analysed as `filmfriction analyze` does; the truth is the "
+             "force extrema of the model's exact trajectory, by the definitions of "
+             "[the analysis](../analysis.md) (y, s at the spring force's maximum and minimum). "
+             "Errors: forces in % of the force drop F_s − F_b, the rest in % of the true value. "
+             "F_k, B and η_eff (the calibration) are not in this table.", "",
+             "## Exact traces", ""]
+    lines += exact_table(exact)
+    lines += ["", "## Noisy traces", ""]
+    lines += noisy_table(noisy)
+    lines += ["", "## Targets", ""] + targets(exact, noisy)
+    lines += ["", "The exact-trace targets hold at 20 samples per slip and above, uniform or at the "
+              "model's event times (below that, at 5 samples per slip, the sampling's own "
+              "resolution is the limit, and the error bars say so). The coverage of the noisy "
+              "error bars falls short of 60-75 %: in the noisy table the bias of a cell is of "
+              "the order of its median standard error (the extremum of a fitted noisy curve "
+              "leans towards the noise, and a flat top or bottom is cut at 2 σ), and with "
+              "correlated noise some slips are missed or split. The energy per slip is read at "
+              "the sample nearest each refined point, and k_f needs sticks sampled by more "
+              "than their two events."]
+    lines += ["", "## The README's example", ""] + readme_example()
+    failed = [s for s in exact + noisy if s.regime == "error"]
+    if failed:
+        lines += ["", f"{len(failed)} cases failed: " + "; ".join(
+            f"{s.case.label()}: {s.message}" for s in failed[:5])]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if args.write:
+        args.write.write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
