@@ -18,7 +18,7 @@ analysis' own definitions (docs/analysis.md, "Definitions"):
 * energy per slip: the heat the contact makes from y to s (the law's friction
   and the damper's work, the model's own integrals).
 
-:func:`score` runs the analysis (:func:`filmfriction.analysis.report.context`
+:func:`score` runs the analysis (:func:`filmfriction.analysis.analyze.context`
 and, on request, the calibration) on a case's trace and compares each
 reported mean ± standard error with the truth: the error in units of the
 force drop (forces) or relative (the rest), and whether ±1 s.e. covers it.
@@ -35,7 +35,7 @@ from scipy.interpolate import CubicHermiteSpline
 from scipy.signal import lfilter
 
 from filmfriction.reduced_model import SpringBlock, laws
-from filmfriction.reduced_model.coulomb import freeze_velocity_for
+from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
 from .trace import Trace, TraceParameters
 
@@ -389,7 +389,7 @@ _QUANTITY = {"static_force": "force", "backward_force": "force", "slip_distance"
 def score(case: Case) -> Score:
     """Analyse ``case``'s trace and score every observable against :func:`truth`."""
     from .energy import energy_table
-    from .report import context
+    from .analyze import context
     from .stickslip import stick_stiffness
 
     r = simulate(case)

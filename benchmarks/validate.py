@@ -4,7 +4,7 @@ Random spring-blocks of every friction law of :mod:`filmfriction.analysis.ground
 (Coulomb, Coulomb + viscous, Coulomb with an elastic film, Stribeck, rate-and-state,
 Klein's Eq. 1), in LJ and SI numbers, sampled uniformly (5 to 500 samples per slip)
 and at the model's own output times, exact and with white or correlated noise; each
-trace analysed as ``filmfriction analyze`` does (:func:`filmfriction.analysis.report.context`)
+trace analysed as ``filmfriction analyze`` does (:func:`filmfriction.analysis.analyze.context`)
 and every observable compared with the model's own answer.
 
 Usage::
@@ -167,7 +167,7 @@ def readme_example():
     block = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,
                         law=laws.Coulomb(static=1.0, kinetic=0.5))
     case = gt.Case("coulomb", block, sampling="events", samples_per_slip=64)
-    from filmfriction.analysis.report import context
+    from filmfriction.analysis.analyze import context
 
     r = gt.simulate(case)
     tr = gt.truth(case, r)

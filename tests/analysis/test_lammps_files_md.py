@@ -46,7 +46,7 @@ def lammps_run(md, tmp_path_factory):
 
 
 def _analysed(path, parameters, **reading):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import read_trace
 
     trace = read_trace(path, **reading, **parameters)

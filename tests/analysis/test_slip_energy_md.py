@@ -61,7 +61,7 @@ def _shifted_tally(shift, yield_index):
 
 
 def _checks(run, spoil):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.trace import read_trace
 
     doc, _ = analyze(spoil(read_trace(run.path)), structure=False)

@@ -157,7 +157,7 @@ def _scaled(tmp_path, columns, scale, name="trace.tsv", names=SI_NAMES):
 
 
 def test_columns_in_their_own_units_give_the_si_analysis(tmp_path, columns):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
 
     si = read_trace(_scaled(tmp_path, columns, {}, "si.tsv"), columns=SI_NAMES, units="si",
                     spring_constant=K, drive_velocity=V)
@@ -188,7 +188,7 @@ def test_columns_in_their_own_units_give_the_si_analysis(tmp_path, columns):
     ({"spring_force": 1e6}, "the stick ramps rise at 1e6 × K·V"),
 ])
 def test_a_column_read_in_the_wrong_unit_is_named(tmp_path, columns, scale, says):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.observables.units_check_section import likely_units
 
     path = _scaled(tmp_path, columns, scale)
@@ -210,7 +210,7 @@ def test_a_column_read_in_the_wrong_unit_is_named(tmp_path, columns, scale, says
 
 
 def test_a_column_named_like_a_unit_but_read_in_another_is_said(tmp_path, columns):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
 
     names = {"time": "t_ms", "spring_force": "F_N", "drive_position": "x_m"}
     path = _scaled(tmp_path, columns, {"time": 1e3}, names=names)
@@ -222,7 +222,7 @@ def test_a_column_named_like_a_unit_but_read_in_another_is_said(tmp_path, column
 
 
 def test_an_md_trace_in_lj_units_passes_the_check(synthetic_run):
-    from filmfriction.analysis.report import analyze
+    from filmfriction.analysis.analyze import analyze
 
     doc, _ = analyze(read_trace(synthetic_run), structure=False)
     check = doc["units_check"]

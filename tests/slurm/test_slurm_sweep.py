@@ -24,7 +24,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from filmfriction.workflows import engine
+from filmfriction.workflows.md import engine
 from filmfriction.workflows.sweep.slurm import SlurmJob, slurm_jobs, submitted_jobs
 
 pytestmark = [pytest.mark.slurm, pytest.mark.md]

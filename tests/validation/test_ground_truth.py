@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis import groundtruth as gt
-from filmfriction.analysis.report import analyze
+from filmfriction.analysis.analyze import analyze
 from filmfriction.reduced_model import SpringBlock, laws
 
 README_BLOCK = SpringBlock(mass=1.0, stiffness=1.0, drive_velocity=0.1,

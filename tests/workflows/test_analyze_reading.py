@@ -53,7 +53,7 @@ def test_units_on_the_command_line_and_in_the_setup_agree(example, run_cli):
     assert table.code == 0, table.err
     assert table.json()["slips"] == doc["slips"]
     # the sfb check reads the same set-up file, its [trace] table left to the analysis
-    from filmfriction.reduced_model.sfb_setup import load_setup
+    from filmfriction.reduced_model.sfb.user_setup import load_setup
 
     assert load_setup(d / "with_trace.toml").spring_constant == 97.0
     # calibrate and report read the file again the recorded way

@@ -13,7 +13,7 @@ import pytest
 
 from filmfriction.workflows.md import runner
 from filmfriction.workflows.sweep import slurm as sweep_slurm
-from filmfriction.workflows.runner import RunFailed
+from filmfriction.workflows.md.runner import RunFailed
 from filmfriction.workflows.sweep.slurm import SlurmJob, report, submitted_jobs
 
 #: lines as the Slurm executor plugin writes them into Snakemake's log

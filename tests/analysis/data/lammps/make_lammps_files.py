@@ -19,7 +19,7 @@ from pathlib import Path
 from filmfriction import md_inputs
 from filmfriction.md_inputs.contract import DATA_FILE
 from filmfriction.workflows import engine, runner
-from filmfriction.workflows.scene import load
+from filmfriction.workflows.md.scene import load
 
 HERE = Path(__file__).parent
 SETTINGS = {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 200, "slide_steps": 2000,
