@@ -6,7 +6,7 @@ from filmfriction.reduced_model import SpringBlock, laws
 
 
 def test_creeping_hold_light_block_no_stall():
-    # M = 1e-6, K = 1e5: period/16 = 1.2e-5, so 1 s used to take ~10^6 LSODA steps (30+ s)
+    # M = 1e-6, K = 1e5: period/16 = 1.2e-5; with that fixed cap 1 s takes ~10^6 steps (30+ s)
     law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-5, v0=1e-6)
     M, K, ext, v_init = 1e-6, 1e5, 0.6 / 1e5 * 0.98, 1e-7
     psi0 = float(law.steady_state(1e-6)[0])
@@ -28,7 +28,7 @@ def test_creeping_hold_light_block_no_stall():
 
 
 def test_light_block_stick_slip_no_stall(monkeypatch):
-    # M = 0.1, K = 0.05: between slips the block creeps at ~1e-6 and LSODA used to crawl
+    # M = 0.1, K = 0.05: between slips the block creeps at ~1e-6, where LSODA alone crawls
     # (1.6e6 evaluations, ~30 s for 80 time units); past STEPS_PER_PERIOD Radau takes over
     from filmfriction.reduced_model.integrators import event_driven as hybrid
     law = laws.RateState(mu0=0.6, a=0.01, b=0.015, dc=1e-2, v0=0.1)

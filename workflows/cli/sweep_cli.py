@@ -9,12 +9,12 @@ import re
 import sys
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable
+from ..inputs import check_ranks, check_writable, UserError
 from ..md.lammps_build import ENV, resolve
 from ..md.scene import SceneError
 from ..sweep import load_aggregate, summary
 from ..sweep.jobs import profile_path, run_sweep
-from ..sweep.plan import SweepPlan, _user_error, plan_sweep
+from ..sweep.plan import SweepPlan, plan_sweep
 
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, RUN_FILE, SWEEP_FILE
 
@@ -70,11 +70,11 @@ def uses_slurm(profile: Path | None) -> bool:
 def check_installed(profile: Path | None) -> None:
     """Snakemake (and the Slurm executor plugin for a Slurm profile) must be importable."""
     if importlib.util.find_spec("snakemake") is None:
-        raise _user_error("Snakemake is not installed: pip install -e '.[sweep]'")
+        raise UserError("Snakemake is not installed: pip install -e '.[sweep]'")
     if profile is not None:
         if (uses_slurm(profile)
                 and importlib.util.find_spec("snakemake_executor_plugin_slurm") is None):
-            raise _user_error(f"profile {profile} uses the Slurm executor, which is not "
+            raise UserError(f"profile {profile} uses the Slurm executor, which is not "
                               "installed: pip install snakemake-executor-plugin-slurm")
 
 
@@ -85,14 +85,14 @@ def check_sweep_dir(out: Path) -> None:
     if (out.is_dir() and any(out.iterdir()) and not (out / SWEEP_FILE).exists()
             and not (out / ".sweep.lock").exists()):
         what = "a run directory" if (out / RUN_FILE).exists() else "not a sweep directory"
-        raise _user_error(f"--out {out}: exists and is {what} (no sweep.json); a sweep writes "
+        raise UserError(f"--out {out}: exists and is {what} (no sweep.json); a sweep writes "
                           "only into a new or empty directory or its own, to resume or extend "
                           "it: choose a new --out")
 
 
 def main_sweep(args: argparse.Namespace) -> int:
     if args.cores < 1:
-        raise _user_error(f"--cores {args.cores}: need at least 1")
+        raise UserError(f"--cores {args.cores}: need at least 1")
     profile = profile_path(args.profile) if args.profile else None
     if not uses_slurm(profile):
         # the points run here: no more ranks than CPUs; on Slurm each point gets its own
@@ -105,7 +105,7 @@ def main_sweep(args: argparse.Namespace) -> int:
         if args.lmp:
             os.environ[ENV] = str(lmp.resolve())      # for Snakemake and every job it starts
     except SceneError as exc:
-        raise _user_error(str(exc)) from None
+        raise UserError(str(exc)) from None
     check_installed(profile)
     out = args.out if args.out is not None else default_out(plan)
     check_writable(out, "--out", directory=True)

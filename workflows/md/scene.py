@@ -399,7 +399,7 @@ def parse_assignment(text: str) -> tuple[str, float | int]:
 
 
 def scenes_directory() -> Path:
-    return Path(str(resources.files("filmfriction.workflows.md") / "scenes"))
+    return Path(str(resources.files("filmfriction.workflows.md") / "scenes")).resolve()
 
 
 def available() -> dict[str, Path]:
