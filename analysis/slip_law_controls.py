@@ -46,7 +46,7 @@ SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
 
 #: The MD's noise as the slip-law fit sees it (LJ units), measured on a run of
 #: ``filmfriction run sfb-similar --fidelity preview`` with
-#: ``python benchmarks/slip_law_controls.py --measure RUN`` (docs/results/slip-law.md):
+#: ``python benchmarks/slip_law_power.py --measure RUN`` (docs/results/slip-law.md):
 #: within a slip the wall's velocity strays from the fitted law's by 0.56–0.75 σ/τ rms
 #: (0.65 on average over 3 slips), correlated over ~3 τ (0.82 at one sample, 0.65 at
 #: 1 τ, 0.44 at 2 τ, 0.08 at 4 τ): the wall moves in bursts and pauses.  The model

@@ -5,7 +5,7 @@ Negative: Coulomb, rate-and-state and velocity-weakening slips are not called
 enough of them, and never ``kinetic``; each law is named by its name where the
 noise lets it be resolved.  40 replicas each (the MD wall's noise drawn anew);
 ≥ 95 % means at most 2 of 40 otherwise.  The rates and the power are in
-docs/results/slip-law.md (``python benchmarks/slip_law_controls.py``).
+docs/results/slip-law.md (``python benchmarks/slip_law_power.py``).
 """
 import pytest
 

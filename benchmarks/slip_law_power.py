@@ -1,7 +1,7 @@
 """The slip-law test's controls and power at the MD's noise (docs/results/slip-law.md).
 
-    python benchmarks/slip_law_controls.py                 # verdict rates and the power
-    python benchmarks/slip_law_controls.py --measure RUN   # the MD noise of a run directory
+    python benchmarks/slip_law_power.py                 # verdict rates and the power
+    python benchmarks/slip_law_power.py --measure RUN   # the MD noise of a run directory
 
 ``--measure`` fits each analysed slip of RUN (its whole slip, F_k + B·v in the
 integrated equation of motion) and prints how far the wall's velocity strays from
