@@ -117,3 +117,14 @@ def test_a_launcher_that_starts_separate_copies_fails_the_run(md, tmp_path):
     assert "LAMMPS ran on 1 MPI rank(s), not the 2 asked" in str(err.value)
     record = json.loads((Path(err.value.run_dir) / "run.json").read_text())
     assert record["status"] == "failed" and "not the 2 asked" in record["error"]
+
+
+def test_a_sweep_with_an_lmp_that_is_none_is_refused_before_anything(run_cli, tmp_path):
+    out = tmp_path / "sweep"
+    r = run_cli("sweep", "stick-slip", "--grid", "seed=1,2", "--lmp", tmp_path / "no-lmp",
+                "--profile", "slurm", "--dry-run", "--out", out)
+    assert r.code == 2
+    assert r.err.strip().splitlines() == [
+        f"filmfriction sweep: error: --lmp {tmp_path / 'no-lmp'}: no such file; give the path "
+        "of a LAMMPS executable (lmp)"]
+    assert not out.exists()
