@@ -39,6 +39,7 @@ import argparse
 import os
 import signal
 import sys
+import time
 from pathlib import Path
 
 # The sweep is split by purpose; this module is the command line and the one
@@ -194,12 +195,13 @@ def main_sweep(args: argparse.Namespace) -> int:
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)
+    started = time.time()
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
     if not args.dry_run and (rc != 0 or uses_slurm(profile)):
         from .sweep_slurm import report, slurm_jobs
 
         text = report(out, [p.name for p in plan.points],
-                      slurm_jobs(out) if uses_slurm(profile) else [])
+                      slurm_jobs(out, since=started) if uses_slurm(profile) else [])
         if text:
             print(text, file=sys.stderr)
     if rc != 0 or args.dry_run:
