@@ -2,7 +2,9 @@
 # Stop the one-node Slurm that tests/slurm/start-cluster.sh started: its jobs are
 # cancelled, then slurmd, slurmctld, slurmdbd, and MariaDB and munged when that script
 # started them (a MariaDB or munged that ran before is left running).  The packages, the
-# configuration and the accounting database stay, so the next start is quick.
+# configuration and the accounting database stay, so the next start is quick.  (With Slurm's
+# commands installed and no controller up, each Snakemake start waits ~10 s: the Slurm
+# executor plugin asks `scontrol show config` when it is imported.)
 # Running it again, or with nothing running, is harmless.
 set -uo pipefail
 

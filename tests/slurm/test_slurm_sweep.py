@@ -166,7 +166,6 @@ def first(cluster, tmp_path_factory, filmfriction_command):
 
     result = run_sweep(cmd, cancel_seed_4, out)
     jobs = slurm_jobs(out)
-    print("Slurm jobs of the first sweep:", *jobs, sep="\n  ")
     assert cancelled, "seed=4's job never appeared in Snakemake's log"
     by_point = {f"seed={s}": [j for j in jobs if j.rule == "point" and j.point == f"seed={s}"]
                 for s in (1, 2, 3, 4)}
@@ -175,7 +174,15 @@ def first(cluster, tmp_path_factory, filmfriction_command):
                            filmfriction_command=filmfriction_command)
 
 
-def test_every_point_is_one_slurm_job_with_the_profiles_resources(first):
+def show(capsys, title: str, jobs: list[SlurmJob]) -> None:
+    """The Slurm job ids and states on the terminal, also when the test passes (CI's log)."""
+    with capsys.disabled():
+        print(f"\n{title}: " + "; ".join(f"{j.job_id} {j.rule} {j.point} {j.state}"
+                                         for j in jobs))
+
+
+def test_every_point_is_one_slurm_job_with_the_profiles_resources(first, capsys):
+    show(capsys, "Slurm jobs of the first sweep", first.jobs)
     assert first.result.returncode == 1, first.result.stdout[-4000:]     # seed=3 failed
     by_point = first.by_point
     assert [len(by_point[p]) for p in ("seed=1", "seed=2")] == [1, 1]
@@ -234,7 +241,7 @@ def test_a_cancelled_and_a_failed_job_are_reported(first):
     assert not (first.out / "aggregate.json").exists()          # a point is missing
 
 
-def test_the_rerun_runs_only_the_missing_point_here_as_one_job_of_two_ranks(first):
+def test_the_rerun_runs_only_the_missing_point_here_as_one_job_of_two_ranks(first, capsys):
     """The same command, the cause of the failure removed and --np 2: the points that have
     a result are not touched (np is not part of a point's inputs)."""
     first.marker.unlink()
@@ -245,7 +252,7 @@ def test_the_rerun_runs_only_the_missing_point_here_as_one_job_of_two_ranks(firs
     result = run_sweep(cmd)
     assert result.returncode == 0, result.stdout[-4000:]
     jobs = slurm_jobs(first.out)
-    print("Slurm jobs of the rerun:", *jobs, sep="\n  ")
+    show(capsys, "Slurm jobs of the rerun", jobs)
     assert sorted((j.rule, j.point, j.state) for j in jobs) == [
         ("analyse", "seed=3", "COMPLETED"), ("point", "seed=3", "COMPLETED")]
     assert kept == {p: (first.out / "points" / p / "run.json").stat().st_mtime_ns for p in kept}

@@ -81,8 +81,17 @@ def test_the_report_names_each_missing_point_with_its_jobs_log_and_failed_runs(t
     assert report(tmp_path, ["seed=1"]) == ""
 
 
-def test_slurm_jobs_without_a_snakemake_log_is_empty(tmp_path):
+def test_slurm_jobs_are_those_of_the_run_that_wrote_the_newest_log(tmp_path):
     assert sweep_slurm.slurm_jobs(tmp_path) == []
+    logs = tmp_path / ".snakemake" / "log"
+    logs.mkdir(parents=True)
+    (logs / "2026-01-01T000000.000000.snakemake.log").write_text(LOG)
+    (logs / "2026-01-02T000000.000000.snakemake.log").write_text(LOG.splitlines()[0] + "\n")
+    assert [j.job_id for j in sweep_slurm.slurm_jobs(tmp_path)] == ["14"]
+    # a sweep that started after that log was written (its Snakemake wrote none): no jobs
+    newest = (logs / "2026-01-02T000000.000000.snakemake.log").stat().st_mtime
+    assert sweep_slurm.slurm_jobs(tmp_path, since=newest + 1) == []
+    assert [j.job_id for j in sweep_slurm.slurm_jobs(tmp_path, since=newest)] == ["14"]
 
 
 def test_a_log_of_separate_one_rank_copies_is_refused(tmp_path):
@@ -118,3 +127,14 @@ def test_a_launcher_that_starts_separate_copies_fails_the_run(md, tmp_path):
     assert "LAMMPS ran on 1 MPI rank(s), not the 2 asked" in str(err.value)
     record = json.loads((Path(err.value.run_dir) / "run.json").read_text())
     assert record["status"] == "failed" and "not the 2 asked" in record["error"]
+
+
+def test_a_sweep_with_an_lmp_that_is_none_is_refused_before_anything(run_cli, tmp_path):
+    out = tmp_path / "sweep"
+    r = run_cli("sweep", "stick-slip", "--grid", "seed=1,2", "--lmp", tmp_path / "no-lmp",
+                "--profile", "slurm", "--dry-run", "--out", out)
+    assert r.code == 2
+    assert r.err.strip().splitlines() == [
+        f"filmfriction sweep: error: --lmp {tmp_path / 'no-lmp'}: no such file; give the path "
+        "of a LAMMPS executable (lmp)"]
+    assert not out.exists()

@@ -7,6 +7,7 @@ import importlib.util
 import os
 import re
 import sys
+import time
 from pathlib import Path
 
 from ..inputs import check_ranks, check_writable, UserError
@@ -113,12 +114,13 @@ def main_sweep(args: argparse.Namespace) -> int:
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
     print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
           f"each -> {out}", file=sys.stderr)
+    started = time.time()
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
     if not args.dry_run and (rc != 0 or uses_slurm(profile)):
         from ..sweep.slurm import report, slurm_jobs
 
         text = report(out, [p.name for p in plan.points],
-                      slurm_jobs(out) if uses_slurm(profile) else [])
+                      slurm_jobs(out, since=started) if uses_slurm(profile) else [])
         if text:
             print(text, file=sys.stderr)
     if rc != 0 or args.dry_run:

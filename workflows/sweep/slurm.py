@@ -76,10 +76,13 @@ class SlurmJob:
     elapsed: str = ""
 
 
-def snakemake_log(sweep_dir: Path) -> Path | None:
-    """Snakemake's log of the newest run in ``sweep_dir`` (None when there is none)."""
+def snakemake_log(sweep_dir: Path, since: float | None = None) -> Path | None:
+    """Snakemake's log of the newest run in ``sweep_dir`` (None when there is none, or
+    when it was last written before the time ``since``: a run that wrote no log)."""
     logs = sorted((Path(sweep_dir) / ".snakemake" / "log").glob("*.snakemake.log"))
-    return logs[-1] if logs else None
+    if not logs or (since is not None and logs[-1].stat().st_mtime < since):
+        return None
+    return logs[-1]
 
 
 def submitted_jobs(log_text: str) -> list[SlurmJob]:
@@ -105,9 +108,10 @@ def sacct_states(job_ids: list[str]) -> dict[str, tuple[str, str, str]]:
     return states
 
 
-def slurm_jobs(sweep_dir: Path) -> list[SlurmJob]:
-    """The Slurm jobs of the newest Snakemake run in ``sweep_dir``, with their states."""
-    log = snakemake_log(sweep_dir)
+def slurm_jobs(sweep_dir: Path, since: float | None = None) -> list[SlurmJob]:
+    """The Slurm jobs of the newest Snakemake run in ``sweep_dir`` (one that wrote its log
+    after the time ``since``), with their states."""
+    log = snakemake_log(sweep_dir, since)
     if log is None:
         return []
     jobs = submitted_jobs(log.read_text(errors="replace"))
