@@ -27,7 +27,7 @@ SETTINGS = {"equilibrate_steps": 2000, "slide_steps": 60000, "trace_every": 50,
 def lammps_run(md, tmp_path_factory):
     from filmfriction import md_inputs
     from filmfriction.md_inputs.contract import DATA_FILE
-    from filmfriction.workflows import engine, runner
+    from filmfriction.workflows.md import engine, runner
 
     scene = md.scene("stick-slip", **SETTINGS)
     d = tmp_path_factory.mktemp("lammps-files")

@@ -18,7 +18,7 @@ from pathlib import Path
 
 from filmfriction import md_inputs
 from filmfriction.md_inputs.contract import DATA_FILE
-from filmfriction.workflows import engine, runner
+from filmfriction.workflows.md import engine, runner
 from filmfriction.workflows.md.scene import load
 
 HERE = Path(__file__).parent
