@@ -42,13 +42,18 @@ Fits (all in the run's LJ units)
     analysis's mean F_s when no slip could be fitted.  The start-up yield is
     reported apart (``first_yield_force``).
 ``kinetic_force`` and ``film_damping``
-    One joint least-squares fit of the slip equation above (closed form,
-    d fixed to the mount's value, each slip started at rest from its own
-    stick ramp, its yield instant free within a few samples of the detected
-    y) to the spring force over every slip window (y to s plus as long again
-    after s, so the re-stick level is constrained).  Uncertainty:
-    jackknife over slips (leave one slip out, refit), which carries the
-    slip-to-slip scatter; with fewer than 3 slips, the fit's covariance.
+    One joint least-squares fit of the slip equation above
+    (:func:`~filmfriction.analysis.slipfit.fit_slips`: closed form, d fixed to the
+    mount's value, each slip started at rest from its own stick ramp, its yield
+    instant and ramp level free, the film's freeze force F_f free where it
+    improves the fit by 2 σ) to the spring force over every slip window (the
+    ramp before y, the slip, and as long again after s, so the re-stick is
+    constrained).  The fit runs in the slips' own force and time scales, so the
+    result does not depend on the units of the trace.  Uncertainty: from the
+    Jacobian at the solution and the residual variance (with the residuals'
+    serial correlation); a parameter at the bound of its range (F_k = 0, B = 0)
+    says so and has none.  The jackknife over slips (leave one slip out, refit)
+    is written beside it as a cross-check.
 ``eta_eff``
     B·D/A with D the mean gap, at the slips' shear rate γ̇ = (Δx0/τ_s)/D.
     With a smooth-sliding run the steady η_eff = (F̄/A)/(V/D) is used instead.
@@ -93,7 +98,7 @@ Example
 >>> cal = calibrate(run_directory(pathlib.Path(tempfile.mkdtemp()) / "run", trajectory=False))
 >>> rc = cal.main
 >>> rc.regime == "stick-slip", round(rc.static_force.value, 2), round(rc.film_damping.value, 1)
-(True, 2.97, 97.5)
+(True, 3.0, 39.6)
 """
 from __future__ import annotations
 
@@ -169,9 +174,7 @@ class RunCalibration:
             e = getattr(self, name)
             out[name] = None if e is None else e.as_dict()
         if self.slip_fit is not None:
-            out["slip_fit"] = {"rms_residual": _num(self.slip_fit.rms_residual),
-                               "n_slips": self.slip_fit.n_slips,
-                               "mount_damping": _num(self.slip_fit.mount_damping)}
+            out["slip_fit"] = self.slip_fit.as_dict()
         out["replay"] = None if self.replay is None else self.replay.as_dict()
         out["failures"] = dict(self.failures)
         return out
@@ -203,7 +206,9 @@ def calibrate_run(run: RunData) -> RunCalibration:
         failures["slip_fit"] = f"no slips to fit (regime {regime})"
     else:
         try:
-            fit = fit_slip_law(run)
+            k_f = kw["shear_stiffness"].value if kw.get("shear_stiffness") else math.inf
+            k = tr.parameters.spring_constant
+            fit = fit_slip_law(run, stick_stiffness=k * k_f / (k + k_f) if k else None)
             kw.update(slip_fit=fit, kinetic_force=fit.kinetic_force, film_damping=fit.film_damping,
                       static_force=fit.static_force)
         except (ValueError, LookupError, RuntimeError) as exc:

@@ -34,7 +34,8 @@ import numpy as np
 
 from filmfriction.analysis.observables import Observable, registered as registered_observables
 from filmfriction.analysis.trace import unit as _unit
-from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
+from filmfriction.analysis.util import format_estimate as _pm, format_pm as _pm_plain
+from filmfriction.analysis.util import format_value as _fmt
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.reduced_model.units import OMCTS
 
@@ -405,10 +406,11 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
               "wall shows.")
     md = cal.get("md_calibration")
     if md is not None:
-        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
-              f"sliding stress {md['sliding_stress']:.4g} ± {md['sliding_stress_err']:.2g}, re-stick stress "
-              f"{_fmt(md['restick_stress'])}, η0 {md['eta_zero']:.4g} ± {md['eta_zero_err']:.2g}, thinning "
-              f"exponent {md['thinning_exponent']:.3g} ± {md['thinning_exponent_err']:.2g}.")
+        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress "
+              f"{_pm_plain(md['yield_stress'], md['yield_stress_err'])}, sliding stress "
+              f"{_pm_plain(md['sliding_stress'], md['sliding_stress_err'])}, re-stick stress "
+              f"{_fmt(md['restick_stress'])}, η0 {_pm_plain(md['eta_zero'], md['eta_zero_err'])}, "
+              f"thinning exponent {_pm_plain(md['thinning_exponent'], md['thinning_exponent_err'], 3)}.")
     for k, v in cal.get("failures", {}).items():
         sec.p(f"Not computed — {k}: {v}.")
     for n in cal.get("notes", []):
