@@ -119,11 +119,15 @@ class SlipLawFit:
 
     Attributes
     ----------
-    kinetic_force, film_damping, freeze_force : Estimate
+    kinetic_force, film_damping : Estimate
         Each with ``at_bound`` set (and no standard error) when the fit ended at
         the bound of its range: F_k = 0 (no rate-independent part), B = 0 (no film
-        drag beyond the mount's dashpot), F_f = 0 (the slips end at rest, no
-        freeze; also where a freeze does not improve the fit by 2 sigma).
+        drag beyond the mount's dashpot).
+    freeze_force : Estimate or None
+        F_f; None where the slips end with the wall at rest (a freeze does not lower
+        χ² by 25, i.e. 5 σ).
+    freeze_note : str
+        Why there is a freeze force or none.
     static_force : Estimate
         Spring force at the fitted yield instants (mean ± standard error).
     mount_damping : float
@@ -154,7 +158,8 @@ class SlipLawFit:
     kinetic_force: Estimate
     film_damping: Estimate
     static_force: Estimate
-    freeze_force: Estimate
+    freeze_force: Estimate | None
+    freeze_note: str
     mount_damping: float
     rms_residual: float
     reduced_chi2: float
@@ -187,7 +192,8 @@ class SlipLawFit:
         from .util import finite_or_none as num
         return {"kinetic_force": self.kinetic_force.as_dict(),
                 "film_damping": self.film_damping.as_dict(),
-                "freeze_force": self.freeze_force.as_dict(),
+                "freeze_force": None if self.freeze_force is None else self.freeze_force.as_dict(),
+                "freeze_note": self.freeze_note,
                 "rms_residual": num(self.rms_residual), "reduced_chi2": num(self.reduced_chi2),
                 "n_slips": self.n_slips, "mount_damping": num(self.mount_damping),
                 "error_method": self.error_method,
@@ -210,16 +216,19 @@ def _windows(n_samples: int, yi, si) -> list[tuple[int, int]]:
 
 
 def _stick_noise(f: np.ndarray, spans) -> float:
-    """Variance of the force's noise from the stick phases between the fitted windows: the
-    second differences of a straight ramp are noise only, 6 sigma^2 for white noise
-    (robust: from their median absolute deviation)."""
+    """Variance of the force's noise on the stick ramps between the fitted windows: the
+    scatter about a straight line fitted to each ramp, the median over the ramps (a
+    stretch that holds an unfitted slip does not count; NaN without ramps of more
+    than 8 samples)."""
     edges = [0] + [x for lo, hi in spans for x in (lo, hi)] + [f.size - 1]
-    parts = [np.diff(f[a + 1:b], 2) for a, b in zip(edges[::2], edges[1::2]) if b - a > 8]
-    if not parts:
-        return math.nan
-    dd = np.concatenate(parts)
-    sigma = 1.4826 * float(np.median(np.abs(dd - np.median(dd)))) / math.sqrt(6.0)
-    return sigma ** 2
+    out = []
+    for a, b in zip(edges[::2], edges[1::2]):
+        seg = f[a + 1:b]
+        if seg.size > 8:
+            x = np.arange(seg.size, dtype=float)
+            out.append(float(np.sum((seg - np.polyval(np.polyfit(x, seg, 1), x)) ** 2))
+                       / (seg.size - 2))
+    return float(np.median(out)) if out else math.nan
 
 
 def _serial_correlation(r: np.ndarray, sizes) -> float:
@@ -256,12 +265,14 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     The fit runs in the dimensionless variables of the module docstring with
     :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``,
     bounds F_k and F_f ∈ [0, min F_s,i), B ≥ 0) from the best point of a coarse
-    grid over (F_k, B, F_f).  The freeze is kept where it lowers χ² by at least
-    4 (2 σ for one parameter), else F_f = 0.  Standard errors: the covariance
+    grid over (F_k, B), once without a freeze and once with F_f starting at the
+    slips' median re-stick force.  The freeze is kept where it lowers χ² by at
+    least 25 (5 σ for one parameter more), else the slips end at rest.  Standard errors: the covariance
     (JᵀJ)⁻¹ s² c of the parameters off their bounds at the solution, J the
     Jacobian, s² the residual variance per degree of freedom and c = (1 + ρ)/(1 − ρ)
-    from the residuals' lag-one autocorrelation ρ (1 for white noise); a
-    parameter at its bound is held there and gets none (``at_bound``).
+    from the residuals' lag-one autocorrelation ρ (1 for white noise).  A
+    parameter at its bound gets none (``at_bound``); the covariance still includes
+    it, so that the others' errors carry the freedom the data leave it.
 
     Parameters
     ----------
@@ -277,8 +288,9 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
         ``lj`` or ``si``: the labels of the estimates.
     jackknife : bool
         Also refit with each slip left out (≥ 3 slips; the ``jackknife`` cross-check).
-    start : (float, float, float), optional
-        (F_k, B, F_f) to start from instead of the grid's best point.
+    start : (float, float, float or None), optional
+        (F_k, B, F_f) to start from instead of the grid's best point (F_f None: the
+        fit with a freeze starts from the grid's).
 
     Raises
     ------
@@ -325,12 +337,15 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     fs_min = min(fs for _, _, fs in data)
     upper_fk = max(0.999 * fs_min, 1e-9)
     level_span = 0.5
+    # a freeze force below the lowest force of the windows cannot act
+    ff_low = min(float(np.min(x[1])) for x in data) - 0.05
 
     def one(i, fk, b, ff, delta, level):
         tt, fi, fs = data[i]
         tau = delta * h
         return coulomb_slip_force(tt - tau, fs + level + rr * tau, fk, b + dd, 1.0, 1.0, vv,
-                                  freeze_force=ff, stick_rate=rr) - fi
+                                  freeze_force=-math.inf if math.isnan(ff) else ff,
+                                  stick_rate=rr) - fi
 
     def pieces(p, subset):
         m_ = len(subset)
@@ -341,41 +356,45 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
 
     def bounds(subset):
         m_ = len(subset)
-        lower = [0.0, 0.0, 0.0] + [shift_range[i][0] for i in subset] + [-level_span] * m_
+        lower = [0.0, 0.0, ff_low] + [shift_range[i][0] for i in subset] + [-level_span] * m_
         upper = [upper_fk, 1e4, upper_fk] + [shift_range[i][1] for i in subset] + [level_span] * m_
         return np.array(lower), np.array(upper)
 
-    def jac(p, subset):
-        """Forward differences; a slip's yield shift and ramp level act on that slip
-        only, so one evaluation with all shifts (all levels) stepped gives their columns."""
+    def jac(p, subset, vary):
+        """Forward differences of the varied parameters; a slip's yield shift and ramp
+        level act on that slip only, so one evaluation with all shifts (all levels)
+        stepped gives their columns."""
         _, upper = bounds(subset)
         m_ = len(subset)
         base = pieces(p, subset)
         flat = np.concatenate(base)
         rows = np.cumsum([0] + [x.size for x in base])
         out = np.zeros((flat.size, p.size))
-        step = 1e-7 * np.maximum(np.abs(p), 1e-2)
+        step = 1e-7 * np.maximum(np.abs(np.nan_to_num(p)), 1e-2)
         step = np.where(p + step > upper, -step, step)
         for c in range(3):
-            q = p.copy()
-            q[c] += step[c]
-            out[:, c] = (resid(q, subset) - flat) / step[c]
+            if vary[c]:
+                q = p.copy()
+                q[c] += step[c]
+                out[:, c] = (resid(q, subset) - flat) / step[c]
         for first in (3, 3 + m_):
             q = p.copy()
             q[first:first + m_] += step[first:first + m_]
             for j, piece in enumerate(pieces(q, subset)):
                 out[rows[j]:rows[j + 1], first + j] = (piece - base[j]) / step[first + j]
-        return out
+        return out[:, vary]
 
     def solve(subset, start, *, freeze=True, tol=1e-8):
-        """least_squares over the parameters (F_f held at 0 unless ``freeze``); returns the
-        full parameter vector, the residuals and the Jacobian's columns of the varied ones."""
+        """least_squares over the parameters (no freeze, F_f = NaN, unless ``freeze``);
+        returns the full parameter vector, the residuals, the Jacobian of the varied
+        ones, which were varied, and scipy's result."""
         lower, upper = bounds(subset)
         vary = np.ones(lower.size, bool)
         vary[2] = freeze
-        full = np.clip(np.asarray(start, float), lower, upper)
+        full = np.asarray(start, float).copy()
+        full[vary] = np.clip(full[vary], lower[vary], upper[vary])
         if not freeze:
-            full[2] = 0.0
+            full[2] = math.nan
 
         def expand(x):
             q = full.copy()
@@ -383,68 +402,80 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
             return q
 
         sol = least_squares(lambda x: resid(expand(x), subset), x0=full[vary],
-                            jac=lambda x: jac(expand(x), subset)[:, vary],
+                            jac=lambda x: jac(expand(x), subset, vary),
                             bounds=(lower[vary], upper[vary]), x_scale="jac",
                             ftol=tol, xtol=tol, gtol=tol)
         return expand(sol.x), sol.fun, sol.jac, vary, sol
 
     every = list(range(n))
-    if start is not None:
-        p0 = np.concatenate([[start[0] / f0, start[1] / b0, start[2] / f0], np.zeros(2 * n)])
-    else:
-        # a coarse grid over (F_k, B, F_f) on up to three slips as the start, each slip at
-        # its detected yield; F_f none (0) or the slips' median re-stick force
-        some = every[:: max(1, n // 3)][:3]
-        restick = float(np.median([f[s] for _, s, _ in slips])) / f0
+    some = every[:: max(1, n // 3)][:3]
+    restick = min(max(float(np.median([f[s] for _, s, _ in slips])) / f0, ff_low), upper_fk)
+
+    def grid_start(freeze_force):
+        """The best point of a coarse grid over (F_k, B) on up to three slips, each slip
+        at its detected yield, F_f fixed (NaN: no freeze)."""
         best = None
         for fk in np.linspace(0.0, 0.95 * fs_min, 7) if fs_min > 0 else [0.0]:
             for b in np.geomspace(2e-3, 2e2, 11):
-                for ff in (0.0, min(max(restick, 0.0), upper_fk)):
-                    q = np.concatenate([[fk, b, ff], np.zeros(2 * len(some))])
-                    cost = float(np.sum(resid(q, some) ** 2))
-                    if best is None or cost < best[0]:
-                        best = (cost, q[:3])
-        p0 = np.concatenate([best[1], np.zeros(2 * n)])
-    p, r, jmat, vary, sol = solve(every, p0)
+                q = np.concatenate([[fk, b, freeze_force], np.zeros(2 * len(some))])
+                cost = float(np.sum(resid(q, some) ** 2))
+                if best is None or cost < best[0]:
+                    best = (cost, q[:3])
+        return np.concatenate([best[1], np.zeros(2 * n)])
+
+    if start is not None:
+        ff0 = math.nan if start[2] is None else start[2] / f0
+        p0 = np.concatenate([[start[0] / f0, start[1] / b0, ff0], np.zeros(2 * n)])
+        starts = (p0, p0 if not math.isnan(ff0) else grid_start(restick))
+    else:
+        starts = (grid_start(math.nan), grid_start(restick))
+    # the slips ending at rest, and the film freezing at F_f, each fitted from its own
+    # start; the freeze is kept only where it lowers chi^2 by 25 or more (5 sigma for one
+    # parameter more; a freeze near the force's minimum, where a slip ending at rest has
+    # its turning point, fits noise more often than one parameter would): a freeze kept
+    # by chance moves F_k and B
+    p, r, jmat, vary, sol = solve(every, starts[0], freeze=False)
+    pf, rf, jf, varyf, solf = solve(every, starts[1], freeze=True)
+    # chi^2 in independent samples: the residual variance times their serial correlation
+    sizes = [x[0].size for x in data]
+    s2_free = (float(np.sum(rf ** 2)) / max(rf.size - pf.size, 1)
+               * _serial_correlation(rf, sizes))
+    gain = (float(np.sum(r ** 2)) - float(np.sum(rf ** 2))) / s2_free
+    if gain >= 25.0:
+        p, r, jmat, vary, sol = pf, rf, jf, varyf, solf
+        freeze_note = f"the freeze lowers chi^2 by {gain:.3g}"
+    else:
+        freeze_note = (f"none: the slips end with the wall at rest (a freeze lowers chi^2 by "
+                       f"{max(gain, 0.0):.2g} < 25 only)")
     lower, upper = bounds(every)
-    # a freeze force below every slip's lowest force never acts: the same model as none
-    if p[2] > 0.0:
-        q = p.copy()
-        q[2] = 0.0
-        if np.array_equal(resid(q, every), r):
-            p = q
-    # the freeze is kept only where it improves the fit beyond chance (its chi^2 drop with
-    # one parameter more at least 4, i.e. 2 sigma): a slip that ends at rest has F_f = 0 at
-    # the bound, where a linearised error would misstate the others'
-    freeze_note = "F_f = 0: the slips end with the wall at rest, no freeze resolved"
-    if p[2] > 0.0:
-        q, r0, j0, vary0, sol0 = solve(every, p, freeze=False)
-        s2_free = float(np.sum(r ** 2)) / max(r.size - p.size, 1)
-        gain = (float(np.sum(r0 ** 2)) - float(np.sum(r ** 2))) / s2_free
-        if gain < 4.0:
-            p, r, jmat, vary, sol = q, r0, j0, vary0, sol0
-            freeze_note = (f"F_f = 0: a freeze improves the fit by chi^2 {gain:.2g} < 4 only, "
-                           "not resolved")
     span = upper - lower
-    at_lower, at_upper = p - lower <= 1e-6 * span, upper - p <= 1e-6 * span
-    at_bound = at_lower | at_upper | ~vary
+    at_lower = vary & (p - lower <= 1e-6 * span)
+    at_upper = vary & (upper - p <= 1e-6 * span)
+    at_bound = at_lower | at_upper
     p = np.where(at_lower, lower, np.where(at_upper, upper, p))
-    free = ~at_bound
-    # standard errors: (J^T J)^-1 s^2 over the parameters off their bounds, s^2 the
-    # residual variance per degree of freedom, times the residuals' serial correlation
-    # (their long-run over their plain variance; 1 for white noise)
+    free = vary & ~at_bound
+    # standard errors: (J^T J)^-1 s^2 c over the parameters off their bounds, s^2 the
+    # residual variance per degree of freedom, c the residuals' serial correlation
     dof = max(r.size - int(free.sum()), 1)
     s2 = float(np.sum(r ** 2)) / dof
-    spans_n = [x[0].size for x in data]
-    corr = _serial_correlation(r, spans_n)
+    corr = _serial_correlation(r, sizes)
+    # the covariance is over every varied parameter, those at a bound too: the others'
+    # errors then include the freedom of a parameter that the data only bound (F_k = 0 is
+    # as consistent with the slips as a small F_k > 0); without that (a singular matrix)
+    # over the ones off their bounds
     err = np.full(p.size, math.nan)
-    cols = jmat[:, free[vary]]
-    if cols.size:
+    for use in (vary, free):
+        cols = jmat[:, use[vary]]
         try:
-            err[free] = np.sqrt(np.clip(np.diag(np.linalg.inv(cols.T @ cols)), 0.0, None)
-                                * s2 * corr)
+            cov = np.linalg.inv(cols.T @ cols)
         except np.linalg.LinAlgError:
-            pass
+            continue
+        diag = np.diag(cov)
+        if np.all(np.isfinite(diag)) and np.all(diag > 0):
+            e_all = np.full(p.size, math.nan)
+            e_all[use] = np.sqrt(diag * s2 * corr)
+            err[free] = e_all[free]
+            break
     shifts = p[3:3 + n] * dt
     yield_forces = np.array([(data[i][2] + p[3 + n + i] + rr * p[3 + i] * h) * f0 for i in every])
     noise = _stick_noise(f / f0, spans)
@@ -460,24 +491,25 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
            f"the slips' force drop {f0:.4g} {u['force']} and sqrt(M/K) = {t0:.4g} "
            f"{u['time']}; standard error from the Jacobian at the solution, the residual "
            f"variance and the residuals' serial correlation (factor {corr:.3g})")
+    law = "joint slip fit (Coulomb + viscous" + (", freeze force)" if vary[2] else ")")
     names = (("kinetic_force", f0, u["force"], "F_k = 0: no rate-independent part resolved"),
              ("film_damping", b0, u["damping"],
               f"B = 0: no film drag beyond the mount's dashpot (d = {d:.4g}) resolved"),
-             ("freeze_force", f0, u["force"], freeze_note))
+             ("freeze_force", f0, u["force"], "the freeze force at its bound"))
     est = {}
     for j, (name, scale, label, bound_note) in enumerate(names):
-        if at_bound[j]:
+        if not vary[j]:
+            est[name] = None
+        elif at_bound[j]:
             est[name] = Estimate(float(p[j] * scale), math.nan, label,
-                                 f"joint slip fit, at the bound of its range ({bound_note})",
+                                 f"{law}, at the bound of its range ({bound_note})",
                                  at_bound=True)
         else:
-            est[name] = Estimate(float(p[j] * scale), float(err[j] * scale), label,
-                                 "joint slip fit (Coulomb + viscous"
-                                 + (", freeze force)" if vary[2] else ")"))
+            est[name] = Estimate(float(p[j] * scale), float(err[j] * scale), label, law)
     fs_err = float(yield_forces.std(ddof=1) / math.sqrt(n)) if n > 1 else math.nan
     return SlipLawFit(
         kinetic_force=est["kinetic_force"], film_damping=est["film_damping"],
-        freeze_force=est["freeze_force"],
+        freeze_force=est["freeze_force"], freeze_note=freeze_note,
         static_force=Estimate(float(yield_forces.mean()), fs_err, u["force"],
                               f"spring force at the fitted yield points of {n} slips, "
                               "mean ± stderr"),

@@ -298,6 +298,8 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
     from filmfriction.reduced_model.klein import KLEIN
 
     sec = Section("Effective viscosity η_eff(γ̇)")
+    if cal is not None:
+        _eta_choice_blocks(sec, cal)
     if cal is None or not cal.get("rate_points"):
         main_failures = cal["runs"][0].get("failures", {}) if cal else {}
         sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
@@ -318,7 +320,7 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
         in_si = ("" if units == "si" else
                  f" (= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s)")
         rate_si = "" if units == "si" else f" (= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s)"
-        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} "
+        sec.p(f"One shear rate only: η_eff = {_pm_plain(eta, err, 3)} "
               f"{_unit(units, 'viscosity')}{in_si} at γ̇ = {_fmt(g, 3)} "
               f"{_unit(units, 'shear_rate')}{rate_si}. "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
@@ -339,10 +341,42 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
               f"slip ({_fmt(dep['sfb_shear_rate_si'], 3)} 1/s): " + "; ".join(parts)
               + f". Chosen by residual: **{dep['chosen']}**. Klein's viscous stress η_eff·γ̇ is "
               f"{_fmt(KLEIN.eta_eff * dep['sfb_shear_rate_si'] / 1e3, 3)} kPa at that rate.")
-    for r in cal["runs"]:
-        if r.get("eta_eff") is not None:
-            sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
+    if len(cal["runs"]) > 1:
+        for r in cal["runs"]:
+            if r.get("eta_eff") is not None:
+                sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
     return sec
+
+
+def _eta_choice_blocks(sec: Section, cal: dict) -> None:
+    """The main run's one η_eff (``eta_eff_choice`` of ``calibration.json``), the other
+    estimates as cross-checks, and the calibration's friction law beside the slip law's."""
+    choice = cal["runs"][0].get("eta_eff_choice")
+    if not choice:
+        return
+    names = {"calibration": "calibration (joint slip fit, B·D/A)",
+             "slips": "slips (Klein's Eq. 1 per slip)", "slip_law": "slip law (F_film = F_k + B·v)",
+             "steady": "steady sliding", "internal": "velocity profile"}
+    if choice["status"] == "resolved":
+        p = choice["primary"]
+        sec.p(f"**The run's η_eff: {_pm(p)}**, from the {names.get(choice['estimator'])}: "
+              f"{choice['reason']}.")
+    else:
+        sec.p(f"**The run's η_eff: not resolved**: {choice['reason']}. The estimates below rest "
+              "on other assumptions; none is the run's η_eff.")
+    checks = choice.get("cross_checks") or []
+    if checks:
+        sec.add(Table(("cross-check", "η_eff", "rests on", "against the primary"),
+                      tuple((names.get(c["estimator"], c["estimator"]), _pm(c["eta_eff"]),
+                             c["rests_on"], c["difference"]
+                             + (f"; **unphysical**: {c['unphysical']}" if c.get("unphysical")
+                                else "")) for c in checks)))
+    law = choice.get("friction_law") or {}
+    if law:
+        text = (f"Friction law: the calibration reads the slips as **{law['calibration']}** "
+                f"(from {law['calibration_rests_on']}), the slip law as **{law['slip_law']}** "
+                f"(from {law['slip_law_rests_on']})")
+        sec.p(text + (": they agree." if law.get("agree") else f"; {law.get('note', '')}."))
 
 
 def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Section:
@@ -358,9 +392,12 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
     source = _source(units)
     sec.p(f"Model: the {'MD' if units == 'lj' else 'driven'} wall's mass M, spring K, drive V and mount dashpot d in "
           "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
-          "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
-          "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
-          "jackknife over slips (see `analysis/calibration.py`).")
+          "film damping B while it slides, and a freeze force F_f where the film re-solidifies "
+          "while the wall still moves. F_k, B and F_f are fitted jointly to the spring force of "
+          "every analysed slip (each slip's yield and ramp level free), in the slips' own force "
+          "and time scales; standard errors come from the fit's Jacobian and residuals, and a "
+          "parameter at the bound of its range says so and has none (see "
+          "`analysis/slipfit.py`).")
     rows = []
     for name in ("static_force", "kinetic_force", "restick_force", "first_yield_force", "film_damping",
                  "eta_eff", "shear_rate", "ageing"):
@@ -401,9 +438,9 @@ def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Se
                 for q, e in errs.items()]
         sec.add(Table(("quantity", source, f"{source} stderr", "model", "error"), tuple(rows)))
         sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
-              "predicting anything; slip distance and period are predictions. The model sticks at the "
-              f"first zero of the wall velocity and has no ringing after s, which the {source} "
-              "wall shows.")
+              "predicting anything; slip distance and period are predictions. The model re-sticks "
+              f"where its wall velocity falls to a freeze velocity fitted to the {source}'s F_b (or "
+              f"at rest) and has no ringing after s, which the {source} wall shows.")
     md = cal.get("md_calibration")
     if md is not None:
         sec.p(f"Handed to the SFB check ({units.upper()}): yield stress "
