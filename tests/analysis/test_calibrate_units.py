@@ -39,8 +39,8 @@ def _scales(system):
 @pytest.fixture(scope="module")
 def si_trace():
     drop = FS - FK
-    duration = 7.5 * 2.0 * drop / (K * V)
-    t = np.arange(0.0, duration, 2e-4)
+    duration = 5.5 * 2.0 * drop / (K * V)       # 5 slips; 30 samples per slip
+    t = np.arange(0.0, duration, 4e-4)
     r = SpringBlock(mass=M, stiffness=K, drive_velocity=V,
                     law=laws.Coulomb(static=FS, kinetic=FK, viscous=B)).simulate(duration, t_eval=t)
     i = r.eval_index
