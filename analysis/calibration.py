@@ -230,7 +230,9 @@ def calibrate_run(run: RunData) -> RunCalibration:
     fit = kw.get("slip_fit")
     d = tr.parameters.mount_damping or 0.0
     choice = choose(doc, kinetic_force=kw.get("kinetic_force"),
-                    film_damping=kw.get("film_damping"), thickness=thickness,
+                    film_damping=kw.get("film_damping"),
+                    damping_scatter=fit.jackknife_stderr[1] if fit is not None else math.nan,
+                    thickness=thickness,
                     area=float(area) if area else math.nan, mount_damping=d, units=tr.units)
     kw["eta_eff_choice"] = choice
     if choice.primary is not None:

@@ -24,7 +24,7 @@ A run can give η_eff several ways, each resting on its own assumption:
 
 :func:`choose` names the primary one: for a ``smooth`` run the steady value; for
 stick-slip the calibration's, when its B is resolved (off its bound and more than
-2 standard errors from zero).  Otherwise the primary is "not resolved" and says
+2 standard errors from zero, by the fit's error and by the slips' scatter).  Otherwise the primary is "not resolved" and says
 why.  Every other available estimate is listed as a cross-check with the assumption
 it rests on and its difference from the primary in standard errors.  The
 calibration's friction law (F_k, B resolved or not) is set beside the slip law's
@@ -51,6 +51,9 @@ __all__ = ["CrossCheck", "ViscosityChoice", "choose", "choice_note", "RESOLVED_S
 
 #: A damping counts as resolved when it exceeds this many standard errors.
 RESOLVED_SIGMAS = 2.0
+
+_TERMS = {"mixed": "both a kinetic part and a film drag", "viscous": "a film drag only",
+          "kinetic": "a kinetic part only", "neither": "neither term"}
 
 #: What each estimator assumes (one line, for people).
 RESTS_ON = {
@@ -145,21 +148,21 @@ def _sigmas(a: Estimate, b: Estimate) -> float:
     return (a.value - b.value) / err if err > 0 else math.nan
 
 
-def _calibration_reading(kinetic: Estimate | None, damping: Estimate | None) -> str:
+def _reading(kinetic: Estimate | None, damping: Estimate | None,
+             damping_scatter: float = math.nan) -> str:
+    """Which terms of F_k + B·v a fit resolves (more than 2 standard errors, off a bound):
+    ``mixed``, ``viscous`` (B only), ``kinetic`` (F_k only) or ``neither``."""
     k_ok = kinetic is not None and not kinetic.at_bound and math.isfinite(kinetic.stderr) \
         and kinetic.value > RESOLVED_SIGMAS * kinetic.stderr
-    b_ok = _resolved(damping)
-    if k_ok and b_ok:
-        return "mixed"
-    if b_ok:
-        return "viscous"
-    if k_ok:
-        return "kinetic"
-    return "none"
+    b_ok = _resolved(damping) and not (math.isfinite(damping_scatter) and damping is not None
+                                       and damping.value <= RESOLVED_SIGMAS * damping_scatter)
+    return {(True, True): "mixed", (False, True): "viscous", (True, False): "kinetic",
+            (False, False): "neither"}[(k_ok, b_ok)]
 
 
 def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
-           film_damping: Estimate | None = None, thickness: float = math.nan,
+           film_damping: Estimate | None = None, damping_scatter: float = math.nan,
+           thickness: float = math.nan,
            area: float = math.nan, mount_damping: float = 0.0,
            units: str = "lj") -> ViscosityChoice:
     """Name the primary η_eff of a run and list the others as cross-checks.
@@ -170,6 +173,9 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
         The run's ``analysis.json``.
     kinetic_force, film_damping : Estimate, optional
         The calibration's joint slip fit (:class:`~filmfriction.analysis.slipfit.SlipLawFit`).
+    damping_scatter : float
+        B's standard error from the slips' scatter (the fit's jackknife); where
+        given, B must be resolved by it too.
     thickness, area : float
         D and A for η = B·D/A.
     mount_damping : float
@@ -223,11 +229,15 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
     cal = estimates.get("calibration")
     if regime == "smooth" and "steady" in estimates:
         primary, reason = "steady", "smooth sliding: the steady stress over V/D"
-    elif cal is not None and _resolved(film_damping):
+    elif cal is not None and _resolved(film_damping) and (
+            not (math.isfinite(damping_scatter) and damping_scatter > 0)
+            or film_damping.value > RESOLVED_SIGMAS * damping_scatter):
         primary = "calibration"
-        reason = (f"stick-slip with the calibration's film damping resolved (B = "
+        reason = (f"stick-slip with the calibration's film damping resolved: B = "
                   f"{film_damping.value:.4g} ± {film_damping.stderr:.2g} {film_damping.units}, "
-                  f"more than {RESOLVED_SIGMAS:g} standard errors from 0)")
+                  f"{film_damping.value / film_damping.stderr:.1f} standard errors from 0"
+                  + (f" ({film_damping.value / damping_scatter:.1f} over the slips' scatter)"
+                     if math.isfinite(damping_scatter) and damping_scatter > 0 else ""))
     else:
         primary = None
         if regime == "smooth":
@@ -238,11 +248,27 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
         elif film_damping.at_bound:
             reason = ("the calibration's film damping B is at its bound 0: the slips' shape "
                       "resolves no film drag beyond the mount's dashpot")
-        else:
+        elif not _resolved(film_damping):
             reason = (f"the calibration's film damping B = {film_damping.value:.4g} ± "
                       f"{film_damping.stderr:.2g} {film_damping.units} is within "
                       f"{RESOLVED_SIGMAS:g} standard errors of 0")
+        else:
+            reason = (f"the calibration's film damping B = {film_damping.value:.4g} ± "
+                      f"{film_damping.stderr:.2g} {film_damping.units} is "
+                      f"{film_damping.value / film_damping.stderr:.1f} standard errors from 0 "
+                      f"by the fit's error but {film_damping.value / damping_scatter:.1f} by "
+                      f"the slips' scatter (± {damping_scatter:.2g}, leave one slip out)")
     main = estimates.get(primary) if primary else None
+    # without a primary the others are set beside the calibration's (else the slips')
+    reference = next(((n, estimates[n]) for n in ("calibration", "slips") if n in estimates),
+                     None)
+    if main is None and len(estimates) > 1:
+        finite = [(n, e) for n, e in estimates.items() if math.isfinite(e.stderr)]
+        spread = max((abs(_sigmas(a, b)) for i, (_, a) in enumerate(finite)
+                      for _, b in finite[i + 1:]), default=math.nan)
+        if math.isfinite(spread):
+            reason += (f"; the {len(estimates)} estimates differ by at most {spread:.1f} "
+                       "standard errors of their difference")
     checks = []
     for name, est in estimates.items():
         if name == primary:
@@ -257,6 +283,10 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
                          f"{kinetic_force.value:.4g} {kinetic_force.units} as viscosity")
             elif math.isfinite(z) and abs(z) > RESOLVED_SIGMAS:
                 diff += "; the two assumptions do not both hold for these slips"
+        elif reference is not None and name != reference[0]:
+            z = _sigmas(est, reference[1])
+            diff = (f"no primary; {z:+.1f} standard errors from the {reference[0]} estimate"
+                    if math.isfinite(z) else "no primary to compare with")
         else:
             diff = "no primary to compare with"
         if name == "calibration" and est.at_bound:
@@ -266,7 +296,8 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
     friction = {}
     verdict = law.get("verdict")
     if film_damping is not None and verdict:
-        reading = _calibration_reading(kinetic_force, film_damping)
+        mine = _reading(kinetic_force, film_damping, damping_scatter)
+        theirs = _reading(_entry(law.get("kinetic_force"), ""), _entry(law.get("damping"), ""))
 
         def show(e):
             if e is None:
@@ -276,21 +307,26 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
             return f"{e.value:.4g} ± {e.stderr:.2g} {e.units}"
 
         friction = {
-            "calibration": reading,
+            "calibration": mine,
             "calibration_rests_on": (f"the shape of the spring force over the slips (F_k = "
                                      f"{show(kinetic_force)}, B = {show(film_damping)})"),
-            "slip_law": verdict,
+            "slip_law": theirs, "slip_law_verdict": verdict,
             "slip_law_rests_on": ("the film force against the wall's velocity during the slips"
                                   + (f" ({law['reason']})" if law.get("reason") else "")),
-            "agree": reading == verdict,
+            "agree": mine == theirs,
         }
-        if reading != verdict:
+        if mine != theirs:
             friction["note"] = (
-                f"the calibration reads the slips as {reading}, the slip law as {verdict}: "
-                "the calibration sees only the spring force, whose shape a kinetic part and a "
-                "viscous drag can trade off against each other; the slip law sees the film "
-                "force directly but through the wall's differentiated velocity; neither "
-                "reading is established until they agree")
+                f"the calibration resolves {_TERMS[mine]}, the slip law {_TERMS[theirs]}: the "
+                "calibration sees only the spring force, whose shape a kinetic part and a "
+                "viscous drag can trade against each other; the slip law sees the film force "
+                "directly but through the wall's differentiated velocity; neither reading is "
+                "established until they agree")
+        elif mine == "neither":
+            friction["note"] = ("neither resolves a kinetic part or a film drag beyond the "
+                                "mount's" + (f" (the slip law's verdict '{verdict}' is its rule "
+                                             "for a drag it does not resolve)"
+                                             if verdict != "none" else ""))
     status = "resolved" if main is not None else "not resolved"
     return ViscosityChoice(status, primary if main is not None else None, main, reason,
                            tuple(checks), friction)

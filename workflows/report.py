@@ -298,13 +298,13 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
     from filmfriction.reduced_model.klein import KLEIN
 
     sec = Section("Effective viscosity η_eff(γ̇)")
-    if cal is not None:
-        _eta_choice_blocks(sec, cal)
+    said = cal is not None and _eta_choice_blocks(sec, cal)
     if cal is None or not cal.get("rate_points"):
         main_failures = cal["runs"][0].get("failures", {}) if cal else {}
-        sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
-                              "“Calibrated reduced model”)" if cal is None else
-                              main_failures.get("eta_eff") or "no run with η_eff") + ".")
+        if not said:
+            sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
+                                  "“Calibrated reduced model”)" if cal is None else
+                                  main_failures.get("eta_eff") or "no run with η_eff") + ".")
         return sec
     units = cal.get("units", "lj")
     png = _attempt(failures, "figure: viscosity", fig_viscosity, cal)
@@ -348,12 +348,13 @@ def _viscosity_section(cal, why_none: str, failures) -> Section:
     return sec
 
 
-def _eta_choice_blocks(sec: Section, cal: dict) -> None:
+def _eta_choice_blocks(sec: Section, cal: dict) -> bool:
     """The main run's one η_eff (``eta_eff_choice`` of ``calibration.json``), the other
-    estimates as cross-checks, and the calibration's friction law beside the slip law's."""
+    estimates as cross-checks, and the calibration's friction law beside the slip law's;
+    False where the calibration has no choice to show."""
     choice = cal["runs"][0].get("eta_eff_choice")
     if not choice:
-        return
+        return False
     names = {"calibration": "calibration (joint slip fit, B·D/A)",
              "slips": "slips (Klein's Eq. 1 per slip)", "slip_law": "slip law (F_film = F_k + B·v)",
              "steady": "steady sliding", "internal": "velocity profile"}
@@ -373,10 +374,16 @@ def _eta_choice_blocks(sec: Section, cal: dict) -> None:
                                 else "")) for c in checks)))
     law = choice.get("friction_law") or {}
     if law:
-        text = (f"Friction law: the calibration reads the slips as **{law['calibration']}** "
-                f"(from {law['calibration_rests_on']}), the slip law as **{law['slip_law']}** "
-                f"(from {law['slip_law_rests_on']})")
-        sec.p(text + (": they agree." if law.get("agree") else f"; {law.get('note', '')}."))
+        terms = {"mixed": "a kinetic part and a film drag", "viscous": "a film drag only",
+                 "kinetic": "a kinetic part only", "neither": "neither term"}
+        text = (f"Friction law, F_k + B·v: the calibration resolves "
+                f"**{terms.get(law['calibration'], law['calibration'])}** (from "
+                f"{law['calibration_rests_on']}), the slip law "
+                f"**{terms.get(law['slip_law'], law['slip_law'])}** (from "
+                f"{law['slip_law_rests_on']})")
+        agree = "they agree" + (f": {law['note']}" if law.get("note") else "")
+        sec.p(text + (f"; {agree}." if law.get("agree") else f"; {law.get('note', '')}."))
+    return True
 
 
 def _calibration_section(cal, why_none: str, remarks: list, run, failures) -> Section:
