@@ -130,15 +130,32 @@ def format_estimate(e, digits: int = 3) -> str:
     '2.5 ± 0.12 ε/σ'
     >>> format_estimate({"mean": 0.5, "stderr": None, "units": "1"})
     '0.5'
+    >>> format_estimate({"value": 0.0, "stderr": None, "units": "N", "at_bound": True})
+    '0 N (at bound)'
     """
     if e is None:
         return "–"
     if isinstance(e, dict):
         v, s, u = e.get("mean", e.get("value")), e.get("stderr"), e.get("units", "")
+        bound = bool(e.get("at_bound"))
     else:
         v, s, u = e.value, e.stderr, e.units
+        bound = bool(getattr(e, "at_bound", False))
     err = f" ± {format_value(s, 2)}" if s is not None and math.isfinite(float(s)) else ""
-    return f"{format_value(v, digits)}{err} {'' if u == '1' else u}".strip()
+    text = f"{format_value(v, digits)}{err} {'' if u == '1' else u}".strip()
+    return text + " (at bound)" if bound else text
+
+
+def format_pm(value, stderr, digits: int = 4) -> str:
+    """'value ± stderr', or 'value (no standard error)' where the error is 0, NaN or None
+    (not known, or the value is a fit's bound): never "± 0".
+
+    >>> format_pm(2.5, 0.1234), format_pm(0.0, 0.0)
+    ('2.5 ± 0.12', '0 (no standard error)')
+    """
+    if stderr is None or not math.isfinite(float(stderr)) or float(stderr) <= 0.0:
+        return f"{format_value(value, digits)} (no standard error)"
+    return f"{format_value(value, digits)} ± {format_value(stderr, 2)}"
 
 
 def pyplot():

@@ -42,16 +42,26 @@ Fits (all in the run's LJ units)
     analysis's mean F_s when no slip could be fitted.  The start-up yield is
     reported apart (``first_yield_force``).
 ``kinetic_force`` and ``film_damping``
-    One joint least-squares fit of the slip equation above (closed form,
-    d fixed to the mount's value, each slip started at rest from its own
-    stick ramp, its yield instant free within a few samples of the detected
-    y) to the spring force over every slip window (y to s plus as long again
-    after s, so the re-stick level is constrained).  Uncertainty:
-    jackknife over slips (leave one slip out, refit), which carries the
-    slip-to-slip scatter; with fewer than 3 slips, the fit's covariance.
+    One joint least-squares fit of the slip equation above
+    (:func:`~filmfriction.analysis.slipfit.fit_slips`: closed form, d fixed to the
+    mount's value, each slip started at rest from its own stick ramp, its yield
+    instant and ramp level free, the film's freeze force F_f free where it
+    improves the fit by 5 σ) to the spring force over every slip window (the
+    ramp before y, the slip, and as long again after s, so the re-stick is
+    constrained).  The fit runs in the slips' own force and time scales, so the
+    result does not depend on the units of the trace.  Uncertainty: from the
+    Jacobian at the solution and the residual variance (with the residuals'
+    serial correlation); a parameter at the bound of its range (F_k = 0, B = 0)
+    says so and has none.  The jackknife over slips (leave one slip out, refit)
+    is written beside it as a cross-check.
 ``eta_eff``
-    B·D/A with D the mean gap, at the slips' shear rate γ̇ = (Δx0/τ_s)/D.
-    With a smooth-sliding run the steady η_eff = (F̄/A)/(V/D) is used instead.
+    The run's one η_eff, named by
+    :func:`~filmfriction.analysis.effective_viscosity.choose` (``eta_eff_choice``
+    in ``calibration.json``): B·D/A with D the mean gap, at the slips' shear rate
+    γ̇ = (Δx0/τ_s)/D, where the fit resolves B; the steady η_eff = ((F̄ − d V)/A)/(V/D)
+    of a smooth-sliding run; else none ("not resolved", with the reason).  The
+    other estimates (Klein's Eq. 1 per slip, the slip law's B, the profile's) are
+    listed as cross-checks with the assumption each rests on.
 ``rate_law``
     With ≥ 3 runs at different shear rates, η_eff = c·γ̇^α fitted with
     :func:`filmfriction.analysis.viscosity.power_law_fit` (α ± its standard error).
@@ -93,7 +103,7 @@ Example
 >>> cal = calibrate(run_directory(pathlib.Path(tempfile.mkdtemp()) / "run", trajectory=False))
 >>> rc = cal.main
 >>> rc.regime == "stick-slip", round(rc.static_force.value, 2), round(rc.film_damping.value, 1)
-(True, 2.91, 100.2)
+(True, 3.0, 39.6)
 """
 from __future__ import annotations
 
@@ -104,6 +114,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .effective_viscosity import ViscosityChoice, choose
 from .estimators import Estimate, ageing, shear_stiffness, summary_estimate
 from ..util import finite_or_none as _num
 from .md_estimates import md_calibration
@@ -133,7 +144,11 @@ class RunCalibration:
     static_force, restick_force, first_yield_force : Estimate or None
     kinetic_force, film_damping : Estimate or None
     eta_eff, shear_rate : Estimate or None
-        The film's η_eff and the shear rate it belongs to.
+        The film's η_eff (the primary of ``eta_eff_choice``; None where it is not
+        resolved) and the shear rate it belongs to.
+    eta_eff_choice : ViscosityChoice or None
+        Which estimate of η_eff is the primary and why, and the others as cross-checks
+        (:func:`filmfriction.analysis.effective_viscosity.choose`).
     ageing : Estimate or None
         dF_s / d ln(t_stick).
     slip_fit : SlipLawFit or None
@@ -154,6 +169,7 @@ class RunCalibration:
     film_damping: Estimate | None = None
     eta_eff: Estimate | None = None
     shear_rate: Estimate | None = None
+    eta_eff_choice: ViscosityChoice | None = None
     ageing: Estimate | None = None
     shear_stiffness: Estimate | None = None
     slip_fit: SlipLawFit | None = None
@@ -169,9 +185,9 @@ class RunCalibration:
             e = getattr(self, name)
             out[name] = None if e is None else e.as_dict()
         if self.slip_fit is not None:
-            out["slip_fit"] = {"rms_residual": _num(self.slip_fit.rms_residual),
-                               "n_slips": self.slip_fit.n_slips,
-                               "mount_damping": _num(self.slip_fit.mount_damping)}
+            out["slip_fit"] = self.slip_fit.as_dict()
+        out["eta_eff_choice"] = (None if self.eta_eff_choice is None
+                                 else self.eta_eff_choice.as_dict())
         out["replay"] = None if self.replay is None else self.replay.as_dict()
         out["failures"] = dict(self.failures)
         return out
@@ -203,47 +219,36 @@ def calibrate_run(run: RunData) -> RunCalibration:
         failures["slip_fit"] = f"no slips to fit (regime {regime})"
     else:
         try:
-            fit = fit_slip_law(run)
+            k_f = kw["shear_stiffness"].value if kw.get("shear_stiffness") else math.inf
+            k = tr.parameters.spring_constant
+            fit = fit_slip_law(run, stick_stiffness=k * k_f / (k + k_f) if k else None)
             kw.update(slip_fit=fit, kinetic_force=fit.kinetic_force, film_damping=fit.film_damping,
                       static_force=fit.static_force)
         except (ValueError, LookupError, RuntimeError) as exc:
             failures["slip_fit"] = str(exc)
-    # eta_eff: from the slip fit, else steady sliding
+    # eta_eff: the one the run's estimators agree to name (effective_viscosity.choose)
     fit = kw.get("slip_fit")
-    if fit is not None and area and math.isfinite(thickness):
-        b = fit.film_damping
-        eta = b.value * thickness / area
+    d = tr.parameters.mount_damping or 0.0
+    choice = choose(doc, kinetic_force=kw.get("kinetic_force"),
+                    film_damping=kw.get("film_damping"),
+                    damping_scatter=fit.jackknife_stderr[1] if fit is not None else math.nan,
+                    thickness=thickness,
+                    area=float(area) if area else math.nan, mount_damping=d, units=tr.units)
+    kw["eta_eff_choice"] = choice
+    if choice.primary is not None:
+        kw["eta_eff"] = choice.primary
+    else:
+        failures["eta_eff"] = f"not resolved: {choice.reason}"
+    steady = (doc.get("viscosity") or {}).get("steady")
+    if choice.estimator in ("steady", "internal") and steady:
+        kw["shear_rate"] = Estimate(steady["shear_rate"]["mean"], math.nan, u["shear_rate"],
+                                    "V / D")
+    elif fit is not None and math.isfinite(thickness):
         slips = doc.get("slips", {})
         dx = (slips.get("slip_distance") or {}).get("mean")
         ts = (slips.get("slip_duration") or {}).get("mean")
-        rate = dx / ts / thickness if dx and ts else math.nan
-        kw["eta_eff"] = Estimate(eta, b.stderr * thickness / area, u["viscosity"],
-                                 "B D / A from the slip fit (D = mean gap)")
-        klein = (doc.get("viscosity", {}).get("from_slip") or {}).get("eta_eff") or {}
-        if fit.damping_at_bound and klein.get("mean"):
-            # F_k carries all of the sliding friction and B is unresolved: the film's
-            # viscosity is then Klein's own reading of the slips (all friction viscous)
-            kw["eta_eff"] = Estimate(float(klein["mean"]), float(klein.get("stderr") or math.nan),
-                                     u["viscosity"],
-                                     "Klein's purely viscous fit of the slips (analysis, mount "
-                                     "removed): the calibration's B is at its lower bound")
-        kw["shear_rate"] = Estimate(rate, math.nan, u["shear_rate"],
-                                    "mean slip velocity (dx0 / tau_s) over the gap")
-    else:
-        steady = doc.get("viscosity", {}).get("steady")
-        if steady:
-            e = steady["eta_eff"]
-            # the spring also pulls the mount dashpot (d V): not the film's
-            d = tr.parameters.mount_damping or 0.0
-            gap = steady.get("thickness", {}).get("mean") or thickness
-            kw["eta_eff"] = Estimate(e["mean"] - d * gap / area, e.get("stderr") or math.nan,
-                                     u["viscosity"],
-                                     f"steady sliding: ((F - d V)/A)/(V/D), block-averaged (mount d = {d:g} "
-                                     "subtracted)")
-            kw["shear_rate"] = Estimate(steady["shear_rate"]["mean"], math.nan, u["shear_rate"],
-                                        "V / D")
-        else:
-            failures["eta_eff"] = "neither a slip fit nor steady sliding in this run"
+        kw["shear_rate"] = Estimate(dx / ts / thickness if dx and ts else math.nan, math.nan,
+                                    u["shear_rate"], "mean slip velocity (dx0 / tau_s) over the gap")
     if fit is not None:
         try:
             restick = kw["restick_force"].value if kw.get("restick_force") else None

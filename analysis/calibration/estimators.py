@@ -39,16 +39,20 @@ class Estimate:
         Unit label (LJ: ε/σ, ετ/σ³, …).
     method : str
         How it was obtained (one line, for people).
+    at_bound : bool
+        The fit ended at the bound of the parameter's range: ``value`` is that bound
+        and there is no standard error (``stderr`` NaN, written null).
     """
 
     value: float
     stderr: float
     units: str
     method: str = ""
+    at_bound: bool = False
 
     def as_dict(self) -> dict:
         return {"value": _num(self.value), "stderr": _num(self.stderr), "units": self.units,
-                "method": self.method}
+                "method": self.method, "at_bound": self.at_bound}
 
     @property
     def rel(self) -> float:

@@ -63,9 +63,11 @@ def md_calibration(runs: list, law, points, notes: list) -> MDCalibration:
     ValueError
         No run with a calibrated slip law, or a non-positive η_eff.
     """
-    ss = [r for r in runs if r.static_force is not None and r.kinetic_force is not None
-          and r.eta_eff is not None]
+    fitted = [r for r in runs if r.static_force is not None and r.kinetic_force is not None]
+    ss = [r for r in fitted if r.eta_eff is not None]
     if not ss:
+        if fitted:
+            raise ValueError("no run with a resolved η_eff to carry to the SFB (see eta_eff)")
         raise ValueError("no run with a calibrated slip law (stick-slip with fitted slips) "
                          "to give the yield stress")
     ys, ys_err = _combine([_stress(r.static_force, r.area) for r in ss])

@@ -161,6 +161,8 @@ class Viscosity(Observable):
                                           area=area, thickness=d, drive_velocity=v_drive,
                                           mount_damping=p.mount_damping or 0.0)
             b_ok = sl.damping[np.isfinite(sl.damping)]
+            # a film damping below the mount's dashpot is unphysical: said, slip by slip
+            negative = [ctx.skip + i + 1 for i, e in enumerate(sl.eta_eff_per_slip) if e < 0]
             visc["from_slip"] = {
                 "eta_eff": ctx.value(sl.eta_eff, sl.eta_eff_stderr, "viscosity",
                                      fit_stderr=finite_or_none(sl.eta_eff_fit_stderr), n=sl.n),
@@ -169,6 +171,12 @@ class Viscosity(Observable):
                                      else math.nan, "damping"),
                 "thickness": ctx.value(d, None, "length", source=d_src),
                 "velocity_source": v_src, "failures": list(sl.failures)}
+            if negative:
+                visc["from_slip"]["unphysical"] = {
+                    "slips": negative,
+                    "note": f"{len(negative)} of {sl.n} slips give η_eff < 0 (their fitted B "
+                            "is below the mount's dashpot): the film's drag is not resolved "
+                            "slip by slip; they are kept in the mean, which stays unbiased"}
             per_slip = {"damping": sl.damping.tolist(), "eta_eff": sl.eta_eff_per_slip.tolist()}
         except MissingInput as exc:
             ctx.skip_part("viscosity.from_slip", exc)
@@ -208,8 +216,18 @@ class Viscosity(Observable):
         return rows
 
     def notes(self, section: dict) -> list[str]:
-        failures = (section.get("from_slip") or {}).get("failures") or []
-        return [f"Slip fits that failed: {'; '.join(map(str, failures))}."] if failures else []
+        slip = section.get("from_slip") or {}
+        failures = slip.get("failures") or []
+        out = [f"Slip fits that failed: {'; '.join(map(str, failures))}."] if failures else []
+        bad = slip.get("unphysical")
+        if bad:
+            out.append(f"Unphysical: slip{'s' if len(bad['slips']) > 1 else ''} "
+                       f"{', '.join(map(str, bad['slips']))}: {bad['note']}.")
+        if slip or section.get("steady"):
+            out.append("These are the analysis' own estimates; the run's one η_eff, and which "
+                       "of these it is, is named in the section on the effective viscosity "
+                       "(from `filmfriction calibrate`).")
+        return out
 
     def figures(self, run) -> list[tuple[str, bytes, str]]:
         out = []
@@ -218,7 +236,8 @@ class Viscosity(Observable):
         if section.get("from_slip") and np.isfinite(eta).any():
             out.append(("eta-per-slip", fig_eta_per_slip(run, eta, section["from_slip"]),
                         "η_eff of each analysed slip from Klein's Eq. (1) fitted to it, with "
-                        "their mean and its standard error (band)."))
+                        "their mean and its standard error (band); a negative one (red "
+                        "cross) is unphysical."))
         prof_v = run.run_dir / VELOCITY_PROFILE
         if prof_v.exists():
             prof_d = run.run_dir / DENSITY_PROFILE
@@ -238,8 +257,13 @@ def fig_eta_per_slip(run, eta: np.ndarray, from_slip: dict) -> bytes:
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 3.4))
     slip = np.arange(run.skip + 1, run.skip + eta.size + 1)
-    ok = np.isfinite(eta)
+    ok = np.isfinite(eta) & (eta >= 0)
     ax.plot(slip[ok], eta[ok], "o", color="tab:blue", ms=6, label="one slip")
+    bad = np.isfinite(eta) & (eta < 0)
+    if bad.any():
+        ax.plot(slip[bad], eta[bad], "x", color="tab:red", ms=8, mew=2,
+                label="unphysical (η_eff < 0)")
+        ax.axhline(0.0, color="0.5", lw=0.8)
     mean = from_slip["eta_eff"].get("mean")
     err = from_slip["eta_eff"].get("stderr")
     units = from_slip["eta_eff"]["units"]

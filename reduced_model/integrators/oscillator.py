@@ -79,6 +79,21 @@ class DampedOscillator:
         ec, es = self.basis(t)
         return f0 * ec + (f0dot + self.gamma * f0) * es
 
+    def scalar_value(self, t: float, f0: float, f0dot: float) -> float:
+        """:meth:`value` at one time, on Python floats (the root finders' inner loop)."""
+        if self.regime == "under":
+            decay = math.exp(-self.gamma * t)
+            ec, es = decay * math.cos(self.w * t), decay * math.sin(self.w * t) / self.w
+        elif self.regime == "critical":
+            ec = math.exp(-self.gamma * t)
+            es = ec * t
+        else:
+            slow, fast = math.exp(self.r_slow * t), math.exp(self.r_fast * t)
+            two_k_t = 2.0 * self.k * t
+            es = (fast * math.expm1(two_k_t) if two_k_t < 1.0 else slow - fast) / (2.0 * self.k)
+            ec = 0.5 * (slow + fast)
+        return f0 * ec + (f0dot + self.gamma * f0) * es
+
     def second_derivative_at_zero(self, f0, f0dot):
         """``f''(0)`` from the equation of motion."""
         return -2.0 * self.gamma * f0dot - self.w0sq * f0
@@ -133,7 +148,7 @@ class DampedOscillator:
         j0 = -2.0 * self.gamma * a0 - self.w0sq * edot0          # e'''(0)
 
         def g(t):
-            return float(self.value(t, edot0, a0)) - level
+            return self.scalar_value(t, edot0, a0) - level
 
         left, g_left = 0.0, edot0 - level
         first_piece = True

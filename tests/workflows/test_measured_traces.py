@@ -95,6 +95,63 @@ def test_calibrate_works_in_si(chain):
     assert not any(c in text for c in LJ_LABELS) and "MD" not in text, text
 
 
+#: the generator of the example (docs/examples/make_measured_trace.py: synthetic.klein_trace's
+#: defaults): Klein's slip, all friction viscous, the film freezing at F_b
+GENERATOR = {"kinetic_force": 0.0, "film_damping": 3.09, "freeze_force": 3.0e-6}
+
+
+def test_calibrate_recovers_the_generators_film(chain):
+    """F_k = 0 is the bound of its range: the fit ends there and says so; B and the freeze
+    force come back within their standard errors (2 of them), none printed as "± 0"."""
+    d, printed = chain
+    run = json.loads((d / "calibration.json").read_text())["runs"][0]
+    fk, b = run["kinetic_force"], run["film_damping"]
+    assert fk["at_bound"] and fk["value"] == 0.0 and fk["stderr"] is None, fk
+    assert abs(b["value"] - GENERATOR["film_damping"]) < 2 * b["stderr"], b
+    ff = run["slip_fit"]["freeze_force"]
+    assert abs(ff["value"] - GENERATOR["freeze_force"]) < 2 * ff["stderr"], ff
+    assert "kinetic_force      0 N (at bound)" in printed["calibrate"]
+    assert "± 0 " not in printed["calibrate"] and "± 0\n" not in printed["calibrate"]
+    # one effective viscosity: the calibration's B·D/A, Klein's per-slip fit a cross-check
+    choice = run["eta_eff_choice"]
+    assert choice["status"] == "resolved" and choice["estimator"] == "calibration", choice
+    assert run["eta_eff"] == choice["primary"]
+    assert [c["estimator"] for c in choice["cross_checks"]] == ["slips"]
+
+
+def test_calibrate_gives_the_same_film_in_micronewtons_nanometres_and_milliseconds(
+        tmp_path, chain):
+    """The example written in µN, nm and ms (a consistent set, read as such with
+    --units si and the set-up in those units): the same physical parameters."""
+    import numpy as np
+
+    d, _ = chain
+    rows = np.loadtxt(EXAMPLES / "sfb_trace.tsv", skiprows=2)
+    lines = ["t_ms\tF_uN\tx_nm"] + [f"{t * 1e3!r}\t{f * 1e6!r}\t{x * 1e9!r}"
+                                      for t, f, x in rows.tolist()]
+    (tmp_path / "trace.tsv").write_text("\n".join(lines) + "\n")
+    si = json.loads((d / "analysis.json").read_text())["source"]["parameters"]
+    # µN/nm = 1e3 N/m; µN ms²/nm = 1e-3 kg; µN ms/nm = 1 kg/s
+    scaled = {"--spring-constant": si["spring_constant"] / 1e3, "--mass": si["mass"] / 1e-3,
+              "--area": si["area"] / 1e-18, "--thickness": si["thickness"] / 1e-9,
+              "--drive-velocity": si["drive_velocity"] / 1e-6}
+    argv = ["analyze", str(tmp_path / "trace.tsv"), "--units", "si", "--column", "time=t_ms",
+            "--column", "spring_force=F_uN", "--column", "drive_position=x_nm"]
+    for flag, value in scaled.items():
+        argv += [flag, repr(value)]
+    assert main(argv) == 0
+    assert main(["calibrate", str(tmp_path)]) == 0
+    mine = json.loads((tmp_path / "calibration.json").read_text())["runs"][0]
+    ref = json.loads((d / "calibration.json").read_text())["runs"][0]
+    for name, scale in (("static_force", 1e-6), ("film_damping", 1.0), ("eta_eff", 1e9),
+                        ("restick_force", 1e-6)):
+        for key in ("value", "stderr"):
+            assert mine[name][key] * scale == pytest.approx(ref[name][key], rel=1e-6), (name, key)
+    assert mine["kinetic_force"]["at_bound"] and mine["kinetic_force"]["value"] == 0.0
+    assert mine["slip_fit"]["freeze_force"]["value"] * 1e-6 == pytest.approx(
+        ref["slip_fit"]["freeze_force"]["value"], rel=1e-6)
+
+
 def test_sfb_runs_on_the_users_setup_and_slip(chain):
     d, printed = chain
     doc = json.loads((d / "sfb.json").read_text())

@@ -37,13 +37,14 @@ def _fmt(e) -> str:
     if e is None:
         return "-"
     err = "" if e.stderr is None or not math.isfinite(e.stderr) else f" ± {e.stderr:.2g}"
-    return f"{e.value:.4g}{err} {e.units}"
+    return f"{e.value:.4g}{err} {e.units}" + (" (at bound)" if e.at_bound else "")
 
 
 def format_calibration(cal) -> str:
     """Human-readable summary of a :class:`filmfriction.analysis.calibration.calibrate.Calibration`:
     an MD run's (LJ units) or a measured trace's (SI units, "trace" for "MD")."""
     from filmfriction.analysis.trace import unit
+    from filmfriction.analysis.util import format_pm
 
     source = "MD" if cal.units == "lj" else "trace"
     out = []
@@ -69,9 +70,10 @@ def format_calibration(cal) -> str:
     if md is not None:
         stress, visc = unit(cal.units, "stress"), unit(cal.units, "viscosity")
         out.append(f"{source} film calibration ({cal.units.upper()} units): yield stress "
-                   f"{md.yield_stress:.4g} ± {md.yield_stress_err:.2g} {stress}, sliding stress "
-                   f"{md.sliding_stress:.4g} ± {md.sliding_stress_err:.2g} {stress}, eta0 "
-                   f"{md.eta_zero:.4g} ± {md.eta_zero_err:.2g} {visc}, n = {md.thinning_exponent:.3g}")
+                   f"{format_pm(md.yield_stress, md.yield_stress_err)} {stress}, sliding stress "
+                   f"{format_pm(md.sliding_stress, md.sliding_stress_err)} {stress}, eta0 "
+                   f"{format_pm(md.eta_zero, md.eta_zero_err)} {visc}, "
+                   f"n = {md.thinning_exponent:.3g}")
     for k, v in cal.failures.items():
         out.append(f"not computed: {k}: {v}")
     out += [f"note: {n}" for n in cal.notes]

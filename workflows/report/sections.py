@@ -9,7 +9,9 @@ from pathlib import Path
 
 from filmfriction.analysis.observables import Observable
 from filmfriction.analysis.trace import unit as _unit
-from filmfriction.analysis.util import format_estimate as _pm, format_value as _fmt
+from filmfriction.analysis.util import format_estimate as _pm, format_pm as _pm_plain
+from filmfriction.analysis.util import format_value as _fmt
+from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 
@@ -85,11 +87,13 @@ def viscosity_section(cal, why_none: str, failures) -> Section:
     from filmfriction.reduced_model.sfb.klein import KLEIN
 
     sec = Section("Effective viscosity η_eff(γ̇)")
+    said = cal is not None and _eta_choice_blocks(sec, cal)
     if cal is None or not cal.get("rate_points"):
         main_failures = cal["runs"][0].get("failures", {}) if cal else {}
-        sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
-                              "“Calibrated reduced model”)" if cal is None else
-                              main_failures.get("eta_eff") or "no run with η_eff") + ".")
+        if not said:
+            sec.p("No η_eff: " + ("it comes from the calibration, which is not available (see "
+                                  "“Calibrated reduced model”)" if cal is None else
+                                  main_failures.get("eta_eff") or "no run with η_eff") + ".")
         return sec
     units = cal.get("units", "lj")
     png = attempt(failures, "figure: viscosity", fig_viscosity, cal)
@@ -105,7 +109,7 @@ def viscosity_section(cal, why_none: str, failures) -> Section:
         in_si = ("" if units == "si" else
                  f" (= {OMCTS.to_si(eta, 'viscosity'):.3g} Pa·s)")
         rate_si = "" if units == "si" else f" (= {OMCTS.to_si(g, 'shear_rate'):.3g} 1/s)"
-        sec.p(f"One shear rate only: η_eff = {_fmt(eta, 3)} ± {_fmt(err, 2)} "
+        sec.p(f"One shear rate only: η_eff = {_pm_plain(eta, err, 3)} "
               f"{_unit(units, 'viscosity')}{in_si} at γ̇ = {_fmt(g, 3)} "
               f"{_unit(units, 'shear_rate')}{rate_si}. "
               "A sweep of drive velocities (several runs) is needed for the shear-rate law.")
@@ -126,10 +130,49 @@ def viscosity_section(cal, why_none: str, failures) -> Section:
               f"slip ({_fmt(dep['sfb_shear_rate_si'], 3)} 1/s): " + "; ".join(parts)
               + f". Chosen by residual: **{dep['chosen']}**. Klein's viscous stress η_eff·γ̇ is "
               f"{_fmt(KLEIN.eta_eff * dep['sfb_shear_rate_si'] / 1e3, 3)} kPa at that rate.")
-    for r in cal["runs"]:
-        if r.get("eta_eff") is not None:
-            sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
+    if len(cal["runs"]) > 1:
+        for r in cal["runs"]:
+            if r.get("eta_eff") is not None:
+                sec.p(f"`{Path(r['run_dir']).resolve().name}`: {r['eta_eff']['method']}.")
     return sec
+
+
+def _eta_choice_blocks(sec: Section, cal: dict) -> bool:
+    """The main run's one η_eff (``eta_eff_choice`` of ``calibration.json``), the other
+    estimates as cross-checks, and the calibration's friction law beside the slip law's;
+    False where the calibration has no choice to show."""
+    choice = cal["runs"][0].get("eta_eff_choice")
+    if not choice:
+        return False
+    names = {"calibration": "calibration (joint slip fit, B·D/A)",
+             "slips": "slips (Klein's Eq. 1 per slip)", "slip_law": "slip law (F_film = F_k + B·v)",
+             "steady": "steady sliding", "internal": "velocity profile"}
+    if choice["status"] == "resolved":
+        p = choice["primary"]
+        sec.p(f"**The run's η_eff: {_pm(p)}**, from the {names.get(choice['estimator'])}: "
+              f"{choice['reason']}.")
+    else:
+        sec.p(f"**The run's η_eff: not resolved**: {choice['reason']}. The estimates below rest "
+              "on other assumptions; none is the run's η_eff.")
+    checks = choice.get("cross_checks") or []
+    if checks:
+        sec.add(Table(("cross-check", "η_eff", "rests on", "against the primary"),
+                      tuple((names.get(c["estimator"], c["estimator"]), _pm(c["eta_eff"]),
+                             c["rests_on"], c["difference"]
+                             + (f"; **unphysical**: {c['unphysical']}" if c.get("unphysical")
+                                else "")) for c in checks)))
+    law = choice.get("friction_law") or {}
+    if law:
+        terms = {"mixed": "a kinetic part and a film drag", "viscous": "a film drag only",
+                 "kinetic": "a kinetic part only", "neither": "neither term"}
+        text = (f"Friction law, F_k + B·v: the calibration resolves "
+                f"**{terms.get(law['calibration'], law['calibration'])}** (from "
+                f"{law['calibration_rests_on']}), the slip law "
+                f"**{terms.get(law['slip_law'], law['slip_law'])}** (from "
+                f"{law['slip_law_rests_on']})")
+        agree = "they agree" + (f": {law['note']}" if law.get("note") else "")
+        sec.p(text + (f"; {agree}." if law.get("agree") else f"; {law.get('note', '')}."))
+    return True
 
 
 def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Section:
@@ -145,9 +188,12 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
     source = trace_source(units)
     sec.p(f"Model: the {'MD' if units == 'lj' else 'driven'} wall's mass M, spring K, drive V and mount dashpot d in "
           "`filmfriction.reduced_model.SpringBlock`, with a Coulomb film (static F_s, kinetic F_k) plus a viscous "
-          "film damping B while it slides. F_k and B are fitted jointly to the spring force of every "
-          "analysed slip (each slip's yield instant free within a few samples); uncertainties are "
-          "jackknife over slips (see `analysis/calibration/calibrate.py`).")
+          "film damping B while it slides, and a freeze force F_f where the film re-solidifies "
+          "while the wall still moves. F_k, B and F_f are fitted jointly to the spring force of "
+          "every analysed slip (each slip's yield and ramp level free), in the slips' own force "
+          "and time scales; standard errors come from the fit's Jacobian and residuals, and a "
+          "parameter at the bound of its range says so and has none (see "
+          "`analysis/calibration/slipfit.py`).")
     rows = []
     for name in ("static_force", "kinetic_force", "restick_force", "first_yield_force", "film_damping",
                  "eta_eff", "shear_rate", "ageing"):
@@ -188,15 +234,16 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
                 for q, e in errs.items()]
         sec.add(Table(("quantity", source, f"{source} stderr", "model", "error"), tuple(rows)))
         sec.p("The peak force is an input of the model (F_s), so its error checks the replay rather than "
-              "predicting anything; slip distance and period are predictions. The model sticks at the "
-              f"first zero of the wall velocity and has no ringing after s, which the {source} "
-              "wall shows.")
+              "predicting anything; slip distance and period are predictions. The model re-sticks "
+              f"where its wall velocity falls to a freeze velocity fitted to the {source}'s F_b (or "
+              f"at rest) and has no ringing after s, which the {source} wall shows.")
     md = cal.get("md_calibration")
     if md is not None:
-        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress {md['yield_stress']:.4g} ± {md['yield_stress_err']:.2g}, "
-              f"sliding stress {md['sliding_stress']:.4g} ± {md['sliding_stress_err']:.2g}, re-stick stress "
-              f"{_fmt(md['restick_stress'])}, η0 {md['eta_zero']:.4g} ± {md['eta_zero_err']:.2g}, thinning "
-              f"exponent {md['thinning_exponent']:.3g} ± {md['thinning_exponent_err']:.2g}.")
+        sec.p(f"Handed to the SFB check ({units.upper()}): yield stress "
+              f"{_pm_plain(md['yield_stress'], md['yield_stress_err'])}, sliding stress "
+              f"{_pm_plain(md['sliding_stress'], md['sliding_stress_err'])}, re-stick stress "
+              f"{_fmt(md['restick_stress'])}, η0 {_pm_plain(md['eta_zero'], md['eta_zero_err'])}, "
+              f"thinning exponent {_pm_plain(md['thinning_exponent'], md['thinning_exponent_err'], 3)}.")
     for k, v in cal.get("failures", {}).items():
         sec.p(f"Not computed — {k}: {v}.")
     for n in cal.get("notes", []):
