@@ -473,10 +473,15 @@ def _quadratic(t, g, lo, hi, centre):
     """Least-squares parabola through g[lo:hi+1] (times relative to ``centre``):
     coefficients (a, b, c) of a u² + b u + c and their covariance (unscaled)."""
     u = t[lo:hi + 1] - centre
-    x = np.column_stack([u * u, u, np.ones_like(u)])
-    coef, *_ = np.linalg.lstsq(x, g[lo:hi + 1], rcond=None)
-    cov = np.linalg.pinv(x.T @ x)
-    return coef, cov, x
+    # solved in times scaled to the window (u/h): in raw units u² and 1 can differ by
+    # more than float64 resolves (LJ times of 1e11), and the fit would depend on the unit
+    h = float(np.max(np.abs(u))) or 1.0
+    us = u / h
+    xs = np.column_stack([us * us, us, np.ones_like(us)])
+    coef_s, *_ = np.linalg.lstsq(xs, g[lo:hi + 1], rcond=None)
+    d = np.array([1.0 / (h * h), 1.0 / h, 1.0])
+    cov = np.linalg.pinv(xs.T @ xs) * np.outer(d, d)
+    return coef_s * d, cov, xs / d
 
 
 def _secant_bound(t, g, i, lo, hi):
@@ -613,6 +618,8 @@ def _noisy_extremum(t, g, i, lo, hi, sigma, lag):
     b = min(k + NOISY_WINDOW_MAX, (k + 1 + int(right[0])) if right.size else seg.size - 1)
     a, b = max(0, min(a, k - 2)), min(seg.size - 1, max(b, k + 2))
     u = t[lo + a:lo + b + 1] - t[i]
+    h = float(np.max(np.abs(u))) or 1.0
+    u = u / h             # the window's own time scale: the fit is the same in any unit
     y = seg[a:b + 1]
     n = u.size
     best = None
@@ -636,7 +643,7 @@ def _noisy_extremum(t, g, i, lo, hi, sigma, lag):
     row = xf[j]
     cov = np.linalg.pinv(x.T @ x)
     err = sigma * math.sqrt(max(float(row @ cov @ row), 0.0) * m)
-    return t[i] + float(fine[j]), float(curve[j]), err
+    return t[i] + float(fine[j]) * h, float(curve[j]), err
 
 
 def _extremum(t, g, i, lo, hi, sigma, lag):

@@ -189,7 +189,7 @@ class SlipLawFit:
         return float(err[0]), float(err[1])
 
     def as_dict(self) -> dict:
-        from .util import finite_or_none as num
+        from ..util import finite_or_none as num
         return {"kinetic_force": self.kinetic_force.as_dict(),
                 "film_damping": self.film_damping.as_dict(),
                 "freeze_force": None if self.freeze_force is None else self.freeze_force.as_dict(),
