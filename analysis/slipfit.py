@@ -263,16 +263,19 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     and a slip started from the wrong force or instant biases F_k and B.
 
     The fit runs in the dimensionless variables of the module docstring with
-    :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``,
-    bounds F_k and F_f ∈ [0, min F_s,i), B ≥ 0) from the best point of a coarse
-    grid over (F_k, B), once without a freeze and with F_f starting at the slips'
-    median re-stick force and a little above it.  The freeze is kept where it lowers χ² by at
-    least 25 (5 σ for one parameter more), else the slips end at rest.  Standard errors: the covariance
-    (JᵀJ)⁻¹ s² c of the parameters off their bounds at the solution, J the
-    Jacobian, s² the residual variance per degree of freedom and c = (1 + ρ)/(1 − ρ)
-    from the residuals' lag-one autocorrelation ρ (1 for white noise).  A
-    parameter at its bound gets none (``at_bound``); the covariance still includes
-    it, so that the others' errors carry the freedom the data leave it.
+    :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``;
+    bounds F_k ∈ [0, min F_s,i), B ≥ 0, F_f between the windows' lowest force and
+    min F_s,i), from the best point of a coarse grid over (F_k, B): once without a
+    freeze, and with F_f starting at the slips' re-stick level and a little above
+    it.  The freeze is kept where it lowers χ² by at least 25 (5 σ for one
+    parameter more), else the slips end at rest.
+
+    Standard errors: the diagonal of (JᵀJ)⁻¹ s² c at the solution, J the Jacobian
+    of every varied parameter, s² the residual variance per degree of freedom and
+    c = (1 + ρ)/(1 − ρ) from the residuals' lag-one autocorrelation ρ (1 for white
+    noise).  A parameter at its bound gets none (``at_bound``); J still holds its
+    column, so that the others' errors carry the freedom the data leave it (where
+    that makes JᵀJ singular, the parameters off their bounds alone).
 
     Parameters
     ----------
