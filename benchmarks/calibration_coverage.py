@@ -185,9 +185,13 @@ def main(argv=None) -> int:
         for q, label in (("kinetic_force", "F_k"), ("film_damping", "B")):
             s = summary(rows, q)
             bound = f"{s['at_bound']}" + (f" (truth 0: {s['bound_truth']})" if s["at_bound"] else "")
-            print(f"| {name} | {args.cases} ({len(rows)}) | {label} | {bound} | {s['cover1']:.0%} "
-                  f"of {s['free']} | {s['cover2']:.0%} | {s['mean_z']:+.2f} | {s['sd_z']:.2f} "
-                  f"| {s['median_rel']:.1%} |", flush=True)
+
+            def num(x, fmt):
+                return "–" if not math.isfinite(x) else format(x, fmt)
+            print(f"| {name} | {args.cases} ({len(rows)}) | {label} | {bound} | "
+                  f"{num(s['cover1'], '.0%')} of {s['free']} | {num(s['cover2'], '.0%')} | "
+                  f"{num(s['mean_z'], '+.2f')} | {num(s['sd_z'], '.2f')} | "
+                  f"{num(s['median_rel'], '.1%')} |", flush=True)
     return 0
 
 

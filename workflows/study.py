@@ -45,12 +45,14 @@ def finish_study(run_dir: Path) -> int:
     failures: dict = {}
     t0 = time.perf_counter()
 
+    from filmfriction.analysis.util import format_pm
+
     doc = _step("analysis", failures, analyse_run, run_dir)
     if doc is not None:
         s = doc["slips"]
         fs = s["static_force"]
         force = ("" if fs["mean"] is None else
-                 f", static force {fs['mean']:.4g} ± {fs['stderr'] or 0:.2g} {fs['units']}")
+                 f", static force {format_pm(fs['mean'], fs['stderr'])} {fs['units']}")
         print(f"analysis: {doc['regime']}, {s['count']} slips{force} -> "
               f"{run_dir / ANALYSIS_FILE}")
 
@@ -61,9 +63,11 @@ def finish_study(run_dir: Path) -> int:
         rc = cal.main
 
         def value(e):       # "-" where the run gave none (no slips: nothing to fit)
-            return "-" if e is None or e.value is None or e.value != e.value else f"{e.value:.4g}"
+            if e is None or e.value is None or e.value != e.value:
+                return "-"
+            return f"{e.value:.4g}" + (" (at bound)" if e.at_bound else "")
         print(f"calibration: F_s {value(rc.static_force)}, F_k {value(rc.kinetic_force)}, "
-              f"B {value(rc.film_damping)}"
+              f"B {value(rc.film_damping)}, η_eff {value(rc.eta_eff)}"
               + (f"; not computed: {', '.join(rc.failures)}" if rc.failures else "") + f" -> {path}")
 
     from filmfriction.analysis.calibration.contact import contact_from_run

@@ -283,6 +283,8 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
                          f"{kinetic_force.value:.4g} {kinetic_force.units} as viscosity")
             elif math.isfinite(z) and abs(z) > RESOLVED_SIGMAS:
                 diff += "; the two assumptions do not both hold for these slips"
+            elif math.isfinite(z):
+                diff += ": they agree within their errors"
         elif reference is not None and name != reference[0]:
             z = _sigmas(est, reference[1])
             diff = (f"no primary; {z:+.1f} standard errors from the {reference[0]} estimate"

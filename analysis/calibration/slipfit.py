@@ -263,16 +263,19 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     and a slip started from the wrong force or instant biases F_k and B.
 
     The fit runs in the dimensionless variables of the module docstring with
-    :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``,
-    bounds F_k and F_f ∈ [0, min F_s,i), B ≥ 0) from the best point of a coarse
-    grid over (F_k, B), once without a freeze and once with F_f starting at the
-    slips' median re-stick force.  The freeze is kept where it lowers χ² by at
-    least 25 (5 σ for one parameter more), else the slips end at rest.  Standard errors: the covariance
-    (JᵀJ)⁻¹ s² c of the parameters off their bounds at the solution, J the
-    Jacobian, s² the residual variance per degree of freedom and c = (1 + ρ)/(1 − ρ)
-    from the residuals' lag-one autocorrelation ρ (1 for white noise).  A
-    parameter at its bound gets none (``at_bound``); the covariance still includes
-    it, so that the others' errors carry the freedom the data leave it.
+    :func:`scipy.optimize.least_squares` (trust-region reflective, ``x_scale="jac"``;
+    bounds F_k ∈ [0, min F_s,i), B ≥ 0, F_f between the windows' lowest force and
+    min F_s,i), from the best point of a coarse grid over (F_k, B): once without a
+    freeze, and with F_f starting at the slips' re-stick level and a little above
+    it.  The freeze is kept where it lowers χ² by at least 25 (5 σ for one
+    parameter more), else the slips end at rest.
+
+    Standard errors: the diagonal of (JᵀJ)⁻¹ s² c at the solution, J the Jacobian
+    of every varied parameter, s² the residual variance per degree of freedom and
+    c = (1 + ρ)/(1 − ρ) from the residuals' lag-one autocorrelation ρ (1 for white
+    noise).  A parameter at its bound gets none (``at_bound``); J still holds its
+    column, so that the others' errors carry the freedom the data leave it (where
+    that makes JᵀJ singular, the parameters off their bounds alone).
 
     Parameters
     ----------
@@ -409,38 +412,66 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
 
     every = list(range(n))
     some = every[:: max(1, n // 3)][:3]
-    restick = min(max(float(np.median([f[s] for _, s, _ in slips])) / f0, ff_low), upper_fk)
+    # where the slips re-stick: the line through the ramp after each detected s, at s (the
+    # force at s itself, a minimum of noisy samples, lies below it by about the noise)
+    after = []
+    for a, b in wins:
+        s_ = by_yield[a][0]
+        if b - s_ >= 3:
+            after.append(float(np.polyval(np.polyfit(t[s_:b + 1] - t[s_], f[s_:b + 1], 1), 0.0)))
+        else:
+            after.append(float(f[s_]))
+    restick = min(max(float(np.median(after)) / f0, ff_low), upper_fk)
 
     def grid_start(freeze_force):
         """The best point of a coarse grid over (F_k, B) on up to three slips, each slip
-        at its detected yield, F_f fixed (NaN: no freeze)."""
+        at its detected yield, F_f fixed (NaN: no freeze; else F_k below it, where an
+        overdamped slip reaches the freeze)."""
         best = None
-        for fk in np.linspace(0.0, 0.95 * fs_min, 7) if fs_min > 0 else [0.0]:
+        top = 0.95 * (fs_min if math.isnan(freeze_force) else min(fs_min, freeze_force))
+        for fk in np.linspace(0.0, top, 7) if top > 0 else [0.0]:
             for b in np.geomspace(2e-3, 2e2, 11):
                 q = np.concatenate([[fk, b, freeze_force], np.zeros(2 * len(some))])
-                cost = float(np.sum(resid(q, some) ** 2))
+                rq = resid(q, some)
+                if not math.isnan(freeze_force):
+                    # a start where the freeze never acts leaves the fit nothing to vary
+                    q0 = q.copy()
+                    q0[2] = math.nan
+                    if np.array_equal(rq, resid(q0, some)):
+                        continue
+                cost = float(np.sum(rq ** 2))
                 if best is None or cost < best[0]:
                     best = (cost, q[:3])
+        if best is None:
+            return None
         return np.concatenate([best[1], np.zeros(2 * n)])
 
+    # starts: the grid's best without a freeze, and with F_f at the slips' re-stick level
+    # and a little above it (where the grid's best at that level leaves a freeze that never
+    # acts, the fit cannot find one)
+    freeze_levels = [min(restick + step, upper_fk) for step in (0.0, 0.03, 0.1)]
     if start is not None:
         ff0 = math.nan if start[2] is None else start[2] / f0
         p0 = np.concatenate([[start[0] / f0, start[1] / b0, ff0], np.zeros(2 * n)])
-        starts = (p0, p0 if not math.isnan(ff0) else grid_start(restick))
+        starts = (p0, [p0] if not math.isnan(ff0) else [grid_start(x) for x in freeze_levels])
     else:
-        starts = (grid_start(math.nan), grid_start(restick))
+        starts = (grid_start(math.nan), [grid_start(x) for x in freeze_levels])
+    starts = (starts[0], [q for q in starts[1] if q is not None])
     # the slips ending at rest, and the film freezing at F_f, each fitted from its own
     # start; the freeze is kept only where it lowers chi^2 by 25 or more (5 sigma for one
     # parameter more; a freeze near the force's minimum, where a slip ending at rest has
     # its turning point, fits noise more often than one parameter would): a freeze kept
     # by chance moves F_k and B
     p, r, jmat, vary, sol = solve(every, starts[0], freeze=False)
-    pf, rf, jf, varyf, solf = solve(every, starts[1], freeze=True)
-    # chi^2 in independent samples: the residual variance times their serial correlation
     sizes = [x[0].size for x in data]
-    s2_free = (float(np.sum(rf ** 2)) / max(rf.size - pf.size, 1)
-               * _serial_correlation(rf, sizes))
-    gain = (float(np.sum(r ** 2)) - float(np.sum(rf ** 2))) / s2_free
+    gain = 0.0
+    if starts[1]:
+        pf, rf, jf, varyf, solf = min((solve(every, q, freeze=True) for q in starts[1]),
+                                      key=lambda x: float(np.sum(x[1] ** 2)))
+        # chi^2 in independent samples: the residual variance times their serial correlation
+        s2_free = (float(np.sum(rf ** 2)) / max(rf.size - pf.size, 1)
+                   * _serial_correlation(rf, sizes))
+        gain = (float(np.sum(r ** 2)) - float(np.sum(rf ** 2))) / s2_free
     if gain >= 25.0:
         p, r, jmat, vary, sol = pf, rf, jf, varyf, solf
         freeze_note = f"the freeze lowers chi^2 by {gain:.3g}"

@@ -59,7 +59,8 @@ def test_a_resolved_damping_makes_the_calibration_primary_and_the_rest_cross_che
     # Klein's purely viscous reading is higher: it takes the resolved F_k for viscosity
     assert "+3.6 standard errors" in checks["slips"].difference
     assert "reads the rate-independent F_k = 30 ε/σ as viscosity" in checks["slips"].difference
-    assert checks["slip_law"].difference.startswith("+0.0 standard errors")
+    assert checks["slip_law"].difference == ("+0.0 standard errors from the primary: they agree "
+                                             "within their errors")
     assert "all sliding friction viscous" in checks["slips"].rests_on
     # the calibration resolves both terms, the slip law the drag only: said, with the evidence
     law = c.friction_law
