@@ -33,7 +33,7 @@ QUIET = {k: (v if k == "velocity_correlation" else v / 10) for k, v in MD_NOISE.
 
 def measure(run_dir: Path) -> dict:
     """The integral-form residual of the run's analysed slips (whole slips)."""
-    from filmfriction.analysis.rundata import load_run
+    from filmfriction.analysis.calibration.rundata import load_run
 
     run = load_run(run_dir)
     tr, p = run.trace, run.trace.parameters

@@ -43,7 +43,7 @@ Fits (all in the run's LJ units)
     reported apart (``first_yield_force``).
 ``kinetic_force`` and ``film_damping``
     One joint least-squares fit of the slip equation above
-    (:func:`~filmfriction.analysis.slipfit.fit_slips`: closed form, d fixed to the
+    (:func:`~filmfriction.analysis.calibration.slipfit.fit_slips`: closed form, d fixed to the
     mount's value, each slip started at rest from its own stick ramp, its yield
     instant and ramp level free, the film's freeze force F_f free where it
     improves the fit by 5 σ) to the spring force over every slip window (the
@@ -56,7 +56,7 @@ Fits (all in the run's LJ units)
     is written beside it as a cross-check.
 ``eta_eff``
     The run's one η_eff, named by
-    :func:`~filmfriction.analysis.effective_viscosity.choose` (``eta_eff_choice``
+    :func:`~filmfriction.analysis.calibration.effective_viscosity.choose` (``eta_eff_choice``
     in ``calibration.json``): B·D/A with D the mean gap, at the slips' shear rate
     γ̇ = (Δx0/τ_s)/D, where the fit resolves B; the steady η_eff = ((F̄ − d V)/A)/(V/D)
     of a smooth-sliding run; else none ("not resolved", with the reason).  The
@@ -148,7 +148,7 @@ class RunCalibration:
         resolved) and the shear rate it belongs to.
     eta_eff_choice : ViscosityChoice or None
         Which estimate of η_eff is the primary and why, and the others as cross-checks
-        (:func:`filmfriction.analysis.effective_viscosity.choose`).
+        (:func:`filmfriction.analysis.calibration.effective_viscosity.choose`).
     ageing : Estimate or None
         dF_s / d ln(t_stick).
     slip_fit : SlipLawFit or None

@@ -4,7 +4,7 @@ A run can give η_eff several ways, each resting on its own assumption:
 
 ``calibration``
     B·D/A from the joint Coulomb + viscous fit of the slips' spring force
-    (:func:`~filmfriction.analysis.slipfit.fit_slips`): the film's drag beyond a
+    (:func:`~filmfriction.analysis.calibration.slipfit.fit_slips`): the film's drag beyond a
     rate-independent part F_k, the viscous term of Klein's Eq. 1 with the
     kinetic force his equation leaves out.  Assumes the slips follow that law.
 ``slips``
@@ -172,7 +172,7 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
     analysis : dict
         The run's ``analysis.json``.
     kinetic_force, film_damping : Estimate, optional
-        The calibration's joint slip fit (:class:`~filmfriction.analysis.slipfit.SlipLawFit`).
+        The calibration's joint slip fit (:class:`~filmfriction.analysis.calibration.slipfit.SlipLawFit`).
     damping_scatter : float
         B's standard error from the slips' scatter (the fit's jackknife); where
         given, B must be resolved by it too.
