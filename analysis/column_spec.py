@@ -90,16 +90,10 @@ def trace_table(path) -> dict:
         negative or non-integer ``skip_rows``, ``comments`` that are not strings; the
         message names the file and the key.
     """
-    import tomllib
+    from filmfriction.reduced_model.sfb.user_setup import read_setup_file
 
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ValueError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
-    table = data.get("trace", {})
+    table = read_setup_file(path).get("trace", {})
     out = {}
     if not isinstance(table, dict):
         raise ValueError(f"{path}: trace = {table!r}: give a table [trace] with "

@@ -34,13 +34,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields, replace
+from pathlib import Path
 
 from .klein import KleinExperiment
 from .check import SFBCheck, sfb_check
 from ..units import OMCTS, LJUnits
 
 __all__ = ["SFBSetup", "MeasuredSlip", "setup_experiment", "sfb_check_setup", "SETUP_KEYS",
-           "load_setup"]
+           "load_setup", "read_setup_file"]
 
 #: The set-up's quantities: name -> (SI unit, meaning).
 SETUP_KEYS = {
@@ -160,6 +161,21 @@ class SFBSetup:
         return out
 
 
+def read_setup_file(path) -> dict:
+    """The set-up file ``path`` as a TOML table; ValueError naming the file when it is
+    missing or not UTF-8 TOML (the one reader of set-up files: :func:`load_setup` and the
+    trace's ``[trace]`` table both use it)."""
+    import tomllib
+
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ValueError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
+
+
 def load_setup(path) -> SFBSetup:
     """The :class:`SFBSetup` in the TOML file ``path`` (named after the file unless it
     says ``name``).  A ``[trace]`` table, how the instrument writes its traces, is not
@@ -172,16 +188,8 @@ def load_setup(path) -> SFBSetup:
         A file that is missing, not UTF-8 TOML, or not a valid set-up; the message
         names the file.
     """
-    import tomllib
-    from pathlib import Path
-
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ValueError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read it as TOML: {exc}") from None
+    data = read_setup_file(path)
     data.pop("trace", None)
     try:
         return SFBSetup.from_dict(data, name=path.stem)
