@@ -11,7 +11,8 @@ Modules (one sitting each):
 * :mod:`filmfriction.analysis.analyze` — the ``analysis.json`` document;
 * :mod:`filmfriction.analysis.observables` — sections of ``analysis.json`` and of the
   report declared one file each (Klein's slip law ...), with their contract;
-* :mod:`filmfriction.analysis.synthetic` — traces and films with known answers;
+* :mod:`filmfriction.analysis.groundtruth` — traces and films with known answers, the
+  analysis scored on them, the slip-law verdict's controls;
 * :mod:`filmfriction.analysis.calibration.calibrate` — the reduced model calibrated on MD runs
   (:func:`calibrate`), from :mod:`~filmfriction.analysis.calibration.rundata`,
   :mod:`~filmfriction.analysis.calibration.slipfit`, :mod:`~filmfriction.analysis.calibration.estimators`,

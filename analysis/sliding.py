@@ -9,7 +9,7 @@ slips).  The ``sliding`` section of ``analysis.json`` is the observable
 
 Example
 -------
->>> from filmfriction.analysis.synthetic import smooth_trace
+>>> from filmfriction.analysis.groundtruth.synthetic import smooth_trace
 >>> from filmfriction.analysis.trace import Trace, TraceParameters
 >>> trace = Trace(smooth_trace(n=2000), TraceParameters(), path="smooth.csv")
 >>> state = sliding_state(trace)

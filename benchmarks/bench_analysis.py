@@ -50,7 +50,7 @@ def _cpu() -> str:
 def bench_trace(n=1_000_000):
     from filmfriction.analysis import energy, stickslip, viscosity
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.synthetic import klein_trace, write_csv
+    from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
     from filmfriction.analysis.trace import read_trace, write_binary_copy
 
     k, m, fs = 97.0, 1.47e-3, 9.7e-6
@@ -139,7 +139,7 @@ def bench_trajectory(frames=400, repeat=7):
     import MDAnalysis as mda
 
     from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder
-    from filmfriction.analysis.synthetic import layered_film
+    from filmfriction.analysis.groundtruth.synthetic import layered_film
 
     with tempfile.TemporaryDirectory() as d:
         top, traj = layered_film(d, layers=4, nx=22, ny=13, frames=frames,

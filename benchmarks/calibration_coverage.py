@@ -23,7 +23,7 @@ Sets (each drawn at random per case):
     As ``lj`` with AR(1) noise of lag-one correlation 0.5–0.9 (the MD's film force is
     correlated over many samples).
 ``klein``
-    Klein's slip (:func:`~filmfriction.analysis.synthetic.klein_trace`: F_k = 0, the film
+    Klein's slip (:func:`~filmfriction.analysis.groundtruth.synthetic.klein_trace`: F_k = 0, the film
     freezes when the force has fallen to F_b) in SI: damping ratio B/2√(KM) in
     [0.3, 3], F_b/F_s in [0.2, 0.5], 20–80 samples per slip, noise 0.5–3 %.  The
     truth F_k = 0 is the bound of its range: where the fit ends there it has no error
@@ -51,7 +51,7 @@ from scipy.signal import lfilter  # noqa: E402
 
 from filmfriction.analysis.calibration.rundata import load_run  # noqa: E402
 from filmfriction.analysis.calibration.slipfit import fit_slip_law  # noqa: E402
-from filmfriction.analysis.synthetic import klein_trace, write_csv  # noqa: E402
+from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv  # noqa: E402
 from filmfriction.reduced_model import SpringBlock, laws  # noqa: E402
 
 WALLS = {

@@ -6,9 +6,9 @@
 ``--measure`` fits each analysed slip of RUN (its whole slip, F_k + B·v in the
 integrated equation of motion) and prints how far the wall's velocity strays from
 the fitted law's (rms) and the autocorrelation of that residual: the numbers
-behind :data:`filmfriction.analysis.slip_law_controls.MD_NOISE`.
+behind :data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`.
 
-Without it: for each control law (:data:`~filmfriction.analysis.slip_law_controls.CONTROLS`)
+Without it: for each control law (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.CONTROLS`)
 the verdicts of 40 noisy replicas at 4, 8 and 30 slips, at the MD's noise and at a
 tenth of it; then the power: the share of replicas of slips resisted by F_k + B·v
 (re-sticking as Klein's) whose B is resolved (2 σ), against the viscous share.
@@ -24,7 +24,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from filmfriction.analysis.slip_law import sigmas
-from filmfriction.analysis.slip_law_controls import (CONTROLS, MD_NOISE, coulomb_viscous,
+from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, coulomb_viscous,
                                                     replica_fits, verdict_rates)
 
 REPLICAS = 40

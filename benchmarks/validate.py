@@ -1,6 +1,6 @@
 """Ground-truth validation of the slip analysis: bias and error-bar coverage on model traces.
 
-Random spring-blocks of every friction law of :mod:`filmfriction.analysis.groundtruth`
+Random spring-blocks of every friction law of :mod:`filmfriction.analysis.groundtruth.cases`
 (Coulomb, Coulomb + viscous, Coulomb with an elastic film, Stribeck, rate-and-state,
 Klein's Eq. 1), in LJ and SI numbers, sampled uniformly (5 to 500 samples per slip)
 and at the model's own output times, exact and with white or correlated noise; each
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis import groundtruth as gt
+from filmfriction.analysis.groundtruth import cases as gt
 
 NAMES = {"static_force": "F_s", "backward_force": "F_b", "slip_distance": "slip distance",
          "slip_duration": "slip duration", "stick_duration": "stick duration",

@@ -23,7 +23,7 @@ another; what several of them need is here, as fixtures:
     The installed ``filmfriction`` script, for tests that run it as a user does.
 ``synthetic_run``
     A run directory in the runner's format with a known answer
-    (:func:`filmfriction.analysis.synthetic.run_directory`), in ``tmp_path``.
+    (:func:`filmfriction.analysis.groundtruth.synthetic.run_directory`), in ``tmp_path``.
 
 Per folder: ``analysis/conftest.py`` (``slip_table``: detection, cycle table and
 ramp fits on a trace) and ``workflows/conftest.py`` (``report_study`` and
@@ -257,7 +257,7 @@ def filmfriction_command() -> str:
 def synthetic_run(tmp_path) -> Path:
     """A run directory in the runner's format from a Klein-type trace with a known
     answer: 4 slips, 3 film layers in a 60-frame trajectory, a ledger that closes."""
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     return run_directory(tmp_path / "synthetic-run", layers=3)
 

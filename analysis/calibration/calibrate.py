@@ -99,7 +99,7 @@ replay, they predict nothing); slip distance and period are predictions.
 Example
 -------
 >>> import tempfile, pathlib
->>> from filmfriction.analysis.synthetic import run_directory
+>>> from filmfriction.analysis.groundtruth.synthetic import run_directory
 >>> cal = calibrate(run_directory(pathlib.Path(tempfile.mkdtemp()) / "run", trajectory=False))
 >>> rc = cal.main
 >>> rc.regime == "stick-slip", round(rc.static_force.value, 2), round(rc.film_damping.value, 1)

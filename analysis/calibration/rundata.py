@@ -3,7 +3,7 @@
 Example
 -------
 >>> import tempfile, pathlib
->>> from filmfriction.analysis.synthetic import run_directory
+>>> from filmfriction.analysis.groundtruth.synthetic import run_directory
 >>> run = load_run(run_directory(pathlib.Path(tempfile.mkdtemp()) / "run", trajectory=False))
 >>> run.analysis["regime"] == "stick-slip", run.n_slips, run.skip
 (True, 4, 1)

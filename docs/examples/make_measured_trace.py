@@ -1,7 +1,7 @@
 """Write ``sfb_trace.tsv`` and ``sfb_trace_units.txt``: measured-style SFB traces for the
 guide docs/measured-traces.md.
 
-The project's synthetic stick-slip (:func:`filmfriction.analysis.synthetic.klein_trace`,
+The project's synthetic stick-slip (:func:`filmfriction.analysis.groundtruth.synthetic.klein_trace`,
 Klein's K, M, B and V; slips obey his Eq. 1) sampled every millisecond, plus 1 % white
 noise on the force, written the way an instrument's export might be: tab-separated, with
 its own column names and units, four to six significant figures.
@@ -16,14 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.synthetic import klein_trace
+from filmfriction.analysis.groundtruth.synthetic import klein_trace
 
 STATIC_FORCE = 9.7e-6          # N, Klein's yield force K x0 ~ 10 uN
 
 trace = klein_trace(cycles=5, dt=1e-3, noise=0.01 * STATIC_FORCE, seed=7)
 out = Path(__file__).with_name("sfb_trace.tsv")
 with out.open("w") as fh:
-    fh.write("# synthetic SFB trace (filmfriction.analysis.synthetic.klein_trace + 1 % noise)\n")
+    fh.write("# synthetic SFB trace (filmfriction.analysis.groundtruth.synthetic.klein_trace + 1 % noise)\n")
     fh.write("t_s\tshear_force_N\tdrive_x_m\n")
     for t, f, x in zip(trace["time"], trace["spring_force"], trace["drive_position"]):
         fh.write(f"{t:.6g}\t{f:.5g}\t{x:.6g}\n")

@@ -5,7 +5,7 @@ import warnings
 import numpy as np
 import pytest
 
-from filmfriction.analysis.synthetic import klein_trace, smooth_trace, write_csv
+from filmfriction.analysis.groundtruth.synthetic import klein_trace, smooth_trace, write_csv
 from filmfriction.analysis.trace import MissingInput, TraceParameters, read_trace
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)

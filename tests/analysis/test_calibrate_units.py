@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.calibration import calibrate as cal_mod
-from filmfriction.analysis.synthetic import write_csv
+from filmfriction.analysis.groundtruth.synthetic import write_csv
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.units import OMCTS
 
@@ -99,7 +99,7 @@ def test_the_error_bars_are_the_fit_covariance_not_zero(calibrations):
 def test_a_parameter_at_its_bound_has_no_error_bar(tmp_path):
     """Klein's slip (F_k = 0, the film freezes at F_b): F_k ends at its bound 0 and says
     so, in the estimate, in calibration.json and in the printout."""
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
     from filmfriction.workflows.cli.calibrate_cli import format_calibration
 
     cal = cal_mod.calibrate(run_directory(tmp_path / "run", trajectory=False))

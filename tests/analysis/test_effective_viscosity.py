@@ -99,7 +99,7 @@ def test_a_negative_estimate_is_flagged_unphysical():
 def test_the_analysis_flags_slips_with_negative_viscosity(tmp_path):
     """A mount dashpot larger than the film's damping: every slip's (B - d) D/A < 0,
     flagged slip by slip in analysis.json (which still validates) and kept in the mean."""
-    from filmfriction.analysis.synthetic import klein_trace, write_csv
+    from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
     from filmfriction.workflows.cli.main import main
 
     d = tmp_path / "run"

@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import cumulative_trapezoid
 
 from filmfriction.analysis.energy import compare_heat, energy_table
-from filmfriction.analysis.synthetic import klein_trace
+from filmfriction.analysis.groundtruth.synthetic import klein_trace
 
 # Klein's SFB numbers (SI): overdamped viscous slips
 KLEIN = dict(spring_constant=97.0, mass=1.47e-3, damping=3.09,

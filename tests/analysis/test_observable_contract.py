@@ -4,7 +4,7 @@ Each registered observable (the built-in sections -- slips, energy, sliding,
 viscosity, structure -- are observables too), and one defined in this file (the
 mean film temperature of each slip: what a user would drop into
 ``analysis/observables/`` as a file of its own), on a synthetic run directory
-with a trajectory (:func:`filmfriction.analysis.synthetic.run_directory`):
+with a trajectory (:func:`filmfriction.analysis.groundtruth.synthetic.run_directory`):
 
 * its section is JSON data and lands in ``analysis.json``, its per-slip columns
   (``<key>_<name>`` unless it names them otherwise, one value per slip) in
@@ -123,7 +123,7 @@ def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
 def study(tmp_path_factory, slip_temperature):
     """The synthetic run analysed and reported with every observable registered."""
     from filmfriction.analysis.calibration.rundata import load_run
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     run_dir = run_directory(tmp_path_factory.mktemp("observables") / "run")
     doc, columns, html, md = analyse_and_report(run_dir)

@@ -4,7 +4,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from filmfriction.analysis.energy import energy_table, ledger, LEDGER_COLUMNS
-from filmfriction.analysis.synthetic import klein_trace
+from filmfriction.analysis.groundtruth.synthetic import klein_trace
 from filmfriction.analysis.viscosity import (power_law_fit, profile_shear, slip_force,
                                 slip_viscosity, steady_viscosity)
 

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from filmfriction.analysis import stickslip, synthetic
+from filmfriction.analysis import stickslip
+from filmfriction.analysis.groundtruth import synthetic
 
 from filmfriction.analysis.stickslip import detect_slips
 

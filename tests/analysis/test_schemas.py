@@ -22,7 +22,7 @@ def _validator(name):
 
 @pytest.fixture(scope="module")
 def lj_analysis(tmp_path_factory):
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     run = run_directory(tmp_path_factory.mktemp("run") / "run")
     assert main(["analyze", str(run)]) == 0
@@ -31,7 +31,7 @@ def lj_analysis(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def si_analysis(tmp_path_factory):
-    from filmfriction.analysis.synthetic import klein_trace, write_csv
+    from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
 
     d = tmp_path_factory.mktemp("si")
     write_csv(d / "t.csv", klein_trace(cycles=4, noise=5e-8))

@@ -1,4 +1,4 @@
-"""The slip-law test's controls at the MD's noise (analysis/slip_law_controls.py).
+"""The slip-law test's controls at the MD's noise (analysis/groundtruth/slip_law_controls.py).
 
 Negative: Coulomb, rate-and-state and velocity-weakening slips are not called
 ``viscous``; positive: Klein's viscous slips are called ``viscous`` once there are
@@ -9,7 +9,7 @@ docs/results/slip-law.md (``python benchmarks/slip_law_power.py``).
 """
 import pytest
 
-from filmfriction.analysis.slip_law_controls import MD_NOISE, verdict_rates
+from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, verdict_rates
 
 REPLICAS = 40
 AT_MOST = 2          # of 40: ≥ 95 % pass

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.stickslip import classify_regime, cycle_table, detect_slips, noise_level
-from filmfriction.analysis.synthetic import sawtooth, smooth_trace
+from filmfriction.analysis.groundtruth.synthetic import sawtooth, smooth_trace
 
 FS, FB, PERIOD, K = 3.0, 1.0, 2.0, 2.0
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder, frame_steps
-from filmfriction.analysis.synthetic import layered_film
+from filmfriction.analysis.groundtruth.synthetic import layered_film
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 

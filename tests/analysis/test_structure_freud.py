@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 from filmfriction.analysis.structure import (DensityProfile, HexaticOrder, LayerNeighbours,
                                              psi6_per_layer)
-from filmfriction.analysis.synthetic import layered_film
+from filmfriction.analysis.groundtruth.synthetic import layered_film
 
 freud = pytest.importorskip("freud")
 warnings.filterwarnings("ignore", category=DeprecationWarning)

@@ -11,7 +11,7 @@ import os
 import numpy as np
 import pytest
 
-from filmfriction.analysis.synthetic import klein_trace
+from filmfriction.analysis.groundtruth.synthetic import klein_trace
 from filmfriction.analysis.trace import (binary_copy_path, map_columns, read_trace,
                                          write_binary_copy)
 

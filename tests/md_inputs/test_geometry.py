@@ -87,7 +87,7 @@ def test_the_scene_counts_from_the_geometry():
 def test_the_synthetic_film_is_the_geometry(tmp_path):
     import MDAnalysis as mda
 
-    from filmfriction.analysis.synthetic import layered_film
+    from filmfriction.analysis.groundtruth.synthetic import layered_film
 
     a, nx, ny = 1.1, 6, 4
     top, _ = layered_film(tmp_path, layers=3, nx=nx, ny=ny, spacing=a, wall_planes=2, frames=1)

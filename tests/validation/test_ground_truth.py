@@ -1,5 +1,5 @@
 """The slip analysis scored on reduced-model traces whose answer is known
-(``filmfriction.analysis.groundtruth``; the whole table: ``benchmarks/validate.py``).
+(``filmfriction.analysis.groundtruth.cases``; the whole table: ``benchmarks/validate.py``).
 
 Targets (docs/results/validation.md): on exact traces with >= 20 samples per slip, F_s and
 F_b within 0.5 % of the force drop, slip distance and duration within 2 %; the error bar
@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis import groundtruth as gt
+from filmfriction.analysis.groundtruth import cases as gt
 from filmfriction.analysis.analyze import analyze
 from filmfriction.reduced_model import SpringBlock, laws
 

@@ -64,7 +64,7 @@ def test_film_figure_from_a_trajectory(synthetic_run):
 def _analysed_synthetic_run(directory):
     """A synthetic run directory (no LAMMPS) with its analysis written, as `filmfriction analyze` does."""
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
     from filmfriction.analysis.trace import read_trace
 
     d = run_directory(directory, trajectory=False)
@@ -107,7 +107,7 @@ def test_report_without_calibration_says_so_and_does_not_calibrate(tmp_path, mon
 
 def test_the_study_writes_what_the_report_renders(tmp_path):
     """The post-MD study on a synthetic run (no LAMMPS): files first, then the report reads them."""
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
     from filmfriction.workflows.rundir import read_calibration, read_sfb
     from filmfriction.workflows.study import finish_study
 

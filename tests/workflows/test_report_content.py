@@ -1,7 +1,7 @@
 """What the report says, on a synthetic run with a known answer (no LAMMPS).
 
 The study (analysis, calibration, SFB check, report) runs once on a run
-directory made by :func:`filmfriction.analysis.synthetic.run_directory`: four
+directory made by :func:`filmfriction.analysis.groundtruth.synthetic.run_directory`: four
 Klein-type slips from 3 to 1 eps/sigma and a 3-layer trajectory.  The same
 content checks run on the real small run in test_report.py (marker md).
 """
@@ -13,7 +13,7 @@ import pytest
 
 @pytest.fixture(scope="module")
 def synthetic_study(tmp_path_factory, report_study):
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     run_dir = run_directory(tmp_path_factory.mktemp("report-synthetic") / "run", layers=3)
     return SimpleNamespace(path=run_dir, labels=report_study(run_dir))
@@ -60,7 +60,7 @@ def test_a_run_without_trajectory_says_which_scene_draws_the_film(tmp_path):
 def test_compare_sets_another_run_beside_the_main_one(synthetic_study, tmp_path, report_study,
                                                        run_cli):
     # a second study, compared: its similarity rows and its point appear; it is not calibrated
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     other = run_directory(tmp_path / "other", layers=4)
     report_study(other)
@@ -103,7 +103,7 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
 
     from matplotlib.figure import Figure
 
-    from filmfriction.analysis.synthetic import klein_trace, write_csv
+    from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
 
     tr = klein_trace(cycles=5, noise=0.005 * 9.7e-6, seed=2)
     write_csv(tmp_path / "trace.csv", {k: tr[k] for k in ("time", "spring_force", "drive_position",

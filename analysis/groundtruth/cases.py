@@ -37,7 +37,7 @@ from scipy.signal import lfilter
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
-from .trace import Trace, TraceParameters
+from ..trace import Trace, TraceParameters
 
 __all__ = ["FAMILIES", "Case", "Truth", "random_case", "simulate", "truth", "sample",
            "Score", "score", "OBSERVABLES"]
@@ -388,9 +388,9 @@ _QUANTITY = {"static_force": "force", "backward_force": "force", "slip_distance"
 
 def score(case: Case) -> Score:
     """Analyse ``case``'s trace and score every observable against :func:`truth`."""
-    from .energy import energy_table
-    from .analyze import context
-    from .stickslip import stick_stiffness
+    from ..energy import energy_table
+    from ..analyze import context
+    from ..stickslip import stick_stiffness
 
     r = simulate(case)
     tr = truth(case, r)

@@ -6,7 +6,7 @@ laws here are slid in the reduced model at the Klein-similar MD scene's scale
 (``sfb-similar``: K = 2 ε/σ², M = 30 m, F_s = 48 ε/σ, sampled every 0.25 τ); the
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
-Each replica adds the MD wall's noise (:func:`~filmfriction.analysis.synthetic.with_wall_noise`)
+Each replica adds the MD wall's noise (:func:`~filmfriction.analysis.groundtruth.synthetic.with_wall_noise`)
 with :data:`MD_NOISE` to the measured velocity:
 
 ``coulomb``      Coulomb, F_s = 48, F_k = 36 ε/σ (B = 0)
@@ -34,8 +34,8 @@ import numpy as np
 
 from filmfriction.reduced_model import SpringBlock, laws
 
-from .slip_law import VERDICTS, FilmForceFit, fit_film_force
-from .stickslip import cycle_table, detect_slips
+from ..slip_law import VERDICTS, FilmForceFit, fit_film_force
+from ..stickslip import cycle_table, detect_slips
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "SCALE", "CONTROLS", "control_trace", "coulomb_viscous", "replica_fits",

@@ -1,0 +1,11 @@
+"""Known answers: traces and films built from a model, and the analysis scored on them.
+
+* :mod:`~filmfriction.analysis.groundtruth.synthetic` — sawtooth, Klein-law and spring-block
+  traces, layered films and whole run directories whose answers are known;
+* :mod:`~filmfriction.analysis.groundtruth.cases` — random spring-block cases, their exact
+  truth read off the model, and the analysis' score on them (``benchmarks/validate.py``);
+* :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` — the slip-law verdict's
+  positive and negative controls and its power.
+
+Nothing in the analysis imports this folder: it stands beside the estimators it checks.
+"""
