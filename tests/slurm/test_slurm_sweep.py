@@ -1,4 +1,5 @@
-"""Sweeps through a real Slurm: `filmfriction sweep ... --profile slurm` on the one-node
+"""Sweeps through a real Slurm: `filmfriction sweep ... --profile slurm` (the shipped profile,
+polling faster: :data:`FAST_POLLING`) on the one-node
 cluster of tests/slurm/start-cluster.sh (munge, slurmctld, slurmd, slurmdbd accounting).
 
 Skipped, with the reason, when no such cluster answers (start one as root on Debian 12 with
@@ -25,13 +26,14 @@ from types import SimpleNamespace
 import pytest
 
 from filmfriction.workflows.md import engine
+from filmfriction.workflows.sweep.jobs import PROFILES
 from filmfriction.workflows.sweep.slurm import SlurmJob, slurm_jobs, submitted_jobs
 
 pytestmark = [pytest.mark.slurm, pytest.mark.md]
 
 SMALL = {"cells_x": 5, "cells_y": 3, "equilibrate_steps": 1000, "slide_steps": 4000,
          "trace_every": 20}
-#: a whole sweep of the tests, at most (each Slurm round trip is 40 s or more)
+#: a whole sweep of the tests, at most
 SWEEP_DEADLINE = 900
 
 
@@ -92,10 +94,29 @@ exec '{engine.lmp_binary()}' "$@"
     return script, calls, marker
 
 
+#: what the tests' profile adds to the shipped one: Snakemake asks Slurm for its jobs'
+#: states every 2 s instead of 40 s after a submission and then every 10 s (a test job
+#: lasts seconds; a production job minutes to hours, where the shipped pace is right)
+FAST_POLLING = """
+slurm-init-seconds-before-status-checks: 2
+seconds-between-status-checks: 2
+"""
+
+
+def fast_profile(folder: Path) -> Path:
+    """The shipped Slurm profile (``--profile slurm``) as a profile directory, polling faster."""
+    profile = folder / "slurm-profile"
+    shutil.copytree(PROFILES / "slurm", profile)
+    with open(profile / "config.yaml", "a", encoding="utf-8") as f:
+        f.write(FAST_POLLING)
+    return profile
+
+
 def sweep_command(filmfriction_command, out: Path, grid: str, np_: int, *extra) -> list[str]:
     sets = [arg for k, v in SMALL.items() for arg in ("--set", f"{k}={v}")]
     return [filmfriction_command, "sweep", "stick-slip", "--grid", grid, *sets,
-            "--np", str(np_), "--profile", "slurm", "--out", str(out), *extra]
+            "--np", str(np_), "--profile", str(fast_profile(out.parent)), "--out", str(out),
+            *extra]
 
 
 def run_sweep(cmd: list[str], on_submitted=None, out: Path | None = None):
