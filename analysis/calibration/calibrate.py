@@ -118,7 +118,7 @@ from .effective_viscosity import ViscosityChoice, choose
 from .estimators import Estimate, ageing, shear_stiffness, summary_estimate
 from ..util import finite_or_none as _num
 from .md_estimates import md_calibration
-from .replay import Replay, _no_restick, replay
+from .replay import Replay, no_restick_reason, replay
 from .rundata import RunData, load_run
 from .slipfit import SlipLawFit, coulomb_slip_force, fit_slip_law
 from ..trace import UNITS
@@ -256,7 +256,7 @@ def calibrate_run(run: RunData) -> RunCalibration:
             kw["replay"] = replay(run, kw["static_force"].value, fit.kinetic_force.value,
                                   fit.film_damping.value, restick_force=restick,
                                   shear_stiffness=shear)
-            why = _no_restick(run, fit.kinetic_force.value, fit.film_damping.value)
+            why = no_restick_reason(run, fit.kinetic_force.value, fit.film_damping.value)
             if why and not kw["replay"].errors["period"]["model_cycles"]:
                 failures["replay"] = why
         except (ValueError, LookupError, RuntimeError) as exc:

@@ -18,7 +18,7 @@ import numpy as np
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
-from .estimators import _num
+from ..util import finite_or_none as _num
 from .rundata import RunData
 
 __all__ = ["Replay", "replay"]
@@ -52,7 +52,7 @@ class Replay:
                 "errors": {k: {kk: _num(vv) for kk, vv in v.items()} for k, v in self.errors.items()}}
 
 
-def _no_restick(run: RunData, kinetic_force: float, film_damping: float) -> str | None:
+def no_restick_reason(run: RunData, kinetic_force: float, film_damping: float) -> str | None:
     """Why the calibrated block cannot come back to rest, if it cannot.
 
     With the mount's d, the slip is overdamped when B + d >= 2 sqrt(K M): the
@@ -79,7 +79,7 @@ def replay(run: RunData, static_force: float, kinetic_force: float, film_damping
 
     With the MD's ``restick_force`` the law gets the freeze velocity that
     re-sticks it there (:func:`freeze_velocity_for`): a fitted, not a predicted,
-    re-stick level, which an overdamped slip (:func:`_no_restick`) needs to stop
+    re-stick level, which an overdamped slip (:func:`no_restick_reason`) needs to stop
     at all.  ``shear_stiffness`` is the stuck film's k_f (inf: rigid).
     """
     tr = run.trace

@@ -65,7 +65,7 @@ def _register(cls) -> None:
     REGISTRY[name] = cls      # (the same class statement run again, e.g. a reload, replaces it)
 
 
-def _exp(x):
+def scalar_exp(x):
     """math.exp on floats (the ODE hot loop: ~10x cheaper than numpy scalars), np.exp on arrays."""
     return math.exp(x) if isinstance(x, float) else np.exp(x)
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import FrictionLaw, _exp, at_least, in_range, non_negative, positive
+from .base import FrictionLaw, scalar_exp, at_least, in_range, non_negative, positive
 
 __all__ = ["StribeckExponential", "StribeckSchnelle", "ExponentialWeakening"]
 
@@ -118,8 +118,8 @@ class StribeckSchnelle(FrictionLaw):
 
     def sliding_force(self, speed, state, normal_load):
         v = speed if isinstance(speed, float) else np.asarray(speed, dtype=float)
-        mu = self.g * (_exp(-self.a * v ** self.b)
-                       + (1.0 - _exp(-self.c * v ** self.d)) * self.e * v ** self.f)
+        mu = self.g * (scalar_exp(-self.a * v ** self.b)
+                       + (1.0 - scalar_exp(-self.c * v ** self.d)) * self.e * v ** self.f)
         return normal_load * mu
 
     def static_force(self, state, normal_load):
@@ -159,7 +159,7 @@ class ExponentialWeakening(FrictionLaw):
 
     def sliding_force(self, speed, state, normal_load):
         return normal_load * (self.kinetic + (self.static - self.kinetic)
-                              * _exp(-speed / self.velocity_scale))
+                              * scalar_exp(-speed / self.velocity_scale))
 
     def static_force(self, state, normal_load):
         return self.static * normal_load

@@ -147,7 +147,7 @@ def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     from types import SimpleNamespace
 
     from filmfriction.analysis.trace import TraceParameters
-    from filmfriction.analysis.calibration.replay import _no_restick
+    from filmfriction.analysis.calibration.replay import no_restick_reason
 
     def run(mass, mount=None):
         p = TraceParameters(spring_constant=100.0, mass=mass, drive_velocity=0.02,
@@ -155,10 +155,10 @@ def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
         return SimpleNamespace(trace=SimpleNamespace(parameters=p))
 
     # the energy-partition scene: B = 97 against 2 sqrt(K M) = 89.4
-    why = _no_restick(run(20.0), 0.0, 97.0)
+    why = no_restick_reason(run(20.0), 0.0, 97.0)
     assert "overdamped (B + d = 97 >= 2 sqrt(K M) = 89.4" in why
     # the default scene: M = 500 and the mount's 150 m/tau, underdamped: it re-sticks
-    assert _no_restick(run(500.0, 150.0), 60.0, 11.0) is None
+    assert no_restick_reason(run(500.0, 150.0), 60.0, 11.0) is None
 
 
 def test_the_film_shear_stiffness_comes_from_the_stick_ramps(tmp_path):
