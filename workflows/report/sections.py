@@ -15,7 +15,7 @@ from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 
-from .document import Figure, Section, Table, fixed_decimals, trace_source
+from .document import Figure, Section, Table, fixed_decimals, link, trace_source
 from .plots import fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity, sfb_reference
 
 
@@ -270,9 +270,13 @@ def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
         sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
                                    f"with bulk viscosity, and (if calibrated) the {ref['calibrated']} "
                                    "film."))
+    from .overview import APPENDIX_TITLE, far_extrapolated
+    far = far_extrapolated(check)
     rows = []
     for r in check.rows:
         if r["source"] == "similarity":   # their own section
+            continue
+        if far and r["source"] == "md-calibrated":   # not a prediction: the appendix
             continue
         unc = r.get("uncertainty")
         rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
@@ -280,8 +284,12 @@ def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
                      "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
     sec.add(Table(("quantity", "source", ref["column"], "model", "ratio", "model range", "units", "note"),
                   tuple(rows)))
+    if far:
+        sec.p(f"The {ref['calibrated']} rows carry the film's law too many decades of shear "
+              f"rate to be predictions: they are in the {link(APPENDIX_TITLE, 'appendix')}, "
+              "without ratios or intervals.")
     sec.p(BRAUN_TOSATTI_NOTE)
-    sec.p(_sfb_reading(check))
+    sec.p(_sfb_reading(check, far))
     for n in check.notes:
         if n != BRAUN_TOSATTI_NOTE:
             sec.p(f"Assumption: {n}")
@@ -302,6 +310,7 @@ def observable_section(obs: Observable, run, failures) -> Section:
         elif why is None:
             why = f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)"
         sec.p(f"{obs.absent}: {why}.")
+        sec.absent = why
         return sec
     what = obs.key.replace("_", " ")
     for text in attempt(failures, f"lead: {what}", obs.lead, run) or ():
@@ -446,7 +455,7 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     return sec
 
 
-def _sfb_reading(check) -> str:
+def _sfb_reading(check, far: bool = False) -> str:
     """What the comparison supports, from the rows' own ratios."""
     def ratio(name, source):
         try:
@@ -467,12 +476,15 @@ def _sfb_reading(check) -> str:
     if ri is not None:
         parts.append(f"With bulk viscosity the same slip would last {ri:.2g} × the observed time.")
     for name in ("yield_stress", "eta_eff", "slip_time"):
-        rm = ratio(name, "md-calibrated")
+        rm = None if far else ratio(name, "md-calibrated")
         if rm is not None:
             parts.append(f"{ref['calibrated'][0].upper()}{ref['calibrated'][1:]} "
                          f"{name.replace('_', ' ')}: ratio {rm:.3g} to {ref['whose']}.")
     if ref["column"] != "Klein":
         pass                    # a measured slip: no MD path to read
+    elif far:
+        parts.append("The MD film's law, carried across many decades of shear rate, gives no "
+                     "SFB-scale prediction here (appendix).")
     elif any(r_["source"] == "md-calibrated" for r_ in check.rows):
         parts.append("Ratios far from 1 on the MD path measure how far a 3-layer LJ film at MD shear rates, "
                      "carried through the unit mapping and the rate law, is from the SFB film; they do not "
@@ -489,6 +501,7 @@ def cost_section(run) -> Section:
     if not rj:
         sec.p(f"No `run.json` in `{run.run_dir}`: not a run of `filmfriction run`, so no cost "
               "or provenance to report.")
+        sec.absent = "a trace, not a run of `filmfriction run`: no `run.json`"
         return sec
     rows = [("status", str(rj.get("status"))),
             ("wall time", f"{_fmt(rj.get('wall_time'))} s"),
