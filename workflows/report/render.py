@@ -34,8 +34,9 @@ from filmfriction.reduced_model.units import OMCTS
 from ..rundir import read_report_inputs, split_sweeps
 from .document import Figure, Section, Table
 from .summary import consistency_checks
-from .overview import appendix_section, consistency_section, summary_section
-from .sections import (PARAMETER_QUANTITIES, calibration_section, cost_section,
+from .overview import (appendix_section, consistency_section, summary_section,
+                       user_contact_point)
+from .sections import (PARAMETER_QUANTITIES, attempt, calibration_section, cost_section,
                        observable_section, scene_section, sfb_section, similarity_section,
                        sweep_section, viscosity_section)
 
@@ -169,9 +170,12 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
                 viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
                 calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
-                sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
+                sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures, run),
                 similarity_section(inputs.sfb, run_dirs, failures,
-                                    compare=[Path(c) for c in compare]),
+                                    compare=[Path(c) for c in compare],
+                                    user_point=attempt(failures, "the set-up on the λ–ζ map",
+                                                       user_contact_point, inputs.sfb,
+                                                       run.analysis)),
                 cost_section(run)]
     if sweeps:
         sections.insert(1 + len(observed), sweep_section(sweeps))

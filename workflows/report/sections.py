@@ -16,7 +16,8 @@ from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 
 from .document import Figure, Section, Table, fixed_decimals, link, trace_source
-from .plots import fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity, sfb_reference
+from .plots import (fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity,
+                    measured_slips, sfb_reference)
 
 
 #: Scene parameter → (quantity for reduced_model.units, LJ unit label).
@@ -251,7 +252,7 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
     return sec
 
 
-def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
+def sfb_section(check, why_none: str, remarks: list, failures, run=None) -> Section:
     """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.rundir.SFBDocument`)."""
     from filmfriction.reduced_model.sfb.klein import BRAUN_TOSATTI_NOTE
 
@@ -263,15 +264,21 @@ def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
         sec.p(why_none)
         sec.p(BRAUN_TOSATTI_NOTE)
         return sec
-    png = None
-    if any(run.t is not None for run in check.slips.values()):
-        png = attempt(failures, "figure: sfb", fig_sfb, check)
-    if png:
-        sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
-                                   f"with bulk viscosity, and (if calibrated) the {ref['calibrated']} "
-                                   "film."))
     from .overview import APPENDIX_TITLE, far_extrapolated
     far = far_extrapolated(check)
+    png = None
+    measured = [] if run is None else attempt(failures, "measured slips", measured_slips, run) or []
+    if any(s.t is not None for s in check.slips.values()):
+        png = attempt(failures, "figure: sfb", lambda: fig_sfb(check, measured, carried_over=not far))
+    if png:
+        sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
+                                   "with bulk viscosity"
+                       + ("" if far else f" and (if calibrated) the {ref['calibrated']} film")
+                       + (f", over the {len(measured)} measured slips (grey, wall displacement "
+                          "since y, up to s)" if measured else
+                          f", and {ref['whose']} slip time and distance (★)")
+                       + ". Each model curve ends at its s (●); a dashed one did not reach s "
+                         "and stops at the figure's window."))
     rows = []
     for r in check.rows:
         if r["source"] == "similarity":   # their own section
@@ -381,7 +388,7 @@ def _bingham_reading(rows) -> str:
     return text
 
 
-def similarity_section(check, run_dirs, failures, compare=()) -> Section:
+def similarity_section(check, run_dirs, failures, compare=(), user_point=None) -> Section:
     """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given: the rows
     each run's ``sfb.json`` holds (Klein's point from his printed parameters)."""
     from filmfriction.reduced_model.sfb.similarity import klein_contact, similarity_numbers
@@ -406,9 +413,14 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
     else:
-        sec.p("Not an MD run: these numbers set an MD film beside Klein's contact. A measured "
-              "trace is an experiment of its own: its slip is set beside the model in the SFB "
-              "section above.")
+        sec.p("Not an MD run: the table of numbers sets an MD film beside Klein's contact. A "
+              "measured trace is an experiment of its own: its slip is set beside the model in "
+              "the SFB section above"
+              + (f", and its contact is placed on the λ–ζ map below beside Klein's: λ = "
+                 f"{_fmt(user_point[3], 3)} ± {_fmt(user_point[4], 2)}, ζ = "
+                 f"{_fmt(user_point[1], 3)} (film ± {_fmt(user_point[2], 2)}, from the "
+                 "set-up's K, M, A, D, V and the measured F_s, F_b and η_eff)."
+                 if user_point is not None else "."))
     others = {}
     for d in list(run_dirs[1:]) + [Path(c) for c in compare]:
         try:
@@ -439,6 +451,8 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     zk = n["film_damping_ratio"].value + n["mount_damping_ratio"].value
     points = [("Klein (SFB, OMCTS)", zk, n["film_damping_ratio"].stderr, n["lambda"].value,
                n["lambda"].stderr)]
+    if user_point is not None:
+        points.append(user_point)
     for d, rs in [(Path(run_dirs[0]), rows)] + list(others.items()):
         if rs:
             points.append(_lambda_zeta_point(f"{scene_of(d) or d.name} (MD)", rs))
