@@ -11,6 +11,7 @@ from pathlib import Path
 from filmfriction.analysis.util import format_value as _fmt
 from filmfriction.md_inputs.contract import RUN_FILE
 
+from ..rundir import reference
 from .document import Section, Table, link
 from .summary import (MAX_DECADES, STATUSES, answers, consistency_checks,
                       extrapolated_decades)
@@ -139,8 +140,8 @@ def summary_section(run, inputs, checks, compared, left_out, failures) -> Sectio
                 row += [ans[i].answer, f"**{ans[i].status}**"]
             rows.append(tuple(row) + (where(a),))
         sec.add(Table(tuple(header) + ("section",), tuple(rows)))
-    sec.p("How a status is decided (established / inconclusive / not comparable): "
-          + " ".join(f"*{a.question}* {a.rule}." for a in main))
+    sec.p("How a status is decided (established / inconclusive / not comparable):")
+    sec.add(Table(("question", "rule"), tuple((a.question, a.rule) for a in main)))
     if left_out:
         sec.p("Left out, their inputs absent: " + "; ".join(
             f"{t} ({why})" for t, why in left_out) + ".")
@@ -184,7 +185,7 @@ def appendix_section(sfb) -> Section | None:
           "in the study measures. These numbers are therefore not predictions: they are "
           "listed here to one significant figure, with no ratio and no interval, and left out "
           f"of the main SFB table (rule: at most {MAX_DECADES:g} decade of extrapolation).")
-    rows = [(r["name"], _fmt(r["klein"], 2), "–" if r["model"] is None else f"~{r['model']:.0e}",
+    rows = [(r["name"], _fmt(reference(r), 2), "–" if r["model"] is None else f"~{r['model']:.0e}",
              r["units"], r["note"]) for r in sfb.rows if r["source"] == "md-calibrated"]
     sec.add(Table(("quantity", "SFB", "carried-over model (order of magnitude)", "units",
                    "note"), tuple(rows)))

@@ -10,6 +10,7 @@ from filmfriction.analysis.trace import unit as _unit
 from filmfriction.analysis.trace_figure import scaled_unit
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 
+from ..rundir import reference
 from .document import fixed_decimals, trace_source
 
 
@@ -161,7 +162,7 @@ def sfb_curves(check, *, carried_over: bool = True) -> list[tuple[str, np.ndarra
     slip time reached): a curve never runs beyond what the table says. ``carried_over``
     False leaves the calibrated film out (a law carried too many decades: appendix)."""
     ref = sfb_reference(check)
-    labels = {"klein": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
+    labels = {"klein": ref["curve"], "setup": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
     if not carried_over:
         labels.pop("md")
     ends = [r.slip_time for k, r in check.slips.items()
@@ -202,7 +203,7 @@ def fig_sfb(check, measured=(), *, carried_over: bool = True, axes_out: list | N
     ref = sfb_reference(check)
     try:
         row = check.row("slip_time")
-        tau, dx = row["klein"], check.doc.get("geometry", {}).get("slip_distance")
+        tau, dx = reference(row), check.doc.get("geometry", {}).get("slip_distance")
     except KeyError:
         tau = dx = None
     if tau and dx and not measured:

@@ -15,6 +15,7 @@ from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 
+from ..rundir import reference
 from .document import Figure, Section, Table, fixed_decimals, link, trace_source
 from .plots import (fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity,
                     measured_slips, sfb_reference)
@@ -286,7 +287,7 @@ def sfb_section(check, why_none: str, remarks: list, failures, run=None) -> Sect
         if far and r["source"] == "md-calibrated":   # not a prediction: the appendix
             continue
         unc = r.get("uncertainty")
-        rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+        rows.append((r["name"], r["source"], _fmt(reference(r), 3), _fmt(r["model"], 3),
                      "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
                      "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
     sec.add(Table(("quantity", "source", ref["column"], "model", "ratio", "model range", "units", "note"),

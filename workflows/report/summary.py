@@ -22,6 +22,8 @@ from filmfriction.analysis.trace import unit as _unit
 from filmfriction.analysis.trace_figure import scaled_unit
 from filmfriction.analysis.util import format_value as _fmt
 
+from ..rundir import reference
+
 __all__ = ["Answer", "Check", "answers", "consistency_checks", "extrapolated_decades",
            "STATUSES", "MAX_DECADES", "REPLAY_TOLERANCE", "BINGHAM_REGIME"]
 
@@ -123,7 +125,9 @@ def _energy(a: dict) -> Answer:
     e = a.get("energy") or {}
     q = "Where does a slip's energy go?"
     rule = ("established: the viscous fraction's standard error is known over ≥ 3 slips and "
-            "every independent heat check (film heat vs the thermostat's) agrees at 99 %")
+            + ("every independent heat check (film heat vs the thermostat's) agrees at 99 %"
+               if units == "lj" else "(a measured trace has no independent heat measurement) "
+               "the film heat comes from the equation of motion"))
     vf = e.get("viscous_fraction") or {}
     if vf.get("mean") is None:
         return Answer(q, "not measured: " + str((a.get("skipped") or {}).get("energy",
@@ -232,7 +236,7 @@ def _sfb_prediction(cal: dict | None, sfb, measured: bool) -> Answer:
     if row is None or row.get("model") is None:
         return Answer(q, "no calibrated slip time", "inconclusive", rule, SECTIONS["sfb"])
     unc = row.get("uncertainty")
-    ref = row.get("klein")
+    ref = reference(row)
     inside = bool(unc and ref is not None and unc[0] <= ref <= unc[1])
     text = (f"slip time {estimate(row['model'], None, 'si', 'time')} "
             + (f"({estimate(unc[0], None, 'si', 'time')} … {estimate(unc[1], None, 'si', 'time')})"
@@ -256,7 +260,7 @@ def _beside_klein(sfb, measured: bool, user_point=None) -> Answer:
             row = sfb.row("slip_time", "sfb-parameters")
         except KeyError:
             return Answer(q, "no slip-time row", "inconclusive", rule, SECTIONS["sfb"])
-        unc, ref = row.get("uncertainty"), row.get("klein")
+        unc, ref = row.get("uncertainty"), reference(row)
         inside = bool(unc and ref is not None and unc[0] <= ref <= unc[1])
         text = (f"slip time {estimate(row['model'], None, 'si', 'time')} "
                 + (f"({estimate(unc[0], None, 'si', 'time')} … "
