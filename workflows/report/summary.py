@@ -168,6 +168,8 @@ def _viscosity(a: dict, cal: dict | None, checks: list) -> Answer:
         if units == "lj":
             from filmfriction.reduced_model.units import OMCTS
             text += f" (= {OMCTS.to_si(p['value'], 'viscosity'):.3g} Pa·s with OMCTS' units)"
+        if eta_disagree:
+            text += "; other estimators disagree with it by more than 2 σ (consistency)"
         return Answer(q, text, "inconclusive" if eta_disagree else "established", rule,
                       SECTIONS["eta"])
     vals = [c["eta_eff"] for c in choice.get("cross_checks") or [] if c.get("eta_eff")]
