@@ -207,8 +207,13 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
     if ageing is not None:
         stderr = math.nan if ageing["stderr"] is None else ageing["stderr"]
         sig = abs(ageing["value"]) > 2 * stderr
+        fs = (rc.get("static_force") or {}).get("value")
+        too_big = fs is not None and abs(ageing["value"]) > abs(fs)
         sec.p(f"Contact ageing: dF_s/d ln(t_stick) = {_pm(ageing)}; "
-              + ("more than two standard errors from zero" if sig else "not resolved (within two standard errors of zero)")
+              + ("larger than F_s itself, so not read as contact ageing (see the consistency "
+                 "section)" if too_big else
+                 "more than two standard errors from zero" if sig else
+                 "not resolved (within two standard errors of zero)")
               + " (a correlation over the detected slips; small secondary slips with short sticks, if the "
                 "detector counts them, push it up too).")
     for k, v in rc.get("failures", {}).items():
