@@ -128,7 +128,8 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
     named = [label for fig in labels for axis in fig for label in axis if label]
     units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
     # SI units, with a prefix chosen for the numbers: no axis offset (1e-5 ...)
-    assert {"µN", "s", "ms", "nm", "pJ", "Pa·s", "1/s"} <= units, units
+    assert {"µN", "s", "pJ", "Pa·s", "1/s", "µm/s"} <= units, units
+    assert not units & {"N", "J", "m/s"}, units       # µN-, pJ-sized numbers in bare units
     # a measured trace: no thermostat or mount dashpot term in the energy figure or its caption
     energy = md.split("## Energy partition", 1)[1].split("\n## ", 1)[0]
     assert "thermostat" not in energy and "dashpot" not in energy
