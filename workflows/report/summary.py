@@ -417,6 +417,13 @@ def consistency_checks(analysis: dict, calibration: dict | None) -> list[Check]:
                              f"{estimate(fs_mean, fs.get('stderr'), units, 'force')}",
                              "a kinetic friction above the static one cannot give stick-slip "
                              "in the model: the fit trades F_k against B" if big else ""))
+    cm = law.get("comoving_mass") or {}
+    if cm.get("mean") is not None:
+        neg = cm["mean"] < 0
+        out.append(Check("slip law's co-moving mass not negative", "disagree" if neg else "agree",
+                         estimate(cm["mean"], cm.get("stderr"), units, "mass"),
+                         "a negative mass is unphysical: the whole-slip fit trades the co-moving "
+                         "mass against the damping, and neither is resolved" if neg else ""))
     # 4. the independent heat checks
     for key, c in ((analysis.get("energy") or {}).get("heat_check") or {}).items():
         out.append(Check(f"film heat vs thermostat's ({key})",
