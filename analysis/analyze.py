@@ -24,6 +24,7 @@ from filmfriction.md_inputs.contract import ANALYSIS_FILE
 from . import observables, stickslip
 from .cycles_csv import write_cycles_csv
 from .observables.observable import Context, Observable
+from .results import AnalysisResult, trace_from_columns
 from .sliding import last_half, not_sliding, sliding_state
 from .stickslip import Regime
 from .trace import MissingInput, Trace, unit
@@ -100,29 +101,49 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                    trajectory_analyses=structure)
 
 
-def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) -> tuple[dict, dict]:
+def analyze(trace, *, skip: int | None = None, structure: bool = True,
+            units: str | None = None, **parameters) -> AnalysisResult:
     """Analyse a trace: the detection and the regime (:func:`context`), then
     every observable (:mod:`filmfriction.analysis.observables`) in its order.
 
     Parameters
     ----------
-    trace : Trace
+    trace : Trace, dict of arrays or pandas DataFrame
+        A trace read from a file, or its columns in memory named as the analysis
+        names them (``time``, ``spring_force``, ``drive_position`` ...).
     skip : int, optional
         Slips left out of the summaries (default: 1, the start-up yield, when
         3 or more slips are found, else 0).
     structure : bool
         Run the trajectory analyses when the run has a trajectory.
+    units, **parameters
+        For columns in memory only: their unit system (``"lj"``, the default, or
+        ``"si"``) and the trace's parameters (``spring_constant``, ``mass``,
+        ``area``, ``thickness``, ``drive_velocity``, ``mount_damping``).
 
     Returns
     -------
-    document : dict
-        The ``analysis.json`` content.
-    per_cycle : dict
-        Per-cycle columns (for the CSV).
+    AnalysisResult
+        ``.document`` (the ``analysis.json`` content, also ``.to_dict()``; its
+        sections as attributes), ``.per_cycle`` (per-cycle columns, also
+        ``.slips_table()``), ``.plot_trace()``, ``.plot_slips()``; it unpacks as
+        ``document, per_cycle``.
+
+    Examples
+    --------
+    >>> from filmfriction.analysis.synthetic import klein_trace
+    >>> r = analyze(klein_trace(), units="si", spring_constant=97.0, mass=1.47e-3,
+    ...             drive_velocity=1e-7)
+    >>> r.status, r.slips["count"]
+    ('stick-slip', 4)
 
     A trace of fewer than :data:`MIN_ROWS` rows is ``unresolved``: its
     ``regime_note`` says why, and every section is in ``skipped`` with that reason.
     """
+    if not isinstance(trace, Trace):
+        trace = trace_from_columns(trace, units=units or "lj", **parameters)
+    elif units is not None or parameters:
+        raise TypeError("units and parameters go with columns in memory; a Trace has its own")
     doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace)}
     skipped: dict[str, str] = {}
     if len(trace) < MIN_ROWS:
@@ -138,7 +159,7 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
             if obs.applies(ctx):
                 skipped[obs.key] = why
         doc["skipped"] = skipped
-        return doc, {}
+        return AnalysisResult(doc, {}, trace)
     ctx = context(trace, skip=skip, structure=structure)
     ctx = replace(ctx, sections=doc, skipped=skipped)
     t, events = trace.time, ctx.events
@@ -171,7 +192,7 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                                  "already written by another observable")
             per_cycle[column] = pad + values
     doc["skipped"] = skipped
-    return doc, per_cycle
+    return AnalysisResult(doc, per_cycle, trace)
 
 
 def run_observable(obs: Observable, ctx: Context) -> tuple[dict, dict]:

@@ -58,11 +58,36 @@ def write_sfb(check, path, extra: dict | None = None) -> Path:
             keep = t <= TRACE_SPAN * run.slip_time
             t, x = t[keep], x[keep]
         lines += [f"{key},{a!r},{b!r}\n" for a, b in zip(t.tolist(), x.tolist())]
-    write_atomic(traces, "".join(lines))
     doc = check.as_dict()
     doc["traces"] = traces.name
     doc.update(extra or {})
+    if doc.get("measured"):
+        doc = measured_keys(doc)
+        lines = [line.replace("klein,", "setup,", 1) if line.startswith("klein,") else line
+                 for line in lines]
+    write_atomic(traces, "".join(lines))
     return write_atomic(path, to_json(doc) + "\n")
+
+
+def measured_keys(doc: dict) -> dict:
+    """An SFB document of a measured slip (``sfb --setup --measured``) keyed by what its
+    numbers are: each row's experiment value under ``measured`` (not ``klein``; no
+    ``klein_source``/``klein_range``, which describe Klein's derivations) and the slip of
+    the set-up's parameters under ``slips.setup`` (not ``slips.klein``)."""
+    out = dict(doc)
+    rows = []
+    for r in doc["rows"]:
+        r = {("measured" if k == "klein" else k): v for k, v in r.items()
+             if k not in ("klein_source", "klein_range")}
+        rows.append(r)
+    out["rows"] = rows
+    out["slips"] = {("setup" if k == "klein" else k): v for k, v in doc["slips"].items()}
+    return out
+
+
+def reference(row: dict):
+    """The experiment's number of an SFB row: the measured one (``measured``) or Klein's."""
+    return row["measured"] if "measured" in row else row.get("klein")
 
 
 def read_json(path):
@@ -210,6 +235,35 @@ def _command(*words) -> str:
     return " ".join(shlex.quote(str(w)) for w in words)
 
 
+#: what a suggested command writes in the place of the user's set-up file, whose path no
+#: output records
+SETUP_PLACEHOLDER = "YOUR_SETUP.toml"
+
+
+def sfb_command(run_dir: Path, cal_path: Path, sfb_path: Path, *, with_calibration=True) -> str:
+    """The ``filmfriction sfb`` command that (re)writes ``sfb_path`` for this run as it was
+    made: a measured trace (SI ``analysis.json``) or an ``sfb.json`` made with ``--setup``
+    keeps ``--setup`` and ``--measured`` (the set-up file's path is not recorded: a
+    placeholder names it), never falling back to Klein's set-up."""
+    measured = False
+    try:
+        doc = read_json(sfb_path)
+        measured = isinstance(doc, dict) and bool(doc.get("setup"))
+    except ValueError:
+        pass
+    try:
+        analysis = read_json(Path(run_dir) / "analysis.json")
+        measured = measured or (isinstance(analysis, dict) and analysis.get("units") == "si")
+    except ValueError:
+        pass
+    words = ["filmfriction", "sfb"]
+    if measured:
+        words += ["--setup", SETUP_PLACEHOLDER, "--measured", run_dir]
+    if with_calibration:
+        words += ["--calibration", cal_path]
+    return _command(*words, "--out", sfb_path)
+
+
 def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dict) -> ReportInputs:
     """Read ``calibration.json`` and ``sfb.json`` of the main run for the report; never compute them.
 
@@ -255,8 +309,7 @@ def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dic
             got.missing.append((f"{cal_path} across the runs given", cal_cmd))
     # as the study runs it: with the MD calibration, unless calibration.json has none
     no_md = cal is not None and cal.get("md_calibration") is None
-    sfb_cmd = (_command("filmfriction", "sfb", "--out", sfb_path) if no_md
-               else _command("filmfriction", "sfb", "--calibration", cal_path, "--out", sfb_path))
+    sfb_cmd = sfb_command(run_dir, cal_path, sfb_path, with_calibration=not no_md)
     failed = _failed(failures, "sfb")
     if failed:
         got.why_no_sfb = f"The SFB check failed: {failed}."

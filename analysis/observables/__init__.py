@@ -2,7 +2,7 @@
 
 Every section of the analysis is an observable: ``slips.py`` (the cycles in
 Klein's notation and the force trace), ``energy.py`` (the energy partition and
-the run's ledger), ``sliding.py`` (the last half as a sliding state),
+the run's ledger), ``sliding.py`` (the time-averaged friction over the last half),
 ``viscosity.py`` (steady, per slip, from the velocity profile), ``structure.py``
 (layers, ψ6 and the gap from the trajectory) and ``slip_law.py`` (Klein's slip
 equation fitted on the slips).  The analysis

@@ -16,6 +16,7 @@ import numpy as np
 from .. import energy as _energy
 from .. import stickslip
 from ..trace import MissingInput, unit
+from ..trace_figure import scaled_unit
 from ..util import finite_or_none
 from .observable import (Context, Observable, entry, format_estimate, format_value, png_bytes,
                          pyplot, shade_slips)
@@ -32,6 +33,10 @@ ENERGY_QUANTITIES = {"spring_released": "energy", "spring_released_exact": "ener
                      "dilation_work": "energy", "quadrature_residual": "1",
                      "thermostat_heat_slip": "energy", "dashpot_static_bias": "force",
                      "film_heat": "energy", "film_heat_cycle": "energy"}
+
+#: energy terms only an MD run has (its thermostat, its mount dashpot, the dilation
+#: against the load, the engine's ledger): not drawn for a measured (SI) trace
+MD_ONLY_TERMS = ("thermostat", "mount dashpot", "dilation", "ledger", "released: stuck film")
 
 #: the independent checks of the film heat: (key, film heat, the thermostat's, windows)
 HEAT_CHECKS = (("slip", "film_heat", "thermostat_heat_slip", "per slip"),
@@ -165,6 +170,16 @@ class Energy(Observable):
         return [text]
 
     def figures(self, run) -> list[tuple[str, bytes, str]]:
+        if run.trace.units == "si":
+            # a measured trace: no thermostat, no mount dashpot, no dilation, no ledger
+            bars = [b for b in energy_bars(run)
+                    if not b[0].strip().startswith(MD_ONLY_TERMS) and math.isfinite(b[1])]
+            return [("energy", fig_energy(bars, unit(run.trace.units, "energy")),
+                     "Where the spring's energy goes, per slip (its window, from just before "
+                     "y to just after s): what is released (the spring, the drive's work "
+                     "during the slip) and where it goes (the film's heat, from the "
+                     "equation of motion, and the ringing left at s); per cycle (y → next "
+                     "y): the film's heat. Mean ± standard error over the analysed slips.")]
         out = [("energy", fig_energy(energy_bars(run), unit(run.trace.units, "energy")),
                 "Where the spring's energy goes. Per slip (its window, from just before y to "
                 "just after s): what is released (spring, drive, the stuck film's elastic "
@@ -241,6 +256,9 @@ def fig_energy(bars, energy_unit: str) -> bytes:
     labels = [b[0] for b in bars]
     vals = np.array([b[1] for b in bars], float)
     errs = np.array([b[2] for b in bars], float)
+    if energy_unit == "J":      # an SI prefix for the numbers, not a 1e-13 offset
+        factor, energy_unit = scaled_unit(vals[np.isfinite(vals)], "si", "energy")
+        vals, errs = vals * factor, errs * factor
     e0 = np.where(np.isfinite(errs), errs, 0.0)
     colors = {"released": "tab:blue", "film": "tab:red", "  the": "tab:pink",
               "ringing": "tab:orange", "mount": "tab:brown", "dilation": "tab:gray",

@@ -31,7 +31,7 @@ class Sliding(Observable):
     """The time-averaged friction and the wall's speed over the last half."""
 
     key = "sliding"
-    title = "The last half as a sliding state"
+    title = "Time-averaged friction over the last half"
     order = 30
     table_header = ("last half of the trace", "value")
 
@@ -48,6 +48,10 @@ class Sliding(Observable):
         return rows
 
     def notes(self, section: dict) -> list[str]:
-        return ["The spring force averaged over the last half of the run is the friction a "
-                "sweep plots against the drive velocity; a wall moving at the drive's "
-                "velocity (ratio 1 within 20 %) slides steadily."]
+        text = ("The spring force averaged over the last half of the run, stick and slip "
+                "alike, is the friction a sweep plots against the drive velocity; it says "
+                "nothing by itself of whether the wall slides steadily.")
+        if section.get("wall_velocity_ratio") is not None:
+            text += (" The wall's mean velocity over the drive's (above) tells: a ratio of 1 "
+                     "within 20 % is steady sliding.")
+        return [text]

@@ -24,6 +24,7 @@ from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
 
 from ..slip_law import BRANCHES, film_force, fit_film_force
 from ..trace import unit
+from ..trace_figure import scaled_unit
 from ..util import finite_or_none
 from .observable import (Context, MissingInput, Observable, column, format_estimate, format_value,
                          parameter, png_bytes, pyplot)
@@ -204,6 +205,12 @@ class SlipLaw(Observable):
         lab = lambda q: unit(tr.units, q)  # noqa: E731
         yi = np.asarray(run.cycles.get("yield_index", []), int)[run.skip:]
         si = np.asarray(run.cycles.get("stick_index", []), int)[run.skip:]
+        # SI: a prefix chosen for the numbers (µN), never an axis offset
+        fscale, flab = scaled_unit(f, tr.units, "force")
+        ff = ff * fscale
+        vscale, vlab = scaled_unit(vs, tr.units, "length")   # m/s as µm/s ...
+        vlab = f"{vlab}/s" if tr.units == "si" else lab("velocity")
+        vs = vs * vscale
         fig, ax = plt.subplots(figsize=(6.4, 4.0))
         cmap = plt.get_cmap("viridis")
         vmax = 0.0
@@ -221,11 +228,11 @@ class SlipLaw(Observable):
             if fk is None or bb is None or vmax <= 0:
                 continue
             vv = np.linspace(0.0, vmax, 50)
-            ax.plot(vv, fk + bb * vv, styles.get(name, "k-"), lw=1.5,
+            ax.plot(vv, (fk + bb * vv / vscale) * fscale, styles.get(name, "k-"), lw=1.5,
                     label=f"{name}: F_k = {fk:.3g} {lab('force')}, B = {bb:.3g} {lab('damping')}")
         ax.axhline(0, color="0.6", lw=0.5)
-        ax.set_xlabel(f"wall velocity during the slip v [{lab('velocity')}]")
-        ax.set_ylabel(f"film force F_spring − M·a − γM(v − V) [{lab('force')}]")
+        ax.set_xlabel(f"wall velocity during the slip v [{vlab}]")
+        ax.set_ylabel(f"film force F_spring − M·a − γM(v − V) [{flab}]")
         # above the axes: inside, it hid slips' points (the loops fill the plane)
         ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, frameon=False)
         return png_bytes(fig)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..trace_figure import scaled_unit
 from ..trace import MissingInput, unit
 from .observable import Context, Observable, entry, format_estimate, png_bytes, pyplot, shade_slips
 
@@ -93,16 +94,21 @@ def fig_trace(run) -> bytes:
     fig, axes = plt.subplots(rows, 1, figsize=(9, 4.2 if rows == 2 else 3), sharex=True,
                              gridspec_kw={"height_ratios": [3, 1][:rows]}, squeeze=False)
     ax = axes[0, 0]
+    # an SI prefix chosen for the numbers (µN, nm), never an axis offset (the time axis
+    # stays in the trace's unit: the slips' shading is drawn on it)
+    ff, lf = scaled_unit(f, tr.units, "force")
+    f = f * ff
     ax.plot(t, f, lw=0.9, color="0.2", label=force_label(tr.units))
     yi = np.asarray(run.cycles.get("yield_index", []), int)
     si = np.asarray(run.cycles.get("stick_index", []), int)
     if len(yi):
         ax.plot(t[yi], f[yi], "v", color="tab:red", ms=6, label="y (yield)")
         ax.plot(t[si], f[si], "^", color="tab:green", ms=6, label="s (re-stick)")
-    ax.set_ylabel(f"spring force [{lab('force')}]")
+    ax.set_ylabel(f"spring force [{lf}]")
     if rows == 2:
-        axes[1, 0].plot(t, tr.columns["gap"], lw=0.7, color="tab:blue", label="gap")
-        axes[1, 0].set_ylabel(f"gap [{lab('length')}]")
+        fg, lg = scaled_unit(tr.columns["gap"], tr.units, "length")
+        axes[1, 0].plot(t, tr.columns["gap"] * fg, lw=0.7, color="tab:blue", label="gap")
+        axes[1, 0].set_ylabel(f"gap [{lg}]")
     for a in axes[:, 0]:
         shade_slips(a, run, label=a is ax)
     # the legend above the axes, right-aligned: never over the trace (nor the offset text)

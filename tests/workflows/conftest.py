@@ -83,6 +83,13 @@ def check_content(run_dir: Path, out: Path | None = None) -> None:
     md = out.with_suffix(".md").read_text()
     for title in SECTIONS:
         assert title in html and title in md, title
+    # the report opens with its summary, then the consistency of its own numbers
+    assert re.findall(r"^## (.+)$", md, re.M)[:2] == [
+        "Summary: the study's questions and answers", "Consistency of the report's own numbers"]
+    assert re.findall(r"<h2 id='([^']+)'>", html)[:1] == ["summary-the-studys-questions-and-answers"]
+    # every link of the summary leads to a section of the page
+    ids = set(re.findall(r"<h2 id='([^']+)'>", html))
+    assert set(re.findall(r"<a href='#([^']+)'>", html)) <= ids
     figures = images(html)
     assert {"trace", "energy", "film", "sfb"} <= set(figures), set(figures)
     for name, data in figures.items():

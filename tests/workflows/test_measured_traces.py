@@ -162,7 +162,8 @@ def test_sfb_runs_on_the_users_setup_and_slip(chain):
     row = next(r for r in doc["rows"] if r["name"] == "slip_time"
                and r["source"] == "sfb-parameters")
     # the measured slip time is the trace's, not Klein's 25 ms
-    assert row["klein"] == pytest.approx(analysis["slips"]["slip_duration"]["mean"])
+    assert row["measured"] == pytest.approx(analysis["slips"]["slip_duration"]["mean"])
+    assert "klein" not in row and "setup" in doc["slips"] and "klein" not in doc["slips"]
     assert row["uncertainty"][0] < row["model"] < row["uncertainty"][1]
     assert doc["units"]["name"] == "SI (identity)"      # an SI calibration is not re-mapped
     assert "measured" in printed["sfb"].splitlines()[2]

@@ -123,9 +123,17 @@ def test_the_study_writes_what_the_report_renders(tmp_path):
     assert "Inputs the report did not find" not in md and "Steps that failed" not in md
     for name in ("trace", "viscosity", "replay", "replay-errors", "sfb"):
         assert (d / f"report-{name}.png").exists(), name
-    # the SFB table of the report is the one in sfb.json, md-calibrated rows included
-    row = check.row("slip_time", "md-calibrated")
-    assert f"| slip_time | md-calibrated | {row['klein']:.3g} |" in md
+    # the SFB table of the report is the one in sfb.json; the md-calibrated rows carry the
+    # law many decades of shear rate: they are in the appendix, without ratio or interval
+    from filmfriction.workflows.report.summary import MAX_DECADES, extrapolated_decades
+
+    assert extrapolated_decades(check.rows) > MAX_DECADES
+    main, appendix = md.split("## Appendix: SFB-scale carry-over")
+    row = check.row("slip_time", "sfb-parameters")
+    assert f"| slip_time | sfb-parameters | {row['klein']:.3g} |" in main
+    assert "| md-calibrated |" not in main
+    assert f"| slip_time | {check.row('slip_time', 'md-calibrated')['klein']:.2g} | ~" in appendix
+    assert md.index("## Summary: the study's questions and answers") < md.index("## Scene")
 
 
 @pytest.mark.md

@@ -127,7 +127,15 @@ def test_a_measured_si_trace_is_reported_in_its_own_units(tmp_path, run_cli, mon
     assert md.splitlines()[0] == f"# filmfriction report — trace.csv ({tmp_path.name})"
     named = [label for fig in labels for axis in fig for label in axis if label]
     units = {u for label in named for u in re.findall(r"\[([^\]]+)\]", label)}
-    assert {"N", "s", "J", "Pa·s", "1/s"} <= units, units
+    # SI units, with a prefix chosen for the numbers: no axis offset (1e-5 ...)
+    assert {"µN", "s", "pJ", "Pa·s", "1/s", "µm/s"} <= units, units
+    assert not units & {"N", "J", "m/s"}, units       # µN-, pJ-sized numbers in bare units
+    # a measured trace: no thermostat or mount dashpot term in the energy figure or its caption
+    energy = md.split("## Energy partition", 1)[1].split("\n## ", 1)[0]
+    assert "thermostat" not in energy and "dashpot" not in energy
+    # the report opens with its summary, then the consistency of its own numbers
+    assert re.findall(r"^## (.+)$", md, re.M)[:2] == [
+        "Summary: the study's questions and answers", "Consistency of the report's own numbers"]
     assert not units & {"ε/σ", "τ", "σ", "ε", "ετ/σ³", "1/τ", "σ/τ"}, units
     for lj in ("ε/σ", "ετ/σ³", " τ ", "LJ", "MD spring force", "the MD trace"):
         assert lj not in md, lj

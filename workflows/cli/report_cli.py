@@ -28,7 +28,8 @@ def register(subparsers) -> None:
                     "('filmfriction analyze RUN_DIR', required), calibration.json ('filmfriction "
                     "calibrate RUN_DIR...'; across several runs or a sweep, give them all) and "
                     "sfb.json ('filmfriction sfb --calibration RUN_DIR/calibration.json --out "
-                    "RUN_DIR/sfb.json'). 'filmfriction run' writes all three. A file that is "
+                    "RUN_DIR/sfb.json'; for a measured trace 'filmfriction sfb --setup MY_SFB.toml "
+                    "--measured RUN_DIR --calibration ... --out ...'). 'filmfriction run' writes all three. A file that is "
                     "missing or out of date is said in the report and printed with the command "
                     "that makes it.")
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",

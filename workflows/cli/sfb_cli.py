@@ -234,7 +234,11 @@ def run(args) -> int:
                                             "measured": dataclasses.asdict(slip)}
         path = write_sfb(check, args.out, extra)
     if args.json:
-        print(json.dumps(check.rows, indent=2, allow_nan=False))
+        from filmfriction.workflows.rundir import measured_keys
+
+        rows = check.rows if setup is None else measured_keys(
+            {"rows": check.rows, "slips": {}})["rows"]   # keyed as sfb.json keys them
+        print(json.dumps(rows, indent=2, allow_nan=False))
         if path is not None:
             print(f"sfb check: {path}", file=sys.stderr)
         return 0

@@ -7,8 +7,10 @@ import math
 import numpy as np
 
 from filmfriction.analysis.trace import unit as _unit
+from filmfriction.analysis.trace_figure import scaled_unit
 from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 
+from ..rundir import reference
 from .document import fixed_decimals, trace_source
 
 
@@ -76,12 +78,15 @@ def fig_replay(run, trace: dict, start_time: float) -> bytes:
     tr = run.trace
     units = run.analysis.get("units", tr.units)
     fig, ax = plt.subplots(figsize=(9, 3.2))
-    ax.plot(tr.time, tr.spring_force, lw=0.9, color="0.3", label=trace_source(units))
-    ax.plot(trace["t"], trace["spring_force"], lw=1.2, color="tab:red", alpha=0.85,
-            label="calibrated model")
-    ax.axvline(start_time, color="tab:red", lw=0.6, ls=":")
-    ax.set_xlabel(f"time [{_unit(units, 'time')}]")
-    ax.set_ylabel(f"spring force [{_unit(units, 'force')}]")
+    # SI prefixes chosen for the numbers (µN, ms ...), never an axis offset
+    ft, lt = scaled_unit(tr.time, units, "time")
+    ff, lf = scaled_unit(tr.spring_force, units, "force")
+    ax.plot(tr.time * ft, tr.spring_force * ff, lw=0.9, color="0.3", label=trace_source(units))
+    ax.plot(np.asarray(trace["t"]) * ft, np.asarray(trace["spring_force"]) * ff, lw=1.2,
+            color="tab:red", alpha=0.85, label="calibrated model")
+    ax.axvline(start_time * ft, color="tab:red", lw=0.6, ls=":")
+    ax.set_xlabel(f"time [{lt}]")
+    ax.set_ylabel(f"spring force [{lf}]")
     # above the axes, right-aligned: never over the traces (nor the offset text)
     ax.legend(fontsize=8, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=2, frameon=False)
     return _png(fig)
@@ -133,27 +138,85 @@ def sfb_reference(check) -> dict:
             "calibrated": "calibrated"}
 
 
-def fig_sfb(check) -> bytes:
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.5, 3.4))
+def measured_slips(run) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each analysed slip of a measured (SI) trace as (time since y, wall displacement
+    since y), from y to its re-stick s; [] for an MD run or without a wall position."""
+    tr = run.trace
+    if run.analysis.get("units", tr.units) != "si":
+        return []
+    x = tr.wall_position()
+    yi = np.asarray(run.cycles.get("yield_index", []), int)
+    si = np.asarray(run.cycles.get("stick_index", []), int)
+    if x is None or yi.size == 0 or si.size != yi.size:
+        return []
+    out = []
+    for a, b in list(zip(yi, si))[run.skip:]:
+        if b > a:
+            out.append((tr.time[a:b + 1] - tr.time[a], x[a:b + 1] - x[a]))
+    return out
+
+
+def sfb_curves(check, *, carried_over: bool = True) -> list[tuple[str, np.ndarray, np.ndarray, bool]]:
+    """The SFB figure's model curves: (label, t [s], x [m], whether s was reached), each cut
+    at its s, or, where s was not reached, at the figure's time window (1.5 × the longest
+    slip time reached): a curve never runs beyond what the table says. ``carried_over``
+    False leaves the calibrated film out (a law carried too many decades: appendix)."""
     ref = sfb_reference(check)
-    labels = {"klein": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
+    labels = {"klein": ref["curve"], "setup": ref["curve"], "bulk": "bulk viscosity", "md": f"{ref['calibrated']} film"}
+    if not carried_over:
+        labels.pop("md")
+    ends = [r.slip_time for k, r in check.slips.items()
+            if k in labels and r.t is not None and math.isfinite(r.slip_time)]
+    window = 1.5 * max(ends) if ends else None
+    out = []
     for key, run in check.slips.items():
         if key not in labels or run.t is None:
             continue
-        t = np.asarray(run.t)
-        end = run.slip_time if math.isfinite(run.slip_time) else t[-1]
-        keep = t <= 1.5 * end
-        ax.plot(t[keep] * 1e3, np.asarray(run.x)[keep] * 1e9, label=labels[key])
-        if math.isfinite(run.slip_time):
-            ax.plot(run.slip_time * 1e3, run.slip_distance * 1e9, "o", color="k", ms=4)
-    ax.set_xscale("symlog", linthresh=1e-2)
-    # slips from tens of nm (Klein) to tens of µm (an MD-calibrated film): a linear axis
-    # would flatten the small ones onto zero
-    ax.set_yscale("symlog", linthresh=1.0)
+        t, x = np.asarray(run.t, float), np.asarray(run.x, float)
+        reached = math.isfinite(run.slip_time)
+        end = run.slip_time if reached else (window if window is not None else t[-1])
+        keep = t <= end
+        out.append((labels[key] + ("" if reached else " (s not reached)"), t[keep], x[keep],
+                    reached))
+    return out
+
+
+def fig_sfb(check, measured=(), *, carried_over: bool = True, axes_out: list | None = None
+            ) -> bytes:
+    """The SFB-scale slips of the reduced model on linear axes with SI prefixes, each up
+    to its s (●), the measured slips (``measured``: (t, x) pairs, SI) in grey beneath, and
+    the legend beside the axes.  ``axes_out`` receives the Axes (for the layout's test)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8.2, 3.6))
+    curves = sfb_curves(check, carried_over=carried_over)
+    t_all = [c[1] for c in curves] + [m[0] for m in measured]
+    x_all = [c[2] for c in curves] + [m[1] for m in measured]
+    ft, lt = scaled_unit(np.concatenate(t_all) if t_all else [1.0], "si", "time")
+    fx, lx = scaled_unit(np.concatenate(x_all) if x_all else [1.0], "si", "length")
+    for i, (t, x) in enumerate(measured):
+        ax.plot(t * ft, x * fx, color="0.55", lw=0.9, alpha=0.8,
+                label="measured slips (y → s)" if i == 0 else None)
+    for label, t, x, reached in curves:
+        (line,) = ax.plot(t * ft, x * fx, lw=1.6, label=label, ls="-" if reached else "--")
+        if reached:
+            ax.plot(t[-1] * ft, x[-1] * fx, "o", color=line.get_color(), ms=5, mec="k")
+    ref = sfb_reference(check)
+    try:
+        row = check.row("slip_time")
+        tau, dx = reference(row), check.doc.get("geometry", {}).get("slip_distance")
+    except KeyError:
+        tau = dx = None
+    if tau and dx and not measured:
+        ax.plot(tau * ft, dx * fx, "*", color="k", ms=11,
+                label=f"{ref['whose']} τ_s and Δx0")
+    ax.set_xlim(left=0)
     ax.set_ylim(bottom=0)
-    ax.set_xlabel("time since yield [ms]")
-    ax.set_ylabel("slip x(t) [nm] (log above 1 nm)")
-    ax.legend(fontsize=7, loc="upper left")
-    ax.set_title("SFB-scale slips in the reduced model (● = s)", fontsize=9)
+    ax.set_xlabel(f"time since yield [{lt}]")
+    ax.set_ylabel(f"slip x(t) [{lx}]")
+    # beside the axes: never over a curve
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    ax.set_title("SFB-scale slips in the reduced model (● = s, where the slip ends)",
+                 fontsize=9)
+    if axes_out is not None:
+        axes_out.append(ax)
     return _png(fig)

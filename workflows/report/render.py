@@ -33,7 +33,10 @@ from filmfriction.reduced_model.units import OMCTS
 
 from ..rundir import read_report_inputs, split_sweeps
 from .document import Figure, Section, Table
-from .sections import (PARAMETER_QUANTITIES, calibration_section, cost_section,
+from .summary import consistency_checks
+from .overview import (appendix_section, consistency_section, summary_section,
+                       user_contact_point)
+from .sections import (PARAMETER_QUANTITIES, attempt, calibration_section, cost_section,
                        observable_section, scene_section, sfb_section, similarity_section,
                        sweep_section, viscosity_section)
 
@@ -63,6 +66,7 @@ def _inline_html(text) -> str:
     out = str(escape(str(text)))
     out = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", out)
     out = re.sub(r"`(.+?)`", r"<code>\1</code>", out)
+    out = re.sub(r"\[([^\]]+)\]\(#([^)\s]+)\)", r"<a href='#\2'>\1</a>", out)
     return Markup(out)
 
 
@@ -161,16 +165,29 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
         "The trace's quantities are in SI units (N, m, s, J, Pa·s), as its analysis records; "
         "nothing is converted.")]
     observed = [observable_section(obs, run, failures) for obs in registered_observables()]
+    checks = consistency_checks(run.analysis, inputs.calibration)
     sections = [scene_section(run), *observed,
                 viscosity_section(inputs.calibration, inputs.why_no_calibration, failures),
                 calibration_section(inputs.calibration, inputs.why_no_calibration,
                                      inputs.calibration_remarks, run, failures),
-                sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures),
+                sfb_section(inputs.sfb, inputs.why_no_sfb, inputs.sfb_remarks, failures, run),
                 similarity_section(inputs.sfb, run_dirs, failures,
-                                    compare=[Path(c) for c in compare]),
+                                    compare=[Path(c) for c in compare],
+                                    user_point=attempt(failures, "the set-up on the λ–ζ map",
+                                                       user_contact_point, inputs.sfb,
+                                                       run.analysis)),
                 cost_section(run)]
     if sweeps:
         sections.insert(1 + len(observed), sweep_section(sweeps))
+    appendix = appendix_section(inputs.sfb)
+    if appendix is not None:
+        sections.append(appendix)
+    # a section whose inputs are absent is left out, with one line in the summary
+    left_out = [(sec.title, sec.absent) for sec in sections if sec.absent]
+    sections = [sec for sec in sections if not sec.absent]
+    compared = [Path(c) for c in compare] + list(run_dirs[1:])
+    sections = [summary_section(run, inputs, checks, compared, left_out, failures),
+                consistency_section(checks), *sections]
     if inputs.missing:
         sec = Section("Inputs the report did not find")
         sec.p("The report renders the files the study writes and computes none of them. These commands "

@@ -15,8 +15,10 @@ from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
 from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 
-from .document import Figure, Section, Table, fixed_decimals, trace_source
-from .plots import fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity, sfb_reference
+from ..rundir import reference
+from .document import Figure, Section, Table, fixed_decimals, link, trace_source
+from .plots import (fig_lambda_zeta, fig_replay, fig_replay_errors, fig_sfb, fig_viscosity,
+                    measured_slips, sfb_reference)
 
 
 #: Scene parameter → (quantity for reduced_model.units, LJ unit label).
@@ -205,8 +207,13 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
     if ageing is not None:
         stderr = math.nan if ageing["stderr"] is None else ageing["stderr"]
         sig = abs(ageing["value"]) > 2 * stderr
+        fs = (rc.get("static_force") or {}).get("value")
+        too_big = fs is not None and abs(ageing["value"]) > abs(fs)
         sec.p(f"Contact ageing: dF_s/d ln(t_stick) = {_pm(ageing)}; "
-              + ("more than two standard errors from zero" if sig else "not resolved (within two standard errors of zero)")
+              + ("larger than F_s itself, so not read as contact ageing (see the consistency "
+                 "section)" if too_big else
+                 "more than two standard errors from zero" if sig else
+                 "not resolved (within two standard errors of zero)")
               + " (a correlation over the detected slips; small secondary slips with short sticks, if the "
                 "detector counts them, push it up too).")
     for k, v in rc.get("failures", {}).items():
@@ -251,7 +258,7 @@ def calibration_section(cal, why_none: str, remarks: list, run, failures) -> Sec
     return sec
 
 
-def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
+def sfb_section(check, why_none: str, remarks: list, failures, run=None) -> Section:
     """The SFB table from ``sfb.json`` (:class:`~filmfriction.workflows.rundir.SFBDocument`)."""
     from filmfriction.reduced_model.sfb.klein import BRAUN_TOSATTI_NOTE
 
@@ -263,25 +270,39 @@ def sfb_section(check, why_none: str, remarks: list, failures) -> Section:
         sec.p(why_none)
         sec.p(BRAUN_TOSATTI_NOTE)
         return sec
+    from .overview import APPENDIX_TITLE, far_extrapolated
+    far = far_extrapolated(check)
     png = None
-    if any(run.t is not None for run in check.slips.values()):
-        png = attempt(failures, "figure: sfb", fig_sfb, check)
+    measured = [] if run is None else attempt(failures, "measured slips", measured_slips, run) or []
+    if any(s.t is not None for s in check.slips.values()):
+        png = attempt(failures, "figure: sfb", lambda: fig_sfb(check, measured, carried_over=not far))
     if png:
         sec.add(Figure("sfb", png, f"SFB-scale slips of the reduced model: {ref['curve']}, the same "
-                                   f"with bulk viscosity, and (if calibrated) the {ref['calibrated']} "
-                                   "film."))
+                                   "with bulk viscosity"
+                       + ("" if far else f" and (if calibrated) the {ref['calibrated']} film")
+                       + (f", over the {len(measured)} measured slips (grey, wall displacement "
+                          "since y, up to s)" if measured else
+                          f", and {ref['whose']} slip time and distance (★)")
+                       + ". Each model curve ends at its s (●); a dashed one did not reach s "
+                         "and stops at the figure's window."))
     rows = []
     for r in check.rows:
         if r["source"] == "similarity":   # their own section
             continue
+        if far and r["source"] == "md-calibrated":   # not a prediction: the appendix
+            continue
         unc = r.get("uncertainty")
-        rows.append((r["name"], r["source"], _fmt(r["klein"], 3), _fmt(r["model"], 3),
+        rows.append((r["name"], r["source"], _fmt(reference(r), 3), _fmt(r["model"], 3),
                      "–" if r["ratio"] is None else f"{r['ratio']:.3g}",
                      "–" if not unc else f"{_fmt(unc[0], 2)} … {_fmt(unc[1], 2)}", r["units"], r["note"]))
     sec.add(Table(("quantity", "source", ref["column"], "model", "ratio", "model range", "units", "note"),
                   tuple(rows)))
+    if far:
+        sec.p(f"The {ref['calibrated']} rows carry the film's law too many decades of shear "
+              f"rate to be predictions: they are in the {link(APPENDIX_TITLE, 'appendix')}, "
+              "without ratios or intervals.")
     sec.p(BRAUN_TOSATTI_NOTE)
-    sec.p(_sfb_reading(check))
+    sec.p(_sfb_reading(check, far))
     for n in check.notes:
         if n != BRAUN_TOSATTI_NOTE:
             sec.p(f"Assumption: {n}")
@@ -302,6 +323,7 @@ def observable_section(obs: Observable, run, failures) -> Section:
         elif why is None:
             why = f"not in this `analysis.json` (rerun `filmfriction analyze {run.run_dir}`)"
         sec.p(f"{obs.absent}: {why}.")
+        sec.absent = why
         return sec
     what = obs.key.replace("_", " ")
     for text in attempt(failures, f"lead: {what}", obs.lead, run) or ():
@@ -372,7 +394,7 @@ def _bingham_reading(rows) -> str:
     return text
 
 
-def similarity_section(check, run_dirs, failures, compare=()) -> Section:
+def similarity_section(check, run_dirs, failures, compare=(), user_point=None) -> Section:
     """Dimensionless numbers beside Klein's, and the λ–ζ map of every run given: the rows
     each run's ``sfb.json`` holds (Klein's point from his printed parameters)."""
     from filmfriction.reduced_model.sfb.similarity import klein_contact, similarity_numbers
@@ -397,9 +419,14 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
         sec.p("No similarity rows in `sfb.json` (make them with `filmfriction sfb --run RUN_DIR "
               "--out RUN_DIR/sfb.json`).")
     else:
-        sec.p("Not an MD run: these numbers set an MD film beside Klein's contact. A measured "
-              "trace is an experiment of its own: its slip is set beside the model in the SFB "
-              "section above.")
+        sec.p("Not an MD run: the table of numbers sets an MD film beside Klein's contact. A "
+              "measured trace is an experiment of its own: its slip is set beside the model in "
+              "the SFB section above"
+              + (f", and its contact is placed on the λ–ζ map below beside Klein's: λ = "
+                 f"{_fmt(user_point[3], 3)} ± {_fmt(user_point[4], 2)}, ζ = "
+                 f"{_fmt(user_point[1], 3)} (film ± {_fmt(user_point[2], 2)}, from the "
+                 "set-up's K, M, A, D, V and the measured F_s, F_b and η_eff)."
+                 if user_point is not None else "."))
     others = {}
     for d in list(run_dirs[1:]) + [Path(c) for c in compare]:
         try:
@@ -430,6 +457,8 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     zk = n["film_damping_ratio"].value + n["mount_damping_ratio"].value
     points = [("Klein (SFB, OMCTS)", zk, n["film_damping_ratio"].stderr, n["lambda"].value,
                n["lambda"].stderr)]
+    if user_point is not None:
+        points.append(user_point)
     for d, rs in [(Path(run_dirs[0]), rows)] + list(others.items()):
         if rs:
             points.append(_lambda_zeta_point(f"{scene_of(d) or d.name} (MD)", rs))
@@ -446,7 +475,7 @@ def similarity_section(check, run_dirs, failures, compare=()) -> Section:
     return sec
 
 
-def _sfb_reading(check) -> str:
+def _sfb_reading(check, far: bool = False) -> str:
     """What the comparison supports, from the rows' own ratios."""
     def ratio(name, source):
         try:
@@ -467,12 +496,15 @@ def _sfb_reading(check) -> str:
     if ri is not None:
         parts.append(f"With bulk viscosity the same slip would last {ri:.2g} × the observed time.")
     for name in ("yield_stress", "eta_eff", "slip_time"):
-        rm = ratio(name, "md-calibrated")
+        rm = None if far else ratio(name, "md-calibrated")
         if rm is not None:
             parts.append(f"{ref['calibrated'][0].upper()}{ref['calibrated'][1:]} "
                          f"{name.replace('_', ' ')}: ratio {rm:.3g} to {ref['whose']}.")
     if ref["column"] != "Klein":
         pass                    # a measured slip: no MD path to read
+    elif far:
+        parts.append("The MD film's law, carried across many decades of shear rate, gives no "
+                     "SFB-scale prediction here (appendix).")
     elif any(r_["source"] == "md-calibrated" for r_ in check.rows):
         parts.append("Ratios far from 1 on the MD path measure how far a 3-layer LJ film at MD shear rates, "
                      "carried through the unit mapping and the rate law, is from the SFB film; they do not "
@@ -489,6 +521,7 @@ def cost_section(run) -> Section:
     if not rj:
         sec.p(f"No `run.json` in `{run.run_dir}`: not a run of `filmfriction run`, so no cost "
               "or provenance to report.")
+        sec.absent = "a trace, not a run of `filmfriction run`: no `run.json`"
         return sec
     rows = [("status", str(rj.get("status"))),
             ("wall time", f"{_fmt(rj.get('wall_time'))} s"),
