@@ -48,7 +48,7 @@ def main(args: argparse.Namespace) -> int:
         resolve(None)            # a $FILMFRICTION_LMP that is no executable: before any run
     except SceneError as exc:
         raise UserError(str(exc)) from None
-    progress = None if args.json else (lambda text: print(text, flush=True))
+    progress = None if args.json or args.quiet else (lambda text: print(text, flush=True))
     try:
         report = run_bench(scene, args.np, args.repeat, args.omp, progress)
     except RuntimeError as exc:

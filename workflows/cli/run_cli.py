@@ -52,7 +52,6 @@ def register(subparsers) -> None:
                         "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
     s = subparsers.add_parser(

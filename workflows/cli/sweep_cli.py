@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 from ..inputs import check_ranks, check_writable, UserError
+from ..progress import note
 from ..md.lammps_build import ENV, resolve
 from ..md.scene import SceneError
 from ..sweep import load_aggregate, summary
@@ -112,8 +113,8 @@ def main_sweep(args: argparse.Namespace) -> int:
     check_writable(out, "--out", directory=True)
     check_sweep_dir(out)
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
-    print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
-          f"each -> {out}", file=sys.stderr)
+    note(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
+         f"each -> {out}")
     started = time.time()
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
     if not args.dry_run and (rc != 0 or uses_slurm(profile)):

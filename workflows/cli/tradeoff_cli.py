@@ -47,7 +47,8 @@ def main(args: argparse.Namespace) -> int:
     # flushed: the progress lines must show while the study runs, even in a log file
 
     def log(msg):
-        print(msg, file=stream, flush=True)
+        if not args.quiet:
+            print(msg, file=stream, flush=True)
     try:
         rows = study(args.quick, out, args.np, log, args.seeds)
     except RuntimeError as exc:
