@@ -306,7 +306,7 @@ def read_only_dir(tmpfs):
 
 @pytest.mark.parametrize("command", [
     lambda ro, t: ["run", "--md-only", "--out", ro / "r"],
-    lambda ro, t: ["analyze", _trace(t), "--output", ro / "a.json"],
+    lambda ro, t: ["analyze", _trace(t), "--out", ro / "a.json"],
     lambda ro, t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", ro / "s"],
     lambda ro, t: ["map", "velocity-stiffness", "--out", ro / "m"],
 ], ids=["run", "analyze", "sweep", "map"])

@@ -5,7 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable, parse_overrides, UserError
+from ..inputs import (check_not_in_run, check_ranks, check_writable, parse_overrides,
+                      UserError)
 
 from filmfriction.md_inputs.contract import RUN_FILE
 
@@ -128,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
+        check_not_in_run(args.out, "--out")
     elif not args.resume:
         check_writable(Path("runs"), "the default --out,", directory=True)
     try:

@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable, UserError
+from ..inputs import cap_workers, check_not_in_run, check_ranks, check_writable, UserError
 from ..progress import note
 from ..md.lammps_build import ENV, resolve
 from ..md.scene import SceneError
@@ -84,6 +84,7 @@ def check_sweep_dir(out: Path) -> None:
     """``out`` must be new, empty or a sweep's own directory (``sweep.json`` or its lock):
     a sweep never writes into a run directory or any other folder."""
     out = Path(out)
+    check_not_in_run(out, "--out")
     if (out.is_dir() and any(out.iterdir()) and not (out / SWEEP_FILE).exists()
             and not (out / ".sweep.lock").exists()):
         what = "a run directory" if (out / RUN_FILE).exists() else "not a sweep directory"
@@ -93,9 +94,12 @@ def check_sweep_dir(out: Path) -> None:
 
 
 def main_sweep(args: argparse.Namespace) -> int:
+    profile = profile_path(args.profile) if args.profile else None
     if args.cores < 1:
         raise UserError(f"--cores {args.cores}: need at least 1")
-    profile = profile_path(args.profile) if args.profile else None
+    if not uses_slurm(profile):
+        # cores used at once here; on Slurm, --cores is how many jobs are queued at once
+        args.cores = cap_workers(args.cores, "--cores")
     if not uses_slurm(profile):
         # the points run here: no more ranks than CPUs; on Slurm each point gets its own
         # allocation of --np tasks
