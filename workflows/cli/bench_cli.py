@@ -31,7 +31,7 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter, as for 'run'")
     p.add_argument("--json", action="store_true", help="print the figures as JSON")
-    p.set_defaults(func=main)
+    p.set_defaults(func=main, writes=False)   # prints only (its runs in a temporary folder)
 
 
 def main(args: argparse.Namespace) -> int:

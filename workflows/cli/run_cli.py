@@ -63,7 +63,7 @@ def register(subparsers) -> None:
     s.add_argument("--parameters", action="store_true",
                    help="list every scene parameter instead: unit, default, allowed range "
                         "and meaning")
-    s.set_defaults(func=list_scenes)
+    s.set_defaults(func=list_scenes, writes=False)      # prints only: no --out
 
     from filmfriction.md_inputs.contract import DATA_FILE
 
