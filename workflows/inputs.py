@@ -100,15 +100,15 @@ def parse_overrides(texts) -> dict:
 
 
 def check_ranks(nprocs: int | None, flag: str = "--np", more: str = "") -> None:
-    """MPI ranks on this machine: at least 1, at most its CPUs (mpiexec would
-    oversubscribe, or fail after the setup).  ``more``: where more ranks are
-    accepted, appended to the message."""
+    """MPI ranks on this machine: at least 1, at most the CPUs this process may use
+    (:func:`usable_cpus`; mpiexec would oversubscribe, or fail after the setup).
+    ``more``: where more ranks are accepted, appended to the message."""
     if nprocs is None:
         return
-    cpus = os.cpu_count() or 1
+    cpus = usable_cpus()
     if not 1 <= nprocs <= cpus:
         raise UserError(f"{flag} {nprocs}: need between 1 and {cpus} MPI ranks "
-                        f"(the CPUs of this machine){more}")
+                        f"(the CPUs this process may use){more}")
 
 
 def usable_cpus() -> int:

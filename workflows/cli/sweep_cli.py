@@ -37,7 +37,7 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="fixed override for every point, e.g. --set slide_steps=20000")
     p.add_argument("--np", type=int, default=2,
-                   help="MPI ranks per point (default 2): at most the CPUs of this machine, "
+                   help="MPI ranks per point (default 2): at most the CPUs this process may use, "
                         "any number with a Slurm profile (--profile slurm)")
     p.add_argument("--cores", type=int, default=2,
                    help="cores Snakemake may use at once on this machine (default 2)")
