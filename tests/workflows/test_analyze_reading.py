@@ -150,7 +150,7 @@ def test_log_options_where_they_do_not_belong(tmp_path, run_cli, synthetic_run):
     assert r.code == 0, r.err
     shutil.copy(LOG, synthetic_run / "log.lammps")
     r = run_cli("analyze", synthetic_run / "log.lammps", "--log-run", "2-3")
-    assert r.code == 2 and "give --output FILE.json" in r.err
+    assert r.code == 2 and "give --out FILE.json" in r.err
 
 
 def test_nan_and_overflowing_cells_are_dropped_not_refused(tmp_path, run_cli):

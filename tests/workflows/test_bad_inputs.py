@@ -91,6 +91,21 @@ def _huge(tmp: Path) -> Path:
     return _csv(tmp / "huge.csv", "time,spring_force", zip(t, force))
 
 
+def _sparse(tmp: Path) -> Path:
+    """A small trace padded to 2 GiB with NUL bytes (sparse: no disk space taken)."""
+    path = _trace(tmp, name="big.csv")
+    with open(path, "r+b") as fh:
+        fh.truncate(2 << 30)
+    return path
+
+
+def _with_nul(tmp: Path) -> Path:
+    path = _trace(tmp, name="nul.csv")
+    with open(path, "ab") as fh:
+        fh.write(b"\0" * 100)
+    return path
+
+
 def _toml(tmp: Path, name: str, text: str) -> Path:
     (tmp / name).write_text(text)
     return tmp / name
@@ -210,6 +225,32 @@ CASES = {
     # -- wrote the HTML under the Markdown twin's name, which then replaced it
     "report --out FILE.md": (lambda t: ["report", _run_dir(t), "--out", t / "rep.md"],
                              "give a .html file name", 2),
+    # -- limits that did not hold: a cost check, physical sanity, nesting, big or binary input
+    "map --resolution 1000": (lambda t: ["map", "velocity-stiffness", "--resolution", "1000",
+                                         "--out", t / "m"],
+                              "1,000,000 cells of up to 2 simulations each, 2,000,000 "
+                              "simulations, above the limit of 40,000", 2),
+    "viscosity --temperature 1e5": (lambda t: ["viscosity", "--temperature", "1e5", "--density",
+                                               "0.8442", "--out", t / "v"],
+                                    "--temperature 100000: at most 10 epsilon/k_B", 2),
+    "viscosity hot for its time step": (lambda t: ["viscosity", "--temperature", "10",
+                                                   "--density", "0.8442", "--timestep", "0.01",
+                                                   "--out", t / "v"],
+                                        "at most 2.5 epsilon/k_B with --timestep 0.01", 2),
+    "run --out inside a run": (lambda t: ["run", "--md-only", "--out", _run_dir(t) / "nested"],
+                               "is inside the run directory", 2),
+    "viscosity --out inside a run": (lambda t: ["viscosity", "--temperature", "0.722",
+                                                "--density", "0.8442", "--out",
+                                                _run_dir(t) / "a" / "b"],
+                                     "is inside the run directory", 2),
+    "sweep --out inside a run": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
+                                            "--dry-run", "--out", _run_dir(t) / "s"],
+                                 "is inside the run directory", 2),
+    "analyze a 2 GiB file": (lambda t: ["analyze", _sparse(t)],
+                             "2,147,483,648 bytes, above the limit of 1,073,741,824", 2),
+    "analyze a trace with NUL bytes": (lambda t: ["analyze", _with_nul(t)],
+                                       "a NUL byte at byte", 2),
+    "analyze a device": (lambda t: ["analyze", "/dev/zero"], "/dev/zero: a NUL byte at byte 0", 2),
     # -- wrote a sweep into it (sweep.json, inputs/, .snakemake/)
     "sweep --out a run directory": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
                                                "--dry-run", "--out", _run_dir(t)],
@@ -240,9 +281,41 @@ def _cli(capsys, *args):
     return code, out, err
 
 
-@pytest.mark.parametrize("case", list(CASES))
-def test_bad_input(case, tmp_path, monkeypatch, capsys):
-    build, fragment, code = CASES[case]
+# environment overrides: id -> (variable, value, command line from tmp, message fragment)
+ENV_CASES = {
+    "FILMFRICTION_MAX_POINTS=abc": (
+        "FILMFRICTION_MAX_POINTS", "abc",
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s"],
+        "environment variable FILMFRICTION_MAX_POINTS='abc': give a whole number >= 1"),
+    "FILMFRICTION_MAX_POINTS=0": (
+        "FILMFRICTION_MAX_POINTS", "0",
+        lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s"],
+        "FILMFRICTION_MAX_POINTS='0': give a whole number >= 1"),
+    "FILMFRICTION_MAX_MAP_SIMULATIONS=1e9": (
+        "FILMFRICTION_MAX_MAP_SIMULATIONS", "1e9",
+        lambda t: ["map", "lambda-zeta", "--out", t / "m"],
+        "FILMFRICTION_MAX_MAP_SIMULATIONS='1e9': give a whole number >= 1"),
+    "FILMFRICTION_MAX_MAP_SIMULATIONS lowered": (
+        "FILMFRICTION_MAX_MAP_SIMULATIONS", "100",
+        lambda t: ["map", "lambda-zeta", "--out", t / "m"],
+        "10,000 simulations, above the limit of 100; give a --resolution of at most 10"),
+    "FILMFRICTION_MAX_INPUT_BYTES=-1": (
+        "FILMFRICTION_MAX_INPUT_BYTES", "-1", lambda t: ["analyze", _trace(t)],
+        "FILMFRICTION_MAX_INPUT_BYTES='-1': give a whole number >= 1"),
+    "FILMFRICTION_MAX_INPUT_BYTES lowered": (
+        "FILMFRICTION_MAX_INPUT_BYTES", "1000", lambda t: ["analyze", _trace(t)],
+        "above the limit of 1,000 bytes for a text input"),
+}
+
+
+@pytest.mark.parametrize("case", list(ENV_CASES))
+def test_bad_environment(case, tmp_path, monkeypatch, capsys):
+    name, value, build, fragment = ENV_CASES[case]
+    monkeypatch.setenv(name, value)
+    _refused(build, fragment, 2, tmp_path, monkeypatch, capsys)
+
+
+def _refused(build, fragment, code, tmp_path, monkeypatch, capsys):
     inputs = tmp_path / "in"
     inputs.mkdir()
     work = tmp_path / "work"            # the working directory: runs/, sweeps/ go here
@@ -257,6 +330,12 @@ def test_bad_input(case, tmp_path, monkeypatch, capsys):
     lines = [ln for ln in err.splitlines() if ln.strip()]
     assert lines[-1].startswith("filmfriction ") and "error" in lines[-1], err
     assert _snapshot(tmp_path) == before, "something was written"
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_input(case, tmp_path, monkeypatch, capsys):
+    _refused(*CASES[case], tmp_path, monkeypatch, capsys)
+
 
 
 def test_debug_shows_the_traceback(tmp_path, run_cli):
@@ -306,7 +385,7 @@ def read_only_dir(tmpfs):
 
 @pytest.mark.parametrize("command", [
     lambda ro, t: ["run", "--md-only", "--out", ro / "r"],
-    lambda ro, t: ["analyze", _trace(t), "--output", ro / "a.json"],
+    lambda ro, t: ["analyze", _trace(t), "--out", ro / "a.json"],
     lambda ro, t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", ro / "s"],
     lambda ro, t: ["map", "velocity-stiffness", "--out", ro / "m"],
 ], ids=["run", "analyze", "sweep", "map"])

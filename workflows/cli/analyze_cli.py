@@ -5,7 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from filmfriction.workflows.inputs import check_run_json, check_writable, UserError
+from filmfriction.workflows.inputs import (check_input_file, check_run_json, check_writable,
+                                          is_stream, read_stream_once, UserError)
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
 
@@ -114,14 +115,32 @@ def register(subparsers) -> None:
                    help="slips left out of the summaries (default: 1 when >= 3 slips)")
     p.add_argument("--no-structure", action="store_true",
                    help="skip the trajectory analyses")
-    p.add_argument("--output", type=Path, default=None,
-                   help="where to write analysis.json (default: next to the trace)")
+    p.add_argument("--out", "--output", dest="output", type=Path, default=None,
+                   metavar="FILE.json",
+                   help="where to write analysis.json, its folder created if missing "
+                        "(default: next to the trace; for a stream such as <(cmd), the "
+                        "working directory); --output is an accepted alias")
     p.add_argument("--no-figure", action="store_true",
                    help="do not draw analysis_trace.png")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    """Entry point; a stream (``<(cmd)``, a FIFO) is read once into a private copy."""
+    if not is_stream(args.path):
+        check_input_file(args.path)
+        return _analyze(args)
+    import tempfile
+
+    stream = args.path
+    with tempfile.TemporaryDirectory(prefix="filmfriction-stream-") as folder:
+        args.path = read_stream_once(stream, folder)
+        if args.output is None:
+            args.output = Path(ANALYSIS_FILE)
+        return _analyze(args, stream=stream)
+
+
+def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     import numpy as np
 
     from filmfriction.analysis.analyze import analyze, to_json, write_outputs
@@ -146,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
                 raise UserError(f"{flag} {value}: {args.path} ran with {name} = {ran} (its "
                                 f"run.json), and is analysed with it; leave {flag} out")
     if args.output is not None:
-        check_writable(args.output, "--output")
+        check_writable(args.output, "--out")
     table = {}
     if args.setup is not None:
         from filmfriction.analysis.column_spec import trace_table
@@ -207,7 +226,7 @@ def run(args: argparse.Namespace) -> int:
         if (args.output is None and (beside / "run.json").is_file()
                 and args.path.name != "trace.csv"):
             raise UserError(f"{args.path}: a file of the run directory {beside}, whose "
-                            "analysis.json is of its trace.csv; give --output FILE.json for "
+                            "analysis.json is of its trace.csv; give --out FILE.json for "
                             "this file's analysis")
     try:
         trace = read_trace(args.path, columns=columns, column_units=units_of,
@@ -247,8 +266,9 @@ def run(args: argparse.Namespace) -> int:
         # `calibrate`/`report` of its directory find it from anywhere, --output elsewhere too
         import os
 
-        doc["source"]["path"] = os.path.relpath(Path(trace.path).resolve(),
-                                                Path(out).parent.resolve())
+        doc["source"]["path"] = (str(stream) if stream is not None else
+                                 os.path.relpath(Path(trace.path).resolve(),
+                                                 Path(out).parent.resolve()))
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     if not args.no_figure:
         from filmfriction.analysis.trace_figure import write_trace_figure
@@ -258,7 +278,7 @@ def run(args: argparse.Namespace) -> int:
                            per_cycle.get("stick_index", []), figure)
         doc["figure"] = figure.name
     json_path, csv_path = write_outputs(doc, per_cycle, out)
-    if (layout is not None and not layout.binary and not trace.notes
+    if (stream is None and layout is not None and not layout.binary and not trace.notes
             and len(trace) >= BINARY_MIN_ROWS):
         # long text traces: later reads (calibrate, report, analyze again) take the copy
         try:

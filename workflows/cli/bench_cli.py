@@ -31,7 +31,7 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter, as for 'run'")
     p.add_argument("--json", action="store_true", help="print the figures as JSON")
-    p.set_defaults(func=main)
+    p.set_defaults(func=main, writes=False)   # prints only (its runs in a temporary folder)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -48,7 +48,7 @@ def main(args: argparse.Namespace) -> int:
         resolve(None)            # a $FILMFRICTION_LMP that is no executable: before any run
     except SceneError as exc:
         raise UserError(str(exc)) from None
-    progress = None if args.json else (lambda text: print(text, flush=True))
+    progress = None if args.json or args.quiet else (lambda text: print(text, flush=True))
     try:
         report = run_bench(scene, args.np, args.repeat, args.omp, progress)
     except RuntimeError as exc:

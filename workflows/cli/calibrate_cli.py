@@ -13,7 +13,7 @@ import math
 import sys
 from pathlib import Path
 
-from filmfriction.workflows.inputs import check_run_source, UserError
+from filmfriction.workflows.inputs import check_run_source, check_writable, UserError
 
 __all__ = ["register", "run", "format_calibration"]
 
@@ -30,6 +30,10 @@ def register(subparsers) -> None:
                         "(aggregate.json) or directories of analysed trace files "
                         "(analysis.json); several runs give the shear-rate law")
     p.add_argument("--json", action="store_true", help="print calibration.json")
+    p.add_argument("--out", type=Path, default=None, metavar="FILE.json",
+                   help="where to write calibration.json, its folder created if missing "
+                        "(default: in the first run directory; the replay's trace goes "
+                        "beside it)")
     p.set_defaults(func=run)
 
 
@@ -90,13 +94,17 @@ def run(args) -> int:
         if not d.is_dir():
             raise UserError(f"{d}: not a directory")
         check_run_source(d)
+    if args.out is not None:
+        check_writable(args.out, "--out")
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
     run_dirs, _ = split_sweeps(list(args.run_dirs))
     try:
         cal = calibrate(run_dirs)
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    path = write_calibration(cal)
+    if args.out is not None:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+    path = write_calibration(cal, args.out)
     if args.json:
         sys.stdout.write(path.read_text())     # the document as written
     else:

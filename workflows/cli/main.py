@@ -30,6 +30,17 @@ COMMANDS = {
 }
 
 
+USAGE_HINT = """\
+Stick-slip friction of confined films: MD scenes, analysis, reduced model and
+comparison with SFB experiments.
+
+  filmfriction run               the default study end to end (LAMMPS, analysis,
+                                 calibration, SFB check, report), as `make run`
+  filmfriction scenes            the scenes 'run' can run
+  filmfriction COMMAND --help    what COMMAND does and its options
+  filmfriction --help            every command"""
+
+
 def _one_line(exc: BaseException) -> tuple[str, int]:
     """The message and exit code for an exception that reached the command line.
 
@@ -61,17 +72,34 @@ def _one_line(exc: BaseException) -> tuple[str, int]:
             "traceback and report it)", EXIT_FAILED)
 
 
+def _habits() -> argparse.ArgumentParser:
+    """The options every sub-command has: how much it says while it works."""
+    parent = argparse.ArgumentParser(add_help=False)
+    said = parent.add_argument_group("what the command says")
+    group = said.add_mutually_exclusive_group()
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress and no notes on stderr (results, warnings and "
+                            "errors still)")
+    group.add_argument("-v", "--verbose", action="store_true",
+                       help="more detail on stderr: the commands started and, when stderr "
+                            "is not a terminal, a progress line at every tenth of a stage")
+    return parent
+
+
 class _Commands:
     """The sub-commands' parsers: a sub-command's --help opens with what it does, its
-    one-line help when it gives no longer description."""
+    one-line help when it gives no longer description; every one has the options of
+    :func:`_habits`."""
 
     def __init__(self, subparsers):
         self._subparsers = subparsers
+        self._parent = _habits()
 
     def add_parser(self, name: str, **kwargs) -> argparse.ArgumentParser:
         short = kwargs.get("help")
         if short and not kwargs.get("description"):
             kwargs["description"] = short[0].upper() + short[1:] + "."
+        kwargs["parents"] = [*kwargs.get("parents", ()), self._parent]
         return self._subparsers.add_parser(name, **kwargs)
 
 
@@ -99,12 +127,18 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     parser = build_parser()
     if not argv:
-        # `filmfriction` alone runs the default study, like `make run`.
-        argv = ["run"]
+        # `filmfriction` alone says what it does and how to start; it runs nothing
+        print(parser.format_usage().rstrip())
+        print(USAGE_HINT)
+        return 2
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from .. import progress
+
+    progress.set_level(progress.QUIET if args.quiet else
+                       progress.VERBOSE if args.verbose else progress.NORMAL)
     try:
         return int(args.func(args) or 0)
     except KeyboardInterrupt:

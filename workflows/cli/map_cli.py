@@ -14,10 +14,17 @@ import argparse
 import math
 from pathlib import Path
 
-from filmfriction.workflows.inputs import check_writable, UserError
+from filmfriction.workflows.inputs import cap_workers, check_writable, env_count, UserError
 
 
 KINDS = ("lambda-zeta", "velocity-stiffness")
+#: grid points per axis when --resolution is not given
+DEFAULT_RESOLUTION = {"lambda-zeta": 100, "velocity-stiffness": 12}
+#: simulations of the block per cell: one Coulomb block per lambda-zeta cell; up to two
+#: contact-age runs (the start-up run, then a longer one if it re-stuck) per (V, K) cell
+SIMULATIONS_PER_CELL = {"lambda-zeta": 1, "velocity-stiffness": 2}
+#: most simulations a map starts unless FILMFRICTION_MAX_MAP_SIMULATIONS says otherwise
+MAX_SIMULATIONS = 40_000
 
 
 def register(subparsers) -> argparse.ArgumentParser:
@@ -33,14 +40,34 @@ def register(subparsers) -> argparse.ArgumentParser:
     p.add_argument("kind", choices=KINDS, help="which plane to map")
     p.add_argument("--out", default=".", help="output directory (created if missing; default: .)")
     p.add_argument("--resolution", type=int, default=None,
-                   help="grid points per axis (default 100 for lambda-zeta, 12 for velocity-stiffness (each cell a full simulation))")
-    p.add_argument("--processes", type=int, default=2, help="worker processes (default 2)")
+                   help="grid points per axis (default 100 for lambda-zeta, 12 for "
+                        "velocity-stiffness, each cell a full simulation); refused before any "
+                        f"work when the map needs more than {MAX_SIMULATIONS:,} simulations "
+                        "(FILMFRICTION_MAX_MAP_SIMULATIONS raises the limit)")
+    p.add_argument("--processes", type=int, default=2,
+                   help="worker processes (default 2; at most the CPUs this process may use, "
+                        "more are capped with a note)")
     p.set_defaults(func=run)
     return p
 
 
 def _user_error(message):
     return UserError(message)
+
+
+def check_cost(kind: str, resolution: int | None) -> None:
+    """Refuse (UserError), before any work, a map of more simulations than the limit
+    (``$FILMFRICTION_MAX_MAP_SIMULATIONS``, default :data:`MAX_SIMULATIONS`)."""
+    n = resolution or DEFAULT_RESOLUTION[kind]
+    per_cell = SIMULATIONS_PER_CELL[kind]
+    needed = n * n * per_cell
+    limit = env_count("FILMFRICTION_MAX_MAP_SIMULATIONS", MAX_SIMULATIONS)
+    if needed > limit:
+        each = "one simulation" if per_cell == 1 else f"up to {per_cell} simulations"
+        raise _user_error(f"--resolution {n}: {n} x {n} = {n * n:,} cells of {each} each, "
+                          f"{needed:,} simulations, above the limit of {limit:,}; give a "
+                          f"--resolution of at most {math.isqrt(limit // per_cell)}, or set "
+                          "FILMFRICTION_MAX_MAP_SIMULATIONS to raise the limit")
 
 
 def run(args) -> int:
@@ -51,8 +78,8 @@ def run(args) -> int:
     n = args.resolution
     if n is not None and not 2 <= n <= 1000:
         raise _user_error(f"--resolution {n}: allowed range is [2, 1000] grid points per axis")
-    if args.processes < 1:
-        raise _user_error(f"--processes {args.processes}: allowed range is [1, inf)")
+    check_cost(args.kind, n)
+    processes = cap_workers(args.processes, "--processes")
 
     check_writable(out, "--out", directory=True)
     out.mkdir(parents=True, exist_ok=True)
@@ -60,13 +87,13 @@ def run(args) -> int:
     import numpy as np
     from filmfriction.reduced_model import maps
 
+    n = n or DEFAULT_RESOLUTION[args.kind]
     if args.kind == "lambda-zeta":
-        n = n or 100
-        result = maps.lambda_zeta_map(np.logspace(-2, 2, n), np.logspace(-3, 1, n), processes=args.processes)
+        result = maps.lambda_zeta_map(np.logspace(-2, 2, n), np.logspace(-3, 1, n),
+                                      processes=processes)
     else:
-        n = n or 12
         result = maps.velocity_stiffness_map(np.logspace(-3, 0, n), np.logspace(-1, 2, n),
-                                             processes=args.processes)
+                                             processes=processes)
     stem = args.kind.replace("-", "_")
     from filmfriction.analysis.util import write_atomic
 
@@ -74,7 +101,7 @@ def run(args) -> int:
     png_path = _plot(result, args.kind, out / f"{stem}.png")
     print(csv_path)
     print(png_path)
-    print(f"# {n} x {n} map in {result.seconds:.2f} s on {args.processes} process(es); "
+    print(f"# {n} x {n} map in {result.seconds:.2f} s on {processes} process(es); "
           f"stick-slip in {100 * result.stick_slip.mean():.1f} % of cells")
     return 0
 

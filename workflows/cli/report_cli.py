@@ -41,7 +41,8 @@ def register(subparsers) -> None:
                         "(their sfb.json similarity rows and their points on the lambda-zeta map); "
                         "not part of the calibration")
     p.add_argument("--out", type=Path, default=None, metavar="FILE",
-                   help="HTML file to write (default RUN_DIR/report.html; the .md goes next to it)")
+                   help="HTML file to write, its folder created if missing (default "
+                        "RUN_DIR/report.html; the .md goes next to it)")
     p.set_defaults(func=run)
 
 
@@ -58,10 +59,9 @@ def run(args) -> int:
     if args.out is not None and args.out.suffix.lower() not in (".html", ".htm"):
         raise UserError(f"--out {args.out}: the report is HTML: give a .html file name (its "
                         "Markdown twin is written beside it as .md)")
-    if args.out is not None and not args.out.parent.is_dir():
-        raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     out = args.out if args.out is not None else args.run_dirs[0] / "report.html"
     check_writable(out, "--out")
+    out.parent.mkdir(parents=True, exist_ok=True)
     try:
         path = build_report(args.run_dirs, out=args.out, log=print, compare=args.compare)
     except ValueError as exc:

@@ -5,7 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable, parse_overrides, UserError
+from ..inputs import (check_not_in_run, check_ranks, check_writable, parse_overrides,
+                      UserError)
 
 from filmfriction.md_inputs.contract import RUN_FILE
 
@@ -52,7 +53,6 @@ def register(subparsers) -> None:
                         "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
     s = subparsers.add_parser(
@@ -63,7 +63,7 @@ def register(subparsers) -> None:
     s.add_argument("--parameters", action="store_true",
                    help="list every scene parameter instead: unit, default, allowed range "
                         "and meaning")
-    s.set_defaults(func=list_scenes)
+    s.set_defaults(func=list_scenes, writes=False)      # prints only: no --out
 
     from filmfriction.md_inputs.contract import DATA_FILE
 
@@ -129,6 +129,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
+        check_not_in_run(args.out, "--out")
     elif not args.resume:
         check_writable(Path("runs"), "the default --out,", directory=True)
     try:

@@ -56,7 +56,8 @@ def register(subparsers) -> None:
                         "its dimensionless numbers beside Klein's")
     p.add_argument("--out", metavar="FILE.json", type=Path, default=None,
                    help="also write the check as the study does (e.g. RUN_DIR/sfb.json, with its "
-                        "slips' traces beside it), for 'filmfriction report'")
+                        "slips' traces beside it), for 'filmfriction report'; its folder is "
+                        "created if missing")
     p.add_argument("--time-unit", choices=("mass", "viscosity"), default="mass",
                    help="the LJ time unit carried to SI: sigma*sqrt(m/eps) of the OMCTS molecule "
                         "(mass, default) or the one that maps the LJ liquid's eta onto OMCTS's "
@@ -186,8 +187,6 @@ def run(args) -> int:
     """Entry point of ``filmfriction sfb``; returns the exit code."""
     from filmfriction.reduced_model import sfb_check
 
-    if args.out is not None and not args.out.parent.is_dir():
-        raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     if args.out is not None:
         check_writable(args.out, "--out")
     units = _units(args)
@@ -232,6 +231,7 @@ def run(args) -> int:
         from filmfriction.workflows.rundir import write_sfb
         extra = None if setup is None else {"setup": setup.as_dict(),
                                             "measured": dataclasses.asdict(slip)}
+        args.out.parent.mkdir(parents=True, exist_ok=True)
         path = write_sfb(check, args.out, extra)
     if args.json:
         from filmfriction.workflows.rundir import measured_keys

@@ -10,7 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable, UserError
+from ..inputs import cap_workers, check_not_in_run, check_ranks, check_writable, UserError
+from ..progress import note
 from ..md.lammps_build import ENV, resolve
 from ..md.scene import SceneError
 from ..sweep import load_aggregate, summary
@@ -36,7 +37,7 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="fixed override for every point, e.g. --set slide_steps=20000")
     p.add_argument("--np", type=int, default=2,
-                   help="MPI ranks per point (default 2): at most the CPUs of this machine, "
+                   help="MPI ranks per point (default 2): at most the CPUs this process may use, "
                         "any number with a Slurm profile (--profile slurm)")
     p.add_argument("--cores", type=int, default=2,
                    help="cores Snakemake may use at once on this machine (default 2)")
@@ -83,6 +84,7 @@ def check_sweep_dir(out: Path) -> None:
     """``out`` must be new, empty or a sweep's own directory (``sweep.json`` or its lock):
     a sweep never writes into a run directory or any other folder."""
     out = Path(out)
+    check_not_in_run(out, "--out")
     if (out.is_dir() and any(out.iterdir()) and not (out / SWEEP_FILE).exists()
             and not (out / ".sweep.lock").exists()):
         what = "a run directory" if (out / RUN_FILE).exists() else "not a sweep directory"
@@ -92,9 +94,12 @@ def check_sweep_dir(out: Path) -> None:
 
 
 def main_sweep(args: argparse.Namespace) -> int:
+    profile = profile_path(args.profile) if args.profile else None
     if args.cores < 1:
         raise UserError(f"--cores {args.cores}: need at least 1")
-    profile = profile_path(args.profile) if args.profile else None
+    if not uses_slurm(profile):
+        # cores used at once here; on Slurm, --cores is how many jobs are queued at once
+        args.cores = cap_workers(args.cores, "--cores")
     if not uses_slurm(profile):
         # the points run here: no more ranks than CPUs; on Slurm each point gets its own
         # allocation of --np tasks
@@ -112,8 +117,8 @@ def main_sweep(args: argparse.Namespace) -> int:
     check_writable(out, "--out", directory=True)
     check_sweep_dir(out)
     grid = " x ".join(f"{a.key}[{len(a.values)}]" for a in plan.grid)
-    print(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
-          f"each -> {out}", file=sys.stderr)
+    note(f"sweep: {plan.scene}, {grid} = {len(plan.points)} points, {plan.np} MPI rank(s) "
+         f"each -> {out}")
     started = time.time()
     rc = run_sweep(plan, out, args.cores, dry_run=args.dry_run, profile=profile)
     if not args.dry_run and (rc != 0 or uses_slurm(profile)):

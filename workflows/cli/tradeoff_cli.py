@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..cost.tradeoff import study
 from ..cost.tradeoff_table import summary
-from ..inputs import check_ranks, check_writable, UserError
+from ..inputs import check_not_in_run, check_ranks, check_writable, UserError
 
 
 def register(subparsers) -> None:
@@ -43,11 +43,13 @@ def main(args: argparse.Namespace) -> int:
 
     check_ranks(args.np)
     check_writable(out, "--out", directory=True)
+    check_not_in_run(out, "--out")
     stream = sys.stderr if args.json else sys.stdout
     # flushed: the progress lines must show while the study runs, even in a log file
 
     def log(msg):
-        print(msg, file=stream, flush=True)
+        if not args.quiet:
+            print(msg, file=stream, flush=True)
     try:
         rows = study(args.quick, out, args.np, log, args.seeds)
     except RuntimeError as exc:

@@ -1,12 +1,11 @@
 """What LAMMPS prints while a scene runs: its log's lines read (stage, atoms, speed,
-loop totals), and the engine child driven with a progress bar (:func:`run_engine`)."""
+loop totals), and the engine child driven with its progress shown (:func:`run_engine`)."""
 from __future__ import annotations
 
 import os
 import re
 import signal
 import subprocess
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -94,15 +93,15 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
     slide (or of a resumed slide); an exception it raises stops LAMMPS.
     ``env``: the engine's environment (default :func:`engine.engine_env`).
     """
-    from tqdm import tqdm
+    from ..progress import detail, progress_bar
 
     t0 = time.perf_counter()
     stage_offset = 0
     stage_name = "resume" if start_step else "setup"
     errors: list[str] = []
     outcome = EngineOutcome(returncode=0, error=None, atom_steps_per_second=[])
-    bar = tqdm(total=total_steps, initial=start_step, unit="step", disable=not progress,
-               desc=label or "lammps", dynamic_ncols=True, file=sys.stderr, smoothing=0.1)
+    bar = progress_bar(total_steps, start_step, label or "lammps", enabled=progress)
+    detail(f"{label or 'lammps'}: {' '.join(str(c) for c in cmd)} (in {cwd})")
     with open(cwd / "lammps.screen", "a") as screen:
         proc = subprocess.Popen(cmd, cwd=cwd, env=env or engine.engine_env(),
                                 stdout=subprocess.PIPE,

@@ -29,10 +29,11 @@ MAX_POINTS = 10000
 
 
 def max_points() -> int:
-    try:
-        return int(os.environ.get("FILMFRICTION_MAX_POINTS", MAX_POINTS))
-    except ValueError:
-        return MAX_POINTS
+    """The cap on a sweep's points: ``$FILMFRICTION_MAX_POINTS`` (a whole number >= 1,
+    checked) or :data:`MAX_POINTS`."""
+    from ..inputs import env_count
+
+    return env_count("FILMFRICTION_MAX_POINTS", MAX_POINTS)
 
 
 def _user_error(message: str) -> Exception:
