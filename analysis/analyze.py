@@ -60,6 +60,18 @@ def _source(trace: Trace) -> dict:
     return source
 
 
+def _provenance(trace: Trace) -> dict:
+    """The document's provenance: the package and the trace's (and run record's) SHA-256."""
+    from filmfriction.md_inputs.contract import RUN_FILE
+
+    from .provenance import provenance
+
+    inputs = {"trace": trace.path}
+    if trace.run_dir is not None:
+        inputs["run.json"] = Path(trace.run_dir) / RUN_FILE
+    return provenance(inputs)
+
+
 def context(trace: Trace, *, skip: int | None = None, structure: bool = True) -> Context:
     """What every section starts from: the slips detected and tabulated, the
     regime (with the sliding check of the last half), the start-up slips left out.
@@ -123,7 +135,8 @@ def analyze(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     A trace of fewer than :data:`MIN_ROWS` rows is ``unresolved``: its
     ``regime_note`` says why, and every section is in ``skipped`` with that reason.
     """
-    doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace)}
+    doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace),
+                 "provenance": _provenance(trace)}
     skipped: dict[str, str] = {}
     if len(trace) < MIN_ROWS:
         n = len(trace)

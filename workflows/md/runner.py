@@ -26,6 +26,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from filmfriction import md_inputs
+from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE,
@@ -138,6 +139,7 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: i
         "layout": {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads},
         "seeds": {"seed": p["seed"]},
         "versions": versions(),
+        "provenance": provenance(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
         "started": datetime.now(timezone.utc).isoformat(),
         "segments": [],
