@@ -43,7 +43,7 @@ from filmfriction.md_inputs.contract import (COMMAND_FILE, DATA_FILE, LOG_FILE, 
 from .inputs import UserError, check_writable
 
 __all__ = ["check_output", "run_directory_of", "own_runs", "RUN_OWN_FILES", "is_project_json",
-           "names_in", "starts_with"]
+           "names_in", "head_has"]
 
 #: The files ``filmfriction run`` writes into its run directory; no other command
 #: replaces them (restart files ``restart.<step>`` too).
@@ -86,13 +86,13 @@ def is_project_json(path: Path) -> bool:
     return isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction")
 
 
-def starts_with(prefix: bytes) -> Callable[[Path], bool]:
-    """A test of a file of the project by its first bytes (the report's Markdown twin:
-    ``b"# filmfriction report"``)."""
+def head_has(mark: bytes, size: int = 4096) -> Callable[[Path], bool]:
+    """A test of a file of the project by a mark in its first ``size`` bytes (the report's
+    page: ``b"<title>filmfriction report"``)."""
     def test(path: Path) -> bool:
         try:
             with open(path, "rb") as fh:
-                return fh.read(len(prefix)) == prefix
+                return mark in fh.read(size)
         except OSError:
             return False
     return test

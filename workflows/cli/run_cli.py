@@ -189,6 +189,9 @@ def write_geometry(args: argparse.Namespace) -> int:
     except SceneError as exc:
         raise UserError(str(exc)) from None
     check_writable(args.out, "--out")
+    from filmfriction.workflows.outputs import check_output
+
+    check_output(args.out, "--out", inputs=[getattr(args, "scene", None)])
     if args.out.is_file():
         # a geometry file written before is replaced; any other file (a trace, a script) is not
         with open(args.out, "rb") as fh:

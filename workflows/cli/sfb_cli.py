@@ -190,6 +190,15 @@ def run(args) -> int:
         raise UserError(f"--out {args.out}: directory {args.out.parent} does not exist")
     if args.out is not None:
         check_writable(args.out, "--out")
+        from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+        from filmfriction.workflows.rundir import SFB_TRACES_SUFFIX
+
+        sources = [args.calibration, args.setup, args.measured, args.run]
+        if args.measured is not None and args.measured.is_dir():
+            sources.append(args.measured / ANALYSIS_FILE)
+        check_output(args.out, "--out", inputs=sources, ours=is_project_json)
+        check_output(args.out.with_name(args.out.stem + SFB_TRACES_SUFFIX), "--out",
+                     inputs=sources, ours=names_in(args.out), what="its slips' traces")
     units = _units(args)
     setup, slip = _setup(args)
     calibration, si = _calibration(args.calibration)
@@ -232,7 +241,13 @@ def run(args) -> int:
         from filmfriction.workflows.rundir import write_sfb
         extra = None if setup is None else {"setup": setup.as_dict(),
                                             "measured": dataclasses.asdict(slip)}
-        path = write_sfb(check, args.out, extra)
+        measured = (None if args.measured is None else args.measured / ANALYSIS_FILE
+                    if args.measured.is_dir() else args.measured)
+        path = write_sfb(check, args.out, extra,
+                         inputs={"calibration": args.calibration, "setup": args.setup,
+                                 "measured": measured,
+                                 "run analysis.json": None if args.run is None
+                                 else args.run / ANALYSIS_FILE})
     if args.json:
         print(json.dumps(check.rows, indent=2, allow_nan=False))
         if path is not None:
