@@ -44,7 +44,6 @@ their own are converted into it.
 from __future__ import annotations
 
 import io
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -856,9 +855,9 @@ def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
     doc_path = directory / ANALYSIS_FILE
     if not doc_path.is_file():
         return None
-    from .util import read_json_object
+    from .documents import read_document
 
-    doc = read_json_object(doc_path)
+    doc = read_document(doc_path, "analysis")
     source = doc.get("source") or {}
     if source.get("run_dir") or not source.get("path"):
         return None
@@ -874,10 +873,9 @@ def _run_record(directory: Path) -> dict:
     """``run.json`` of a run directory (empty when there is none)."""
     if not (directory / RUN_FILE).exists():
         return {}
-    try:
-        return json.loads((directory / RUN_FILE).read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{directory / RUN_FILE}: not valid JSON: {exc}") from None
+    from .documents import read_document
+
+    return read_document(directory / RUN_FILE, "run")
 
 
 def _run_parameters(run: dict) -> dict:

@@ -65,8 +65,11 @@ def check_run_json(run_dir, flag: str = "") -> dict | None:
     if not path.is_file():
         return None
     where = f"{flag} {path}" if flag else str(path)
+    from filmfriction.analysis.documents import check_document
+
     try:
-        return read_json_object(path, where, what="a JSON object (a run record)")
+        return check_document(read_json_object(path, where, what="a JSON object (a run record)"),
+                              "run", where)
     except ValueError as exc:
         raise UserError(str(exc)) from None
 

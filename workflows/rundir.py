@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.documents import check_document
 from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.analysis.analyze import to_json
@@ -70,8 +71,9 @@ def write_sfb(check, path, extra: dict | None = None, inputs: dict | None = None
     return write_atomic(path, to_json(doc) + "\n")
 
 
-def read_json(path):
-    """The JSON document at ``path``, or ``None`` if there is no such file.
+def read_json(path, kind: str | None = None):
+    """The JSON document at ``path``, or ``None`` if there is no such file; checked as a
+    document of ``kind`` (:func:`filmfriction.analysis.documents.check_document`) when given.
 
     Raises
     ------
@@ -82,9 +84,12 @@ def read_json(path):
     if not path.is_file():
         return None
     try:
-        return json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"{path}: cannot read: {exc}") from None
+    if kind is not None and not (kind == "sfb" and isinstance(doc, list)):
+        check_document(doc, kind, path)
+    return doc
 
 
 def _columns(path: Path) -> dict:
@@ -104,7 +109,7 @@ def read_calibration(path):
         arrays when its CSV exists (else ``None``).
     """
     path = Path(path)
-    doc = read_json(path)
+    doc = read_json(path, "calibration")
     if doc is None:
         return None
     if doc.get("run_dirs_relative_to") == "calibration.json":
@@ -159,7 +164,7 @@ def read_sfb(path):
     only (no notes, no slips).
     """
     path = Path(path)
-    doc = read_json(path)
+    doc = read_json(path, "sfb")
     if doc is None:
         return None
     if isinstance(doc, list):

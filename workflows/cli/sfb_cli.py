@@ -106,7 +106,15 @@ def _calibration(path: Path | None):
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    if isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction.calibration/"):
+    from filmfriction.analysis.documents import check_document
+
+    calibration_json = str(data.get("schema", "")).startswith("filmfriction.calibration/")
+    try:
+        check_document(data, "calibration" if calibration_json else "md_calibration",
+                       f"calibration file {path}")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    if calibration_json:
         # a calibration.json: its md_calibration is what the SFB check takes
         if data.get("md_calibration") is None:
             why = (data.get("failures") or {}).get("md_calibration", "no md_calibration in it")
@@ -141,7 +149,10 @@ def _setup(args):
         raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
                         "analyze TRACE_FILE --units si ...' first)")
     try:
-        doc = read_json_object(doc_path, f"--measured {doc_path}")
+        from filmfriction.analysis.documents import check_document
+
+        doc = check_document(read_json_object(doc_path, f"--measured {doc_path}"), "analysis",
+                             f"--measured {doc_path}")
         slip = measured_slip(doc, f"--measured {doc_path}")
     except ValueError as exc:
         raise UserError(str(exc)) from None

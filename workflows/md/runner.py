@@ -389,6 +389,12 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
         raise SceneError(f"{record_path}: not a readable run record ({exc})") from None
     if not isinstance(record, dict) or not isinstance(record.get("scene"), dict):
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
+    from filmfriction.analysis.documents import check_document
+
+    try:
+        check_document(record, "run-resume", record_path)
+    except ValueError as exc:
+        raise SceneError(str(exc)) from None
     if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
     good, bad = restarts.check(run_dir)
