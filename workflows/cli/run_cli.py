@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs import check_ranks, check_writable, parse_overrides, UserError
+from ..inputs import check_ranks, check_run_json, check_writable, parse_overrides, UserError
 
 from filmfriction.md_inputs.contract import RUN_FILE
 
@@ -127,6 +127,9 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
 
+    if args.resume:
+        # the record read back is checked before the directory is locked
+        check_run_json(args.resume, "--resume", kind="run-resume")
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
     elif not args.resume:
