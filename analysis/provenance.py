@@ -31,7 +31,7 @@ import os
 import subprocess
 from pathlib import Path
 
-__all__ = ["provenance", "input_digests", "file_sha256", "git_state"]
+__all__ = ["provenance", "input_digests", "file_sha256", "git_state", "checkout_state"]
 
 
 def file_sha256(path) -> str:
@@ -47,7 +47,13 @@ def file_sha256(path) -> str:
 def git_state() -> tuple[str | None, bool | None]:
     """``(commit, dirty)`` of the git checkout the package runs from, ``(None, None)``
     when it does not run from one (or git is missing or fails)."""
-    root = Path(__file__).resolve().parent.parent
+    return checkout_state(Path(__file__).resolve().parent.parent)
+
+
+def checkout_state(root: Path) -> tuple[str | None, bool | None]:
+    """``(commit, dirty)`` of the git checkout whose top folder is ``root`` (``(None,
+    None)`` when ``root`` is not one)."""
+    root = Path(root)
     if not (root / ".git").exists():
         return None, None
     env = {k: v for k, v in os.environ.items() if not k.startswith("GIT_")}
