@@ -61,6 +61,18 @@ def _source(trace: Trace) -> dict:
     return source
 
 
+def _provenance(trace: Trace) -> dict:
+    """The document's provenance: the package and the trace's (and run record's) SHA-256."""
+    from filmfriction.md_inputs.contract import RUN_FILE
+
+    from .provenance import provenance
+
+    inputs = {"trace": trace.path}
+    if trace.run_dir is not None:
+        inputs["run.json"] = Path(trace.run_dir) / RUN_FILE
+    return provenance(inputs)
+
+
 def context(trace: Trace, *, skip: int | None = None, structure: bool = True) -> Context:
     """What every section starts from: the slips detected and tabulated, the
     regime (with the sliding check of the last half), the start-up slips left out.
@@ -144,7 +156,8 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
         trace = trace_from_columns(trace, units=units or "lj", **parameters)
     elif units is not None or parameters:
         raise TypeError("units and parameters go with columns in memory; a Trace has its own")
-    doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace)}
+    doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace),
+                 "provenance": _provenance(trace)}
     skipped: dict[str, str] = {}
     if len(trace) < MIN_ROWS:
         n = len(trace)

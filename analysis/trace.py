@@ -30,10 +30,13 @@ entry of :data:`UNITS` that labels it) and ``run.json``, and optionally
 ave/chunk``) and ``trajectory.dcd`` + ``topology.data``.
 
 Speed: a text trace is parsed by NumPy's C reader (~0.2 s per 10⁶ rows of three
-columns); a binary copy beside it (``trace.npy``, :func:`write_binary_copy`, written
-by ``filmfriction analyze`` for traces of :data:`BINARY_MIN_ROWS` rows or more) is
-read instead while it is at least as new as the text (~0.01 s; see
-``benchmarks/bench_analysis.py``).
+columns); a binary copy (:func:`write_binary_copy`, written by ``filmfriction analyze``
+for traces of :data:`BINARY_MIN_ROWS` rows or more) is read instead while the text's
+content is the one it was made from (~0.01 s; see ``benchmarks/bench_analysis.py``).
+The copy lives in the project's cache folder beside the text, ``.filmfriction/``, under
+a name keyed by the SHA-256 of the text's bytes (:func:`binary_copy_path`): it never
+takes a name the user may use, and a text replaced by another (of any date) is read
+again.
 
 The unit system, ``lj`` or ``si``, labels the outputs; only columns given with a unit of
 their own are converted into it.
@@ -41,7 +44,6 @@ their own are converted into it.
 from __future__ import annotations
 
 import io
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,7 +54,8 @@ from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE, SWEEP_FILE,
 
 __all__ = ["MissingInput", "TraceParameters", "TraceLayout", "Trace", "read_trace",
            "read_csv_trace", "map_columns", "detect_delimiter", "trace_column_names",
-           "write_binary_copy", "binary_copy_path", "BINARY_MIN_ROWS", "UNITS", "unit"]
+           "write_binary_copy", "binary_copy_path", "content_sha256", "BINARY_MIN_ROWS",
+           "CACHE_DIR", "CACHE_MIN_BYTES", "UNITS", "unit"]
 
 REQUIRED_COLUMNS = ("time", "spring_force")
 
@@ -154,7 +157,7 @@ class TraceLayout:
     columns : dict
         Analysis name → the file's column name, for the columns renamed.
     binary : bool
-        Read from the binary copy beside the text (:func:`write_binary_copy`).
+        Read from the binary copy of the text (:func:`write_binary_copy`).
     kind : str
         ``"table"`` (a text table, LAMMPS's ``fix print`` and ``fix ave/time`` files
         among them) or ``"lammps-log"`` (a log's thermo output).
@@ -170,6 +173,9 @@ class TraceLayout:
         The rows dropped for empty, NaN or infinite cells: ``count``, ``lines`` (the
         file's line numbers, at most 20) or ``rows``, and per column ``columns``
         (empty: none).
+    content_sha256 : str or None
+        The SHA-256 of the text file's bytes as read (a text table of
+        :data:`CACHE_MIN_BYTES` or more): the key of its binary copy.
     """
 
     delimiter: str = "comma"
@@ -181,6 +187,7 @@ class TraceLayout:
     comments: tuple = ("#",)
     log_run: str | None = None
     dropped: dict = field(default_factory=dict)
+    content_sha256: str | None = None
 
     def source(self) -> dict:
         """What ``analysis.json``'s ``source`` records to read the file again so."""
@@ -504,22 +511,43 @@ def _read_table(path: Path, skip_rows: int = 0, comments=COMMENTS):
 
 _DELIMITER_NAMES = {",": "comma", "\t": "tab", ";": "semicolon", None: "whitespace"}
 
-#: A text trace of at least this many rows gets a binary copy beside it when
+#: A text trace of at least this many rows gets a binary copy when
 #: ``filmfriction analyze`` reads it (:func:`write_binary_copy`).
 BINARY_MIN_ROWS = 100_000
+#: Text files smaller than this are read as text (their hash is not taken).
+CACHE_MIN_BYTES = 1 << 20
+#: The project's cache folder, beside a trace file.
+CACHE_DIR = ".filmfriction"
 
 
-def binary_copy_path(path) -> Path:
-    """Where the binary copy of the text trace ``path`` lives: ``trace.csv`` → ``trace.npy``."""
-    return Path(path).with_suffix(".npy")
+def content_sha256(path) -> str:
+    """The SHA-256 of the file's bytes (hex)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def binary_copy_path(path, digest: str | None = None) -> Path:
+    """Where the binary copy of the text trace ``path`` lives: the cache folder beside it,
+    keyed by the text's content, ``.filmfriction/<name>.<sha256>.npy`` (``digest``: the
+    SHA-256 already taken)."""
+    path = Path(path)
+    digest = digest or content_sha256(path)
+    return path.parent / CACHE_DIR / f"{path.name}.{digest}.npy"
 
 
 def write_binary_copy(trace: "Trace") -> Path:
-    """Write the binary copy of ``trace``'s text file beside it (atomically): a NumPy
-    structured array whose fields are the file's columns, named as in its header.
+    """Write the binary copy of ``trace``'s text file (atomically) into the cache folder
+    beside it: a NumPy structured array whose fields are the file's columns, named as
+    in its header, under the SHA-256 of the text as read (``trace.layout.content_sha256``).
 
-    :func:`read_csv_trace` reads it instead of the text when it is at least as new
-    as the text and has the header's names; text edited later is read again.
+    :func:`read_csv_trace` reads it instead of the text while the text's bytes are the
+    ones it was made from and it has the header's names; older copies of the same file
+    are removed.
     """
     import io
 
@@ -530,24 +558,39 @@ def write_binary_copy(trace: "Trace") -> Path:
         raise ValueError(f"{trace.path}: read with unit conversions, dropped rows or notes "
                          f"({'; '.join(trace.notes)}): a binary copy holds a text table's "
                          "columns as written, so none is made")
+    if layout.binary or not layout.content_sha256:
+        raise ValueError(f"{trace.path}: not read from a text file of {CACHE_MIN_BYTES} bytes "
+                         "or more; no binary copy is made")
     names = [layout.columns.get(name, name) for name in trace.columns]
     table = np.empty(len(trace), dtype=[(name, "<f8") for name in names])
     for name, values in zip(names, trace.columns.values()):
         table[name] = values
     buf = io.BytesIO()
     np.save(buf, table, allow_pickle=False)
-    return write_atomic(binary_copy_path(trace.path), buf.getvalue())
+    copy = binary_copy_path(trace.path, layout.content_sha256)
+    cache = copy.parent
+    if cache.exists() and (cache.is_symlink() or not cache.is_dir()):
+        raise ValueError(f"{cache}: not the project's cache folder (a file or a link); "
+                         "no binary copy is made")
+    cache.mkdir(exist_ok=True)
+    write_atomic(copy, buf.getvalue())
+    import glob
+    import re
+
+    ours = re.compile(re.escape(Path(trace.path).name) + r"\.[0-9a-f]{64}\.npy")
+    for old in cache.glob(glob.escape(Path(trace.path).name) + ".*.npy"):
+        if old != copy and ours.fullmatch(old.name):
+            old.unlink(missing_ok=True)
+    return copy
 
 
-def _read_binary_copy(path: Path, names: list[str]) -> dict | None:
-    """The columns of ``path``'s binary copy, or None when there is none, it is older
-    than the text, or its fields are not the header's ``names``."""
-    copy = binary_copy_path(path)
-    if copy == path:
+def _read_binary_copy(path: Path, names: list[str], digest: str | None) -> dict | None:
+    """The columns of ``path``'s binary copy, or None when there is none for the text's
+    content ``digest`` or its fields are not the header's ``names``."""
+    if digest is None:
         return None
+    copy = binary_copy_path(path, digest)
     try:
-        if copy.stat().st_mtime_ns < path.stat().st_mtime_ns:
-            return None
         table = np.load(copy, allow_pickle=False)
     except (OSError, ValueError):
         return None
@@ -734,7 +777,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
     params = parameters or TraceParameters()
     comments = tuple(comments) or COMMENTS
     column_units = dict(column_units or {})
-    numbers, from_binary, dropped = None, False, {}
+    numbers, from_binary, dropped, digest = None, False, {}, None
     if log_run is not None or is_lammps_log(path):
         if skip_rows:
             raise ValueError(f"--skip-rows {skip_rows}: {path} is a LAMMPS log, read by its "
@@ -756,7 +799,9 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
         raw_head = path.read_bytes() if skip_rows else path.open("rb").read(65536)
         start, header, sep = _header(raw_head, path, skip_rows, comments)
         renames = map_columns(_split(header, sep), columns, str(path))
-        cols = _read_binary_copy(path, list(renames))
+        digest = (content_sha256(path) if path.is_file()
+                  and path.stat().st_size >= CACHE_MIN_BYTES else None)
+        cols = _read_binary_copy(path, list(renames), digest)
         notes, from_binary = [], cols is not None
         if cols is None:
             names, data, numbers, notes, sep = _read_table(path, skip_rows, comments)
@@ -789,7 +834,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
     mapped = {renames[s]: s for s in renames if renames[s] != s}
     layout = TraceLayout(delimiter, mapped, from_binary, kind=kind, column_units=column_units,
                          skip_rows=skip_rows, comments=comments, log_run=log_run,
-                         dropped=dropped)
+                         dropped=dropped, content_sha256=digest)
     return Trace(cols, params, path, notes=tuple(notes), layout=layout)
 
 
@@ -810,9 +855,9 @@ def _analysed_trace_file(directory: Path) -> tuple[Path, dict] | None:
     doc_path = directory / ANALYSIS_FILE
     if not doc_path.is_file():
         return None
-    from .util import read_json_object
+    from .documents import read_document
 
-    doc = read_json_object(doc_path)
+    doc = read_document(doc_path, "analysis")
     source = doc.get("source") or {}
     if source.get("run_dir") or not source.get("path"):
         return None
@@ -828,10 +873,9 @@ def _run_record(directory: Path) -> dict:
     """``run.json`` of a run directory (empty when there is none)."""
     if not (directory / RUN_FILE).exists():
         return {}
-    try:
-        return json.loads((directory / RUN_FILE).read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{directory / RUN_FILE}: not valid JSON: {exc}") from None
+    from .documents import read_document
+
+    return read_document(directory / RUN_FILE, "run")
 
 
 def _run_parameters(run: dict) -> dict:

@@ -60,15 +60,20 @@ def check_writable(path, flag: str, *, directory: bool = False) -> None:
     os.unlink(name)
 
 
-def check_run_json(run_dir, flag: str = "") -> dict | None:
+def check_run_json(run_dir, flag: str = "", kind: str = "run") -> dict | None:
     """``RUN_DIR/run.json`` as a dict (None when absent); UserError when it is not
-    UTF-8, not JSON, or not a JSON object."""
+    UTF-8, not JSON, not a JSON object, or not of the form of a run record (``kind``:
+    ``"run"``, or ``"run-resume"`` for what a resume reads;
+    :func:`filmfriction.analysis.documents.check_document`)."""
     path = Path(run_dir) / RUN_FILE
     if not path.is_file():
         return None
     where = f"{flag} {path}" if flag else str(path)
+    from filmfriction.analysis.documents import check_document
+
     try:
-        return read_json_object(path, where, what="a JSON object (a run record)")
+        return check_document(read_json_object(path, where, what="a JSON object (a run record)"),
+                              kind, where)
     except ValueError as exc:
         raise UserError(str(exc)) from None
 

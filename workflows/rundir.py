@@ -12,15 +12,19 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shlex
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.documents import check_document
+from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.analysis.analyze import to_json
-from filmfriction.md_inputs.contract import AGGREGATE_FILE, CALIBRATION_FILE, SFB_FILE
+from filmfriction.md_inputs.contract import (AGGREGATE_FILE, ANALYSIS_FILE, CALIBRATION_FILE,
+                                             SFB_FILE)
 from filmfriction.reduced_model.sfb.rows import find_row
 
 from .sweep.aggregate import load_aggregate
@@ -35,14 +39,15 @@ SFB_TRACES_SUFFIX = "_slips.csv"
 TRACE_SPAN = 2.0
 
 
-def write_sfb(check, path, extra: dict | None = None) -> Path:
+def write_sfb(check, path, extra: dict | None = None, inputs: dict | None = None) -> Path:
     """Write an SFB check (:class:`filmfriction.reduced_model.SFBCheck`) as ``sfb.json``.
 
     The document is ``check.as_dict()`` plus ``traces``, the name of the CSV
     (``slip,time,x``, SI) with every slip's trace from the yield point y to
     twice its slip time (the whole run when s was not reached), written
     beside it.  ``extra`` adds top-level entries (the user's ``setup`` and
-    ``measured`` slip of ``filmfriction sfb --setup``).
+    ``measured`` slip of ``filmfriction sfb --setup``); ``inputs`` (role -> file: the
+    calibration, the set-up, the measured analysis) go into its ``provenance``.
 
     Returns
     -------
@@ -66,6 +71,7 @@ def write_sfb(check, path, extra: dict | None = None) -> Path:
         lines = [line.replace("klein,", "setup,", 1) if line.startswith("klein,") else line
                  for line in lines]
     write_atomic(traces, "".join(lines))
+    doc["provenance"] = provenance(inputs)
     return write_atomic(path, to_json(doc) + "\n")
 
 
@@ -90,8 +96,9 @@ def reference(row: dict):
     return row["measured"] if "measured" in row else row.get("klein")
 
 
-def read_json(path):
-    """The JSON document at ``path``, or ``None`` if there is no such file.
+def read_json(path, kind: str | None = None):
+    """The JSON document at ``path``, or ``None`` if there is no such file; checked as a
+    document of ``kind`` (:func:`filmfriction.analysis.documents.check_document`) when given.
 
     Raises
     ------
@@ -102,9 +109,12 @@ def read_json(path):
     if not path.is_file():
         return None
     try:
-        return json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ValueError(f"{path}: cannot read: {exc}") from None
+    if kind is not None and not (kind == "sfb" and isinstance(doc, list)):
+        check_document(doc, kind, path)
+    return doc
 
 
 def _columns(path: Path) -> dict:
@@ -124,9 +134,14 @@ def read_calibration(path):
         arrays when its CSV exists (else ``None``).
     """
     path = Path(path)
-    doc = read_json(path)
+    doc = read_json(path, "calibration")
     if doc is None:
         return None
+    if doc.get("run_dirs_relative_to") == "calibration.json":
+        # the runs as written relative to the file's folder: as paths from here
+        for entry in doc.get("runs") or []:
+            if isinstance(entry, dict) and isinstance(entry.get("run_dir"), str):
+                entry["run_dir"] = os.path.normpath(path.parent.absolute() / entry["run_dir"])
     name = doc.get("replay_trace")
     trace = path.with_name(name) if name else None
     if trace is not None and trace.is_file():
@@ -174,7 +189,7 @@ def read_sfb(path):
     only (no notes, no slips).
     """
     path = Path(path)
-    doc = read_json(path)
+    doc = read_json(path, "sfb")
     if doc is None:
         return None
     if isinstance(doc, list):
@@ -191,6 +206,29 @@ def read_sfb(path):
              for k, s in (doc.get("slips") or {}).items()}
     return SFBDocument(rows=doc.get("rows", []), notes=tuple(doc.get("notes", ())), slips=slips,
                        calibration=doc.get("calibration"), doc=doc)
+
+
+def changed_inputs(doc: dict) -> list[str]:
+    """The inputs of a document (its ``provenance.inputs``) whose content is not the one
+    it was made from any more: the ``analysis.json`` of each run of a ``calibration.json``
+    (read back by :func:`read_calibration`: its runs' paths as from here), compared by
+    SHA-256.  File times are not looked at: a copied or moved run is not out of date."""
+    from filmfriction.analysis.provenance import file_sha256
+
+    recorded = ((doc.get("provenance") or {}).get("inputs") or {})
+    out = []
+    for i, entry in enumerate(doc.get("runs") or []):
+        want = (recorded.get(f"runs[{i}] {ANALYSIS_FILE}") or {}).get("sha256")
+        if not want or not isinstance(entry, dict) or not entry.get("run_dir"):
+            continue
+        now = Path(entry["run_dir"]) / ANALYSIS_FILE
+        try:
+            same = file_sha256(now) == want
+        except OSError:
+            same = False
+        if not same:
+            out.append(str(now))
+    return out
 
 
 def _failed(failures: dict, step: str) -> str | None:
@@ -307,6 +345,14 @@ def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dic
                 f"`calibration.json` covers the runs {', '.join('`' + str(c) + '`' for c in covered)}, "
                 f"not the {len(run_dirs)} of this report; `{cal_cmd}` writes the calibration across them.")
             got.missing.append((f"{cal_path} across the runs given", cal_cmd))
+        else:
+            changed = changed_inputs(cal)
+            if changed:
+                got.calibration_remarks.append(
+                    f"`calibration.json` was computed from other contents of "
+                    f"{', '.join('`' + c + '`' for c in changed)} (their SHA-256 differ from the "
+                    f"ones it records); `{cal_cmd}` recomputes it.")
+                got.missing.append((f"{cal_path} (out of date)", cal_cmd))
     # as the study runs it: with the MD calibration, unless calibration.json has none
     no_md = cal is not None and cal.get("md_calibration") is None
     sfb_cmd = sfb_command(run_dir, cal_path, sfb_path, with_calibration=not no_md)

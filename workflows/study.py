@@ -14,7 +14,7 @@ import traceback
 from pathlib import Path
 
 from filmfriction.analysis.analyze import analyse_run
-from filmfriction.md_inputs.contract import ANALYSIS_FILE, SFB_FILE
+from filmfriction.md_inputs.contract import ANALYSIS_FILE, CALIBRATION_FILE, SFB_FILE
 
 from .rundir import write_sfb
 
@@ -32,7 +32,8 @@ def _step(name: str, failures: dict, fn, *args, **kwargs):
 
 
 def _write_sfb(run_dir: Path, check) -> Path:
-    return write_sfb(check, run_dir / SFB_FILE)
+    return write_sfb(check, run_dir / SFB_FILE,
+                     inputs={"calibration": run_dir / CALIBRATION_FILE})
 
 
 def finish_study(run_dir: Path) -> int:

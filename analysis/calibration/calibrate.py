@@ -423,6 +423,11 @@ def rate_dependence(points, units=None) -> dict:
     return out
 
 
+#: ``calibration.json``'s ``run_dirs_relative_to``: its runs' ``run_dir`` are relative to
+#: the folder of the file itself (older files hold absolute paths).
+RUN_DIRS_RELATIVE_TO = "calibration.json"
+
+
 def write_calibration(cal: Calibration, path=None) -> Path:
     """Write ``calibration.json`` atomically (default: in the first run directory).
 
@@ -439,8 +444,24 @@ def write_calibration(cal: Calibration, path=None) -> Path:
     from filmfriction.analysis.util import write_atomic
     from filmfriction.analysis.analyze import to_json
 
+    from filmfriction.analysis.provenance import provenance
+    from filmfriction.md_inputs.contract import ANALYSIS_FILE, TRACE_FILE
+
     path = Path(path) if path is not None else cal.main.run.run_dir / "calibration.json"
     doc = cal.as_dict()
+    # the runs as seen from this file's folder: a run directory moved or copied with its
+    # calibration.json keeps it (RUN_DIRS_RELATIVE_TO says how to read them)
+    base = path.parent.resolve()
+    for entry in doc["runs"]:
+        entry["run_dir"] = os.path.relpath(Path(entry["run_dir"]).resolve(), base)
+    doc["run_dirs_relative_to"] = RUN_DIRS_RELATIVE_TO
+    inputs = {}
+    for i, r in enumerate(cal.runs):
+        d = Path(r.run.run_dir)
+        inputs[f"runs[{i}] {ANALYSIS_FILE}"] = d / ANALYSIS_FILE
+        inputs[f"runs[{i}] trace"] = r.run.trace.path if Path(r.run.trace.path).is_file() \
+            else d / TRACE_FILE
+    doc["provenance"] = provenance(inputs)
     doc["replay_trace"] = None
     rp = cal.main.replay
     if rp is not None:

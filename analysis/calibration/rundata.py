@@ -10,7 +10,6 @@ Example
 """
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -93,10 +92,9 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     apath = run_dir / ANALYSIS_FILE
     cpath = run_dir / "analysis_cycles.csv"
     if apath.exists() and cpath.exists():
-        try:
-            doc = json.loads(apath.read_text())
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"{apath}: not valid JSON: {exc}") from None
+        from filmfriction.analysis.documents import read_document
+
+        doc = read_document(apath, "analysis")
         cycles = read_cycles_csv(cpath)
         # read once, as analysed (not with the run's parameters, then again)
         trace = read_trace(run_dir, **_analysed_parameters(doc))

@@ -82,7 +82,7 @@ REGISTRY: dict[str, type[Observable]] = {}
 #: The ``analysis.json`` keys that the analysis writes itself, around the
 #: observables' sections (no observable may take one).
 BUILT_IN = frozenset({"schema", "units", "source", "regime", "regime_criterion", "regime_note",
-                      "detection", "skipped", "cycles_csv"})
+                      "detection", "skipped", "cycles_csv", "provenance"})
 
 _KEY = re.compile(r"[a-z][a-z0-9_]*")
 

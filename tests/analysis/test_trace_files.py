@@ -97,21 +97,26 @@ def test_an_unmapped_file_says_how_to_map(tmp_path, columns):
         read_trace(path)
 
 
-def test_the_binary_copy_is_read_only_while_fresh(tmp_path, columns):
+def test_the_binary_copy_is_read_only_while_fresh(tmp_path, columns, monkeypatch):
+    import filmfriction.analysis.trace as trace_mod
+
+    monkeypatch.setattr(trace_mod, "CACHE_MIN_BYTES", 0)      # this short file too
     path = _write(tmp_path / "trace.tsv", columns, "\t")
     text = read_trace(path, columns=NAMES)
     assert not text.layout.binary
     copy = write_binary_copy(text)
-    assert copy == binary_copy_path(path) == tmp_path / "trace.npy"
+    assert copy == binary_copy_path(path)
+    assert copy.parent == tmp_path / trace_mod.CACHE_DIR and copy.name.startswith("trace.tsv.")
+    assert not (tmp_path / "trace.npy").exists()
     binary = read_trace(path, columns=NAMES)
     assert binary.layout.binary
     for k in columns:
         np.testing.assert_array_equal(binary.columns[k], text.columns[k])
-    # the text edited after the copy: the text is read again
+    # the text edited after the copy, and dated before it: the text is read again
     shorter = {k: v[:-10] for k, v in columns.items()}
     _write(path, shorter, "\t")
     st = copy.stat()
-    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns - 10**9))
     again = read_trace(path, columns=NAMES)
     assert not again.layout.binary and len(again) == len(columns["time"]) - 10
 

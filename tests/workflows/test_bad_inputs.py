@@ -36,6 +36,11 @@ def _latin1(tmp: Path, name: str, text: str) -> Path:
     return tmp / name
 
 
+def _link(target: Path, link: Path) -> Path:
+    link.symlink_to(target)
+    return link
+
+
 def _afile(tmp: Path) -> Path:
     (tmp / "afile").write_text("x")
     return tmp / "afile"
@@ -109,6 +114,83 @@ def _with_nul(tmp: Path) -> Path:
 def _toml(tmp: Path, name: str, text: str) -> Path:
     (tmp / name).write_text(text)
     return tmp / name
+
+
+def _edited(tmp: Path, name: str, file: str, edit, analysed: bool = False) -> Path:
+    """A synthetic run directory (analysed when ``analysed``) whose JSON ``file`` is passed
+    through ``edit`` (a hand-edited or foreign document)."""
+    import json
+
+    from filmfriction.analysis.analyze import analyse_run
+    from filmfriction.analysis.synthetic import run_directory
+
+    d = run_directory(tmp / name, trajectory=False)
+    if analysed:
+        analyse_run(d)
+    doc = json.loads((d / file).read_text())
+    edit(doc)
+    (d / file).write_text(json.dumps(doc))
+    return d
+
+
+def _set(path: str, value):
+    """An edit setting the entry at the dotted ``path``."""
+    def edit(doc):
+        *head, last = path.split(".")
+        for key in head:
+            doc = doc[key]
+        doc[last] = value
+    return edit
+
+
+def _analysed_file(tmp: Path, edit=None) -> Path:
+    """The directory of an analysed trace file (analysis.json beside the trace), its
+    analysis.json passed through ``edit``."""
+    import json
+
+    from filmfriction.analysis.analyze import analyze, write_outputs
+    from filmfriction.analysis.trace import read_trace
+
+    d = tmp / "measured"
+    d.mkdir()
+    trace = _trace(d, name="scan.csv")
+    doc, per_cycle = analyze(read_trace(trace, units="si", spring_constant=97.0), structure=False)
+    doc["source"]["path"] = "scan.csv"
+    if edit is not None:
+        edit(doc)
+    write_outputs(doc, per_cycle, d / "analysis.json")
+    (d / "analysis.json").write_text(json.dumps(doc))
+    return d
+
+
+def _resumable(tmp: Path, edit) -> Path:
+    """An interrupted run's record, passed through ``edit``, for --resume."""
+    import json
+
+    d = tmp / "stopped"
+    d.mkdir()
+    doc = {"schema": "filmfriction.run/1", "status": "interrupted", "np": 1,
+           "scene": {"name": "stick-slip", "description": "x", "models": [],
+                     "expected_cost": "", "parameters": {}}}
+    edit(doc)
+    (d / "run.json").write_text(json.dumps(doc))
+    return d
+
+
+def _fifo(tmp: Path) -> Path:
+    os.mkfifo(tmp / "pipe")
+    return tmp / "pipe"
+
+
+def _user_file(tmp: Path, name: str, text: str = "the user's own notes\n") -> Path:
+    (tmp / name).write_text(text)
+    return tmp / name
+
+
+def _setup_file(tmp: Path) -> Path:
+    return _toml(tmp, "mine.toml", "name = 'mine'\nspring_constant = 97\nmass = 0.002\n"
+                                   "contact_area = 1e-8\nfilm_thickness = 3.6e-9\nload = 1e-3\n"
+                                   "drive_velocity = 1e-6\n")
 
 
 # id: (command line from tmp, message fragment, exit code)
@@ -258,6 +340,103 @@ CASES = {
     "sweep --out another folder": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
                                               "--dry-run", "--out", _afile(t).parent],
                                    "not a sweep directory", 2),
+    # -- replaced an input, another run's file, a device or a file not of the project
+    "analyze --output the trace itself": (
+        lambda t: ["analyze", _trace(t), "--output", t / "trace.csv"], "is the input", 2),
+    "analyze --output the trace through a link": (
+        lambda t: ["analyze", _trace(t), "--output", _link(t / "trace.csv", t / "alias.csv")],
+        "is the input", 2),
+    "analyze --output the run's run.json": (
+        lambda t: ["analyze", _run_dir(t), "--output", t / "run" / "run.json"],
+        "which only 'filmfriction run' writes", 2),
+    "analyze --output another run's analysis.json": (
+        lambda t: ["analyze", _trace(t), "--output", _run_dir(t) / "analysis.json"],
+        "which is not an input of this command", 2),
+    "analyze --output /dev/null": (lambda t: ["analyze", _trace(t), "--output", "/dev/null"],
+                                   "is a character device, not a regular file", 2),
+    "analyze --output a FIFO": (lambda t: ["analyze", _trace(t), "--output", _fifo(t)],
+                                "is a FIFO (named pipe), not a regular file", 2),
+    "analyze --output a file not of the project": (
+        lambda t: ["analyze", _trace(t), "--output", _user_file(t, "notes.json", "{}")],
+        "exists and was not written by filmfriction", 2),
+    "analyze: its cycles table onto a user's file": (
+        lambda t: ["analyze", _trace(t), "--output",
+                   (_user_file(t, "a_cycles.csv"), t / "a.json")[1]],
+        "(its cycles table): exists and was not written by filmfriction", 2),
+    "sfb --out a run's run.json": (lambda t: ["sfb", "--out", _run_dir(t) / "run.json"],
+                                   "which only 'filmfriction run' writes", 2),
+    "sfb --out a run's trace.csv": (lambda t: ["sfb", "--out", _run_dir(t) / "trace.csv"],
+                                    "which only 'filmfriction run' writes", 2),
+    "sfb --out its calibration": (
+        lambda t: ["sfb", "--calibration", _toml(t, "c.json", '{"yield_stress": 1.0, '
+                                                              '"eta_zero": 2.0}'),
+                   "--out", t / "c.json"], "is the input", 2),
+    "sfb --out a file not of the project": (
+        lambda t: ["sfb", "--out", _user_file(t, "sfb.json", "[]")],
+        "exists and was not written by filmfriction", 2),
+    "report --out beside the user's Markdown": (
+        lambda t: ["report", _run_dir(t), "--out",
+                   (_user_file(t, "notes.md"), t / "notes.html")[1]],
+        "(its Markdown twin): exists and was not written by filmfriction", 2),
+    "report --out the user's page": (
+        lambda t: ["report", _run_dir(t), "--out", _user_file(t, "page.html", "<html>")],
+        "exists and was not written by filmfriction", 2),
+    "report --out into another run": (
+        lambda t: ["report", _run_dir(t), "--out", _md_run(t) / "report.html"],
+        "which is not an input of this command", 2),
+    "geometry --out a run's data file": (
+        lambda t: ["geometry", "--out", _run_dir(t) / "geometry.data"],
+        "which only 'filmfriction run' writes", 2),
+    "map --out a run directory": (lambda t: ["map", "lambda-zeta", "--resolution", "2",
+                                             "--out", _run_dir(t)],
+                                  "which is not an input of this command", 2),
+    # -- hand-edited or foreign documents: an internal error (exit 1, no input named)
+    "--resume: scene.name missing": (
+        lambda t: ["run", "--resume", _resumable(t, lambda d: d["scene"].pop("name"))],
+        "stopped/run.json: scene.name missing: expected a string", 2),
+    "--resume: np a word": (
+        lambda t: ["run", "--resume", _resumable(t, _set("np", "two"))],
+        'np = "two": expected a positive whole number', 2),
+    "analyze: trace_parameters a string": (
+        lambda t: ["analyze", _edited(t, "r", "run.json", _set("trace_parameters", "abc"))],
+        'r/run.json: trace_parameters = "abc": expected a JSON object or null', 2),
+    "analyze: trace_parameters a list": (
+        lambda t: ["analyze", _edited(t, "r", "run.json", _set("trace_parameters", [1]))],
+        "trace_parameters = [1]: expected a JSON object or null", 2),
+    "analyze: K text": (
+        lambda t: ["analyze", _edited(t, "r", "run.json",
+                                      _set("trace_parameters.spring_constant", "abc"))],
+        'trace_parameters.spring_constant = "abc": expected a positive number', 2),
+    "analyze: K true": (
+        lambda t: ["analyze", _edited(t, "r", "run.json",
+                                      _set("trace_parameters.spring_constant", True))],
+        "trace_parameters.spring_constant = true: expected a positive number", 2),
+    "analyze: source a string": (
+        lambda t: ["analyze", _analysed_file(t, _set("source", "abc"))],
+        'measured/analysis.json: source = "abc": expected a JSON object', 2),
+    "analyze: source a list": (
+        lambda t: ["analyze", _analysed_file(t, _set("source", []))],
+        "source = []: expected a JSON object", 2),
+    "report: scene a list": (
+        lambda t: ["report", _edited(t, "r", "run.json", _set("scene", [1]))],
+        "r/run.json: scene = [1]: expected a JSON object", 2),
+    "calibrate: slips a list": (
+        lambda t: ["calibrate", _edited(t, "r", "analysis.json", _set("slips", [1]),
+                                        analysed=True)],
+        "r/analysis.json: slips = [1]: expected a JSON object", 2),
+    "calibrate: static force true": (
+        lambda t: ["calibrate", _edited(t, "r", "analysis.json",
+                                        _set("slips.static_force", {"mean": True}),
+                                        analysed=True)],
+        "slips.static_force.mean = true: expected a number or null", 2),
+    "sfb --measured: spring constant text": (
+        lambda t: ["sfb", "--setup", _setup_file(t), "--measured",
+                   _analysed_file(t, _set("source.parameters.spring_constant", "97"))],
+        'source.parameters.spring_constant = "97": expected a positive number', 2),
+    "sfb --calibration: a stress true": (
+        lambda t: ["sfb", "--calibration", _toml(t, "c.json", '{"yield_stress": true, '
+                                                              '"eta_zero": 2.0}')],
+        "yield_stress = true: expected a number or null", 2),
 }
 
 

@@ -250,6 +250,17 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
                             f"{first + 2}): arithmetic on them overflows; rescale the trace")
     out = args.output or ((trace.run_dir or trace.path.parent) / ANALYSIS_FILE)
     check_writable(out, "output")
+    # no output replaces an input, another run's file or a file not of the project
+    from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+
+    flag = "--output" if args.output is not None else "output"
+    sources = [args.path, trace.path, args.setup]
+    check_output(out, flag, inputs=sources, ours=is_project_json)
+    side = Path(out).with_name(Path(out).stem + "_cycles.csv")
+    check_output(side, flag, inputs=sources, ours=names_in(Path(out)), what="its cycles table")
+    if not args.no_figure:
+        side = Path(out).with_name(Path(out).stem + "_trace.png")
+        check_output(side, flag, inputs=sources, ours=names_in(Path(out)), what="its figure")
     try:
         doc, per_cycle = analyze(trace, skip=args.skip,
                                  structure=not args.no_structure)

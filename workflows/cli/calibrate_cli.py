@@ -98,6 +98,14 @@ def run(args) -> int:
         check_writable(args.out, "--out")
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
     run_dirs, _ = split_sweeps(list(args.run_dirs))
+    from filmfriction.analysis.calibration.calibrate import REPLAY_TRACE_SUFFIX
+    from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+
+    if run_dirs:
+        out = Path(run_dirs[0]) / "calibration.json"
+        check_output(out, "calibration.json", inputs=args.run_dirs, ours=is_project_json)
+        check_output(out.with_name(out.stem + REPLAY_TRACE_SUFFIX), "calibration.json",
+                     inputs=args.run_dirs, ours=names_in(out), what="its replay trace")
     try:
         cal = calibrate(run_dirs)
     except ValueError as exc:

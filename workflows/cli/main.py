@@ -125,6 +125,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    for stream in (sys.stdout, sys.stderr):
+        # a path the terminal's encoding cannot show (a non-ASCII name under LANG=C) is
+        # printed escaped, never an error after the outputs are written
+        try:
+            stream.reconfigure(errors="backslashreplace")
+        except (AttributeError, ValueError, OSError):
+            pass
     parser = build_parser()
     if not argv:
         # `filmfriction` alone says what it does and how to start; it runs nothing

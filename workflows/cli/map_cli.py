@@ -82,6 +82,11 @@ def run(args) -> int:
     processes = cap_workers(args.processes, "--processes")
 
     check_writable(out, "--out", directory=True)
+    from filmfriction.workflows.outputs import check_output
+
+    stem = args.kind.replace("-", "_")
+    for name in (f"{stem}.csv", f"{stem}.png"):
+        check_output(out / name, "--out")
     out.mkdir(parents=True, exist_ok=True)
 
     import numpy as np

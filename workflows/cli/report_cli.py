@@ -61,6 +61,13 @@ def run(args) -> int:
                         "Markdown twin is written beside it as .md)")
     out = args.out if args.out is not None else args.run_dirs[0] / "report.html"
     check_writable(out, "--out")
+    from filmfriction.workflows.outputs import check_output, head_has
+    from filmfriction.workflows.report.render import REPORT_HTML_MARK, REPORT_MD_MARK
+
+    inputs = [*args.run_dirs, *args.compare]
+    check_output(out, "--out", inputs=inputs, ours=head_has(REPORT_HTML_MARK))
+    check_output(out.with_suffix(".md"), "--out", inputs=inputs, ours=head_has(REPORT_MD_MARK),
+                 what="its Markdown twin")
     out.parent.mkdir(parents=True, exist_ok=True)
     try:
         path = build_report(args.run_dirs, out=args.out, log=print, compare=args.compare)

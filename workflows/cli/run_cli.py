@@ -5,8 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs import (check_not_in_run, check_ranks, check_writable, parse_overrides,
-                      UserError)
+from ..inputs import (check_not_in_run, check_ranks, check_run_json, check_writable,
+                      parse_overrides, UserError)
 
 from filmfriction.md_inputs.contract import RUN_FILE
 
@@ -127,6 +127,9 @@ def run(args: argparse.Namespace) -> int:
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
 
+    if args.resume:
+        # the record read back is checked before the directory is locked
+        check_run_json(args.resume, "--resume", kind="run-resume")
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
         check_not_in_run(args.out, "--out")
@@ -190,6 +193,9 @@ def write_geometry(args: argparse.Namespace) -> int:
     except SceneError as exc:
         raise UserError(str(exc)) from None
     check_writable(args.out, "--out")
+    from filmfriction.workflows.outputs import check_output
+
+    check_output(args.out, "--out", inputs=[getattr(args, "scene", None)])
     if args.out.is_file():
         # a geometry file written before is replaced; any other file (a trace, a script) is not
         with open(args.out, "rb") as fh:

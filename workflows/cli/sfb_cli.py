@@ -107,7 +107,15 @@ def _calibration(path: Path | None):
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    if isinstance(data, dict) and str(data.get("schema", "")).startswith("filmfriction.calibration/"):
+    from filmfriction.analysis.documents import check_document
+
+    calibration_json = str(data.get("schema", "")).startswith("filmfriction.calibration/")
+    try:
+        check_document(data, "calibration" if calibration_json else "md_calibration",
+                       f"calibration file {path}")
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    if calibration_json:
         # a calibration.json: its md_calibration is what the SFB check takes
         if data.get("md_calibration") is None:
             why = (data.get("failures") or {}).get("md_calibration", "no md_calibration in it")
@@ -142,7 +150,10 @@ def _setup(args):
         raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
                         "analyze TRACE_FILE --units si ...' first)")
     try:
-        doc = read_json_object(doc_path, f"--measured {doc_path}")
+        from filmfriction.analysis.documents import check_document
+
+        doc = check_document(read_json_object(doc_path, f"--measured {doc_path}"), "analysis",
+                             f"--measured {doc_path}")
         slip = measured_slip(doc, f"--measured {doc_path}")
     except ValueError as exc:
         raise UserError(str(exc)) from None
@@ -189,6 +200,15 @@ def run(args) -> int:
 
     if args.out is not None:
         check_writable(args.out, "--out")
+        from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+        from filmfriction.workflows.rundir import SFB_TRACES_SUFFIX
+
+        sources = [args.calibration, args.setup, args.measured, args.run]
+        if args.measured is not None and args.measured.is_dir():
+            sources.append(args.measured / ANALYSIS_FILE)
+        check_output(args.out, "--out", inputs=sources, ours=is_project_json)
+        check_output(args.out.with_name(args.out.stem + SFB_TRACES_SUFFIX), "--out",
+                     inputs=sources, ours=names_in(args.out), what="its slips' traces")
     units = _units(args)
     setup, slip = _setup(args)
     calibration, si = _calibration(args.calibration)
@@ -232,7 +252,13 @@ def run(args) -> int:
         extra = None if setup is None else {"setup": setup.as_dict(),
                                             "measured": dataclasses.asdict(slip)}
         args.out.parent.mkdir(parents=True, exist_ok=True)
-        path = write_sfb(check, args.out, extra)
+        measured = (None if args.measured is None else args.measured / ANALYSIS_FILE
+                    if args.measured.is_dir() else args.measured)
+        path = write_sfb(check, args.out, extra,
+                         inputs={"calibration": args.calibration, "setup": args.setup,
+                                 "measured": measured,
+                                 "run analysis.json": None if args.run is None
+                                 else args.run / ANALYSIS_FILE})
     if args.json:
         from filmfriction.workflows.rundir import measured_keys
 

@@ -171,4 +171,9 @@ def launcher() -> list[str] | None:
     import shlex
 
     text = os.environ.get(LAUNCHER_ENV, "").strip()
-    return shlex.split(text) if text else None
+    try:
+        return shlex.split(text) if text else None
+    except ValueError as exc:        # an unbalanced quote
+        raise SceneError(f"{LAUNCHER_ENV} {text!r}: {exc} (it is split into words as a shell "
+                         "would: close the quote, e.g. \"mpiexec -n\" or '/opt/my mpi/mpiexec')"
+                         ) from None

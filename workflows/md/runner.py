@@ -26,6 +26,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from filmfriction import md_inputs
+from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE,
@@ -138,6 +139,7 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: i
         "layout": {"cores": nprocs * threads, "mpi_ranks": nprocs, "omp_threads": threads},
         "seeds": {"seed": p["seed"]},
         "versions": versions(),
+        "provenance": provenance(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
         "started": datetime.now(timezone.utc).isoformat(),
         "segments": [],
@@ -387,6 +389,12 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
         raise SceneError(f"{record_path}: not a readable run record ({exc})") from None
     if not isinstance(record, dict) or not isinstance(record.get("scene"), dict):
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
+    from filmfriction.analysis.documents import check_document
+
+    try:
+        check_document(record, "run-resume", record_path)
+    except ValueError as exc:
+        raise SceneError(str(exc)) from None
     if record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
     good, bad = restarts.check(run_dir)

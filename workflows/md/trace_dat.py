@@ -3,6 +3,7 @@ resume, and converted to ``trace.csv`` (:data:`~filmfriction.md_inputs.contract.
 from __future__ import annotations
 
 import io
+import math
 from pathlib import Path
 
 import numpy as np
@@ -55,8 +56,16 @@ def slide_origin(run_dir: Path) -> tuple[str, str]:
     origin_file = run_dir / SLIDE_ORIGIN_FILE
     if not origin_file.exists():
         raise SceneError(f"{origin_file} is missing: cannot resume")
-    x0, z0 = origin_file.read_text().split()
-    return repr(float(x0)), repr(float(z0))
+    try:
+        words = origin_file.read_text(encoding="utf-8").split()
+        x0, z0 = (float(w) for w in words)
+        if not (math.isfinite(x0) and math.isfinite(z0)):
+            raise ValueError
+    except (UnicodeDecodeError, ValueError):
+        shown = origin_file.read_bytes()[:60].decode("utf-8", "replace").strip()
+        raise SceneError(f"{origin_file}: {shown!r}: expected two finite numbers, the wall's x "
+                         "and z at the slide's start (LAMMPS writes them): cannot resume") from None
+    return repr(x0), repr(z0)
 
 
 def rewrite_trace_dat(path: Path, rows: np.ndarray) -> None:

@@ -19,6 +19,7 @@ import numpy as np
 
 from filmfriction import md_inputs
 from filmfriction.analysis import green_kubo as gk
+from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.md_inputs.contract import COMMAND_FILE, LOG_FILE
 from filmfriction.reduced_model import units as U
@@ -238,6 +239,7 @@ def analyse(settings: Settings, run_dir: Path, wall_time: float = math.nan) -> d
         },
         "notes": notes,
         "settings": asdict(settings),
+        "provenance": provenance(),
     }
     write_atomic(run_dir / "viscosity.json", json.dumps(out, indent=2) + "\n")
     return out

@@ -88,6 +88,12 @@ def _templates(*, html: bool):
     return env
 
 
+#: How the report's HTML page and its Markdown twin begin (what tells them from a user's
+#: file of the same name, which the report never replaces).
+REPORT_HTML_MARK = b"<title>filmfriction report"
+REPORT_MD_MARK = b"# filmfriction report"
+
+
 def _render_html(title: str, intro: list, sections: list) -> str:
     return _templates(html=True).get_template("report.html.j2").render(
         title=title, intro=intro, sections=sections)
@@ -198,8 +204,20 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
         sec = Section("Steps that failed")
         sec.add(Table(("step", "reason"), tuple((k, v) for k, v in failures.items())))
         sections.append(sec)
-    _write_atomic(out, _render_html(title, intro, sections))
+    html = _render_html(title, intro, sections)
     md_text, files = _render_md(title, intro, sections, out.stem)
+    # nothing replaces a file the report did not write: its page, its Markdown twin, and
+    # the twin's figures (those the twin there names)
+    from ..outputs import check_output, head_has, names_in
+
+    sources = [*given, *compare]
+    check_output(out, "--out", inputs=sources, ours=head_has(REPORT_HTML_MARK))
+    check_output(out.with_suffix(".md"), "--out", inputs=sources, ours=head_has(REPORT_MD_MARK),
+                 what="its Markdown twin")
+    for name in files:
+        check_output(out.parent / name, "--out", inputs=sources,
+                     ours=names_in(out.with_suffix(".md")), what="a figure of its Markdown twin")
+    _write_atomic(out, html)
     for name, data in files.items():
         _write_atomic(out.parent / name, data)
     _write_atomic(out.with_suffix(".md"), md_text)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime, sliding_steadily
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, SWEEP_FILE
@@ -327,6 +328,8 @@ def build_aggregate(sweep_dir: Path) -> tuple[dict, list[dict]]:
     doc["calibration_runs"] = [r["run_dir"] for r in rows if r["regime"] == STICK_SLIP]
     doc["run_dirs"] = [r["run_dir"] for r in rows]
     doc["outputs"] = ["aggregate.json", "aggregate.csv"]
+    doc["provenance"] = provenance({f"{Path(r['run_dir']).name} {ANALYSIS_FILE}":
+                                    Path(r["run_dir"]) / ANALYSIS_FILE for r in rows})
     return doc, rows
 
 
