@@ -235,7 +235,7 @@ def test_stop_reaps_a_tree_of_sessions():
 @pytest.mark.parametrize("value, fragment", [
     ("/nowhere/mpiexec", "program '/nowhere/mpiexec' no such file"),
     ("no-such-launcher-xyz -n", "program 'no-such-launcher-xyz' not found on PATH"),
-    ("mpiexec 'unbalanced", "cannot split it into words (No closing quotation)"),
+    ('mpiexec "-n', "'mpiexec \"-n': No closing quotation"),
 ], ids=["missing path", "not on PATH", "a quote"])
 def test_a_launcher_that_is_not_there_is_refused(tmp_path, silent_lmp, run_cli, monkeypatch,
                                                  value, fragment):

@@ -210,17 +210,18 @@ def launcher() -> list[str] | None:
     text = os.environ.get(LAUNCHER_ENV, "").strip()
     if not text:
         return None
-    accepted = "give the MPI launcher's command, e.g. srun or /opt/mpich/bin/mpiexec"
     try:
         words = shlex.split(text)
-    except ValueError as exc:
-        raise SceneError(f"{LAUNCHER_ENV}={text!r}: cannot split it into words ({exc}); "
-                         f"{accepted}") from None
+    except ValueError as exc:        # an unbalanced quote
+        raise SceneError(f"{LAUNCHER_ENV} {text!r}: {exc} (it is split into words as a shell "
+                         "would: close the quote, e.g. \"mpiexec -n\" or '/opt/my mpi/mpiexec')"
+                         ) from None
     program = words[0] if words else ""
     found = shutil.which(program) if program and os.sep not in program else None
     path = Path(found or program).expanduser()
     if not program or not path.is_file() or not os.access(path, os.X_OK):
         why = "not found on PATH" if os.sep not in program else (
             "not executable" if path.is_file() else "no such file")
-        raise SceneError(f"{LAUNCHER_ENV}={text!r}: program {program!r} {why}; {accepted}")
+        raise SceneError(f"{LAUNCHER_ENV} {text!r}: program {program!r} {why}; give the MPI "
+                         "launcher's command, e.g. srun or /opt/mpich/bin/mpiexec")
     return words
