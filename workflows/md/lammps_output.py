@@ -2,15 +2,13 @@
 loop totals), and the engine child driven with its progress shown (:func:`run_engine`)."""
 from __future__ import annotations
 
-import os
 import re
-import signal
 import subprocess
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import engine
+from . import engine, reap
 
 
 # ---------------------------------------------------------------- the engine
@@ -143,9 +141,10 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
                         done = min(step, total_steps)
             proc.wait()
         except BaseException:
-            # Ctrl-C, SIGTERM, or on_step refusing the run: LAMMPS stops too
-            os.killpg(proc.pid, signal.SIGTERM)
-            proc.wait()
+            # Ctrl-C, SIGTERM, or on_step refusing the run: LAMMPS, its launcher and
+            # every MPI rank stop too (SIGKILL after reap.GRACE seconds), before the
+            # caller records anything
+            reap.stop(proc)
             bar.close()
             raise
         finally:

