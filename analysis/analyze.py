@@ -143,7 +143,7 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
 
     Examples
     --------
-    >>> from filmfriction.analysis.synthetic import klein_trace
+    >>> from filmfriction.analysis.groundtruth.synthetic import klein_trace
     >>> r = analyze(klein_trace(), units="si", spring_constant=97.0, mass=1.47e-3,
     ...             drive_velocity=1e-7)
     >>> r.status, r.slips["count"]

@@ -122,7 +122,7 @@ def _edited(tmp: Path, name: str, file: str, edit, analysed: bool = False) -> Pa
     import json
 
     from filmfriction.analysis.analyze import analyse_run
-    from filmfriction.analysis.synthetic import run_directory
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
 
     d = run_directory(tmp / name, trajectory=False)
     if analysed:

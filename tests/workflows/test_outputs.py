@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.analyze import analyse_run
-from filmfriction.analysis.synthetic import run_directory
+from filmfriction.analysis.groundtruth.synthetic import run_directory
 from filmfriction.analysis.trace import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
                                          read_trace, write_binary_copy)
 
