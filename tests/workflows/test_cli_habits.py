@@ -122,7 +122,7 @@ def test_progress_without_a_terminal_is_lines(level, shown, tmp_path, capsys):
     stage_lines = [ln for ln in lines if "started" in ln or "steps in" in ln]
     # setup, equilibrate, slide: each starts and ends once
     assert [ln.split(":")[0] for ln in stage_lines if "started" in ln] == [
-        "test", "test equilibrate", "test slide"]
+        "test setup", "test equilibrate", "test slide"]
     assert stage_lines[-1].startswith("test slide: at step 500 of 500")
     tenths = [ln for ln in lines if ln.endswith("%)")]
     if shown == "tenths":

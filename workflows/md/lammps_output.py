@@ -98,7 +98,8 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
     stage_name = "resume" if start_step else "setup"
     errors: list[str] = []
     outcome = EngineOutcome(returncode=0, error=None, atom_steps_per_second=[])
-    bar = progress_bar(total_steps, start_step, label or "lammps", enabled=progress)
+    bar = progress_bar(total_steps, start_step, f"{label or 'lammps'} {stage_name}",
+                       enabled=progress)
     detail(f"{label or 'lammps'}: {' '.join(str(c) for c in cmd)} (in {cwd})")
     with open(cwd / "lammps.screen", "a") as screen:
         proc = subprocess.Popen(cmd, cwd=cwd, env=env or engine.engine_env(),
@@ -116,7 +117,7 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
                     if m.group(1) == "slide" and stage_name == "equilibrate":
                         stage_offset = done
                     stage_name = m.group(1)
-                    bar.set_description(f"{label} {stage_name}".strip())
+                    bar.set_description(f"{label or 'lammps'} {stage_name}")
                     continue
                 m = _ATOMS.match(line)
                 if m:

@@ -10,7 +10,6 @@ import io
 import json
 import math
 import subprocess
-import sys
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -103,7 +102,9 @@ class Settings:
 
 
 def _progress(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
+    from ..progress import note
+
+    note(message)
 
 
 def run(settings: Settings, run_dir: Path, progress=_progress) -> dict:
