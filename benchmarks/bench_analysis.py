@@ -3,7 +3,7 @@
 * a 10⁶-sample stick-slip trace (SFB-like, Klein's parameters, noisy) —
   target ≤ 1 s for detection + cycle table + energy + slip-viscosity fits;
   reading it (comma-separated text, tab-separated text with its own column
-  names, the binary copy ``trace.npy``) and reading + the full ``analyze``
+  names, the binary copy in ``.filmfriction/``) and reading + the full ``analyze``
   document — target ≤ 0.3 s — each as median, min and max of 7 runs;
 * trajectory analyses of a 2288-atom film on one core — target ≥ 1000 frames/s
   (median and spread of several runs, wall and CPU time) — and ψ6 on two
@@ -94,7 +94,7 @@ def bench_trace(n=1_000_000):
         full_binary = _spread(lambda: analyze(read_trace(p, **params)))
     print(f"  read text trace (comma):             {text}")
     print(f"  read text trace (tab, mapped names): {tsv}")
-    print(f"  read binary copy (trace.npy):        {binary}")
+    print(f"  read binary copy (.filmfriction/):   {binary}")
     print(f"  read text + full analyze():          {full_text}")
     print(f"  read binary + full analyze():        {full_binary}   target <= 0.3 s")
 

@@ -43,7 +43,7 @@ from filmfriction.md_inputs.contract import (COMMAND_FILE, DATA_FILE, LOG_FILE, 
 from .inputs import UserError, check_writable
 
 __all__ = ["check_output", "run_directory_of", "own_runs", "RUN_OWN_FILES", "is_project_json",
-           "names_in", "head_has"]
+           "names_in", "head_has", "any_of"]
 
 #: The files ``filmfriction run`` writes into its run directory; no other command
 #: replaces them (restart files ``restart.<step>`` too).
@@ -112,6 +112,11 @@ def names_in(document: Path) -> Callable[[Path], bool]:
             return False
         return f'"{path.name}"' in text or f"({path.name})" in text
     return test
+
+
+def any_of(*tests: Callable[[Path], bool]) -> Callable[[Path], bool]:
+    """A test passed when one of ``tests`` is."""
+    return lambda path: any(test(path) for test in tests)
 
 
 def check_output(path, flag: str, *, inputs: Iterable = (), ours: Callable[[Path], bool] | None = None,

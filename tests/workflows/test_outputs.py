@@ -217,3 +217,15 @@ def test_a_path_the_terminal_cannot_show(tmp_path, filmfriction_command):
                         "--no-figure"], capture_output=True, text=True, env=env, timeout=300)
     assert r.returncode == 0, r.stderr
     assert "donn\\xe9es" in r.stdout and (d / "analysis.json").is_file()
+
+
+def test_the_reports_figures_never_replace_a_users_file(calibrated_run, run_cli, tmp_path):
+    """The Markdown twin's figures (<stem>-<name>.png) go beside --out: a file of that
+    name the twin there does not name is the user's, and nothing is written."""
+    out = tmp_path / "notes"
+    out.mkdir()
+    (out / "page-trace.png").write_bytes(b"the user's own picture")
+    r = run_cli("report", calibrated_run, "--out", out / "page.html")
+    assert r.code == 2 and "(a figure of its Markdown twin): exists and was not written" in r.err
+    assert sorted(p.name for p in out.iterdir()) == ["page-trace.png"]
+    assert (out / "page-trace.png").read_bytes() == b"the user's own picture"

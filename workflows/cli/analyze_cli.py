@@ -251,13 +251,15 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     out = args.output or ((trace.run_dir or trace.path.parent) / ANALYSIS_FILE)
     check_writable(out, "output")
     # no output replaces an input, another run's file or a file not of the project
-    from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+    from filmfriction.workflows.outputs import (any_of, check_output, head_has,
+                                                is_project_json, names_in)
 
     flag = "--output" if args.output is not None else "output"
     sources = [args.path, trace.path, args.setup]
     check_output(out, flag, inputs=sources, ours=is_project_json)
     side = Path(out).with_name(Path(out).stem + "_cycles.csv")
-    check_output(side, flag, inputs=sources, ours=names_in(Path(out)), what="its cycles table")
+    check_output(side, flag, inputs=sources, what="its cycles table",
+                 ours=any_of(names_in(Path(out)), head_has(b"yield_index,stick_index,", 64)))
     if not args.no_figure:
         side = Path(out).with_name(Path(out).stem + "_trace.png")
         check_output(side, flag, inputs=sources, ours=names_in(Path(out)), what="its figure")

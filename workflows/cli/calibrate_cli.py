@@ -102,10 +102,12 @@ def run(args) -> int:
     from filmfriction.workflows.outputs import check_output, is_project_json, names_in
 
     if run_dirs:
+        # a sweep's runs are inputs too: the calibration goes into the first
+        sources = [*args.run_dirs, *run_dirs]
         out = Path(run_dirs[0]) / "calibration.json"
-        check_output(out, "calibration.json", inputs=args.run_dirs, ours=is_project_json)
+        check_output(out, "calibration.json", inputs=sources, ours=is_project_json)
         check_output(out.with_name(out.stem + REPLAY_TRACE_SUFFIX), "calibration.json",
-                     inputs=args.run_dirs, ours=names_in(out), what="its replay trace")
+                     inputs=sources, ours=names_in(out), what="its replay trace")
     try:
         cal = calibrate(run_dirs)
     except ValueError as exc:

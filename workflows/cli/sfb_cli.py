@@ -200,7 +200,8 @@ def run(args) -> int:
 
     if args.out is not None:
         check_writable(args.out, "--out")
-        from filmfriction.workflows.outputs import check_output, is_project_json, names_in
+        from filmfriction.workflows.outputs import (any_of, check_output, head_has,
+                                                    is_project_json, names_in)
         from filmfriction.workflows.rundir import SFB_TRACES_SUFFIX
 
         sources = [args.calibration, args.setup, args.measured, args.run]
@@ -208,7 +209,8 @@ def run(args) -> int:
             sources.append(args.measured / ANALYSIS_FILE)
         check_output(args.out, "--out", inputs=sources, ours=is_project_json)
         check_output(args.out.with_name(args.out.stem + SFB_TRACES_SUFFIX), "--out",
-                     inputs=sources, ours=names_in(args.out), what="its slips' traces")
+                     inputs=sources, what="its slips' traces",
+                     ours=any_of(names_in(args.out), head_has(b"slip,time,x\n", 16)))
     units = _units(args)
     setup, slip = _setup(args)
     calibration, si = _calibration(args.calibration)

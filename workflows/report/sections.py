@@ -340,9 +340,13 @@ def observable_section(obs: Observable, run, failures) -> Section:
 
 def _similarity_rows(run_dir: Path) -> list[dict]:
     """The ``similarity`` rows of ``run_dir/sfb.json`` (what the study wrote)."""
-    doc = json.loads((Path(run_dir) / SFB_FILE).read_text())
+    from ..rundir import read_json
+
+    doc = read_json(Path(run_dir) / SFB_FILE, "sfb")
+    if doc is None:
+        raise ValueError(f"{Path(run_dir) / SFB_FILE}: no such file")
     rows = doc["rows"] if isinstance(doc, dict) else doc
-    return [r for r in rows if r["source"] == "similarity"]
+    return [r for r in rows if isinstance(r, dict) and r.get("source") == "similarity"]
 
 
 def _lambda_zeta_point(label: str, rows: list[dict]) -> tuple:

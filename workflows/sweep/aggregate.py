@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.documents import read_document
 from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime, sliding_steadily
@@ -136,7 +137,7 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
     run_dir = sweep_dir / "points" / name
     inputs = json.loads((sweep_dir / "inputs" / f"{name}.json").read_text())
     p = inputs["parameters"]
-    doc = json.loads((run_dir / ANALYSIS_FILE).read_text())
+    doc = read_document(run_dir / ANALYSIS_FILE, "analysis")
     row = {"point": name, **{f"grid.{k}": v for k, v in point["values"].items()},
            "drive_velocity": p["drive_velocity"], "spring_constant": p["spring_constant"],
            "normal_pressure": p["normal_pressure"], "temperature": p["temperature"],
