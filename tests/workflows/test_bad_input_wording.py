@@ -136,3 +136,17 @@ def test_a_full_disk_names_the_commands_own_remedy(command, remedy):
     assert code == 1 and message.startswith("out/report.html: No space left on device")
     assert message.endswith(remedy), message
     assert ("--resume" in message) == (command == "run")
+
+
+def test_a_full_disk_during_report_does_not_advise_resume(synthetic_run, tmpfs, run_cli):
+    """The report of a run written into a 32 kB tmpfs (root only): one line naming the
+    file, exit 1, and the remedy of the report, not --resume."""
+    tiny = tmpfs("tiny", "size=32k", "the full-disk test needs root")
+    assert run_cli("analyze", synthetic_run).code == 0
+    r = run_cli("report", synthetic_run, "--out", tiny / "report.html")
+    assert r.code == 1, r.err
+    lines = [ln for ln in r.err.splitlines() if ln.strip()]
+    assert f"{tiny}/" in lines[-1] and "No space left on device" in lines[-1], r.err
+    assert "Traceback" not in r.err
+    assert "free space, then run filmfriction report again" in lines[-1], r.err
+    assert "--resume" not in r.err
