@@ -354,6 +354,19 @@ def _numbers(line: str, sep: str | None) -> bool:
     return bool(fields)
 
 
+def _head_bytes(path: Path, lines: int = 64) -> bytes:
+    """The file's first 64 kB, or more until it holds ``lines`` whole lines (a header
+    wider than 64 kB is read whole) or the file ends."""
+    with open(path, "rb") as fh:
+        raw = fh.read(65536)
+        while raw.count(b"\n") <= lines:
+            more = fh.read(1 << 20)
+            if not more:
+                break
+            raw += more
+    return raw
+
+
 def _header(raw: bytes, path: Path, skip_rows: int = 0,
             comments=COMMENTS) -> tuple[int, str, str | None]:
     """Where the data rows start (line index), the header's text and the delimiter.
@@ -616,7 +629,8 @@ def map_columns(names, mapping: dict | None, where="", aliases: dict | None = No
     ------
     ValueError
         A target that the analysis does not know, a source column not in the
-        header (both list what exists), or two sources for one name.
+        header (both list what exists), two sources for one name, or one source
+        for two names.
 
     Examples
     --------
@@ -644,6 +658,10 @@ def map_columns(names, mapping: dict | None, where="", aliases: dict | None = No
             raise ValueError(f"{where}--column {target}={src}: no column {src!r} in the header "
                              f"(columns: {', '.join(names)}"
                              + (f"; {_SKIP_HINT})" if lost and len(mapping) > 1 else ")"))
+        first = next((t for t, s in mapping.items() if s == src), target)
+        if first != target:
+            raise ValueError(f"{where}--column {first}={src} and --column {target}={src}: one "
+                             f"column given for two names; each name reads a column of its own")
         renames[src] = target
     targets = list(renames.values())
     for target in set(targets):
@@ -796,7 +814,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
         cols = {n: np.ascontiguousarray(data[:, j]) for j, n in enumerate(names)}
         delimiter, kind = "whitespace", "lammps-log"
     else:
-        raw_head = path.read_bytes() if skip_rows else path.open("rb").read(65536)
+        raw_head = path.read_bytes() if skip_rows else _head_bytes(path)
         start, header, sep = _header(raw_head, path, skip_rows, comments)
         renames = map_columns(_split(header, sep), columns, str(path))
         digest = (content_sha256(path) if path.is_file()

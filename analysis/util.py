@@ -62,9 +62,11 @@ def write_atomic(path, data: str | bytes) -> Path:
         with os.fdopen(fd, mode) as fh:
             fh.write(data)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename is None:
+            exc.filename = str(path)        # a failed write (a full disk) names its file
         raise
     return path
 

@@ -231,8 +231,15 @@ def sfb_check(calibration=None, units: LJUnits = OMCTS, experiment: KleinExperim
         law = NewtonianFilm(viscosity=eta, area=A, thickness=D)
         return run_slip(M, K, x0, law, restick_force=restick, label=label)
 
-    main = klein_run(ex.eta_eff, "Klein parameters, eta_eff")
     dB = ex.damping_rel_err
+    if not dB < 1.0:
+        raise ValueError(
+            f"the film's damping B = A eta_eff / D has a relative error of {dB:.0%} (eta_eff "
+            f"{ex.eta_eff:.4g} +- {ex.eta_eff_err:.2g} Pa s, contact area {A:.4g} +- "
+            f"{ex.contact_area_err:.2g} m2, film thickness {D:.4g} +- "
+            f"{ex.film_thickness_err:.2g} m): B - 1 sigma is not positive; the check needs "
+            "errors that add up (in quadrature) to less than 100 %")
+    main = klein_run(ex.eta_eff, "Klein parameters, eta_eff")
     lo = klein_run(ex.eta_eff * (1 - dB), "B - 1 sigma")
     hi = klein_run(ex.eta_eff * (1 + dB), "B + 1 sigma")
     bulk = klein_run(ex.eta_bulk, "bulk viscosity")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from pathlib import Path
 
 from ..inputs import EXIT_BAD_INPUT, EXIT_FAILED, UserError
 
@@ -41,28 +42,63 @@ comparison with SFB experiments.
   filmfriction --help            every command"""
 
 
-def _one_line(exc: BaseException) -> tuple[str, int]:
+def _undecodable_file(exc: UnicodeDecodeError) -> str | None:
+    """Where a UnicodeDecodeError came from, as "FILE, line N" (None: not found): the
+    file the failing read was reading (a ``Path`` whose ``read_text`` failed, an open
+    text file, a ``path`` argument), its first byte that is not UTF-8 located anew."""
+    import io
+
+    tb, frames = exc.__traceback__, []
+    while tb is not None:
+        frames.append(tb.tb_frame)
+        tb = tb.tb_next
+    for frame in reversed(frames):                     # the innermost reader first
+        for name, value in frame.f_locals.items():
+            if isinstance(value, io.TextIOWrapper) and isinstance(value.name, str):
+                value = value.name
+            elif not (isinstance(value, Path) or (isinstance(value, str) and name in (
+                    "path", "file", "filename", "source"))):
+                continue
+            try:
+                path = Path(value)
+                if not path.is_file() or path.stat().st_size > 1 << 28:
+                    continue
+                path.read_bytes().decode("utf-8")
+            except UnicodeDecodeError as again:
+                line = path.read_bytes()[:again.start].count(b"\n") + 1
+                return f"{path}, line {line}"
+            except (OSError, ValueError):
+                continue
+    return None
+
+
+def _one_line(exc: BaseException, command: str | None = None) -> tuple[str, int]:
     """The message and exit code for an exception that reached the command line.
 
     Bad input (UserError, a scene's SceneError, a file that cannot be read or
     written, a file that is not UTF-8) is exit 2; anything else is a failed
-    run, exit 1.  The message names the input and the value.
+    run, exit 1.  The message names the input and the value.  A full disk is
+    a failure; only ``run`` is advised to resume.
     """
     from ..md.scene import SceneError
 
     if isinstance(exc, (UserError, SceneError)):
         return str(exc), EXIT_BAD_INPUT
     if isinstance(exc, UnicodeDecodeError):
-        return (f"a file is not UTF-8 text ({exc.reason} at byte {exc.start}); give a "
-                f"UTF-8 file", EXIT_BAD_INPUT)
+        where = _undecodable_file(exc)
+        return (f"{where or 'a file'}: not UTF-8 text ({exc.reason}: byte "
+                f"{exc.object[exc.start:exc.start + 1]!r}); save it as UTF-8",
+                EXIT_BAD_INPUT)
     if isinstance(exc, OSError):
         import errno
 
         what = exc.strerror or str(exc)
         where = f"{exc.filename}: " if exc.filename else ""
         if exc.errno in (errno.ENOSPC, errno.EDQUOT):
-            return (f"{where}{what}: the disk is full; free space and resume the run "
-                    "(--resume DIR) or run again", EXIT_FAILED)
+            remedy = ("free space, then resume the run (--resume DIR) or run it again"
+                      if command == "run" else
+                      f"free space, then run filmfriction {command or 'the command'} again")
+            return f"{where}{what}: the disk is full; {remedy}", EXIT_FAILED
         return f"{where}{what}", EXIT_BAD_INPUT
     from ..md.runner import RunFailed
 
@@ -163,6 +199,6 @@ def main(argv: list[str] | None = None) -> int:
             import traceback
 
             traceback.print_exc()
-        message, code = _one_line(exc)
+        message, code = _one_line(exc, args.command)
         print(f"filmfriction {args.command}: error: {message}", file=sys.stderr)
         return code

@@ -167,6 +167,7 @@ def probe(path: Path, source: str) -> LammpsBuild:
     try:
         stat = Path(path).stat()
         returncode, stdout, stderr = _help(Path(path), stat.st_mtime_ns, stat.st_size)
+        sha256 = _sha256(Path(path), stat.st_mtime_ns, stat.st_size)
     except (OSError, subprocess.TimeoutExpired) as exc:
         raise SceneError(f"{source} {path}: cannot run it ({exc})") from None
     version, packages = parse_help(stdout)
@@ -176,7 +177,7 @@ def probe(path: Path, source: str) -> LammpsBuild:
                          f"(exit {returncode}: {tail[0][:200]}); give a LAMMPS "
                          "executable")
     return LammpsBuild(path=path, source=source, version=version, packages=packages,
-                       sha256=_sha256(Path(path), stat.st_mtime_ns, stat.st_size))
+                       sha256=sha256)
 
 
 @lru_cache(maxsize=8)

@@ -417,7 +417,7 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
             raise SceneError(f"no scene {name_or_path!r}; known scenes: "
                              f"{', '.join(scenes)} (or give a path to a .toml file)")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a BOM is accepted
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
     except UnicodeDecodeError as exc:
