@@ -233,7 +233,7 @@ def _sfb_prediction(cal: dict | None, sfb, measured: bool) -> Answer:
                None)
     if decades > MAX_DECADES:
         return Answer(q, f"the law is carried {decades:.1f} decades of shear rate beyond its "
-                      "calibrated rates: no prediction (its rows are in the appendix)",
+                      "calibrated rates: no prediction (the run's report lists them in an appendix)",
                       "not comparable", rule, "Appendix: SFB-scale carry-over")
     if row is None or row.get("model") is None:
         return Answer(q, "no calibrated slip time", "inconclusive", rule, SECTIONS["sfb"])
