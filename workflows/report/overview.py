@@ -143,8 +143,8 @@ def summary_section(run, inputs, checks, compared, left_out, failures) -> Sectio
     sec.p("How a status is decided (established / inconclusive / not comparable):")
     sec.add(Table(("question", "rule"), tuple((a.question, a.rule) for a in main)))
     if left_out:
-        sec.p("Left out, their inputs absent: " + "; ".join(
-            f"{t} ({why})" for t, why in left_out) + ".")
+        sec.p("Left out, their inputs absent: " + " ".join(
+            f"**{t}**: {why}" for t, why in left_out))
     return sec
 
 
