@@ -124,10 +124,10 @@ def _energy(a: dict) -> Answer:
     units = a.get("units", "lj")
     e = a.get("energy") or {}
     q = "Where does a slip's energy go?"
-    rule = ("established: the viscous fraction's standard error is known over ≥ 3 slips and "
-            + ("every independent heat check (film heat vs the thermostat's) agrees at 99 %"
-               if units == "lj" else "(a measured trace has no independent heat measurement) "
-               "the film heat comes from the equation of motion"))
+    rule = ("established: the viscous fraction's standard error is known over ≥ 3 slips"
+            + (" and every independent heat check (film heat vs the thermostat's) agrees at 99 %"
+               if units == "lj" else " (a measured trace has no independent heat measurement: "
+               "the film heat is the equation of motion's)"))
     vf = e.get("viscous_fraction") or {}
     if vf.get("mean") is None:
         return Answer(q, "not measured: " + str((a.get("skipped") or {}).get("energy",
