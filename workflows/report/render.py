@@ -187,7 +187,8 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
                 for sec in sections if sec.absent]
     sections = [sec for sec in sections if not sec.absent]
     compared = [Path(c) for c in compare] + list(run_dirs[1:])
-    sections = [summary_section(run, inputs, checks, compared, left_out, failures),
+    sections = [summary_section(run, inputs, checks, compared, left_out, failures,
+                                [sec.title for sec in sections]),
                 consistency_section(checks), *sections]
     if inputs.missing:
         sec = Section("Inputs the report did not find")
