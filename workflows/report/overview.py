@@ -93,7 +93,7 @@ def _documents(run_dir: Path):
     return analysis, cal, sfb
 
 
-def summary_section(run, inputs, checks, compared, left_out, failures) -> Section:
+def summary_section(run, inputs, checks, compared, left_out, failures, titles=()) -> Section:
     """The opening section: each question answered for the main run (and beside it every
     compared run), with its status, the rule of that status and a link to its section."""
     sec = Section(SUMMARY_TITLE)
@@ -115,7 +115,11 @@ def summary_section(run, inputs, checks, compared, left_out, failures) -> Sectio
     gone = {t for t, _ in left_out}
 
     def where(a):
-        return "left out (inputs absent)" if a.section in gone else link(a.section, "→")
+        # the section's title as the report writes it (the SFB one names the set-up)
+        title = next((t for t in titles if t.startswith(a.section)), None)
+        if title is None:
+            return "left out (inputs absent)" if a.section in gone else "–"
+        return link(title, "→")
     counts = {s: sum(x.status == s for x in main) for s in STATUSES}
     bad = [c for c in checks if c.status == "disagree"]
     sec.p("What this study found, each answer with its uncertainty (± one standard error "
@@ -143,8 +147,8 @@ def summary_section(run, inputs, checks, compared, left_out, failures) -> Sectio
     sec.p("How a status is decided (established / inconclusive / not comparable):")
     sec.add(Table(("question", "rule"), tuple((a.question, a.rule) for a in main)))
     if left_out:
-        sec.p("Left out, their inputs absent: " + "; ".join(
-            f"{t} ({why})" for t, why in left_out) + ".")
+        sec.p("Left out, their inputs absent: " + " ".join(
+            f"**{t}**: {why}" for t, why in left_out))
     return sec
 
 

@@ -189,10 +189,12 @@ def build_report(run_dirs, out=None, *, failures=None, log=None, compare=()) -> 
     if appendix is not None:
         sections.append(appendix)
     # a section whose inputs are absent is left out, with one line in the summary
-    left_out = [(sec.title, sec.absent) for sec in sections if sec.absent]
+    left_out = [(sec.title, next((b for b in sec.blocks if isinstance(b, str)), sec.absent))
+                for sec in sections if sec.absent]
     sections = [sec for sec in sections if not sec.absent]
     compared = [Path(c) for c in compare] + list(run_dirs[1:])
-    sections = [summary_section(run, inputs, checks, compared, left_out, failures),
+    sections = [summary_section(run, inputs, checks, compared, left_out, failures,
+                                [sec.title for sec in sections]),
                 consistency_section(checks), *sections]
     if inputs.missing:
         sec = Section("Inputs the report did not find")

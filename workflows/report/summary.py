@@ -124,10 +124,10 @@ def _energy(a: dict) -> Answer:
     units = a.get("units", "lj")
     e = a.get("energy") or {}
     q = "Where does a slip's energy go?"
-    rule = ("established: the viscous fraction's standard error is known over ≥ 3 slips and "
-            + ("every independent heat check (film heat vs the thermostat's) agrees at 99 %"
-               if units == "lj" else "(a measured trace has no independent heat measurement) "
-               "the film heat comes from the equation of motion"))
+    rule = ("established: the viscous fraction's standard error is known over ≥ 3 slips"
+            + (" and every independent heat check (film heat vs the thermostat's) agrees at 99 %"
+               if units == "lj" else " (a measured trace has no independent heat measurement: "
+               "the film heat is the equation of motion's)"))
     vf = e.get("viscous_fraction") or {}
     if vf.get("mean") is None:
         return Answer(q, "not measured: " + str((a.get("skipped") or {}).get("energy",
@@ -233,7 +233,7 @@ def _sfb_prediction(cal: dict | None, sfb, measured: bool) -> Answer:
                None)
     if decades > MAX_DECADES:
         return Answer(q, f"the law is carried {decades:.1f} decades of shear rate beyond its "
-                      "calibrated rates: no prediction (its rows are in the appendix)",
+                      "calibrated rates: no prediction (the run's report lists them in an appendix)",
                       "not comparable", rule, "Appendix: SFB-scale carry-over")
     if row is None or row.get("model") is None:
         return Answer(q, "no calibrated slip time", "inconclusive", rule, SECTIONS["sfb"])
