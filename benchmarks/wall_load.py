@@ -29,8 +29,8 @@ import numpy as np
 #: The film and slider every wall model is measured with (the Klein-similar
 #: scene's film; a stiff spring so that each ramp is short).
 BASE = {"film_layers": 4, "temperature": 0.71, "spring_constant": 20.0, "wall_mass": 500.0,
-        "mount_damping": 0.3, "drive_velocity": 0.04, "equilibrate_steps": 5000,
-        "slide_steps": 30000, "trace_every": 20, "restart_every": 0}
+        "mount_damping": 0.3, "drive_velocity": 0.08, "equilibrate_steps": 4000,
+        "slide_steps": 16000, "trace_every": 20, "restart_every": 0}
 
 #: Wall models: the scene parameters that make each.
 MODELS = {

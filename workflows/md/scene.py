@@ -108,7 +108,7 @@ FLEXIBLE_WALL_ATOM_MASS = 2.0
 FLEXIBLE_WALL_MAX_TEMPERATURE = 0.5 * FLEXIBLE_WALL_EPSILON
 
 # A twisted top wall is stretched to fit the box: at most this strain along x or y.
-TWISTED_WALL_MAX_STRAIN = 0.03
+TWISTED_WALL_MAX_STRAIN = 0.05
 
 # A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
