@@ -93,6 +93,12 @@ def measure(run_dir: Path) -> dict:
             "status": record.get("status")}
 
 
+def _finished(run_dir: Path) -> bool:
+    """The trace reaches the end of the slide (a run still going is left out)."""
+    last = (run_dir / "trace.dat").read_text().rstrip().rsplit("\n", 1)[-1].split()
+    return bool(last) and last[0].isdigit() and int(last[0]) >= BASE["slide_steps"]
+
+
 def fit(points: list[tuple[float, float]]) -> dict | None:
     """F_s = F_0 + mu * L by least squares over (L, F_s) points, with standard errors."""
     from scipy.stats import linregress
@@ -132,7 +138,7 @@ def main(argv=None) -> int:
                     if a.report_only:
                         continue
                     subprocess.run(command(a.out, model, pressure, seed), check=False)
-                if not (run_dir / "run.json").is_file():
+                if not (run_dir / "run.json").is_file() or not _finished(run_dir):
                     continue
                 m = measure(run_dir)
                 m.update(pressure=pressure, seed=seed, load=pressure * m["area"])
@@ -151,6 +157,29 @@ def main(argv=None) -> int:
             print(f"{model}: F_s = ({result['F0']:.2f} ± {result['F0_se']:.2f}) + "
                   f"({result['mu']:.3f} ± {result['mu_se']:.3f}) L over {result['points']} runs; "
                   f"F_0/A = {result['F0'] / area:.3f} ± {result['F0_se'] / area:.3f} eps/sigma^3")
+    print("\n| wall model | runs (pinned) | seeds | F_0 (ε/σ) | μ | F_0/A (ε/σ³) | F_s/A at P = 0.01 (ε/σ³) |")
+    print("|---|---|---|---|---|---|---|")
+    for model, entry in table.items():
+        rows, result = entry["runs"], entry["fit"]
+        if not rows:
+            continue
+        area = rows[0]["area"]
+        low = [r["static_force"] / area for r in rows
+               if r["static_force"] is not None and r["pressure"] == min(pressures)]
+        seeds_run = sorted({r["seed"] for r in rows})
+        n_pinned = sum(r["pinned"] for r in rows)
+        if result:
+            cells = (f"{result['F0']:.1f} ± {result['F0_se']:.1f} | "
+                     f"{result['mu']:.3f} ± {result['mu_se']:.3f} | "
+                     f"{result['F0'] / area:.3f} ± {result['F0_se'] / area:.3f}")
+        else:
+            late = [r["mean_force_late"] for r in rows]
+            cells = (f"slides freely (mean force {np.mean(late):.2f}, largest "
+                     f"{max(r['max_force'] for r in rows):.2f}) | – | –")
+        low_text = (f"{np.mean(low):.3f}" + (f" ± {np.std(low, ddof=1) / np.sqrt(len(low)):.3f}"
+                                             if len(low) > 1 else "")) if low else "–"
+        print(f"| {model} | {len(rows)} ({n_pinned}) | {','.join(map(str, seeds_run))} | "
+              f"{cells} | {low_text} |")
     doc = {"base": BASE, "models": table, "command": "python benchmarks/wall_load.py " +
            " ".join(argv if argv is not None else sys.argv[1:])}
     from filmfriction.analysis.util import write_atomic
