@@ -141,7 +141,7 @@ def test_the_script_refuses_a_data_file_of_another_vacancy_fraction(tmp_path):
     out = subprocess.run(cmd, cwd=tmp_path, env=engine.engine_env(), capture_output=True,
                          text=True, timeout=300)
     assert out.returncode != 0
-    assert "has 27 atoms in the bottom wall's surface plane, not the 30 sites less " \
+    assert "has 27 atoms in the surface plane of the bottom wall, not the 30 sites less " \
            "wall_vacancies 0.2" in out.stdout
     # the data file of these parameters is accepted
     (tmp_path / DATA_FILE).write_text(scene.geometry().lammps_data())
