@@ -75,6 +75,7 @@ class Fcc111:
     z0: float = 0.0                 # z of the first plane
     stacking: int = 0               # stacking index (mod 3) of the first plane
     origin: tuple[float, float] = (0.0, 0.0)  # in-plane shift, in fractions of a cell
+    turned: bool = False            # rows along y (a 90 degree turn, a 30 degree twist)
 
     @property
     def plane_spacing(self) -> float:
@@ -87,7 +88,10 @@ class Fcc111:
 
     @property
     def strain(self) -> tuple[float, float]:
-        """In-plane strain of the rows along x and y against ``spacing`` (0 unless fitted)."""
+        """In-plane strain of the lattice along x and y against ``spacing`` (0 unless fitted)."""
+        if self.turned:
+            return (self.box[0] / self.cells[1] / (SQRT3 * self.spacing) - 1.0,
+                    self.box[1] / self.cells[0] / self.spacing - 1.0)
         return (self.box[0] / self.cells[0] / self.spacing - 1.0,
                 self.box[1] / self.cells[1] / (SQRT3 * self.spacing) - 1.0)
 
@@ -125,6 +129,11 @@ class Fcc111:
         k = (self.stacking - (1 - self.planes)) % 3
         slab.translate([(k * 0.5 + self.origin[0]) * a,
                         (k / 6.0 + self.origin[1]) * SQRT3 * a, self.z0])
+        if self.turned:
+            # x <-> y: a mirror through the diagonal, which for a close-packed
+            # plane is its 90 degree turn (the plane is symmetric about its rows)
+            slab.positions = slab.positions[:, [1, 0, 2]]
+            slab.set_cell([slab.cell[1, 1], slab.cell[0, 0], slab.cell[2, 2]])
         # stretch the planes to the box (the film fits the walls' box)
         slab.set_cell([self.box[0], self.box[1], slab.cell[2, 2]], scale_atoms=True)
         slab.pbc = (True, True, False)
@@ -147,7 +156,7 @@ class Fcc111:
 
 def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1, *,
            fit: tuple[float, float] | None = None, z0: float = 0.0, stacking: int = 0,
-           origin: tuple[float, float] = (0.0, 0.0)) -> Fcc111:
+           origin: tuple[float, float] = (0.0, 0.0), turned: bool = False) -> Fcc111:
     """``planes`` close-packed fcc(111) planes of nearest-neighbour distance ``spacing``.
 
     Parameters
@@ -173,6 +182,12 @@ def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1
     origin : (float, float)
         In-plane shift of every plane, in fractions of the cell
         (:class:`ConfinedFilm` uses :data:`ORIGIN`, off the periodic boundary).
+    turned : bool
+        The planes turned by 90 degrees about z, their close-packed rows along
+        y (for a close-packed plane, whose rows repeat every 60 degrees, a
+        30 degree twist: the farthest from alignment).  ``cells`` then counts
+        atoms along a row (now along y) and row pairs along x: the box is
+        ``(cells[1] * sqrt(3) * spacing, cells[0] * spacing)``.
 
     Returns
     -------
@@ -185,21 +200,29 @@ def fcc111(spacing: float, cells: tuple[int, int] | None = None, planes: int = 1
     ((7.700000000000001, 7.62102355330306), 56, 0.898146)
     >>> fcc111(1.1, planes=3, fit=wall.box).cells
     (7, 4)
+    >>> turned = fcc111(1.1, planes=3, fit=wall.box, turned=True)
+    >>> turned.cells, [round(e, 4) for e in turned.strain]
+    ((7, 4), [0.0104, -0.0103])
     """
     if (cells is None) == (fit is None):
         raise ValueError("give either cells or fit")
+    along, across = (1, 0) if turned else (0, 1)    # the box axes of rows and row pairs
     if fit is not None:
         lx, ly = float(fit[0]), float(fit[1])
-        cells = (max(1, round(lx / spacing)), max(1, round(ly / (SQRT3 * spacing))))
+        size = (lx, ly)
+        cells = (max(1, round(size[along] / spacing)),
+                 max(1, round(size[across] / (SQRT3 * spacing))))
     else:
         cells = (int(cells[0]), int(cells[1]))
         if min(cells) < 1:
             raise ValueError(f"cells {cells}: need at least one cell along x and y")
-        lx, ly = cells[0] * spacing, cells[1] * SQRT3 * spacing
+        size = [0.0, 0.0]
+        size[along], size[across] = cells[0] * spacing, cells[1] * SQRT3 * spacing
+        lx, ly = size
     if planes < 0:
         raise ValueError(f"planes {planes}: need 0 or more")
     return Fcc111(float(spacing), cells, (lx, ly), int(planes), float(z0), int(stacking),
-                  (float(origin[0]), float(origin[1])))
+                  (float(origin[0]), float(origin[1])), bool(turned))
 
 
 @dataclass(frozen=True)
@@ -222,6 +245,17 @@ class ConfinedFilm:
     flexible_walls : bool
         Every wall plane but the outermost one of each wall is mobile (types
         ``BOTTOM_FLEXIBLE`` and ``TOP_FLEXIBLE``).
+    top_wall_twisted : bool
+        The top wall turned by 90 degrees about z (a 30 degree twist of its
+        close-packed rows against the bottom wall's and the film's), its
+        lattice stretched to the box (``fcc111(turned=True)``): the film is in
+        registry with the bottom wall only.
+    vacancy_fraction : float
+        Fraction of the atoms of each wall's plane facing the film removed,
+        at sites drawn at random (``fraction * atoms per plane`` to the
+        nearest whole number, halves up, from each wall, without replacement).
+    vacancy_seed : int
+        Seed of the vacancies' draw (``numpy.random.default_rng``).
 
     Layout along z: the bottom wall's planes from z = 0 up; the film's first
     plane one film plane spacing above the bottom wall's last; the top wall's
@@ -244,6 +278,9 @@ class ConfinedFilm:
     wall_planes: int
     cutoff: float
     flexible_walls: bool
+    top_wall_twisted: bool = False
+    vacancy_fraction: float = 0.0
+    vacancy_seed: int = 0
 
     @cached_property
     def bottom(self) -> Fcc111:
@@ -259,8 +296,19 @@ class ConfinedFilm:
     @cached_property
     def top(self) -> Fcc111:
         z0 = self.film.top + self.film.plane_spacing + TOP_WALL_ROOM
+        if self.top_wall_twisted:
+            return fcc111(self.wall_spacing, planes=self.wall_planes, fit=self.bottom.box,
+                          z0=z0, stacking=self.wall_planes + self.film_layers,
+                          origin=ORIGIN, turned=True)
         return fcc111(self.wall_spacing, self.cells, self.wall_planes, z0=z0,
                       stacking=self.wall_planes + self.film_layers, origin=ORIGIN)
+
+    @property
+    def vacancies_per_wall(self) -> tuple[int, int]:
+        """Atoms taken out of the (bottom, top) wall's plane facing the film."""
+        # the nearest whole number, halves up (as film_slide.lmp checks it)
+        return (math.floor(self.vacancy_fraction * self.bottom.atoms_per_plane + 0.5),
+                math.floor(self.vacancy_fraction * self.top.atoms_per_plane + 0.5))
 
     @property
     def box(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float]]:
@@ -278,15 +326,23 @@ class ConfinedFilm:
         writes the box's own z bounds).
         """
         out = []
-        for stack, rigid, mobile, outer in (
-                (self.bottom, AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE, 0),
-                (self.film, AtomType.FILM, AtomType.FILM, None),
-                (self.top, AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE, self.wall_planes - 1)):
+        rng = np.random.default_rng(self.vacancy_seed) if self.vacancy_fraction > 0 else None
+        removed = dict(zip((0, 2), self.vacancies_per_wall))
+        for i, (stack, rigid, mobile, outer, inner) in enumerate((
+                (self.bottom, AtomType.BOTTOM_WALL, AtomType.BOTTOM_FLEXIBLE, 0,
+                 self.wall_planes - 1),
+                (self.film, AtomType.FILM, AtomType.FILM, None, None),
+                (self.top, AtomType.TOP_WALL, AtomType.TOP_FLEXIBLE, self.wall_planes - 1,
+                 0))):
             part = stack.atoms()
             kind = np.full(len(part), int(rigid))
             if self.flexible_walls and outer is not None:
                 kind[stack.plane != outer] = int(mobile)
             part.numbers = kind
+            if rng is not None and removed.get(i, 0) > 0:
+                # vacancies in the plane facing the film
+                sites = np.flatnonzero(stack.plane == inner)
+                del part[rng.choice(sites, removed[i], replace=False)]
             out.append(part)
         system = out[0] + out[1] + out[2]
         (_, lx), (_, ly), (zlo, zhi) = self.box
@@ -322,4 +378,7 @@ class ConfinedFilm:
         return (f"film_slide geometry: wall_spacing={self.wall_spacing!r} "
                 f"film_spacing={self.film_spacing!r} cells={self.cells[0]}x{self.cells[1]} "
                 f"film_layers={self.film_layers} wall_planes={self.wall_planes} "
-                f"cutoff={self.cutoff!r} walls={'flexible' if self.flexible_walls else 'rigid'}")
+                f"cutoff={self.cutoff!r} walls={'flexible' if self.flexible_walls else 'rigid'}"
+                + (" top_wall=twisted" if self.top_wall_twisted else "")
+                + (f" vacancy_fraction={self.vacancy_fraction!r} vacancy_seed={self.vacancy_seed}"
+                   if self.vacancy_fraction > 0 else ""))

@@ -107,6 +107,9 @@ FLEXIBLE_WALL_ATOM_MASS = 2.0
 # their melting near kT = 0.7 eps_ww (tests/test_md_walls.py runs it).
 FLEXIBLE_WALL_MAX_TEMPERATURE = 0.5 * FLEXIBLE_WALL_EPSILON
 
+# A twisted top wall is stretched to fit the box: at most this strain along x or y.
+TWISTED_WALL_MAX_STRAIN = 0.05
+
 # A cutoff at the LJ minimum leaves only the repulsion (Weeks-Chandler-Andersen).
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
 
@@ -144,6 +147,14 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
       "rigid: each wall one rigid body; flexible: the planes facing the film are an LJ "
       "crystal on a rigid outer plane, so heat and strain can enter the walls",
       choices=("rigid", "flexible")),
+    P("top_wall_twist", str, "-", "aligned", 0, 0,
+      "aligned: the top wall's close-packed rows along x, as the bottom wall's and the "
+      "film's; twisted: turned by 90 degrees about z (30 degrees off the rows), its lattice "
+      "stretched to the box, so the film is in registry with the bottom wall only",
+      choices=("aligned", "twisted")),
+    P("wall_vacancies", float, "-", 0.0, 0.0, 0.5,
+      "fraction of each wall's plane facing the film left vacant, at random sites "
+      "drawn from seed"),
     P("thermostat_placement", str, "-", "film", 0, 0,
       "film: Langevin on the film along y only; walls: on the flexible walls' atoms "
       "(the film unthermostatted, as in an experiment); both",
@@ -252,7 +263,9 @@ def geometry(p: dict) -> ConfinedFilm:
         wall_spacing=p["wall_spacing"], film_spacing=p["film_spacing"],
         cells=(p["cells_x"], p["cells_y"]), film_layers=p["film_layers"],
         wall_planes=p["wall_layers"] or fewest_wall_planes(p["cutoff"], p["wall_spacing"]),
-        cutoff=p["cutoff"], flexible_walls=p["wall_model"] == "flexible")
+        cutoff=p["cutoff"], flexible_walls=p["wall_model"] == "flexible",
+        top_wall_twisted=p["top_wall_twist"] == "twisted",
+        vacancy_fraction=p["wall_vacancies"], vacancy_seed=p["seed"])
 
 
 def derived_quantities(p: dict) -> dict[str, float]:
@@ -274,8 +287,11 @@ def derived_quantities(p: dict) -> dict[str, float]:
         "wall_layers": wall_layers,
         "wall_atoms_per_layer": wall_per_layer,
         # the top wall's planes facing the film, mobile when the walls are flexible
-        "top_flexible_mass": (wall_layers - 1) * wall_per_layer * FLEXIBLE_WALL_ATOM_MASS
+        "top_flexible_mass": ((wall_layers - 1) * g.top.atoms_per_plane
+                              - g.vacancies_per_wall[1]) * FLEXIBLE_WALL_ATOM_MASS
         if flexible else 0.0,
+        "top_wall_strain_x": g.top.strain[0],
+        "top_wall_strain_y": g.top.strain[1],
         "spring_period": 2.0 * math.pi / omega,
         "timestep_limit": min(LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"])),
                               2.0 * math.pi / omega / STEPS_PER_SPRING_PERIOD),
@@ -325,6 +341,14 @@ def check_consistency(p: dict) -> None:
         raise SceneError(
             f"thermostat_damping {p['thermostat_damping']:g} tau is shorter than 10 time steps "
             f"({10 * dt:g} tau): the Langevin thermostat would be unstable")
+    if p["top_wall_twist"] == "twisted":
+        for axis, strain in zip("xy", (q["top_wall_strain_x"], q["top_wall_strain_y"])):
+            if abs(strain) > TWISTED_WALL_MAX_STRAIN:
+                raise SceneError(
+                    f"top_wall_twist = 'twisted' does not fit the box along {axis}: the turned "
+                    f"top wall would be strained by {100 * strain:+.1f} % (limit "
+                    f"{100 * TWISTED_WALL_MAX_STRAIN:g} %); choose cells_x, cells_y with "
+                    f"cells_x close to sqrt(3) * cells_y * k / m for whole k, m (7 x 4: 1 %)")
     flexible_mass = q["top_flexible_mass"]
     if p["wall_mass"] <= flexible_mass:
         raise SceneError(
