@@ -89,8 +89,10 @@ class SlipEvents:
         before the end of the trace (not counted as a slip).
     cycle_noise : float
         Standard deviation of what does not repeat from one cycle to the next
-        (:func:`cycle_noise`; 0 with fewer than 2 slips or a noise given): the
-        floor of the noise the threshold is set from.
+        (:func:`cycle_noise`), the floor of the noise the threshold is set from
+        where the local estimate is blind to correlated noise (see
+        :func:`detect_slips`); 0 where it was not computed (a rough trace whose
+        noise estimate converged, a noise or threshold given, fewer than 2 slips).
     """
 
     yield_index: np.ndarray
