@@ -137,3 +137,22 @@ def test_the_error_bars_cover_the_truth_on_random_traces():
         assert 0.45 <= s["cover1"] <= 0.92, (q, s)
         assert s["cover2"] >= 0.8, (q, s)
         assert abs(s["mean_z"]) < 0.8, (q, s)
+
+
+def test_issue_example_is_recovered_in_both_unit_systems(tmp_path):
+    # issue 21: F_k = 2.0 uN, B = 1.5 kg/s once came back as start-grid points "± 0" in SI
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "calibration_example.py"
+    spec = importlib.util.spec_from_file_location("calibration_example", path)
+    ex = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ex)
+    trace = ex.example_trace()
+    results = [ex.calibrate_in(units, tmp_path / f"u{i}", trace)[1:]
+               for i, units in enumerate(ex.SYSTEMS.values())]
+    for (fk, efk, fk_bound), (b, eb, b_bound) in results:
+        assert not fk_bound and not b_bound
+        assert 0.0 < efk < 0.05 * fk and 0.0 < eb < 0.05 * b
+        assert abs(fk - ex.FK) < 3.0 * efk and abs(b - ex.B) < 3.0 * eb
+    (fk1, efk1, _), (b1, eb1, _) = results[0]
+    (fk2, efk2, _), (b2, eb2, _) = results[1]
+    assert fk2 == pytest.approx(fk1, rel=1e-6) and b2 == pytest.approx(b1, rel=1e-6)
+    assert efk2 == pytest.approx(efk1, rel=1e-6) and eb2 == pytest.approx(eb1, rel=1e-6)
