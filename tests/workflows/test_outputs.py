@@ -191,7 +191,7 @@ def test_slide_origin_not_numbers(tmp_path):
     assert slide_origin(tmp_path) == ("1.5", "-2.0")
 
 
-def test_a_quote_in_the_launcher_is_refused(monkeypatch):
+def test_a_quote_in_the_launcher_is_refused(monkeypatch, tmp_path):
     from filmfriction.workflows.md import lammps_build
     from filmfriction.workflows.md.scene import SceneError
 
@@ -199,8 +199,13 @@ def test_a_quote_in_the_launcher_is_refused(monkeypatch):
     with pytest.raises(SceneError, match="FILMFRICTION_MPIEXEC 'mpiexec \"-n': No closing "
                                          "quotation"):
         lammps_build.launcher()
-    monkeypatch.setenv(lammps_build.LAUNCHER_ENV, "'/opt/my mpi/mpiexec' -bind-to none")
-    assert lammps_build.launcher() == ["/opt/my mpi/mpiexec", "-bind-to", "none"]
+    # a quoted program path with a space is one word (the program must exist)
+    launcher = tmp_path / "my mpi" / "mpiexec"
+    launcher.parent.mkdir()
+    launcher.write_text("#!/bin/sh\n")
+    launcher.chmod(0o755)
+    monkeypatch.setenv(lammps_build.LAUNCHER_ENV, f"'{launcher}' -bind-to none")
+    assert lammps_build.launcher() == [str(launcher), "-bind-to", "none"]
 
 
 def test_a_path_the_terminal_cannot_show(tmp_path, filmfriction_command):
