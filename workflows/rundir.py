@@ -273,21 +273,24 @@ def _command(*words) -> str:
     return " ".join(shlex.quote(str(w)) for w in words)
 
 
-#: what a suggested command writes in the place of the user's set-up file, whose path no
-#: output records
+#: what a suggested command writes in the place of the user's set-up file when no output
+#: records its path (an ``sfb.json`` records it in its provenance)
 SETUP_PLACEHOLDER = "YOUR_SETUP.toml"
 
 
 def sfb_command(run_dir: Path, cal_path: Path, sfb_path: Path, *, with_calibration=True) -> str:
     """The ``filmfriction sfb`` command that (re)writes ``sfb_path`` for this run as it was
     made: a measured trace (SI ``analysis.json``) or an ``sfb.json`` made with ``--setup``
-    keeps ``--setup`` and ``--measured`` (the set-up file's path is not recorded: a
-    placeholder names it), never falling back to Klein's set-up."""
-    measured = False
+    keeps ``--setup`` and ``--measured`` (the set-up file as ``sfb.json``'s provenance
+    records it, else a placeholder), never falling back to Klein's set-up."""
+    measured, setup_file = False, SETUP_PLACEHOLDER
     try:
         doc = read_json(sfb_path)
         measured = isinstance(doc, dict) and bool(doc.get("setup"))
-    except ValueError:
+        recorded = (((doc or {}).get("provenance") or {}).get("inputs") or {}).get("setup")
+        if isinstance(recorded, dict) and isinstance(recorded.get("path"), str):
+            setup_file = recorded["path"]
+    except (ValueError, AttributeError):
         pass
     try:
         analysis = read_json(Path(run_dir) / "analysis.json")
@@ -296,7 +299,7 @@ def sfb_command(run_dir: Path, cal_path: Path, sfb_path: Path, *, with_calibrati
         pass
     words = ["filmfriction", "sfb"]
     if measured:
-        words += ["--setup", SETUP_PLACEHOLDER, "--measured", run_dir]
+        words += ["--setup", setup_file, "--measured", run_dir]
     if with_calibration:
         words += ["--calibration", cal_path]
     return _command(*words, "--out", sfb_path)

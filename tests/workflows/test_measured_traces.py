@@ -274,3 +274,14 @@ def test_an_analysis_written_elsewhere_finds_its_trace_from_any_directory(tmp_pa
     r = run_cli("calibrate", ".")
     assert r.code == 0, r.err
     assert (tmp_path / "results" / "calibration.json").is_file()
+
+
+def test_the_suggested_sfb_command_names_the_users_setup_file(chain):
+    """sfb.json records the set-up file in its provenance; the command the report suggests
+    to remake it keeps that file, --measured and the calibration (never Klein's set-up)."""
+    from filmfriction.workflows.rundir import SETUP_PLACEHOLDER, sfb_command
+
+    d, _ = chain
+    cmd = sfb_command(d, d / "calibration.json", d / "sfb.json")
+    assert f"--setup {d / 'my_sfb.toml'} --measured {d}" in cmd, cmd
+    assert SETUP_PLACEHOLDER not in cmd
