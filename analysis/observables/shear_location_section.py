@@ -10,9 +10,10 @@ velocity as a share of the wall's slip velocity,
 
     f_k = (v_k − v_bottom) / (v_top − v_bottom),
 
-is averaged over each slip and then over the slips (standard error: their scatter;
-with fewer than 3 slips, over the frame pairs, each pair one sample, which is
-optimistic when frames are closer than the film's velocity correlation time).  The
+is taken per slip from the slip's mean velocities, then averaged over the slips
+(standard error: their scatter; with fewer than 3 slips, over blocks of consecutive
+frame pairs, which is optimistic when a block is shorter than the film's velocity
+correlation time).  The
 jumps between neighbours — bottom wall → layer 1, layer k → k + 1, layer n → top
 wall — add up to 1: the share of the wall's displacement taken up at each plane.
 
@@ -144,20 +145,30 @@ def shear_shares(share_per_slip) -> dict:
             "largest": k, "n": int(m)}
 
 
-def locate(universe, edges, windows, **types) -> dict:
-    """:func:`layer_velocities` in the slip windows, the shares per slip (or per frame
-    pair with fewer than :data:`MIN_SLIPS_FOR_SCATTER` slips), and :func:`shear_shares`."""
+def locate(universe, edges, windows, *, blocks: int = 4, **types) -> dict:
+    """:func:`layer_velocities` in the slip windows, the shares per slip (with fewer than
+    :data:`MIN_SLIPS_FOR_SCATTER` slips, per block: each slip's frame pairs cut into
+    ``blocks`` consecutive blocks), and :func:`shear_shares`.  A sample's share is the
+    ratio of its mean velocities, (⟨v_k⟩ − ⟨v_bottom⟩)/(⟨v_top⟩ − ⟨v_bottom⟩): a ratio
+    of frame-pair velocities would blow up where the wall has nearly stopped."""
     lv = layer_velocities(universe, edges, windows, **types)
-    slip_v = lv["top"] - lv["bottom"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f = (lv["layer"] - lv["bottom"][:, None]) / slip_v[:, None]
     slips = np.unique(lv["slip"])
     if slips.size >= MIN_SLIPS_FOR_SCATTER:
-        rows = np.array([np.nanmean(f[lv["slip"] == s], axis=0) for s in slips])
-        unit = "slip"
+        groups, unit = [lv["slip"] == s for s in slips], "slip"
     else:
-        rows, unit = f, "frame pair"
-    out = shear_shares(rows)
+        groups, unit = [], "block"
+        for s in slips:
+            idx = np.flatnonzero(lv["slip"] == s)
+            groups += [np.isin(np.arange(lv["slip"].size), part)
+                       for part in np.array_split(idx, blocks) if part.size]
+    rows = []
+    for g in groups:
+        b, w = lv["bottom"][g].mean(), lv["top"][g].mean()
+        rows.append((np.nanmean(lv["layer"][g], axis=0) - b) / (w - b) if w != b
+                    else np.full(lv["layer"].shape[1], np.nan))
+    nl = lv["layer"].shape[1]
+    out = shear_shares(np.asarray(rows, float).reshape(-1, nl))
+    slip_v = lv["top"] - lv["bottom"]
     out.update({"samples": unit, "frame_pairs": int(lv["slip"].size),
                 "slips": int(slips.size),
                 "wall_slip_velocity": float(np.mean(slip_v)) if slip_v.size else None})

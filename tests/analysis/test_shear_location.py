@@ -55,9 +55,9 @@ def test_slip_inside_the_film(tmp_path):
 
 
 def test_frames_outside_the_slips_do_not_count(tmp_path):
-    # a single window: frame pairs are the samples (fewer than 3 slips)
+    # a single window: blocks of frame pairs are the samples (fewer than 3 slips)
     out = _located(tmp_path, [0.0] * (LAYERS + 1) + [V], windows=[(0.0, 5.0)])
-    assert out["samples"] == "frame pair" and out["frame_pairs"] == 10
+    assert out["samples"] == "block" and out["frame_pairs"] == 10 and out["n"] == 4
     assert out["location"] == "top interface"
 
 
