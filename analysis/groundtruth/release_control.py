@@ -41,7 +41,7 @@ from scipy.signal import savgol_filter
 from ..slip_law import FilmForceFit, fit_film_force
 from ..stickslip import cycle_table
 
-__all__ = ["release_slip", "fit_releases", "profile_width"]
+__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
 
 
 def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, int]:
@@ -95,3 +95,27 @@ def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
     coef, cov = np.polyfit(z, f, 1, w=w, cov="unscaled" if w is not None else True)
     slope, se = float(coef[0]), float(np.sqrt(cov[0, 0]))
     return 1.0 / slope, se / slope ** 2
+
+
+def release_profile(run_dir, *, blocks: int = 4) -> dict:
+    """Where the shear sits in a release run's slip (its trajectory; the slip cut into
+    ``blocks``) and the profile's width W = D + 2b: the ``shear_location`` numbers
+    plus ``width``, ``width_stderr``, ``area`` and ``layer_z``."""
+    import json
+    from pathlib import Path
+
+    from .. import structure as st
+    from ..observables.shear_location_section import locate
+
+    run_dir = Path(run_dir)
+    tr = np.genfromtxt(run_dir / "trace.csv", delimiter=",", names=True)
+    y, s = release_slip(tr["time"], tr["wall_position"])
+    t0, t1 = float(tr["time"][y]), float(tr["time"][s])
+    u = st.open_trajectory(run_dir / "topology.data", run_dir / "trajectory.dcd")
+    layers = st.DensityProfile(st.select_types(u, [1])).run().results.layers
+    out = locate(u, layers["edges"], [(t0, t1)], blocks=blocks)
+    out["width"], out["width_stderr"] = profile_width(layers["positions"], out["share"],
+                                                      out["share_stderr"])
+    out["area"] = json.loads((run_dir / "run.json").read_text())["trace_parameters"]["area"]
+    out["layer_z"] = [float(z) for z in layers["positions"]]
+    return out
