@@ -210,7 +210,7 @@ def write_csv(path, columns: dict) -> None:
 
 def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2,
                  frames=20, thermal=0.05, melt_frames=(), nsavc=100, seed=0,
-                 flexible_walls=False, timestep=0.005):
+                 flexible_walls=False, timestep=0.005, plane_velocity=None):
     """Write ``topology.data`` + ``trajectory.dcd`` of a film of ``layers``
     close-packed (111) planes between two walls, for structure tests.
 
@@ -224,7 +224,11 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     ``wall_model = flexible``) only each wall's outermost plane keeps type 2
     or 3, its planes facing the film are types 4 and 5 and rattle as the
     film does.  The DCD header holds ``nsavc`` and ``timestep`` as LAMMPS
-    writes them (its timestep unconverted, as ``delta``).
+    writes them (its timestep unconverted, as ``delta``).  ``plane_velocity``
+    (``layers + 2`` values: the bottom wall, each
+    film layer, the top wall) moves each plane along x at that velocity (σ/τ),
+    positions unwrapped as the script's DCD has them: a film of known velocity
+    profile.
 
     Returns
     -------
@@ -260,8 +264,16 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     film = types == AtomType.FILM
     mobile = film | (types == AtomType.BOTTOM_FLEXIBLE) | (types == AtomType.TOP_FLEXIBLE)
     coords = np.empty((frames, n, 3), np.float32)
+    drift = np.zeros(n)
+    if plane_velocity is not None:
+        pv = np.asarray(plane_velocity, float)
+        if pv.shape != (layers + 2,):
+            raise ValueError(f"plane_velocity has {pv.size} values, needs layers + 2 = "
+                             f"{layers + 2} (bottom wall, each layer, top wall)")
+        drift = pv[np.clip(stack.plane - wall_planes + 1, 0, layers + 1)]
     for f in range(frames):
         pos = pos0 + rng.normal(0.0, thermal, pos0.shape) * mobile[:, None]
+        pos[:, 0] += drift * f * nsavc * timestep
         if f in melt_frames:
             pos[film, :2] = rng.uniform(0, 1, (film.sum(), 2)) * [lx, ly]
         coords[f] = pos

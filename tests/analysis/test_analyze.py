@@ -192,8 +192,10 @@ def test_a_trace_too_short_to_classify_is_unresolved_with_its_reason(tmp_path, r
     assert f"{rows} data row{'' if rows == 1 else 's'}: too short to classify" \
         in doc["regime_note"]
     # every section is listed as skipped with that reason, none is written (but the
-    # structure of a CSV trace: it has no run directory, so no trajectory, no place at all)
-    keys = [o.key for o in registered() if run_dir or o.key != "structure"] + ["detection"]
+    # trajectory sections of a CSV trace: it has no run directory, so no trajectory, no
+    # place at all)
+    keys = [o.key for o in registered()
+            if run_dir or o.key not in ("structure", "shear_location")] + ["detection"]
     assert sorted(doc["skipped"]) == sorted(keys)
     assert all(why == doc["regime_note"] for why in doc["skipped"].values())
     assert not set(keys) & set(doc)

@@ -179,5 +179,5 @@ def test_set_takes_a_whole_number_written_as_a_float(text, value):
 def test_set_refusal_shows_the_parameters_own_range():
     from filmfriction.workflows.md.scene import parse_assignment
 
-    with pytest.raises(SceneError, match=r"not a number in \(0, 5\] sigma/tau"):
+    with pytest.raises(SceneError, match=r"not a number in \[0, 5\] sigma/tau"):
         parse_assignment("drive_velocity=fast")

@@ -137,7 +137,9 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: i
         },
         "trace_parameters": {
             "spring_constant": p["spring_constant"], "mass": p["wall_mass"],
-            "area": d["area"], "thickness": None, "drive_velocity": p["drive_velocity"],
+            # a release test has no drive: the spring's end is fixed (None, as for a trace
+            # without one)
+            "area": d["area"], "thickness": None, "drive_velocity": p["drive_velocity"] or None,
             "mount_damping": (p["mount_damping"] * p["wall_mass"]) or None,
             "units": "lj",
         },

@@ -117,7 +117,10 @@ P = Parameter
 # Physics' own names: these are the user-facing contract.
 PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("drive_velocity", float, "sigma/tau", 0.02, 0.0, 5.0,
-      "velocity of the spring's far end", low_open=True),
+      "velocity of the spring's far end (0 only with release_offset > 0)"),
+    P("release_offset", float, "sigma", 0.0, 0.0, 1000.0,
+      "release test: the spring's far end starts this far ahead of the wall (x0), "
+      "so the wall is let go from a stretched spring; 0 = no offset"),
     P("spring_constant", float, "epsilon/sigma^2", 100.0, 0.0, 1.0e5,
       "stiffness of the drive spring", low_open=True),
     P("normal_pressure", float, "epsilon/sigma^3", 1.0, 0.0, 100.0,
@@ -302,6 +305,10 @@ def derived_quantities(p: dict) -> dict[str, float]:
 
 def check_consistency(p: dict) -> None:
     """Checks between parameters, each naming the values and the reason."""
+    if p["drive_velocity"] == 0.0 and p["release_offset"] == 0.0:
+        raise SceneError(
+            "drive_velocity = 0.0 sigma/tau: must be > 0, or a release test "
+            "(release_offset > 0: the wall let go from a spring stretched by x0, undriven)")
     q = derived_quantities(p)
     dt = p["timestep"]
     lj_limit = LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"]))

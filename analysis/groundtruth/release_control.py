@@ -1,0 +1,121 @@
+"""The slip law's MD positive control: a liquid film resisting a wall let go from a stretched spring.
+
+The ``liquid-release`` scene lets the top wall go from a spring stretched by x0 = 20 σ,
+with no drive (``drive_velocity = 0``, ``release_offset = 20``), on a film that is a
+liquid (kT = 1.5 ε).  A liquid has no yield stress, so the slip is Klein's Eq. 1 with
+nothing else: M x'' + B x' = K(x0 − x), and B is the Couette damping of the film,
+
+    B = η A / (D + 2b) = η A / W,
+
+η the liquid's viscosity, A the area, D the film's thickness and b the slip length at
+each wall; W = D + 2b is the width over which the film's velocity profile, extended
+linearly, goes from the bottom wall's velocity to the top wall's, i.e. 1/(d f/dz) with f
+the layers' velocity shares (:mod:`~filmfriction.analysis.observables.shear_location_section`).
+
+:func:`release_slip` finds the release's slip in a trace (the first swing: from the
+release to the first stop of the wall); :func:`fit_releases` fits the slip law
+(:func:`~filmfriction.analysis.slip_law.fit_film_force`) to the slips of several
+releases (independent seeds) together, so that the errors are the slips' scatter.
+
+Example
+-------
+A Klein block released from x0 = 20 (M = 500, K = 1, B = 20), sampled as the MD is:
+
+>>> import numpy as np
+>>> from scipy.integrate import solve_ivp
+>>> t = np.arange(0, 120, 0.05)
+>>> sol = solve_ivp(lambda _, y: [y[1], (20 - y[0] - 20 * y[1]) / 500], (0, 120), [0, 0],
+...                 t_eval=t, rtol=1e-10, atol=1e-10)
+>>> x, v = sol.y
+>>> y, s = release_slip(t, x)
+>>> fit = fit_releases([{"time": t, "wall_position": x, "wall_velocity": v,
+...                      "spring_force": 20 - x}] * 3, mass=500.0)
+>>> round(fit.decelerating.damping, 2), abs(fit.decelerating.kinetic_force) < 1e-3
+(20.0, True)
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from ..slip_law import FilmForceFit, fit_film_force
+from ..stickslip import cycle_table
+
+__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
+
+
+def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, int]:
+    """(0, stick index) of a release: the slip runs from the first sample to the first
+    stop of the wall after its peak velocity (the wall's velocity smoothed over
+    ``smoothing`` time units, Savitzky–Golay of order 2, crossing zero)."""
+    t, x = np.asarray(time, float), np.asarray(wall_position, float)
+    dt = float(t[1] - t[0])
+    w = max(5, int(round(smoothing / dt)) | 1)
+    if w >= t.size:
+        raise ValueError(f"trace of {t.size} samples is shorter than the smoothing window {w}")
+    v = savgol_filter(x, w, 2, deriv=1, delta=dt)
+    peak = int(np.argmax(v))
+    stops = np.flatnonzero(v[peak:] <= 0)
+    if not v[peak] > 0 or stops.size == 0:
+        raise ValueError("the wall does not stop within the trace: run the release longer")
+    return 0, peak + int(stops[0])
+
+
+def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
+                 comoving_mass: bool = False) -> FilmForceFit:
+    """The slip law fitted to the release slips of ``traces`` (dicts of trace columns
+    ``time``, ``spring_force``, ``wall_position``, ``wall_velocity``, one per release,
+    uniformly sampled at one interval), each slip from :func:`release_slip`."""
+    parts, yi, si, offset, t0 = [], [], [], 0, 0.0
+    for tr in traces:
+        t = np.asarray(tr["time"], float)
+        y, s = release_slip(t, tr["wall_position"])
+        dt = float(t[1] - t[0])
+        parts.append({k: np.asarray(tr[k], float)[:s + 1] for k in
+                      ("spring_force", "wall_position", "wall_velocity")}
+                     | {"time": t[:s + 1] - t[0] + t0})
+        yi.append(offset + y)
+        si.append(offset + s)
+        offset += s + 1
+        t0 = parts[-1]["time"][-1] + dt
+    cols = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    # each release's positions from its own origin, continued: the integral form uses Δx only
+    table = cycle_table(cols["time"], cols["spring_force"], np.array(yi), np.array(si))
+    return fit_film_force(cols["time"], cols["spring_force"], cols["wall_velocity"], table,
+                          mass=mass, mount_damping=mount_damping,
+                          wall_position=cols["wall_position"], comoving_mass=comoving_mass)
+
+
+def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
+    """W = D + 2b and its standard error from the layers' velocity shares f(z): the
+    inverse slope of a straight line through (z_k, f_k) (weighted by 1/σ² when the
+    errors are given)."""
+    z, f = np.asarray(layer_z, float), np.asarray(share, float)
+    w = None if share_stderr is None else 1.0 / np.asarray(share_stderr, float)
+    coef, cov = np.polyfit(z, f, 1, w=w, cov="unscaled" if w is not None else True)
+    slope, se = float(coef[0]), float(np.sqrt(cov[0, 0]))
+    return 1.0 / slope, se / slope ** 2
+
+
+def release_profile(run_dir, *, blocks: int = 4) -> dict:
+    """Where the shear sits in a release run's slip (its trajectory; the slip cut into
+    ``blocks``) and the profile's width W = D + 2b: the ``shear_location`` numbers
+    plus ``width``, ``width_stderr``, ``area`` and ``layer_z``."""
+    import json
+    from pathlib import Path
+
+    from .. import structure as st
+    from ..observables.shear_location_section import locate
+
+    run_dir = Path(run_dir)
+    tr = np.genfromtxt(run_dir / "trace.csv", delimiter=",", names=True)
+    y, s = release_slip(tr["time"], tr["wall_position"])
+    t0, t1 = float(tr["time"][y]), float(tr["time"][s])
+    u = st.open_trajectory(run_dir / "topology.data", run_dir / "trajectory.dcd")
+    layers = st.DensityProfile(st.select_types(u, [1])).run().results.layers
+    out = locate(u, layers["edges"], [(t0, t1)], blocks=blocks)
+    out["width"], out["width_stderr"] = profile_width(layers["positions"], out["share"],
+                                                      out["share_stderr"])
+    out["area"] = json.loads((run_dir / "run.json").read_text())["trace_parameters"]["area"]
+    out["layer_z"] = [float(z) for z in layers["positions"]]
+    return out
