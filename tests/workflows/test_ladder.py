@@ -52,3 +52,22 @@ def test_combine_seeds_uses_the_scatter_between_seeds():
     m, e, n = ladder.combine_seeds(rows, "x")
     assert (m, n) == (2.0, 3) and e == pytest.approx(1 / math.sqrt(3))
     assert ladder.combine_seeds([{"x": (math.nan, 1.0)}], "x")[2] == 0
+
+
+def test_slip_temperature_rise_recovers_a_known_rise(tmp_path):
+    import numpy as np
+
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 400.0, 0.25)
+    slips = [(100.0, 120.0, 0.07), (200.0, 230.0, 0.14), (300.0, 310.0, 0.07)]
+    temp = 0.71 + 0.005 * rng.standard_normal(t.size)
+    for y, s, dt in slips:
+        temp[(t >= y) & (t <= s)] += dt
+    (tmp_path / "trace.csv").write_text("time,film_temperature\n" + "".join(
+        f"{a},{b}\n" for a, b in zip(t, temp)))
+    (tmp_path / "analysis_cycles.csv").write_text("yield_time,stick_time\n" + "".join(
+        f"{y},{s}\n" for y, s, _ in slips))
+    rise, err = ladder.slip_temperature_rise(tmp_path)
+    truth = np.mean([dt for *_, dt in slips]) / 0.71
+    assert abs(rise - truth) < 3 * err + 1e-3
+    assert err == pytest.approx(np.std([0.07, 0.14, 0.07], ddof=1) / 0.71 / np.sqrt(3), rel=0.1)
