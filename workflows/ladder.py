@@ -1,0 +1,367 @@
+"""The slider-mass ladder: the Klein-similar film under sliders from M = 30 to 2.4×10⁶ m.
+
+The Bingham number Bi = η_eff/η_bulk of the Klein-similar scene (``sfb-similar``) is about 1
+because its slider is light and its slips fast.  The ladder keeps the film, the walls, the load
+and the spring of that scene and raises the slider's mass M, lowering the drive velocity V so
+that V stays well below the slips' velocity, and the mount's dashpot γ so that its damping
+ratio γ/(2√(K/M)) stays the scene's 0.019 (γ = 0.01·√(30/M)).  Each rung is one sweep of the
+project's sweep machinery (``filmfriction sweep sfb-similar --grid seed=...``, Snakemake, so it
+runs on a cluster unchanged); the rungs differ in their fixed values, which a grid product
+cannot express.
+
+    python -m filmfriction.workflows.ladder plan [--steps-per-second R]
+    python -m filmfriction.workflows.ladder run --root DIR [--profile slurm] [--np N]
+    python -m filmfriction.workflows.ladder collect --root DIR [--json OUT]
+
+``plan`` prints the rungs, their ``filmfriction sweep`` commands and the steps each run takes
+(and its time at R steps per second).  ``run`` runs the sweeps one after another in the order
+of :data:`STAGES` (one seed of the Bi ≥ 30 rung, one seed of every other rung, then the other
+seeds), each sweep with ``--cores`` = ``--np`` so that one LAMMPS runs at a time; run it
+again to resume (finished points are not redone).  ``collect`` reads every finished point
+(``analysis.json``, and the similarity numbers of :mod:`filmfriction.reduced_model.sfb.similarity`
+from :func:`filmfriction.analysis.calibration.contact.contact_from_run`) and gives per rung the
+slips, the slip velocity, F_k and B of both branches of the slip law, B/B_bulk, the exponent
+n, the Bingham number and the slip heating, each with its standard error.
+
+Slide steps per rung: the spring's end must travel the first extension x0 = F_s/K and then one
+slip length per further slip, at V, and each slip lasts about slip/v̄; v̄ is taken as the
+sfb-similar scene's 0.65 σ/τ scaled by √(30/M) (the slips' shape at fixed film force does not
+depend on M, their time scale is √(M/K)); 15 % margin, rounded up to 10⁵ steps.
+"""
+from __future__ import annotations
+
+import argparse
+import fcntl
+import json
+import math
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = ["Rung", "RUNGS", "STAGES", "slide_steps", "sweep_command", "collect_rung",
+           "combine_seeds"]
+
+SCENE = "sfb-similar"
+#: The scene's own slider and mount: M = 30 m, γ = 0.01 /τ.
+REFERENCE_MASS = 30.0
+REFERENCE_MOUNT_DAMPING = 0.01
+#: Cost model, from the sfb-similar runs (docs/results/sfb-similar.md): yield force F_s ≈ 50 ε/σ
+#: at K = 2 ε/σ² (x0 ≈ 25 σ), slips of ≈ 14 σ at v̄ ≈ 0.65 σ/τ for M = 30 m.
+STATIC_FORCE = 50.0
+SPRING_CONSTANT = 2.0
+SLIP_LENGTH = 14.0
+REFERENCE_SLIP_VELOCITY = 0.65
+TIMESTEP = 0.005
+MARGIN = 1.15
+SEEDS = (1, 2, 3)
+
+
+def slide_steps(mass: float, drive_velocity: float, slips: int) -> int:
+    """Steps for ``slips`` slips (the start-up slip included) under a slider of ``mass``.
+
+    >>> slide_steps(240000, 0.002, 4)
+    9500000
+    >>> slide_steps(30, 0.02, 8)
+    1500000
+    """
+    x0 = STATIC_FORCE / SPRING_CONSTANT
+    v_slip = REFERENCE_SLIP_VELOCITY * math.sqrt(REFERENCE_MASS / mass)
+    t = (x0 + (slips - 1) * SLIP_LENGTH) / drive_velocity + slips * SLIP_LENGTH / v_slip
+    return int(math.ceil(MARGIN * t / TIMESTEP / 1e5) * 100000)
+
+
+@dataclass(frozen=True)
+class Rung:
+    """One slider mass of the ladder.
+
+    Parameters
+    ----------
+    mass : float
+        The top wall's mass M (m).
+    drive_velocity : float
+        V (σ/τ).
+    slips : int
+        Slips the run is sized for, the start-up slip included (≥ 4: ≥ 3 analysed).
+    planned : bool
+        Planned and costed, not run by ``run`` (too long for 30 min on 2 cores).
+    """
+
+    mass: float
+    drive_velocity: float
+    slips: int
+    planned: bool = False
+
+    @property
+    def mount_damping(self) -> float:
+        """γ (1/τ) keeping the mount's damping ratio of sfb-similar, 3 significant digits."""
+        return float(f"{REFERENCE_MOUNT_DAMPING * math.sqrt(REFERENCE_MASS / self.mass):.3g}")
+
+    @property
+    def slip_velocity_estimate(self) -> float:
+        return REFERENCE_SLIP_VELOCITY * math.sqrt(REFERENCE_MASS / self.mass)
+
+    @property
+    def slide_steps(self) -> int:
+        return slide_steps(self.mass, self.drive_velocity, self.slips)
+
+    @property
+    def name(self) -> str:
+        return f"M={self.mass:g}"
+
+    def sets(self) -> list[str]:
+        return [f"wall_mass={self.mass:g}", f"drive_velocity={self.drive_velocity:g}",
+                f"mount_damping={self.mount_damping:g}", f"slide_steps={self.slide_steps}"]
+
+
+#: The rungs, lightest first.  M = 2.4e5 is the Bi ≥ 30 rung (the ``sfb-heavy`` scene is its
+#: seed 1); M = 2.4e6 is planned and costed only.
+RUNGS = (Rung(30, 0.02, 8), Rung(300, 0.02, 8), Rung(3000, 0.01, 6), Rung(30000, 0.005, 5),
+         Rung(240000, 0.002, 4), Rung(2.4e6, 0.0005, 4, planned=True))
+HEAVY = RUNGS[4]
+#: The campaign's order: (rung, seeds); a later stage on a rung adds seeds to its sweep.
+STAGES = ((HEAVY, (1,)),) + tuple((r, (1,)) for r in RUNGS[:4]) + tuple(
+    (r, SEEDS) for r in RUNGS[:5])
+
+
+def sweep_command(rung: Rung, seeds, root: Path, np_: int = 1,
+                  profile: str | None = None) -> list[str]:
+    """The ``filmfriction sweep`` command of one rung (``--cores`` = ``np_``: one run at a time)."""
+    cmd = ["filmfriction", "sweep", SCENE, "--grid", "seed=" + ",".join(map(str, seeds))]
+    for s in rung.sets():
+        cmd += ["--set", s]
+    cmd += ["--np", str(np_), "--cores", str(np_), "--out", str(Path(root) / rung.name)]
+    if profile:
+        cmd += ["--profile", profile]
+    return cmd
+
+
+# -- collect -------------------------------------------------------------------------------
+
+def _est(entry):
+    """(mean, stderr) of an analysis entry ``{"mean", "stderr"}`` or a bare number."""
+    if isinstance(entry, dict):
+        m, e = entry.get("mean"), entry.get("stderr")
+    else:
+        m, e = entry, None
+    m = math.nan if m is None else float(m)
+    e = math.nan if e is None else float(e)
+    return m, e
+
+
+def point_row(run_dir: Path) -> dict:
+    """The ladder's quantities of one finished point, each as (value, stderr)."""
+    from filmfriction.analysis.calibration.contact import contact_from_run
+    from filmfriction.reduced_model.sfb.similarity import similarity_numbers
+
+    analysis = json.loads((run_dir / "analysis.json").read_text())
+    slips = analysis.get("slips") or {}
+    law = analysis.get("slip_law") or {}
+    br = law.get("branches") or {}
+    row = {"point": run_dir.name, "regime": (analysis.get("regime")
+                                             or (analysis.get("sliding") or {}).get("regime")),
+           "slips": slips.get("count") or 0,
+           "verdict": law.get("verdict")}
+    for b in ("decelerating", "accelerating"):
+        x = br.get(b) or {}
+        row[f"{b}_kinetic_force"] = _est(x.get("kinetic_force"))
+        row[f"{b}_damping"] = _est(x.get("damping"))
+        row[f"{b}_exponent"] = _est(x.get("exponent"))
+        row[f"{b}_slips"] = x.get("slips")
+    row["damping_over_bulk"] = (float(law["damping_over_bulk"]) if law.get("damping_over_bulk")
+                                is not None else math.nan,
+                                float(law.get("damping_over_bulk_stderr") or math.nan))
+    try:
+        nums = similarity_numbers(contact_from_run(run_dir))
+    except (ValueError, KeyError, TypeError) as exc:
+        row["similarity_error"] = str(exc)
+        nums = {}
+    for k in ("bingham_number", "slip_heating", "film_damping_ratio", "mount_damping_ratio",
+              "slip_velocity_over_thermal", "slip_over_extension"):
+        n = nums.get(k)
+        row[k] = (n.value, n.stderr) if n is not None else (math.nan, math.nan)
+    row["slip_temperature_rise"] = slip_temperature_rise(run_dir)
+    t = row["slip_velocity_over_thermal"]
+    temp = ((json.loads((run_dir / "run.json").read_text()).get("scene") or {})
+            .get("parameters") or {}).get("temperature")
+    row["slip_velocity"] = ((t[0] * math.sqrt(temp), t[1] * math.sqrt(temp)) if temp
+                            else (math.nan, math.nan))
+    return row
+
+
+def slip_temperature_rise(run_dir: Path) -> tuple[float, float]:
+    """The film's measured temperature rise during a slip over its temperature, ± s.e. over slips.
+
+    Per analysed cycle (``analysis_cycles.csv``): the film temperature averaged over the slip
+    (yield to re-stick) less its average over the stick before the yield, over the stick's
+    average.  Unlike the similarity rows' adiabatic ``slip_heating``, this is what the
+    thermostatted film shows.
+    """
+    import numpy as np
+
+    trace, cycles = run_dir / "trace.csv", run_dir / "analysis_cycles.csv"
+    if not (trace.is_file() and cycles.is_file()):
+        return math.nan, math.nan
+    tr = np.genfromtxt(trace, delimiter=",", names=True)
+    cy = np.genfromtxt(cycles, delimiter=",", names=True, ndmin=1)
+    if "film_temperature" not in tr.dtype.names or cy.size == 0:
+        return math.nan, math.nan
+    t, temp = tr["time"], tr["film_temperature"]
+    rises = []
+    previous_stick = float(t[0])
+    for y, s in zip(cy["yield_time"], cy["stick_time"]):
+        stick = temp[(t >= previous_stick) & (t < y)]
+        slip = temp[(t >= y) & (t <= s)]
+        previous_stick = float(s)
+        if stick.size > 1 and slip.size > 1:
+            rises.append((slip.mean() - stick.mean()) / stick.mean())
+    if not rises:
+        return math.nan, math.nan
+    r = np.asarray(rises)
+    return float(r.mean()), float(r.std(ddof=1) / math.sqrt(r.size)) if r.size > 1 else math.nan
+
+
+QUANTITIES = ("slip_velocity", "decelerating_kinetic_force", "decelerating_damping",
+              "accelerating_kinetic_force", "accelerating_damping", "damping_over_bulk",
+              "decelerating_exponent", "accelerating_exponent", "bingham_number",
+              "slip_heating", "slip_temperature_rise", "film_damping_ratio", "mount_damping_ratio")
+
+
+def combine_seeds(rows: list[dict], key: str) -> tuple[float, float, int]:
+    """Mean over seeds and its standard error, with the number of seeds used.
+
+    One seed: its own standard error.  Several: the scatter between seeds, s/√n
+    (each seed an independent repeat of the same rung).
+
+    >>> combine_seeds([{"x": (1.0, 0.2)}, {"x": (3.0, 0.2)}], "x")
+    (2.0, 1.0, 2)
+    >>> combine_seeds([{"x": (1.0, 0.2)}], "x")
+    (1.0, 0.2, 1)
+    """
+    vals = [r[key] for r in rows if key in r and math.isfinite(r[key][0])]
+    if not vals:
+        return math.nan, math.nan, 0
+    if len(vals) == 1:
+        return vals[0][0], vals[0][1], 1
+    xs = [v[0] for v in vals]
+    mean = sum(xs) / len(xs)
+    var = sum((x - mean) ** 2 for x in xs) / (len(xs) - 1)
+    return mean, math.sqrt(var / len(xs)), len(xs)
+
+
+def collect_rung(sweep_dir: Path) -> dict:
+    """Every finished point of one rung's sweep, and the rung's seed-combined quantities."""
+    sweep_dir = Path(sweep_dir)
+    plan = json.loads((sweep_dir / "sweep.json").read_text())
+    rows = [point_row(p) for p in sorted((sweep_dir / "points").glob("*"))
+            if (p / "analysis.json").is_file()]
+    out = {"sweep": sweep_dir.name, "fixed": plan.get("fixed"), "points": rows,
+           "seeds": len(rows), "slips": sum(r["slips"] for r in rows)}
+    for k in QUANTITIES:
+        m, e, n = combine_seeds(rows, k)
+        out[k] = {"mean": m, "stderr": e, "seeds": n}
+    return out
+
+
+def _fmt(q: dict) -> str:
+    m, e = q["mean"], q["stderr"]
+    if not math.isfinite(m):
+        return "–"
+    return f"{m:.3g} ± {e:.2g}" if math.isfinite(e) else f"{m:.3g}"
+
+
+def table(rungs: list[dict]) -> str:
+    """The markdown table of the collected rungs."""
+    head = ("| rung | seeds | slips | v̄_slip (σ/τ) | F_k dec (ε/σ) | B dec (m/τ) | F_k acc | B acc "
+            "| B_dec/B_bulk | n dec | n acc | Bi (Eq. 1) | ΔT/T adiabatic | ΔT/T measured |")
+    lines = [head, "|" + "---|" * 14]
+    for r in rungs:
+        lines.append("| " + " | ".join([
+            r["sweep"], str(r["seeds"]), str(r["slips"]), _fmt(r["slip_velocity"]),
+            _fmt(r["decelerating_kinetic_force"]), _fmt(r["decelerating_damping"]),
+            _fmt(r["accelerating_kinetic_force"]), _fmt(r["accelerating_damping"]),
+            _fmt(r["damping_over_bulk"]), _fmt(r["decelerating_exponent"]),
+            _fmt(r["accelerating_exponent"]), _fmt(r["bingham_number"]),
+            _fmt(r["slip_heating"]), _fmt(r["slip_temperature_rise"])]) + " |")
+    return "\n".join(lines)
+
+
+# -- command line --------------------------------------------------------------------------
+
+def _plan(args) -> int:
+    for r in RUNGS:
+        cost = (f", {r.slide_steps / args.steps_per_second / 60:.0f} min at "
+                f"{args.steps_per_second:g} steps/s" if args.steps_per_second else "")
+        print(f"{r.name}: V = {r.drive_velocity:g}, γ = {r.mount_damping:g}, v̄_slip ≈ "
+              f"{r.slip_velocity_estimate:.2g}, {r.slips} slips, {r.slide_steps} steps{cost}"
+              + (" (planned, not run)" if r.planned else ""))
+        print("    " + " ".join(sweep_command(r, SEEDS, args.root)))
+    return 0
+
+
+def _wait_for_lock(sweep_dir: Path) -> None:
+    """Wait until no sweep holds ``sweep_dir`` (e.g. one started by hand)."""
+    lock = sweep_dir / ".sweep.lock"
+    if not lock.exists():
+        return
+    with open(lock, "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _run(args) -> int:
+    exe = Path(sys.executable).with_name("filmfriction")
+    for rung, seeds in STAGES:
+        _wait_for_lock(Path(args.root) / rung.name)
+        cmd = sweep_command(rung, seeds, args.root, args.np, args.profile)
+        cmd[0] = str(exe)
+        print("ladder:", " ".join(cmd), flush=True)
+        code = subprocess.call(cmd)
+        if code:
+            print(f"ladder: {rung.name} seeds {seeds}: exit {code} (going on)", flush=True)
+    return 0
+
+
+def _collect(args) -> int:
+    root = Path(args.root)
+    rungs = []
+    for r in RUNGS:
+        d = root / r.name
+        if (d / "sweep.json").is_file():
+            got = collect_rung(d)
+            got.update(mass=r.mass, drive_velocity=r.drive_velocity,
+                       mount_damping=r.mount_damping, slide_steps=r.slide_steps)
+            rungs.append(got)
+    print(table(rungs))
+    if args.json:
+        from filmfriction.analysis.util import write_atomic
+        write_atomic(Path(args.json), json.dumps({"schema": "filmfriction.mass-ladder/1",
+                                                  "rungs": rungs}, indent=1))
+    return 0
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m filmfriction.workflows.ladder",
+                                description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="what", required=True)
+    a = sub.add_parser("plan")
+    a.add_argument("--steps-per-second", type=float, default=None)
+    a.add_argument("--root", default="sweeps/ladder")
+    a.set_defaults(func=_plan)
+    a = sub.add_parser("run")
+    a.add_argument("--root", default="sweeps/ladder")
+    a.add_argument("--np", type=int, default=1)
+    a.add_argument("--profile", default=None)
+    a.set_defaults(func=_run)
+    a = sub.add_parser("collect")
+    a.add_argument("--root", default="sweeps/ladder")
+    a.add_argument("--json", default=None)
+    a.set_defaults(func=_collect)
+    args = p.parse_args(argv)
+    if getattr(args, "np", 1) < 1:
+        p.error(f"--np {args.np}: give at least 1")
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
