@@ -1,4 +1,4 @@
-"""The calibration on issue 21's example: a trace with F_k = 2.0 µN and B = 1.5 kg/s, in
+"""The calibration on a known example: a trace with F_k = 2.0 µN and B = 1.5 kg/s, in
 N, m, s and in µN, nm, ms.
 
     .venv/bin/python benchmarks/calibration_example.py

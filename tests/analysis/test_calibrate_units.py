@@ -140,7 +140,7 @@ def test_the_error_bars_cover_the_truth_on_random_traces():
 
 
 def test_issue_example_is_recovered_in_both_unit_systems(tmp_path):
-    # issue 21: F_k = 2.0 uN, B = 1.5 kg/s once came back as start-grid points "± 0" in SI
+    # F_k = 2.0 uN, B = 1.5 kg/s once came back as start-grid points "± 0" in SI
     path = Path(__file__).resolve().parents[2] / "benchmarks" / "calibration_example.py"
     spec = importlib.util.spec_from_file_location("calibration_example", path)
     ex = importlib.util.module_from_spec(spec)
