@@ -4,7 +4,8 @@ MPICH's ``mpiexec`` (hydra) starts a proxy that calls ``setsid``, and the proxy
 starts each MPI rank in a session of its own: signalling the launcher's
 process group reaches the launcher only, and a launcher killed outright leaves
 its proxy and ranks running.  :func:`stop` therefore follows the process tree
-(parent pids in ``/proc``), asks every process in it to stop (SIGTERM), waits
+(parent pids in ``/proc``) and the sessions of its processes (a process orphaned when its
+parent dies keeps its session), asks every process in it to stop (SIGTERM), waits
 :data:`GRACE` seconds, kills what is left (SIGKILL), and returns once none of
 them runs any more.  A process is known by its pid and its start time, so a pid
 the kernel reuses is never signalled.
@@ -26,7 +27,7 @@ import signal
 import subprocess
 import time
 
-__all__ = ["GRACE", "descendants", "stop"]
+__all__ = ["GRACE", "descendants", "in_sessions", "stop"]
 
 #: seconds an engine has between SIGTERM and SIGKILL
 GRACE = 5.0
@@ -34,15 +35,15 @@ GRACE = 5.0
 _Proc = tuple[int, int]         # (pid, start time in clock ticks)
 
 
-def _stat(pid: int) -> tuple[int, str, int] | None:
-    """(parent pid, state, start time) of ``pid``; None when it does not exist."""
+def _stat(pid: int) -> tuple[int, str, int, int] | None:
+    """(parent pid, state, start time, session id) of ``pid``; None when it does not exist."""
     try:
         with open(f"/proc/{pid}/stat", "rb") as fh:
             text = fh.read().decode(errors="replace")
     except OSError:
         return None
     fields = text[text.rfind(")") + 2:].split()     # after "pid (comm) "
-    return int(fields[1]), fields[0], int(fields[19])
+    return int(fields[1]), fields[0], int(fields[19]), int(fields[3])
 
 
 def descendants(pid: int) -> list[_Proc]:
@@ -59,6 +60,28 @@ def descendants(pid: int) -> list[_Proc]:
             found.append(child)
             todo.append(child[0])
     return found
+
+
+def in_sessions(sessions: set[int]) -> list[_Proc]:
+    """Every living process whose session is one of ``sessions``, as (pid, start time): a
+    process orphaned by its parent's death (reparented to init) keeps its session."""
+    found = []
+    for name in os.listdir("/proc"):
+        if name.isdigit():
+            info = _stat(int(name))
+            if info is not None and info[3] in sessions and info[1] not in ("Z", "X"):
+                found.append((int(name), info[2]))
+    return found
+
+
+def _sessions(procs, own: int) -> set[int]:
+    """The sessions of the living ``procs``, the caller's own left out."""
+    out = set()
+    for proc in procs:
+        info = _stat(proc[0])
+        if info is not None and info[2] == proc[1]:
+            out.add(info[3])
+    return out - {own}
 
 
 def _alive(proc: _Proc) -> bool:
@@ -82,8 +105,20 @@ def stop(popen: subprocess.Popen, grace: float = GRACE) -> list[int]:
     needed SIGKILL."""
     held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
     saved = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    own = os.getsid(0)
     try:
         tree = set(descendants(popen.pid))
+        sessions = _sessions(tree | {(popen.pid, (_stat(popen.pid) or (0, "", 0, 0))[2])}, own)
+
+        def grow() -> None:
+            # the launcher's descendants, and every process of the engine's sessions: a
+            # child started while stopping, or orphaned when its parent died, is still found
+            nonlocal tree, sessions
+            if popen.poll() is None:
+                tree |= set(descendants(popen.pid))
+            tree |= set(in_sessions(sessions))
+            sessions |= _sessions(tree, own)
+
         if popen.poll() is None:
             try:
                 os.killpg(popen.pid, signal.SIGTERM)    # the launcher (its own session)
@@ -92,21 +127,25 @@ def stop(popen: subprocess.Popen, grace: float = GRACE) -> list[int]:
         _signal(tree, signal.SIGTERM)
         deadline = time.monotonic() + grace
         while time.monotonic() < deadline:
-            if popen.poll() is None:
-                tree |= set(descendants(popen.pid))     # started while stopping
+            grow()
             if popen.poll() is not None and not any(_alive(p) for p in tree):
                 return []
             time.sleep(0.05)
-        if popen.poll() is None:
-            tree |= set(descendants(popen.pid))
-        killed = [p[0] for p in tree if _alive(p)] + ([popen.pid] if popen.poll() is None
-                                                      else [])
+        grow()
+        killed = [p[0] for p in tree if _alive(p) and p[0] != popen.pid] + (
+            [popen.pid] if popen.poll() is None else [])
         _signal(tree, signal.SIGKILL)
         if popen.poll() is None:
             popen.kill()
         popen.wait()
-        # a killed rank whose parent also died is reaped by init: wait for that too
-        while any(_alive(p) for p in tree):
+        # a killed rank whose parent also died is reaped by init: wait for that too, and
+        # kill what its last moments started (found through the engine's sessions)
+        while True:
+            grow()
+            left = [p for p in tree if _alive(p)]
+            if not left:
+                break
+            _signal(left, signal.SIGKILL)
             time.sleep(0.02)
         return killed
     finally:
