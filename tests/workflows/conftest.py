@@ -234,3 +234,22 @@ def interrupted_run():
             "segments": [], "trace_parameters": {}}))
         return run_dir
     return make
+
+
+def _lock_held(run_dir: Path) -> bool:
+    """Whether some process still holds the run directory's lock."""
+    import fcntl
+
+    with open(run_dir / ".lock") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return True
+        fcntl.flock(fh, fcntl.LOCK_UN)
+    return False
+
+
+@pytest.fixture
+def lock_held():
+    """``lock_held(run_dir)``: whether some process still holds the run directory's lock."""
+    return _lock_held

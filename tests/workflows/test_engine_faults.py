@@ -11,7 +11,6 @@ run directory, the lock free.
 """
 from __future__ import annotations
 
-import fcntl
 import json
 import os
 import signal
@@ -90,15 +89,6 @@ def _processes_in(run_dir: Path) -> list[int]:
     return found
 
 
-def _locked(run_dir: Path) -> bool:
-    with open(run_dir / ".lock") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            return True
-        fcntl.flock(fh, fcntl.LOCK_UN)
-    return False
-
 
 def _kill_leftovers(run_dir: Path) -> None:
     for pid in _processes_in(run_dir):
@@ -176,7 +166,8 @@ def test_a_scene_script_that_writes_no_trace_fails(tmp_path, run_cli, monkeypatc
 # ---------------------------------------------------------------- an engine that hangs
 @pytest.mark.parametrize("signals", [[signal.SIGTERM], [signal.SIGINT, signal.SIGINT]],
                          ids=["SIGTERM", "SIGINT twice"])
-def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signals):
+def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signals,
+                                                  lock_held):
     """Launcher, proxy and both ranks (each a session of its own) are gone before
     run.json says interrupted and the lock is free; a second Ctrl-C does not cut
     that short."""
@@ -207,7 +198,7 @@ def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signal
     assert "Traceback" not in err and "interrupted" in err
     record = json.loads((out / "run.json").read_text())
     assert record["status"] == "interrupted" and signals[0].name in record["error"]
-    assert not _locked(out)
+    assert not lock_held(out)
 
 
 def test_stop_reaps_a_tree_of_sessions():
@@ -279,7 +270,8 @@ def test_a_resume_with_a_launcher_that_is_not_there_leaves_run_json(tmp_path, si
     assert (run_dir / "run.json").read_text() == before       # interrupted, as it was
 
 
-def test_an_unexpected_error_leaves_run_json_failed(tmp_path, silent_lmp, monkeypatch):
+def test_an_unexpected_error_leaves_run_json_failed(tmp_path, silent_lmp, monkeypatch,
+                                                   lock_held):
     def broken(*args, **kwargs):
         raise RuntimeError("something nobody foresaw")
 
@@ -290,7 +282,7 @@ def test_an_unexpected_error_leaves_run_json_failed(tmp_path, silent_lmp, monkey
                        lmp=silent_lmp)
     record = json.loads((out / "run.json").read_text())
     assert record["status"] == "failed" and record["error"] == "something nobody foresaw"
-    assert not _locked(out)
+    assert not lock_held(out)
 
 
 # ---------------------------------------------------------------- a run directory is data

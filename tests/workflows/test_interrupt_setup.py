@@ -64,7 +64,7 @@ SMALL = ["--set", "slide_steps=4000", "--set", "restart_every=2000",
                          ids=["SIGTERM", "SIGHUP", "SIGINT"])
 @pytest.mark.parametrize("where", ["_record", "run_engine"],
                          ids=["before run.json", "run.json written, engine not started"])
-def test_signal_during_setup_of_a_run(tmp_path, where, sig):
+def test_signal_during_setup_of_a_run(tmp_path, where, sig, lock_held):
     out = tmp_path / "run"
     code, _, err = _interrupt(tmp_path, where, ["run", "--md-only", "--quiet", "--np", "1",
                                                 "--out", str(out), *SMALL], sig)
@@ -76,20 +76,8 @@ def test_signal_during_setup_of_a_run(tmp_path, where, sig):
     assert sig.name in record["error"] and "before LAMMPS started" in record["error"]
     assert "resume_command" not in record
     assert record["scene"]["name"] == "stick-slip"
-    assert not (out / ".lock").exists() or not _locked(out)
+    assert not (out / ".lock").exists() or not lock_held(out)
 
-
-def _locked(run_dir: Path) -> bool:
-    """Whether some process still holds the run directory's lock."""
-    import fcntl
-
-    with open(run_dir / ".lock") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            return True
-        fcntl.flock(fh, fcntl.LOCK_UN)
-    return False
 
 
 @pytest.mark.parametrize("where", ["rewrite_trace_dat", "run_engine"],
