@@ -9,12 +9,13 @@ project's sweep machinery (``filmfriction sweep sfb-similar --grid seed=...``, S
 runs on a cluster unchanged); the rungs differ in their fixed values, which a grid product
 cannot express.
 
-    python -m filmfriction.workflows.ladder plan [--steps-per-second R]
-    python -m filmfriction.workflows.ladder run --root DIR [--profile slurm] [--np N]
-    python -m filmfriction.workflows.ladder collect --root DIR [--json OUT]
+    filmfriction ladder plan [--steps-per-second R]
+    filmfriction ladder run --root DIR [--profile slurm] [--np N]
+    filmfriction ladder collect --root DIR [--out FILE]
 
-``plan`` prints the rungs, their ``filmfriction sweep`` commands and the steps each run takes
-(and its time at R steps per second).  ``run`` runs the sweeps one after another in the order
+(the command line is ``workflows/cli/ladder_cli.py``).  ``plan`` prints the rungs, their
+``filmfriction sweep`` commands and the steps each run takes (and its time at R steps per
+second, a rate the user measures).  ``run`` runs the sweeps one after another in the order
 of :data:`STAGES` (one seed of the Bi ≥ 30 rung, one seed of every other rung, then the other
 seeds), each sweep with ``--cores`` = ``--np`` so that one LAMMPS runs at a time; run it
 again to resume (finished points are not redone).  ``collect`` reads every finished point
@@ -26,21 +27,20 @@ n, the Bingham number and the slip heating, each with its standard error.
 Slide steps per rung: the spring's end must travel the first extension x0 = F_s/K and then one
 slip length per further slip, at V, and each slip lasts about slip/v̄; v̄ is taken as the
 sfb-similar scene's 0.65 σ/τ scaled by √(30/M) (the slips' shape at fixed film force does not
-depend on M, their time scale is √(M/K)); 15 % margin, rounded up to 10⁵ steps.
+depend on M, their time scale is √(M/K)); 15 % margin, rounded up to 10⁵ steps.  The heavy
+rungs (M ≥ 2.4×10⁵) take :data:`HEAVY_STEP_FACTOR` times that: the first slip of the M = 2.4×10⁵
+rung ran 34 σ at 0.031 σ/τ (docs/results/mass-ladder.md), 2.4× longer than the model's slip,
+so a cycle takes ≈ 15 000 τ and the model's steps hold one slip fewer than it was sized for.
 """
 from __future__ import annotations
 
-import argparse
-import fcntl
 import json
 import math
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["Rung", "RUNGS", "STAGES", "slide_steps", "sweep_command", "collect_rung",
-           "combine_seeds"]
+           "combine_seeds", "campaign_steps", "HEAVY_STEP_FACTOR"]
 
 SCENE = "sfb-similar"
 #: The scene's own slider and mount: M = 30 m, γ = 0.01 /τ.
@@ -55,20 +55,26 @@ REFERENCE_SLIP_VELOCITY = 0.65
 TIMESTEP = 0.005
 MARGIN = 1.15
 SEEDS = (1, 2, 3)
+#: The heavy rungs' steps over the cost model's: the measured first slip of M = 2.4×10⁵
+#: (34 σ against the model's 14 σ) makes a cycle ≈ 15 000 τ at V = 0.002.
+HEAVY_STEP_FACTOR = 1.4
 
 
-def slide_steps(mass: float, drive_velocity: float, slips: int) -> int:
-    """Steps for ``slips`` slips (the start-up slip included) under a slider of ``mass``.
+def slide_steps(mass: float, drive_velocity: float, slips: int, factor: float = 1.0) -> int:
+    """Steps for ``slips`` slips (the start-up slip included) under a slider of ``mass``,
+    by the cost model, times ``factor``, rounded up to 10⁵ steps.
 
     >>> slide_steps(240000, 0.002, 4)
     9500000
+    >>> slide_steps(240000, 0.002, 4, factor=1.4)
+    13300000
     >>> slide_steps(30, 0.02, 8)
     1500000
     """
     x0 = STATIC_FORCE / SPRING_CONSTANT
     v_slip = REFERENCE_SLIP_VELOCITY * math.sqrt(REFERENCE_MASS / mass)
     t = (x0 + (slips - 1) * SLIP_LENGTH) / drive_velocity + slips * SLIP_LENGTH / v_slip
-    return int(math.ceil(MARGIN * t / TIMESTEP / 1e5) * 100000)
+    return int(math.ceil(factor * MARGIN * t / TIMESTEP / 1e5 - 1e-9) * 100000)
 
 
 @dataclass(frozen=True)
@@ -85,12 +91,16 @@ class Rung:
         Slips the run is sized for, the start-up slip included (≥ 4: ≥ 3 analysed).
     planned : bool
         Planned and costed, not run by ``run`` (too long for 30 min on 2 cores).
+    step_factor : float
+        The rung's steps over the cost model's (:data:`HEAVY_STEP_FACTOR` for the heavy
+        rungs, whose measured slips are longer than the model's).
     """
 
     mass: float
     drive_velocity: float
     slips: int
     planned: bool = False
+    step_factor: float = 1.0
 
     @property
     def mount_damping(self) -> float:
@@ -103,7 +113,19 @@ class Rung:
 
     @property
     def slide_steps(self) -> int:
+        return slide_steps(self.mass, self.drive_velocity, self.slips, self.step_factor)
+
+    @property
+    def model_steps(self) -> int:
+        """The cost model's steps, before :attr:`step_factor`."""
         return slide_steps(self.mass, self.drive_velocity, self.slips)
+
+    @property
+    def run_steps(self) -> int:
+        """Every step of one run: the scene's equilibration and the slide."""
+        from .md.scene import load
+
+        return load(SCENE).parameters["equilibrate_steps"] + self.slide_steps
 
     @property
     def name(self) -> str:
@@ -117,11 +139,28 @@ class Rung:
 #: The rungs, lightest first.  M = 2.4e5 is the Bi ≥ 30 rung (the ``sfb-heavy`` scene is its
 #: seed 1); M = 2.4e6 is planned and costed only.
 RUNGS = (Rung(30, 0.02, 8), Rung(300, 0.02, 8), Rung(3000, 0.01, 6), Rung(30000, 0.005, 5),
-         Rung(240000, 0.002, 4), Rung(2.4e6, 0.0005, 4, planned=True))
+         Rung(240000, 0.002, 4, step_factor=HEAVY_STEP_FACTOR),
+         Rung(2.4e6, 0.0005, 4, planned=True, step_factor=HEAVY_STEP_FACTOR))
 HEAVY = RUNGS[4]
 #: The campaign's order: (rung, seeds); a later stage on a rung adds seeds to its sweep.
 STAGES = ((HEAVY, (1,)),) + tuple((r, (1,)) for r in RUNGS[:4]) + tuple(
     (r, SEEDS) for r in RUNGS[:5])
+
+
+def campaign_steps() -> tuple[int, int]:
+    """(runs, steps) of the whole campaign (:data:`STAGES`, every run's equilibration and
+    slide): its cost in steps; its wall time is steps over a measured rate.
+
+    A later stage on a rung re-runs no seed an earlier one finished.
+    """
+    seeds: dict[str, set] = {}
+    runs = steps = 0
+    for rung, stage_seeds in STAGES:
+        new = set(stage_seeds) - seeds.setdefault(rung.name, set())
+        seeds[rung.name] |= new
+        runs += len(new)
+        steps += len(new) * rung.run_steps
+    return runs, steps
 
 
 def sweep_command(rung: Rung, seeds, root: Path, np_: int = 1,
@@ -284,84 +323,3 @@ def table(rungs: list[dict]) -> str:
             _fmt(r["accelerating_exponent"]), _fmt(r["bingham_number"]),
             _fmt(r["slip_heating"]), _fmt(r["slip_temperature_rise"])]) + " |")
     return "\n".join(lines)
-
-
-# -- command line --------------------------------------------------------------------------
-
-def _plan(args) -> int:
-    for r in RUNGS:
-        cost = (f", {r.slide_steps / args.steps_per_second / 60:.0f} min at "
-                f"{args.steps_per_second:g} steps/s" if args.steps_per_second else "")
-        print(f"{r.name}: V = {r.drive_velocity:g}, γ = {r.mount_damping:g}, v̄_slip ≈ "
-              f"{r.slip_velocity_estimate:.2g}, {r.slips} slips, {r.slide_steps} steps{cost}"
-              + (" (planned, not run)" if r.planned else ""))
-        print("    " + " ".join(sweep_command(r, SEEDS, args.root)))
-    return 0
-
-
-def _wait_for_lock(sweep_dir: Path) -> None:
-    """Wait until no sweep holds ``sweep_dir`` (e.g. one started by hand)."""
-    lock = sweep_dir / ".sweep.lock"
-    if not lock.exists():
-        return
-    with open(lock, "a") as fh:
-        fcntl.flock(fh, fcntl.LOCK_EX)
-        fcntl.flock(fh, fcntl.LOCK_UN)
-
-
-def _run(args) -> int:
-    exe = Path(sys.executable).with_name("filmfriction")
-    for rung, seeds in STAGES:
-        _wait_for_lock(Path(args.root) / rung.name)
-        cmd = sweep_command(rung, seeds, args.root, args.np, args.profile)
-        cmd[0] = str(exe)
-        print("ladder:", " ".join(cmd), flush=True)
-        code = subprocess.call(cmd)
-        if code:
-            print(f"ladder: {rung.name} seeds {seeds}: exit {code} (going on)", flush=True)
-    return 0
-
-
-def _collect(args) -> int:
-    root = Path(args.root)
-    rungs = []
-    for r in RUNGS:
-        d = root / r.name
-        if (d / "sweep.json").is_file():
-            got = collect_rung(d)
-            got.update(mass=r.mass, drive_velocity=r.drive_velocity,
-                       mount_damping=r.mount_damping, slide_steps=r.slide_steps)
-            rungs.append(got)
-    print(table(rungs))
-    if args.json:
-        from filmfriction.analysis.util import write_atomic
-        write_atomic(Path(args.json), json.dumps({"schema": "filmfriction.mass-ladder/1",
-                                                  "rungs": rungs}, indent=1))
-    return 0
-
-
-def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m filmfriction.workflows.ladder",
-                                description=__doc__.split("\n\n")[0])
-    sub = p.add_subparsers(dest="what", required=True)
-    a = sub.add_parser("plan")
-    a.add_argument("--steps-per-second", type=float, default=None)
-    a.add_argument("--root", default="sweeps/ladder")
-    a.set_defaults(func=_plan)
-    a = sub.add_parser("run")
-    a.add_argument("--root", default="sweeps/ladder")
-    a.add_argument("--np", type=int, default=1)
-    a.add_argument("--profile", default=None)
-    a.set_defaults(func=_run)
-    a = sub.add_parser("collect")
-    a.add_argument("--root", default="sweeps/ladder")
-    a.add_argument("--json", default=None)
-    a.set_defaults(func=_collect)
-    args = p.parse_args(argv)
-    if getattr(args, "np", 1) < 1:
-        p.error(f"--np {args.np}: give at least 1")
-    return args.func(args)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -316,27 +316,20 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path, cli, s
     assert stamps == {p: p.stat().st_mtime_ns for p in out.glob("points/*/*.json")}
 
 
-@pytest.mark.md
-def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, filmfriction_command):
-    out = tmp_path / "sweep"
-    args = ["stick-slip", "--grid", "drive_velocity=0.05,0.2,0.5", "--np", "1",
-            "--cores", "1", "--out", str(out), *small_args]
-    proc = subprocess.Popen([filmfriction_command, "sweep", *args],
+def _start(filmfriction_command, args) -> subprocess.Popen:
+    return subprocess.Popen([filmfriction_command, "sweep", *args],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+
+def _stop(proc: subprocess.Popen, until, what: str) -> str:
+    """Wait (≤ 120 s) until ``until()`` is true while the sweep runs, then stop it with
+    SIGTERM as a user would; return its output (it must exit 130)."""
     deadline = time.time() + 120
     try:
-        # wait for one completed point and the next one's run in progress (LAMMPS writes
-        # its trace into the hidden directory), then stop the sweep as a user would
-        while not (completed(out)
-                   and list(out.glob("points/.*.tmp-*/trace.dat"))):
+        while not until():
             assert proc.poll() is None, proc.stdout.read()[-3000:]
-            assert time.time() < deadline, "no point completed in 120 s"
-            time.sleep(0.1)
-        assert any("lmp" in cmd for cmd in processes_in(out)), "an engine is running"
-        before = set(completed(out))
-        # the point whose run is in progress: points/.<point>.tmp-<pid>/
-        running = {p.parent.name[1:].rsplit(".tmp-", 1)[0]
-                   for p in out.glob("points/.*.tmp-*/trace.dat")}
+            assert time.time() < deadline, f"not in 120 s: {what}"
+            time.sleep(0.05)
         proc.send_signal(signal.SIGTERM)
         rc = proc.wait(timeout=60)
     finally:
@@ -344,31 +337,88 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
             proc.kill()
     log = proc.stdout.read()
     assert rc == 130, log[-3000:]
+    return log
+
+
+def _newest_restart(run_dir: Path) -> int:
+    from filmfriction.workflows.md import restarts
+
+    good = restarts.usable(run_dir)
+    return good[-1][0] if good else -1
+
+
+@pytest.mark.md
+def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_command,
+                                                     lock_held):
+    """Kill a sweep while a point runs, kill its resume, then let it finish: the
+    finished point is never redone, the interrupted one keeps its partial run (restart
+    files included) and is continued from it, and its trace is whole."""
+    out = tmp_path / "sweep"
+    # long enough that a restart file is written well before the end, whatever the speed
+    steps = {**STEPS, "slide_steps": 10000, "restart_every": 1000}
+    args = ["stick-slip", "--grid", "drive_velocity=0.05,0.5", "--np", "1", "--cores", "1",
+            "--out", str(out),
+            *[arg for k, v in {**md.box, **steps}.items() for arg in ("--set", f"{k}={v}")]]
+
+    def partials():
+        return [p for p in out.glob("points/.*.partial")
+                if not (out / "points" / p.name[1:-len(".partial")] / "run.json").exists()]
+
+    # 1. one point completed, the next one's run has a restart file: stop the sweep
+    _stop(_start(filmfriction_command, args),
+          lambda: completed(out) and any(_newest_restart(p) > 0 for p in partials()),
+          "one point completed and the next one's first restart file")
     done = completed(out)
-    assert before <= set(done), "a point finished before the kill was lost"
-    interrupted = running - {p.parent.name for p in before}
-    assert interrupted, "no run was in progress when the sweep was killed"
-    for name in interrupted:
-        assert not (out / "points" / name / "run.json").exists(), \
-            f"the interrupted point {name} was put in place as if it had completed"
+    assert len(done) == 1
     kept = {p: (p.stat().st_ino, p.stat().st_mtime_ns) for p in done}
-    for p in done:
-        assert json.loads(p.read_text())["status"] in ("completed", "completed_with_warnings")
+    (partial,) = partials()
+    name = partial.name[1:-len(".partial")]
+    assert not (out / "points" / name / "run.json").exists(), \
+        f"the interrupted point {name} was put in place as if it had completed"
+    record = json.loads((partial / "run.json").read_text())
+    assert record["status"] == "interrupted", record["status"]
+    first_stop = _newest_restart(partial)
+    assert first_stop > 0, "the partial run and its restart files are kept"
     time.sleep(0.5)
     assert processes_in(out) == [], "an engine was left running"
-    assert not list(out.glob("points/.*")), "the interrupted run's directory is cleaned up"
+    assert not lock_held(partial)
     assert not (out / "failed").exists(), "an interrupt is not a failed run"
 
-    r = cli(*args, timeout=300)
+    # 2. the next sweep resumes it; stop that one too once it has written a newer restart
+    _stop(_start(filmfriction_command, args),
+          lambda: _newest_restart(partial) > first_stop,
+          "the resumed run's next restart file")
+    record = json.loads((partial / "run.json").read_text())
+    assert record["status"] == "interrupted" and record["resumed_from"] == f"restart.{first_stop}"
+    second_stop = _newest_restart(partial)
+    assert second_stop > first_stop, "the resume's own progress is kept"
+    assert not (out / "points" / name / "run.json").exists() and not (out / "failed").exists()
+    time.sleep(0.5)
+    assert processes_in(out) == [], "an engine was left running"
+
+    # 3. the third sweep finishes it from there
+    r = subprocess.run([filmfriction_command, "sweep", *args], capture_output=True, text=True,
+                       timeout=300)
     assert r.returncode == 0, r.stderr[-3000:]
     for p, stamp in kept.items():
         assert (p.stat().st_ino, p.stat().st_mtime_ns) == stamp, f"{p} was re-run"
     agg = sweep.load_aggregate(out)
-    assert len(agg.points) == 3
+    assert len(agg.points) == 2
     for run_dir in agg.run_dirs:
         assert json.loads((run_dir / "run.json").read_text())["status"] == "completed"
         assert (run_dir / "analysis.json").exists()
-    assert not (out / "superseded").exists()
+    resumed = out / "points" / name
+    record = json.loads((resumed / "run.json").read_text())
+    assert record["resumed_from"] == f"restart.{second_stop}"
+    assert len(record["commands"]) == 3, "started once, resumed twice, never afresh"
+    # the same steps as the point that ran in one go, none twice, none missing at a seam
+    trace, whole = md.trace(resumed), md.trace(next(iter(kept)).parent)
+    assert len(trace) == len(whole) == steps["slide_steps"] // steps["trace_every"] + 1
+    assert trace["step"][0] == 0 and trace["step"][-1] == steps["slide_steps"]
+    assert np.all(np.diff(trace["step"]) == steps["trace_every"])
+    assert md.ledger_closure(trace) < 0.02
+    assert not list(out.glob("points/.*")), "no partial run left behind"
+    assert not (out / "superseded").exists() and not (out / "failed").exists()
 
 
 @pytest.mark.parametrize("lo, hi, at_least", [(0.013, 0.062, 2), (8.0, 60.0, 2), (1e-3, 1.0, 4)])

@@ -26,6 +26,8 @@ COMMANDS = {
     "report": "filmfriction.workflows.cli.report_cli",
     "tradeoff": "filmfriction.workflows.cli.tradeoff_cli",
     "sweep": "filmfriction.workflows.cli.sweep_cli",
+    # the slider-mass ladder: one sweep per rung
+    "ladder": "filmfriction.workflows.cli.ladder_cli",
     # bulk LJ viscosity by Green-Kubo
     "viscosity": "filmfriction.workflows.cli.viscosity_cli",
 }

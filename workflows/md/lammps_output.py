@@ -80,6 +80,9 @@ class EngineOutcome:
     area: float | None = None
     atom_steps_per_second: list | None = None
     wall_time: float = 0.0
+    #: the engine ended with a nonzero exit code and no ERROR line of its own: it was
+    #: stopped from outside (a signal, the out-of-memory killer, a lost node)
+    killed: bool = False
 
 
 def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = True,
@@ -156,4 +159,5 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
         outcome.error = errors[0]
     elif proc.returncode != 0:
         outcome.error = f"LAMMPS exited with code {proc.returncode} (see lammps.screen)"
+        outcome.killed = True
     return outcome

@@ -52,11 +52,19 @@ DATA_FILE = contract.DATA_FILE
 
 
 class RunFailed(RuntimeError):
-    """LAMMPS stopped with an error, lost atoms, or produced NaN; see ``run.json``."""
+    """LAMMPS stopped with an error, lost atoms, or produced NaN; see ``run.json``.
 
-    def __init__(self, message: str, run_dir: Path):
+    ``resumable`` is True when the run stopped for a reason outside the simulation (its
+    engine ended with a nonzero exit and no error message of its own, i.e. it was
+    killed; a full disk) and holds a usable restart file: :func:`resume` continues it.
+    A failure of the simulation itself (LAMMPS's ERROR, lost atoms, NaN, a short or
+    broken trace) is not: a resume would repeat it.
+    """
+
+    def __init__(self, message: str, run_dir: Path, resumable: bool = False):
         super().__init__(message)
         self.run_dir = run_dir
+        self.resumable = resumable
 
 
 class ContractBroken(RuntimeError):
@@ -330,7 +338,7 @@ def _drive(scene, run_dir, record, cmd, total, start_step, progress):
             write_json(run_dir / RUN_FILE, record)
         except OSError:
             pass
-        raise RunFailed(f"run failed: {message}", run_dir) from None
+        raise RunFailed(f"run failed: {message}", run_dir, resumable=bool(good)) from None
 
 
 def _rows_problem(run_dir: Path, dat, scene: Scene, returncode: int) -> str | None:
@@ -399,16 +407,21 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
     if status == "interrupted":
         return run_dir
     if error:
-        raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir)
+        killed = outcome is not None and outcome.killed and error == outcome.error
+        raise RunFailed(f"run failed: {error}\n(partial results kept in {run_dir})", run_dir,
+                        resumable=killed and bool(restarts.usable(run_dir)))
     restarts.prune(run_dir)
     return run_dir
 
 
 def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
-           lmp: str | Path | None = None) -> Path:
+           lmp: str | Path | None = None, launcher: list[str] | None = None) -> Path:
     """Continue an interrupted or failed run from its newest usable restart file.
 
     ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
+    ``launcher``: what starts the MPI ranks, as for :func:`execute` (None: the venv's
+    ``mpiexec``, or ``$FILMFRICTION_MPIEXEC`` for a site build); a sweep point that
+    started under ``srun`` resumes under ``srun``.
     ``lmp`` None: as for a new run (``$FILMFRICTION_LMP``, else the wheel's); the
     path ``run.json`` records is never run.  When the build differs from the
     recorded one (version, packages or the executable's SHA-256), one line on
@@ -422,7 +435,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
         lock = RunLock(run_dir).acquire()
         state = {"record": None, "scene": None}
         try:
-            return _resume(run_dir, nprocs, progress, state, lmp)
+            return _resume(run_dir, nprocs, progress, state, lmp, launcher)
         except KeyboardInterrupt as exc:
             if state["record"] is not None:      # run.json was (being) set to running
                 _interrupted(run_dir, state["record"], state["scene"], exc)
@@ -437,7 +450,8 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
             lock.release()
 
 
-def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp) -> Path:
+def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
+            launcher: list[str] | None = None) -> Path:
     from . import scene as scene_mod
 
     record_path = run_dir / RUN_FILE
@@ -480,7 +494,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp)
     threads = int((record.get("layout") or {}).get("omp_threads", 1))
     # the LAMMPS of this installation (or --lmp), never a path read from the
     # directory: a run directory is data, not a program to execute
-    build, launcher = _lammps(lmp, "--lmp", scene, nprocs, None, script, threads)
+    build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script, threads)
     changed = lammps_build.differs(record.get("lammps"), build)
     if changed:
         record.setdefault("notes", []).append(changed)

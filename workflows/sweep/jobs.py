@@ -16,6 +16,8 @@ from pathlib import Path
 
 
 
+from filmfriction.md_inputs.contract import RUN_FILE
+
 from .plan import SweepLock, SweepPlan, _user_error, write_plan
 
 SNAKEFILE = Path(__file__).with_name("sweep.smk")
@@ -129,13 +131,94 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
-def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") -> Path:
-    """Run one grid point into ``run_dir``, atomically.
+def partial_dir(run_dir: Path) -> Path:
+    """Where a point's run lives until it completes: ``points/.<point>.partial/``.
 
-    LAMMPS runs in a fresh hidden directory next to ``run_dir``; only a
-    completed run is renamed to ``run_dir``.  A stale ``run_dir`` (an older
-    run whose parameters changed) moves to ``superseded/``, a failed run to
-    ``failed/``; nothing is deleted except this job's own interrupted run.
+    An interrupted run stays there with its restart files, and the next sweep of the
+    same plan resumes it (:func:`run_point`)."""
+    run_dir = Path(run_dir)
+    return run_dir.with_name(f".{run_dir.name}.partial")
+
+
+def _set_aside(path: Path, sweep_dir: Path, kind: str, name: str, stamp: str) -> Path:
+    """Move ``path`` to ``sweep_dir/kind/name.stamp`` (a new name: nothing is replaced)."""
+    target = sweep_dir / kind / f"{name}.{stamp}"
+    target.parent.mkdir(exist_ok=True)
+    for i in range(1, 1000):
+        if not target.exists():
+            break
+        target = sweep_dir / kind / f"{name}.{stamp}-{i}"
+    os.replace(path, target)
+    return target
+
+
+def _adopt_leftovers(run_dir: Path, partial: Path, sweep_dir: Path, stamp: str) -> None:
+    """Hidden ``.<point>.tmp-<pid>`` run directories of jobs that died (the layout of
+    earlier sweeps): the first becomes the partial run, any other goes to ``superseded/``."""
+    for old in sorted(run_dir.parent.glob(f".{run_dir.name}.tmp-*")):
+        pid = old.name.rsplit("-", 1)[-1]
+        if not pid.isdigit() or _pid_alive(int(pid)):
+            continue
+        if not partial.exists():
+            os.replace(old, partial)
+        else:
+            _set_aside(old, sweep_dir, "superseded", run_dir.name, stamp)
+
+
+def why_not_resumable(partial: Path, parameters: dict) -> str | None:
+    """Why the partial run cannot be resumed for a point of ``parameters`` (None: it can,
+    or it completed and only needs to be put in place)."""
+    from ..md import restarts
+
+    try:
+        record = json.loads((partial / RUN_FILE).read_text(encoding="utf-8"))
+        recorded = record["scene"]["parameters"]
+    except FileNotFoundError:
+        return "it has no run.json"
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        return f"its run.json is not a readable run record ({exc})"
+    if recorded != parameters:
+        changed = sorted(k for k in set(recorded) | set(parameters)
+                         if recorded.get(k) != parameters.get(k))
+        return f"its parameters differ from the plan's ({', '.join(changed)})"
+    if record.get("status") in ("completed", "completed_with_warnings"):
+        return None
+    if not restarts.usable(partial):
+        return "it holds no usable restart file"
+    return None
+
+
+def _keep_partial(partial: Path) -> None:
+    """After an interrupt: the partial run stays for the next sweep to resume, unless it
+    holds no restart file (stopped before the first one: nothing to resume)."""
+    import shutil
+
+    from ..md import restarts
+
+    if not partial.is_dir():
+        return
+    if restarts.restart_files(partial):
+        print(f"partial run kept in {partial}: the next sweep resumes it", file=sys.stderr)
+    else:
+        shutil.rmtree(partial, ignore_errors=True)
+        print("stopped before the first restart file: the next sweep starts this point "
+              "afresh", file=sys.stderr)
+
+
+def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") -> Path:
+    """Run one grid point into ``run_dir``, atomically, resuming its interrupted run.
+
+    LAMMPS runs in ``points/.<point>.partial/`` (:func:`partial_dir`); only a
+    completed run is renamed to ``run_dir``.  A run stopped by SIGINT, SIGTERM or
+    SIGHUP, or killed from outside (:attr:`~filmfriction.workflows.md.runner.RunFailed.resumable`),
+    stays there with its restart files, and the next job of the same point continues
+    it from the newest one (:func:`filmfriction.workflows.md.runner.resume`, under the
+    same launcher) instead of starting afresh.  A partial run that cannot be resumed
+    (the point's parameters changed, no usable restart file) moves to ``superseded/``
+    and the point starts afresh; a run that failed in the simulation itself (LAMMPS's
+    ERROR, lost atoms, NaN) moves to ``failed/``; a stale ``run_dir`` (an older run
+    whose parameters changed) moves to ``superseded/``.  Nothing is deleted except an
+    interrupted run that holds no restart file (nothing to resume).
 
     Parameters
     ----------
@@ -149,9 +232,7 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
         ``mpiexec`` (the venv's) or a command such as ``srun --mpi=pmi2`` (the Snakefile's
         ``launcher`` resource, set by the profile).
     """
-    import shutil
-
-    from ..md.runner import RunFailed, execute
+    from ..md.runner import RunFailed, RunLock, execute, resume
     from ..md.scene import load
 
     doc = json.loads(Path(inputs).read_text())
@@ -162,42 +243,53 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
     run_dir = Path(run_dir)
     sweep_dir = run_dir.parent.parent
     run_dir.parent.mkdir(parents=True, exist_ok=True)
-    # leftovers of this point's jobs that died without cleaning up
-    for old in run_dir.parent.glob(f".{run_dir.name}.tmp-*"):
-        pid = old.name.rsplit("-", 1)[-1]
-        if pid.isdigit() and not _pid_alive(int(pid)):
-            shutil.rmtree(old, ignore_errors=True)
-    tmp = run_dir.with_name(f".{run_dir.name}.tmp-{os.getpid()}")
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    partial = partial_dir(run_dir)
+    _adopt_leftovers(run_dir, partial, sweep_dir, stamp)
+    resuming = partial.exists()
+    if resuming:
+        # a job of this point still driving it (its lock is held): refused, nothing moved
+        RunLock(partial).acquire().release()
+        why = why_not_resumable(partial, doc["parameters"])
+        if why:
+            moved = _set_aside(partial, sweep_dir, "superseded", run_dir.name, stamp)
+            print(f"the partial run of this point cannot be resumed: {why}; moved to "
+                  f"{moved}, starting afresh", file=sys.stderr)
+            resuming = False
     # ranks of one thread: Snakemake exports OMP_NUM_THREADS = the rule's threads (the
     # point's cores, --np), which would give every rank that many OpenMP threads
     os.environ["OMP_NUM_THREADS"] = "1"
-    stamp = time.strftime("%Y%m%d-%H%M%S")
+    words = shlex.split(launcher)
+    words = None if words in ([], ["mpiexec"]) else words
     try:
-        words = shlex.split(launcher)
-        execute(scene, out=tmp, nprocs=np_, progress=False,
-                launcher=None if words in ([], ["mpiexec"]) else words)
-    except RunFailed:
+        if not resuming:
+            execute(scene, out=partial, nprocs=np_, progress=False, launcher=words)
+        elif json.loads((partial / RUN_FILE).read_text())["status"].startswith("completed"):
+            print(f"the partial run {partial} completed before its job ended; "
+                  "putting it in place", file=sys.stderr)
+        else:
+            print(f"resuming the partial run {partial}", file=sys.stderr)
+            resume(partial, nprocs=np_, progress=False, launcher=words)
+    except RunFailed as exc:
+        if not (_INTERRUPTED or exc.resumable):
+            failed = _set_aside(partial, sweep_dir, "failed", run_dir.name, stamp)
+            print(f"run failed; kept in {failed}", file=sys.stderr)
+            raise
+        # an interrupt, or an engine killed from outside: for a sweep neither is a
+        # result; the next sweep resumes the run
+        _keep_partial(partial)
         if _INTERRUPTED:
-            # the runner turns an interrupt into a failed run; for a sweep it is neither
-            # a result nor a failure: the next sweep starts this point afresh
-            shutil.rmtree(tmp, ignore_errors=True)
             raise KeyboardInterrupt from None
-        failed = sweep_dir / "failed" / f"{run_dir.name}.{stamp}"
-        failed.parent.mkdir(exist_ok=True)
-        os.replace(tmp, failed)
-        print(f"run failed; kept in {failed}", file=sys.stderr)
         raise
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)   # interrupted: the next sweep starts it afresh
+    except KeyboardInterrupt:
+        _keep_partial(partial)
         raise
     if run_dir.exists():
         if any(run_dir.iterdir()):
-            superseded = sweep_dir / "superseded" / f"{run_dir.name}.{stamp}"
-            superseded.parent.mkdir(exist_ok=True)
-            os.replace(run_dir, superseded)
+            _set_aside(run_dir, sweep_dir, "superseded", run_dir.name, stamp)
         else:
             run_dir.rmdir()      # Snakemake made it as the parent of run.json
-    os.replace(tmp, run_dir)
+    os.replace(partial, run_dir)
     return run_dir
 
 
