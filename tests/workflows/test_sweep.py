@@ -365,9 +365,9 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_
                 if not (out / "points" / p.name[1:-len(".partial")] / "run.json").exists()]
 
     # 1. one point completed, the next one's run has a restart file: stop the sweep
-    _stop(_start(filmfriction_command, args),
-          lambda: completed(out) and any(_newest_restart(p) > 0 for p in partials()),
-          "one point completed and the next one's first restart file")
+    log = _stop(_start(filmfriction_command, args),
+                lambda: completed(out) and any(_newest_restart(p) > 0 for p in partials()),
+                "one point completed and the next one's first restart file")
     done = completed(out)
     assert len(done) == 1
     kept = {p: (p.stat().st_ino, p.stat().st_mtime_ns) for p in done}
@@ -379,6 +379,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_
     assert record["status"] == "interrupted", record["status"]
     first_stop = _newest_restart(partial)
     assert first_stop > 0, "the partial run and its restart files are kept"
+    assert f"partial run kept in points/{partial.name} (newest usable restart " in log, log
     time.sleep(0.5)
     assert processes_in(out) == [], "an engine was left running"
     assert not lock_held(partial)

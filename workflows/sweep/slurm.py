@@ -133,7 +133,7 @@ def _last_error(log: Path) -> str:
 def report(sweep_dir: Path, points: list[str], jobs: list[SlurmJob] | None = None) -> str:
     """Lines on what a sweep left undone: every point of ``points`` without an
     ``analysis.json``, with its Slurm jobs (``jobs``, e.g. :func:`slurm_jobs`), the error of
-    its log and its failed runs; and the Slurm jobs that did not complete.  Empty when
+    its log, its partial run kept for the next sweep and its failed runs; and the Slurm jobs that did not complete.  Empty when
     every point has its analysis and every job completed."""
     sweep_dir = Path(sweep_dir)
     jobs = jobs or []
@@ -159,6 +159,15 @@ def report(sweep_dir: Path, points: list[str], jobs: list[SlurmJob] | None = Non
             error = _last_error(log) if log.exists() else ""
             if error:
                 what.append(f"{log.relative_to(sweep_dir)}: {error}")
+        partial = sweep_dir / "points" / f".{point}.partial"
+        if partial.is_dir():
+            from ..md import restarts
+
+            good = restarts.usable(partial)
+            what.append(f"partial run kept in {partial.relative_to(sweep_dir)} ("
+                        + (f"newest usable restart {good[-1][1].name}; the next sweep resumes "
+                           "it)" if good else "no usable restart file: the next sweep starts "
+                           "afresh and moves it to superseded/)"))
         kept = sweep_dir / "failed"
         failed = sorted(p.name for p in kept.iterdir()
                         if p.name.startswith(f"{point}.")) if kept.is_dir() else []
