@@ -83,6 +83,20 @@ def _sweep_dir(tmp: Path) -> Path:
     return d
 
 
+def _foreign_rung(tmp: Path) -> Path:
+    """A ladder root whose first rung's folder holds someone's file, no sweep.json."""
+    (tmp / "ladder" / "M=240000").mkdir(parents=True)
+    (tmp / "ladder" / "M=240000" / "notes.txt").write_text("mine")
+    return tmp / "ladder"
+
+
+def _empty_rung(tmp: Path) -> Path:
+    """A ladder root with one rung's sweep planned, no point finished."""
+    (tmp / "ladder" / "M=30" / "points").mkdir(parents=True)
+    (tmp / "ladder" / "M=30" / "sweep.json").write_text('{"fixed": {}}')
+    return tmp / "ladder"
+
+
 def _analysed_file_dir(tmp: Path) -> Path:
     d = tmp / "measured"
     d.mkdir()
@@ -433,6 +447,31 @@ CASES = {
         lambda t: ["sfb", "--setup", _setup_file(t), "--measured",
                    _analysed_file(t, _set("source.parameters.spring_constant", "97"))],
         'source.parameters.spring_constant = "97": expected a positive number', 2),
+    # -- filmfriction ladder
+    "ladder plan --steps-per-second 0": (lambda t: ["ladder", "plan", "--steps-per-second", "0"],
+                                         "--steps-per-second 0: give a positive rate", 2),
+    "ladder run --np 0": (lambda t: ["ladder", "run", "--np", "0", "--root", t / "l"],
+                          "--np 0", 2),
+    "ladder run --np 1000 here": (lambda t: ["ladder", "run", "--np", "1000", "--root", t / "l"],
+                                  "--np 1000", 2),
+    "ladder run --profile unknown": (lambda t: ["ladder", "run", "--profile", "nowhere",
+                                                "--root", t / "l"], "no such profile", 2),
+    "ladder run --root a file": (lambda t: ["ladder", "run", "--root", _afile(t)],
+                                 "is a file", 2),
+    "ladder run --root in a run": (lambda t: ["ladder", "run", "--root",
+                                              _run_with(t, "r", "{}") / "ladder"],
+                                   "inside the run directory", 2),
+    "ladder run: a rung's folder not a sweep": (lambda t: ["ladder", "run", "--root",
+                                                           _foreign_rung(t)],
+                                                "not a sweep directory", 2),
+    "ladder collect --root missing": (lambda t: ["ladder", "collect", "--root", t / "none"],
+                                      "no such directory", 2),
+    "ladder collect --root without rungs": (lambda t: ["ladder", "collect", "--root", t],
+                                            "holds no rung's sweep", 2),
+    "ladder collect --out a run's file": (lambda t: ["ladder", "collect", "--root",
+                                                     _empty_rung(t), "--out",
+                                                     _run_with(t, "r", "{}") / "run.json"],
+                                          "of the run directory", 2),
     "sfb --calibration: a stress true": (
         lambda t: ["sfb", "--calibration", _toml(t, "c.json", '{"yield_stress": true, '
                                                               '"eta_zero": 2.0}')],

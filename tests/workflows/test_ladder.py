@@ -1,5 +1,6 @@
 """The slider-mass ladder's plan: every rung is a valid sweep, and the Bi >= 30 scene is its rung."""
 import math
+from pathlib import Path
 
 import pytest
 
@@ -71,3 +72,96 @@ def test_slip_temperature_rise_recovers_a_known_rise(tmp_path):
     truth = np.mean([dt for *_, dt in slips]) / 0.71
     assert abs(rise - truth) < 3 * err + 1e-3
     assert err == pytest.approx(np.std([0.07, 0.14, 0.07], ddof=1) / 0.71 / np.sqrt(3), rel=0.1)
+
+
+def test_the_heavy_rungs_take_more_steps_than_the_cost_model_the_others_its_own():
+    for r in ladder.RUNGS:
+        if r.mass >= 2.4e5:
+            assert r.step_factor == ladder.HEAVY_STEP_FACTOR == 1.4
+            assert r.slide_steps == pytest.approx(1.4 * r.model_steps, rel=0.01), r.name
+        else:
+            assert r.slide_steps == r.model_steps, r.name
+    # the measured cycle of M = 2.4e5 (first yield after 13 840 tau, then about 15 300 tau a
+    # cycle: 28.4 sigma of loading at V = 0.002, 1 070 tau of slip) fits 4 slips in its slide
+    t = ladder.HEAVY.slide_steps * ladder.TIMESTEP
+    assert 4 <= 1 + (t - 13840) // 15300 < 5
+
+
+def _plan_lines(capsys, *args):
+    from filmfriction.workflows.cli.main import main
+
+    capsys.readouterr()
+    assert main(["ladder", "plan", *args]) == 0
+    return capsys.readouterr().out.splitlines()
+
+
+def test_plan_states_each_rungs_steps_and_the_campaigns(capsys):
+    lines = _plan_lines(capsys)
+    for r in ladder.RUNGS:
+        (line,) = [ln for ln in lines if ln.startswith(f"{r.name}:")]
+        assert f"{r.slide_steps} slide steps" in line and f"{r.run_steps} steps a run" in line
+        assert ("× 1.4" in line) == (r.step_factor != 1)
+        assert ("planned, not run" in line) == r.planned
+        assert "min at" not in line                # no time without a measured rate
+    # the campaign: every seed of every rung that is run, each run once
+    runs = [(r, s) for r in ladder.RUNGS if not r.planned for s in ladder.SEEDS]
+    total = sum(r.run_steps for r, _ in runs)
+    assert lines[-1].startswith(f"campaign ('filmfriction ladder run'): {len(runs)} runs, "
+                                f"{total} steps")
+    # with a rate the user measured: the time is steps over it
+    lines = _plan_lines(capsys, "--steps-per-second", "10000")
+    heavy = [ln for ln in lines if ln.startswith(f"{ladder.HEAVY.name}:")][0]
+    assert f", {ladder.HEAVY.run_steps / 10000 / 60:.0f} min at 10000 steps/s" in heavy
+    assert f"{total / 10000 / 3600:.1f} h at 10000 steps/s" in lines[-1]
+
+
+def test_plan_prints_the_sweep_commands_that_run_runs(capsys):
+    lines = _plan_lines(capsys, "--root", "L")
+    for r in ladder.RUNGS:
+        assert "    " + " ".join(ladder.sweep_command(r, ladder.SEEDS, "L")) in lines
+
+
+def test_run_runs_the_stages_through_the_sweep_and_stops_on_an_interrupt(tmp_path, monkeypatch,
+                                                                        capsys):
+    from filmfriction.workflows.cli import ladder_cli
+    from filmfriction.workflows.cli.main import main
+
+    calls, codes = [], {ladder.RUNGS[1].name: 1, ladder.RUNGS[3].name: 130}
+
+    def fake_sweep(args):
+        calls.append(args)
+        return codes.get(Path(args.out).name, 0)
+
+    monkeypatch.setattr(ladder_cli, "main_sweep", fake_sweep)
+    assert main(["ladder", "run", "--root", str(tmp_path / "L"), "--np", "1"]) == 130
+    err = capsys.readouterr()
+    expected = [(r.name, seeds) for r, seeds in ladder.STAGES]
+    got = [(Path(a.out).name, tuple(int(s) for s in a.grid[0][5:].split(","))) for a in calls]
+    # a failed rung does not stop the ladder; an interrupted one does, and says how to resume
+    assert got == expected[:expected.index((ladder.RUNGS[3].name, (1,))) + 1]
+    assert f"{ladder.RUNGS[1].name} seeds (1,): exit 1 (going on)" in err.out
+    assert "run the same command again to resume" in err.err
+    for a in calls:
+        rung = next(r for r in ladder.RUNGS if r.name == Path(a.out).name)
+        assert a.scene == ladder.SCENE and a.overrides == rung.sets()
+        assert a.np == a.cores == 1 and Path(a.out).parent == tmp_path / "L"
+    assert not (tmp_path / "L").exists(), "the fake sweep wrote nothing; nor did the ladder"
+
+
+def test_collect_writes_the_rungs_it_finds(tmp_path, capsys):
+    from filmfriction.workflows.cli.main import main
+
+    rung = tmp_path / "L" / ladder.HEAVY.name
+    (rung / "points").mkdir(parents=True)
+    (rung / "sweep.json").write_text('{"fixed": {"wall_mass": 240000}}')
+    out = tmp_path / "ladder.json"
+    capsys.readouterr()
+    assert main(["ladder", "collect", "--root", str(tmp_path / "L"), "--out", str(out)]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert len(table) == 3 and table[2].startswith(f"| {ladder.HEAVY.name} | 0 | 0 |")
+    import json
+
+    doc = json.loads(out.read_text())
+    assert doc["schema"] == "filmfriction.mass-ladder/1"
+    assert [r["mass"] for r in doc["rungs"]] == [ladder.HEAVY.mass]
+    assert doc["rungs"][0]["slide_steps"] == ladder.HEAVY.slide_steps
