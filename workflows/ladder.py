@@ -18,7 +18,8 @@ cannot express.
 second, a rate the user measures).  ``run`` runs the sweeps one after another in the order
 of :data:`STAGES` (one seed of the Bi ≥ 30 rung, one seed of every other rung, then the other
 seeds), each sweep with ``--cores`` = ``--np`` so that one LAMMPS runs at a time; run it
-again to resume (finished points are not redone).  ``collect`` reads every finished point
+again to resume (finished points are not redone, an interrupted one continues from its
+newest restart file).  ``collect`` reads every finished point
 (``analysis.json``, and the similarity numbers of :mod:`filmfriction.reduced_model.sfb.similarity`
 from :func:`filmfriction.analysis.calibration.contact.contact_from_run`) and gives per rung the
 slips, the slip velocity, F_k and B of both branches of the slip law, B/B_bulk, the exponent
