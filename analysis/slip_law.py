@@ -37,7 +37,9 @@ and keeps constants), so the smoothing removes noise, not the law.
 
 Verdict (one of :data:`VERDICTS`).  Each term is *resolved* when it exceeds
 2 σ — at the coverage of a normal 2 σ (97.7 % one-sided) with the Student t of
-the errors' degrees of freedom — and *ruled out as dominant* when the run had
+the errors' degrees of freedom — and carries at least :data:`NUMERICAL_FLOOR` of
+the film force |F_k| + |B·v̄| (on an exact trace the errors vanish and the
+quadrature's own error would read as a term), and *ruled out as dominant* when the run had
 95 % power to resolve it at half the film force F̄ (the power analysis, on the
 run's own errors: :func:`detectable`):
 
@@ -89,7 +91,8 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.cycles import CycleTable
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
-           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE"]
+           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
+           "NUMERICAL_FLOOR"]
 
 #: The verdicts, in the order the rules are tried.
 VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
@@ -102,6 +105,11 @@ POWER = 0.95
 #: A term not resolved is ruled out as dominant when the run would have resolved it (at
 #: :data:`POWER`) carrying this share of the mean film force.
 DOMINANT_SHARE = 0.5
+#: A term is resolved only when it also carries at least this share of the film force
+#: (|F_k| + |B·v̄|): the numerical floor of the sampled equation of motion (its
+#: trapezoid impulse and the sampling leave terms of 1e-4–1e-3 of the force on exact
+#: model traces at the controls' sampling, with standard errors far smaller).
+NUMERICAL_FLOOR = 0.01
 #: Default window of the velocity that picks the fitted samples, as a share of the median
 #: slip duration.
 SMOOTHING = 0.1
@@ -455,9 +463,19 @@ def _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
             f"95 % power at 2 σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
     if not all(math.isfinite(x) for x in (z_fk, z_b, fbar, vbar)):
         return "inconclusive", f"errors not defined: {nums}"
-    if z_b <= -r:
+    # a term counts only above the numerical floor too: on an exact trace its error is
+    # ~0 and the quadrature's own error would otherwise read as a resolved term
+    floor = NUMERICAL_FLOOR * (abs(fk) + abs(b * vbar))
+    b_big, fk_big = abs(b * vbar) >= floor, abs(fk) >= floor
+    small = [f"{name} carries {abs(val) / (abs(fk) + abs(b * vbar)):.1e} of the force, "
+             f"under the numerical floor {NUMERICAL_FLOOR:g}"
+             for name, val, big, z in (("F_k", fk, fk_big, z_fk), ("B·v̄", b * vbar, b_big, z_b))
+             if abs(z) >= r and not big]
+    if small:
+        nums = f"{nums}; {'; '.join(small)}"
+    if z_b <= -r and b_big:
         return "velocity-weakening", f"B resolved negative: {nums}"
-    b_res, fk_res = z_b >= r, z_fk >= r
+    b_res, fk_res = z_b >= r and b_big, z_fk >= r and fk_big
     if b_res and fk_res:
         return "mixed", f"both terms resolved (viscous share {b * vbar / fbar:.2f}): {nums}"
     if fbar <= 0:
