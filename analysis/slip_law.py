@@ -52,6 +52,12 @@ run's own errors: :func:`detectable`):
 * ``inconclusive`` — anything else: nothing resolved, or the missing term could
   carry half the force unseen.
 
+A window of the table in which the wall did not slip — the spring force falls over it
+by less than :data:`MIN_RELAXATION` of its value at the yield, as when a solid film
+holds the wall and it only rattles in its well — is left out, and the reasons say
+how far and how fast the wall moved in it; with no window left every branch is
+``inconclusive`` (no slip, no law).
+
 ``detectable_damping`` is the smallest B the run resolves at 2 σ in 95 % of
 repeats; B, it and the B of a no-slip film of bulk viscosity (η_bulk·A/D,
 computed by the caller) belong side by side.  σ_B and σ_Fk are the standard
@@ -80,7 +86,7 @@ A reduced-model trace with known F_k and B (a Coulomb + viscous block) gives the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import stats as sps
@@ -92,7 +98,7 @@ from filmfriction.reduced_model.cycles import CycleTable
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
-           "NUMERICAL_FLOOR"]
+           "NUMERICAL_FLOOR", "MIN_RELAXATION"]
 
 #: The verdicts, in the order the rules are tried.
 VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
@@ -110,6 +116,10 @@ DOMINANT_SHARE = 0.5
 #: trapezoid impulse and the sampling leave terms of 1e-4–1e-3 of the force on exact
 #: model traces at the controls' sampling, with standard errors far smaller).
 NUMERICAL_FLOOR = 0.01
+#: A window is a slip only when the spring force falls over it by at least this share of
+#: its value at the yield (K·(Δx − VΔt) of F_s): a window in which the wall did not move
+#: (a film holding the wall, the wall rattling in its well) is refused, not fitted.
+MIN_RELAXATION = 0.05
 #: Default window of the velocity that picks the fitted samples, as a share of the median
 #: slip duration.
 SMOOTHING = 0.1
@@ -207,6 +217,10 @@ class FilmForceFit:
         Window of the guiding velocity in samples (0: not smoothed).
     comoving_mass : bool
         Whether the m_c·a term was fitted.
+    still_windows : int
+        Windows of the table left out because the wall did not slip in them (the
+        spring relaxed by less than :data:`MIN_RELAXATION` of its force); the
+        reasons say by how much it moved.
     """
 
     decelerating: BranchFit
@@ -221,6 +235,7 @@ class FilmForceFit:
     per_slip_loop_area: np.ndarray
     smoothing_window: int
     comoving_mass: bool
+    still_windows: int = 0
 
     # the verdict's branch, as the single law the callers quote
     @property
@@ -565,9 +580,15 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     segs = {name: [] for name in BRANCHES + ("whole",)}
     ranges = []
     edge = w // 2 + 1
-    for y, s in zip(table.yield_index, table.stick_index):
+    still = []                       # (slip, Δx, v̄, relaxation) of windows with no slip
+    for j, (y, s) in enumerate(zip(table.yield_index, table.stick_index)):
         y, s = int(y), int(s)
         g = guide[y:s + 1]
+        relaxed = (f[y] - f[s]) / abs(f[y]) if f[y] else math.nan
+        if not relaxed >= MIN_RELAXATION:
+            still.append((j, float(x[s] - x[y]), float((x[s] - x[y]) / (t[s] - t[y]))
+                          if t[s] > t[y] else math.nan, float(relaxed)))
+            g = g[:0]
         if g.size < 3 or not np.max(g) > 0:
             for name in segs:
                 segs[name].append(None)
@@ -591,6 +612,8 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             segs[name].append(_Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
         ranges.append((min_velocity_fraction * peak, peak))
     fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in segs}
+    if still:
+        fits = _refuse_still(fits, still, len(table))
     acc, dec = fits["accelerating"], fits["decelerating"]
     lo, hi = np.array(ranges, float).reshape(-1, 2).T
     # the loop between the two branches' lines, over the velocities both cover
@@ -601,7 +624,23 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         gap = area / (hi - lo)
     la, lf = _mean_se(area), _mean_se(gap)
     return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
-                        lf[1], area, w, comoving_mass)
+                        lf[1], area, w, comoving_mass, len(still))
+
+
+def _refuse_still(fits: dict, still: list, total: int) -> dict:
+    """The branches with the windows in which the wall did not move said so: all
+    ``inconclusive`` when no window is left, else the fit of the others with a note."""
+    j, dx, vbar, relaxed = (np.array(c, float) for c in zip(*still))
+    note = (f"{len(still)} of {total} window(s) left out, the wall did not slip in them: "
+            f"it moved Δx = {', '.join(f'{d:.3g}' for d in dx[:5])}"
+            f"{', …' if dx.size > 5 else ''} at a mean velocity "
+            f"{', '.join(f'{u:.3g}' for u in vbar[:5])}{', …' if dx.size > 5 else ''}, "
+            f"relaxing the spring by {100 * np.nanmax(relaxed):.2g} % of its force at most "
+            f"(a slip relaxes it by {100 * MIN_RELAXATION:g} % or more)")
+    if len(still) == total:
+        return {k: replace(b, verdict="inconclusive", reason=f"no slip: {note}")
+                for k, b in fits.items()}
+    return {k: replace(b, reason=f"{b.reason}; {note}") for k, b in fits.items()}
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:
