@@ -37,7 +37,9 @@ and keeps constants), so the smoothing removes noise, not the law.
 
 Verdict (one of :data:`VERDICTS`).  Each term is *resolved* when it exceeds
 2 σ — at the coverage of a normal 2 σ (97.7 % one-sided) with the Student t of
-the errors' degrees of freedom — and *ruled out as dominant* when the run had
+the errors' degrees of freedom — and carries at least :data:`NUMERICAL_FLOOR` of
+the film force |F_k| + |B·v̄| (on an exact trace the errors vanish and the
+quadrature's own error would read as a term), and *ruled out as dominant* when the run had
 95 % power to resolve it at half the film force F̄ (the power analysis, on the
 run's own errors: :func:`detectable`):
 
@@ -49,6 +51,12 @@ run's own errors: :func:`detectable`):
   been resolved (Braun–Tosatti's reading);
 * ``inconclusive`` — anything else: nothing resolved, or the missing term could
   carry half the force unseen.
+
+A window of the table in which the wall did not slip — the spring force falls over it
+by less than :data:`MIN_RELAXATION` of its value at the yield, as when a solid film
+holds the wall and it only rattles in its well — is left out, and the reasons say
+how far and how fast the wall moved in it; with no window left every branch is
+``inconclusive`` (no slip, no law).
 
 ``detectable_damping`` is the smallest B the run resolves at 2 σ in 95 % of
 repeats; B, it and the B of a no-slip film of bulk viscosity (η_bulk·A/D,
@@ -78,7 +86,7 @@ A reduced-model trace with known F_k and B (a Coulomb + viscous block) gives the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import stats as sps
@@ -89,7 +97,8 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.cycles import CycleTable
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
-           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE"]
+           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
+           "NUMERICAL_FLOOR", "MIN_RELAXATION"]
 
 #: The verdicts, in the order the rules are tried.
 VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
@@ -102,6 +111,15 @@ POWER = 0.95
 #: A term not resolved is ruled out as dominant when the run would have resolved it (at
 #: :data:`POWER`) carrying this share of the mean film force.
 DOMINANT_SHARE = 0.5
+#: A term is resolved only when it also carries at least this share of the film force
+#: (|F_k| + |B·v̄|): the numerical floor of the sampled equation of motion (its
+#: trapezoid impulse and the sampling leave terms of 1e-4–1e-3 of the force on exact
+#: model traces at the controls' sampling, with standard errors far smaller).
+NUMERICAL_FLOOR = 0.01
+#: A window is a slip only when the spring force falls over it by at least this share of
+#: its value at the yield (K·(Δx − VΔt) of F_s): a window in which the wall did not move
+#: (a film holding the wall, the wall rattling in its well) is refused, not fitted.
+MIN_RELAXATION = 0.05
 #: Default window of the velocity that picks the fitted samples, as a share of the median
 #: slip duration.
 SMOOTHING = 0.1
@@ -199,6 +217,10 @@ class FilmForceFit:
         Window of the guiding velocity in samples (0: not smoothed).
     comoving_mass : bool
         Whether the m_c·a term was fitted.
+    still_windows : int
+        Windows of the table left out because the wall did not slip in them (the
+        spring relaxed by less than :data:`MIN_RELAXATION` of its force); the
+        reasons say by how much it moved.
     """
 
     decelerating: BranchFit
@@ -213,6 +235,7 @@ class FilmForceFit:
     per_slip_loop_area: np.ndarray
     smoothing_window: int
     comoving_mass: bool
+    still_windows: int = 0
 
     # the verdict's branch, as the single law the callers quote
     @property
@@ -455,9 +478,19 @@ def _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
             f"95 % power at 2 σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
     if not all(math.isfinite(x) for x in (z_fk, z_b, fbar, vbar)):
         return "inconclusive", f"errors not defined: {nums}"
-    if z_b <= -r:
+    # a term counts only above the numerical floor too: on an exact trace its error is
+    # ~0 and the quadrature's own error would otherwise read as a resolved term
+    floor = NUMERICAL_FLOOR * (abs(fk) + abs(b * vbar))
+    b_big, fk_big = abs(b * vbar) >= floor, abs(fk) >= floor
+    small = [f"{name} carries {abs(val) / (abs(fk) + abs(b * vbar)):.1e} of the force, "
+             f"under the numerical floor {NUMERICAL_FLOOR:g}"
+             for name, val, big, z in (("F_k", fk, fk_big, z_fk), ("B·v̄", b * vbar, b_big, z_b))
+             if abs(z) >= r and not big]
+    if small:
+        nums = f"{nums}; {'; '.join(small)}"
+    if z_b <= -r and b_big:
         return "velocity-weakening", f"B resolved negative: {nums}"
-    b_res, fk_res = z_b >= r, z_fk >= r
+    b_res, fk_res = z_b >= r and b_big, z_fk >= r and fk_big
     if b_res and fk_res:
         return "mixed", f"both terms resolved (viscous share {b * vbar / fbar:.2f}): {nums}"
     if fbar <= 0:
@@ -547,9 +580,15 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     segs = {name: [] for name in BRANCHES + ("whole",)}
     ranges = []
     edge = w // 2 + 1
-    for y, s in zip(table.yield_index, table.stick_index):
+    still = []                       # (slip, Δx, v̄, relaxation) of windows with no slip
+    for j, (y, s) in enumerate(zip(table.yield_index, table.stick_index)):
         y, s = int(y), int(s)
         g = guide[y:s + 1]
+        relaxed = (f[y] - f[s]) / abs(f[y]) if f[y] else math.nan
+        if not relaxed >= MIN_RELAXATION:
+            still.append((j, float(x[s] - x[y]), float((x[s] - x[y]) / (t[s] - t[y]))
+                          if t[s] > t[y] else math.nan, float(relaxed)))
+            g = g[:0]
         if g.size < 3 or not np.max(g) > 0:
             for name in segs:
                 segs[name].append(None)
@@ -573,6 +612,8 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             segs[name].append(_Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
         ranges.append((min_velocity_fraction * peak, peak))
     fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in segs}
+    if still:
+        fits = _refuse_still(fits, still, len(table))
     acc, dec = fits["accelerating"], fits["decelerating"]
     lo, hi = np.array(ranges, float).reshape(-1, 2).T
     # the loop between the two branches' lines, over the velocities both cover
@@ -583,7 +624,23 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         gap = area / (hi - lo)
     la, lf = _mean_se(area), _mean_se(gap)
     return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
-                        lf[1], area, w, comoving_mass)
+                        lf[1], area, w, comoving_mass, len(still))
+
+
+def _refuse_still(fits: dict, still: list, total: int) -> dict:
+    """The branches with the windows in which the wall did not move said so: all
+    ``inconclusive`` when no window is left, else the fit of the others with a note."""
+    j, dx, vbar, relaxed = (np.array(c, float) for c in zip(*still))
+    note = (f"{len(still)} of {total} window(s) left out, the wall did not slip in them: "
+            f"it moved Δx = {', '.join(f'{d:.3g}' for d in dx[:5])}"
+            f"{', …' if dx.size > 5 else ''} at a mean velocity "
+            f"{', '.join(f'{u:.3g}' for u in vbar[:5])}{', …' if dx.size > 5 else ''}, "
+            f"relaxing the spring by {100 * np.nanmax(relaxed):.2g} % of its force at most "
+            f"(a slip relaxes it by {100 * MIN_RELAXATION:g} % or more)")
+    if len(still) == total:
+        return {k: replace(b, verdict="inconclusive", reason=f"no slip: {note}")
+                for k, b in fits.items()}
+    return {k: replace(b, reason=f"{b.reason}; {note}") for k, b in fits.items()}
 
 
 def _mean_se(x: np.ndarray) -> tuple[float, float]:

@@ -5,9 +5,13 @@
 
 Prints the slip law fitted to the runs' release slips together
 (:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict,
-the decelerating branch and the whole slip), each run's layer velocity shares, where
-the shear sits and the width W = D + 2b of its profile, and B = η·A/W with η the
-liquid's viscosity at the film's state point (``filmfriction viscosity``).
+each branch and the whole slip, the whole slip again with a co-moving mass), how
+many releases the rule would need at the releases' own scatter (the kinetic force
+ruled out at half the film force: :func:`~filmfriction.analysis.slip_law.detectable`
+< F̄/2 with the per-release standard deviation of F_k), each run's layer velocity
+shares, where the shear sits and the width W = D + 2b of its profile, and
+B = η·A/W with η the liquid's viscosity at the film's state point
+(``filmfriction viscosity``).
 """
 from __future__ import annotations
 
@@ -19,6 +23,20 @@ import sys
 import numpy as np
 
 from filmfriction.analysis.groundtruth.release_control import fit_releases, release_profile
+from filmfriction.analysis.slip_law import DOMINANT_SHARE, detectable
+
+
+def releases_needed(branch, most: int = 1000) -> int | None:
+    """Releases at which a kinetic force of DOMINANT_SHARE·F̄ would be resolved at 95 %
+    power, with the branch's per-release scatter of F_k (None: not within ``most``)."""
+    fk = branch.per_slip_kinetic_force[np.isfinite(branch.per_slip_kinetic_force)]
+    if fk.size < 2 or not branch.mean_force > 0:
+        return None
+    sd = float(fk.std(ddof=1))
+    for n in range(2, most + 1):
+        if detectable(sd / math.sqrt(n), n - 1) < DOMINANT_SHARE * branch.mean_force:
+            return n
+    return None
 
 
 def main(argv=None) -> int:
@@ -33,10 +51,19 @@ def main(argv=None) -> int:
         p = json.load(open(f"{run}/run.json"))["trace_parameters"]
         mass = p["mass"]
     fit = fit_releases(traces, mass=mass)
+    with_mass = fit_releases(traces, mass=mass, comoving_mass=True).whole
     print(f"{len(traces)} releases, M = {mass:g}: verdict {fit.verdict} ({fit.reason})")
-    for br in (fit.decelerating, fit.accelerating, fit.whole):
-        print(f"  {br.branch:12s} F_k = {br.kinetic_force:.2f} ± {br.kinetic_force_stderr:.2f}, "
-              f"B = {br.damping:.2f} ± {br.damping_stderr:.2f}; verdict {br.verdict}")
+    for br in (fit.decelerating, fit.accelerating, fit.whole, with_mass):
+        name = br.branch + (" + m_c" if br is with_mass else "")
+        mc = (f", m_c = {br.comoving_mass:.0f} ± {br.comoving_mass_stderr:.0f}"
+              if br is with_mass else "")
+        print(f"  {name:14s} F_k = {br.kinetic_force:.2f} ± {br.kinetic_force_stderr:.2f} "
+              f"({br.kinetic_sigmas:+.1f} σ), B = {br.damping:.2f} ± {br.damping_stderr:.2f} "
+              f"({br.damping_sigmas:+.1f} σ){mc}; F̄ = {br.mean_force:.2f}, "
+              f"n = {br.exponent:.2f} ± {br.exponent_stderr:.2f}; verdict {br.verdict}; "
+              f"releases the rule needs: {releases_needed(br)}")
+        print(f"      per release: F_k {np.round(br.per_slip_kinetic_force, 2).tolist()}, "
+              f"B {np.round(br.per_slip_damping, 2).tolist()}")
     widths = []
     for run in a.runs:
         prof = release_profile(run)
@@ -50,10 +77,13 @@ def main(argv=None) -> int:
     eta, eta_se = a.viscosity
     b = eta * prof["area"] / wm
     b_se = b * math.hypot(eta_se / eta, wse / wm)
-    whole = fit.whole
-    print(f"W = {wm:.2f} ± {wse:.2f}, A = {prof['area']:.2f}: eta*A/W = {b:.2f} ± {b_se:.2f}; "
-          f"whole-slip B / (eta*A/W) = {whole.damping / b:.2f} ± "
-          f"{whole.damping / b * math.hypot(whole.damping_stderr / whole.damping, b_se / b):.2f}")
+    print(f"W = {wm:.2f} ± {wse:.2f}, A = {prof['area']:.2f}: eta*A/W = {b:.2f} ± {b_se:.2f}")
+    for name, br in (("decelerating", fit.decelerating), ("whole", fit.whole),
+                     ("whole + m_c", with_mass)):
+        r = br.damping / b
+        print(f"  {name:14s} B / (eta*A/W) = {r:.2f} ± "
+              f"{r * math.hypot(br.damping_stderr / br.damping, b_se / b):.2f}; "
+              f"B − eta*A/W = {br.damping - b:.2f} ± {math.hypot(br.damping_stderr, b_se):.2f}")
     return 0
 
 

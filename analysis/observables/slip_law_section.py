@@ -179,7 +179,10 @@ class SlipLaw(Observable):
         return [f"Why: {section.get('reason', '')}. Klein himself proposed this test (his note "
                 "27: the friction force against the sliding velocity during the slip). "
                 "`inconclusive` says that the run's slips are too few or too noisy to tell; "
-                "what the test can resolve at the MD's noise is in docs/results/slip-law.md."]
+                "what the test can resolve at the MD's noise is in docs/results/slip-law.md. "
+                "The verdict is this film's: it bears on Klein's film, and on Braun & "
+                "Tosatti's reading of it, only when the run's Bingham number η_eff/η_bulk "
+                "(sfb.json, `bingham_number`) is ≫ 1, as his is (~10⁴)."]
 
     def figure(self, run) -> bytes | None:
         """The film's force against the wall's velocity during the slips, with the

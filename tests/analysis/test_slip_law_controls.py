@@ -9,7 +9,8 @@ docs/results/slip-law.md (``python benchmarks/slip_law_power.py``).
 """
 import pytest
 
-from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, verdict_rates
+from filmfriction.analysis.groundtruth.slip_law_controls import (
+    _DRIVE, MD_NOISE, control_trace, coulomb_viscous, replica_fits, verdict_rates)
 
 REPLICAS = 40
 AT_MOST = 2          # of 40: ≥ 95 % pass
@@ -46,3 +47,28 @@ def test_coulomb_slips_are_kinetic_where_the_noise_allows():
 def test_weakening_slips_are_velocity_weakening_where_the_noise_allows():
     rates = verdict_rates("weakening", REPLICAS, 30, noise=QUIET)
     assert rates["velocity-weakening"] >= REPLICAS - AT_MOST, rates
+
+
+def _exact(trace, drive_velocity):
+    # noise-free: the replica's noise set to zero
+    return replica_fits(trace, 1, drive_velocity=drive_velocity,
+                        noise={"velocity_noise": 0.0, "velocity_correlation": 0.9,
+                               "rattle": 0.0})[0]
+
+
+@pytest.mark.parametrize("law, verdict", [("viscous", "viscous"), ("coulomb", "kinetic"),
+                                          ("weakening", "velocity-weakening"),
+                                          ("rate-state", "velocity-weakening")])
+def test_exact_controls_are_named_by_their_law_on_every_branch(law, verdict):
+    # on a noise-free trace the errors are ~0: a negligible term (the quadrature's own
+    # error, 1e-4 of the force) must not read as resolved (Coulomb's B, the viscous F_k)
+    fit = _exact(control_trace(law, 8), _DRIVE[law])
+    for br in (fit.decelerating, fit.whole):
+        assert br.verdict == verdict, (br.branch, br.reason)
+
+
+@pytest.mark.parametrize("share, verdict", [(0.0, "kinetic"), (0.5, "mixed"), (1.0, "viscous")])
+def test_exact_coulomb_viscous_slips_by_their_share(share, verdict):
+    fit = _exact(coulomb_viscous(share), 0.1)
+    for br in (fit.decelerating, fit.accelerating, fit.whole):
+        assert br.verdict == verdict, (br.branch, br.reason)

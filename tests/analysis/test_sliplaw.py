@@ -167,3 +167,65 @@ def test_no_slips_and_bad_input():
         _fit(r, tab, smoothing=2.0)
     with pytest.raises(ValueError, match="wall_position"):
         fit_film_force(r.t, r.spring_force, r.v, tab, mass=1.0, wall_position=r.x[:-1])
+
+
+def _pinned_wall(amplitudes, *, mass=500.0, k=1.0, held=20.0, period=15.0, dt=0.05):
+    # a wall held by a solid film at the spring force `held`, rattling in its well:
+    # x = a(1 − cos ωt), one amplitude per period; the windows are its forward swings
+    w = 2 * np.pi / period
+    t = np.arange(0, period * len(amplitudes), dt)
+    a = np.asarray(amplitudes)[np.minimum((t / period).astype(int), len(amplitudes) - 1)]
+    x, v = a * (1 - np.cos(w * t)), a * w * np.sin(w * t)
+    n = int(round(period / dt))
+    ys = np.arange(0, t.size - n, n)
+    return t, held - k * x, v, x, cycle_table(t, held - k * x, ys, ys + n // 2)
+
+
+def test_a_wall_that_did_not_move_is_no_slip():
+    # swings of 0.1–0.14 σ against a spring stretched by 20 σ: fitted, they read as a
+    # resolved kinetic force (or weakening, or mixed, by branch); they are no slip
+    t, f, v, x, tab = _pinned_wall(0.05 + 0.02 * np.sin(0.37 * np.arange(20)))
+    fit = fit_film_force(t, f, v, tab, mass=500.0, wall_position=x)
+    assert fit.still_windows == len(tab)
+    for br in (fit.decelerating, fit.accelerating, fit.whole):
+        assert br.verdict == "inconclusive", br.reason
+        assert br.reason.startswith("no slip") and "moved Δx = 0.1" in br.reason, br.reason
+
+
+def test_a_real_stuck_md_wall_is_no_slip():
+    # a solid film (wall–film bond 2 ε) holding the liquid-release wall at 20 ε/σ for the
+    # whole run; the windows are the wall's forward swings in its well (0.05–0.17 σ)
+    from pathlib import Path
+    from scipy.signal import argrelextrema, savgol_filter
+    from filmfriction.analysis.groundtruth.release_control import fit_releases
+    path = Path(__file__).parent / "data" / "stuck_wall_trace.csv"
+    tr = np.genfromtxt(path, delimiter=",", names=True, skip_header=2)
+    t, f, x, v = tr["time"], tr["spring_force"], tr["wall_position"], tr["wall_velocity"]
+    xs = savgol_filter(x, 101, 2)
+    lo, hi = argrelextrema(xs, np.less, order=20)[0], argrelextrema(xs, np.greater, order=20)[0]
+    ys = np.array([a for a in lo if np.any(hi > a)])
+    ss = np.array([hi[hi > a][0] for a in ys])
+    assert ys.size >= 5 and np.all(x[ss] - x[ys] < 0.2)
+    fit = fit_film_force(t, f, v, cycle_table(t, f, ys, ss), mass=500.0, wall_position=x)
+    assert fit.still_windows == ys.size
+    for br in (fit.decelerating, fit.accelerating, fit.whole):
+        assert br.verdict == "inconclusive" and br.reason.startswith("no slip"), br.reason
+    # the release control's own window (from the start to the wall's first stop)
+    fit = fit_releases([{k: tr[k] for k in tr.dtype.names}], mass=500.0)
+    assert fit.verdict == "inconclusive" and fit.reason.startswith("no slip"), fit.reason
+    assert "mean velocity" in fit.reason
+
+
+def test_slips_among_still_windows_are_fitted_and_the_still_ones_named():
+    r, tab = _run(0.4, 0.5)
+    t, f, v, x = r.t, r.spring_force, r.v, r.x
+    # a window inside a stick (the force rising: the spring not relaxed) joins the slips
+    y, s = int(tab.stick_index[1]), int(tab.yield_index[2])
+    assert s - y >= 3 and f[s] > f[y]
+    mixed = cycle_table(t, f, np.insert(tab.yield_index[1:], 1, y),
+                        np.insert(tab.stick_index[1:], 1, s))
+    fit = fit_film_force(t, f, v, mixed, mass=1.0, drive_velocity=0.01, wall_position=x)
+    assert fit.still_windows == 1
+    assert fit.kinetic_force == pytest.approx(0.4, abs=2e-3)
+    assert fit.damping == pytest.approx(0.5, rel=5e-3)
+    assert f"1 of {len(mixed)} window(s) left out" in fit.reason

@@ -123,3 +123,16 @@ def test_friction_law_disagreement_keeps_the_slip_law_from_established():
     clash = _calibration(law_agree=False)
     assert answers(a, agree, None, consistency_checks(a, agree))[6].status == "established"
     assert answers(a, clash, None, consistency_checks(a, clash))[6].status == "inconclusive"
+
+
+def test_the_slip_law_answer_speaks_of_klein_only_at_a_large_bingham_number():
+    a = _analysis()
+    a["slip_law"] = {"verdict": "kinetic", "kinetic_force": {"mean": 30.0, "stderr": 5.0},
+                     "damping": {"mean": 1.0, "stderr": 20.0},
+                     "detectable_damping": {"mean": 50.0}}
+    near_bulk = answers(a, None, _sfb(bi=(1.2, 0.8, 1.6)))[6].answer
+    assert "about this film only" in near_bulk and "Bi ≫ 1" in near_bulk, near_bulk
+    unknown = answers(a, None, None)[6].answer
+    assert "not computed" in unknown, unknown
+    klein_like = answers(a, None, _sfb(bi=(2e4, 1.5e4, 2.5e4)))[6].answer
+    assert "about this film only" not in klein_like, klein_like

@@ -291,9 +291,9 @@ def _beside_klein(sfb, measured: bool, user_point=None) -> Answer:
     return Answer(q, text, status, rule, SECTIONS["similarity"])
 
 
-def _slip_law(a: dict, checks: list) -> Answer:
+def _slip_law(a: dict, checks: list, sfb=None) -> Answer:
     units = a.get("units", "lj")
-    q = "Is the sliding friction viscous (Klein) or kinetic (Braun & Tosatti)?"
+    q = "Is this film's sliding friction viscous (Klein's Eq. 1) or kinetic (Braun & Tosatti)?"
     rule = ("the slip law's own verdict: established when it names a term (viscous, kinetic, "
             "mixed) resolved at 2 σ and the calibration's friction law agrees with it; "
             "inconclusive otherwise, with the smallest B the run resolves at 95 % power")
@@ -308,8 +308,24 @@ def _slip_law(a: dict, checks: list) -> Answer:
     clash = any(c.status == "disagree" and c.name.startswith("friction law") for c in checks)
     if clash:
         text += "; the calibration's friction law disagrees (consistency)"
+    text += _reach(sfb)
     return Answer(q, text, "inconclusive" if clash or verdict in ("inconclusive", "neither", "?")
                   else "established", rule, SECTIONS["slip_law"])
+
+
+def _reach(sfb) -> str:
+    """What the slip law's verdict says about Klein's film: nothing unless Bi ≫ 1."""
+    bi = next((r for r in ([] if sfb is None else sfb.rows)
+               if r["name"] == "bingham_number" and r["source"] == "similarity"), None)
+    if not bi or bi.get("model") is None:
+        return ("; about this film only: its Bingham number is not computed, so whether it "
+                "bears on Klein's film (which needs Bi ≫ 1) is not known")
+    lo, _ = bi.get("uncertainty") or (bi["model"], bi["model"])
+    if lo > BINGHAM_REGIME:
+        return ""
+    return (f"; about this film only: at Bi = {_fmt(bi['model'], 3)} (Klein's "
+            f"{_fmt(bi['klein'], 3)}) it does not decide between Klein's reading and Braun & "
+            f"Tosatti's, which needs Bi ≫ 1")
 
 
 def answers(analysis: dict, calibration: dict | None, sfb, checks=(), user_point=None
@@ -320,7 +336,7 @@ def answers(analysis: dict, calibration: dict | None, sfb, checks=(), user_point
     measured = bool(sfb is not None and sfb.doc.get("measured"))
     out = [_stick_slip(analysis), _energy(analysis), _viscosity(analysis, calibration, list(checks)),
            _replay(calibration, units), _sfb_prediction(calibration, sfb, measured),
-           _beside_klein(sfb, measured, user_point), _slip_law(analysis, list(checks))]
+           _beside_klein(sfb, measured, user_point), _slip_law(analysis, list(checks), sfb)]
     return out
 
 
