@@ -154,7 +154,16 @@ def run(args: argparse.Namespace) -> int:
 
     if args.resume:
         # the record read back is checked before the directory is locked
-        check_run_json(args.resume, "--resume", kind="run-resume")
+        record = check_run_json(args.resume, "--resume", kind="run-resume")
+        if args.slide_to is not None and record is not None:
+            import copy
+
+            from ..md.target import extend_record
+
+            try:
+                extend_record(args.resume, copy.deepcopy(record), args.slide_to)
+            except SceneError as exc:
+                raise UserError(str(exc)) from None
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
         check_not_in_run(args.out, "--out")
@@ -255,6 +264,9 @@ def _resume_study(args) -> int:
     from ..md.replicas import resume_study
     from ..md.scene import SceneError
 
+    if args.slide_to is not None:
+        raise UserError(f"--slide-to {args.slide_to}: continues one run; {args.resume} is a "
+                        "study of replicas (its rule decides the slide)")
     try:
         code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp)
     except SceneError as exc:

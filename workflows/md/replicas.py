@@ -308,10 +308,11 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None) -> int:
                 out_of = (budget.steps is not None and slide >= budget.steps) or \
                     (budget.seconds is not None and spent >= budget.seconds)
                 for t, c in zip(targets, checks):
-                    note(f"replicas: slide {slide}: {t.observable} ± "
-                         f"{100 * c.relative_error:.2f} % (target ± {100 * t.relative:.2f} %)"
-                         f" over {c.n_slips} slip(s) in {c.estimate.n_replicas} run(s): "
-                         f"{'met' if c.met else 'not met'}")
+                    now = (f"± {100 * c.relative_error:.2f} %" if math.isfinite(
+                        c.relative_error) else "no error yet")
+                    note(f"replicas: slide {slide}: {t.observable} {now} (target ± "
+                         f"{100 * t.relative:.2f} %) over {c.n_slips} slip(s) in "
+                         f"{c.estimate.n_replicas} run(s): {'met' if c.met else 'not met'}")
                 if met:
                     record["stop"] = {"reason": "every target met: " +
                                       "; ".join(c.reason for c in checks), "met": True}
