@@ -42,7 +42,7 @@ from filmfriction.md_inputs.contract import RUN_FILE, SCENE_FILE
 from ..rundir import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, STUDY_FILE, replica_dir,
                       replica_log)
 from .locks import DirectoryLock
-from .run_record import new_run_dir, scene_toml
+from .run_record import OWN_SCRIPT, new_run_dir, scene_toml
 from .scene import Scene, SceneError
 from .target import OBSERVABLES, Budget, next_slide, slip_values
 
@@ -121,6 +121,8 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
         first = min(first, budget.steps)
     study = new_run_dir(scene.name, out)
     seeds = replica_seeds(scene.parameters["seed"], replicas)
+    if scene.script:            # the scene's own script beside its copy (scene.toml names it)
+        write_atomic(study / OWN_SCRIPT, Path(scene.script).read_bytes())
     write_atomic(study / SCENE_FILE, scene_toml(scene))
     record = {
         "schema": SCHEMA, "status": "running", "scene": scene.name,
@@ -242,6 +244,15 @@ def _run_jobs(study: Path, jobs: dict[int, list[str]], workers: int) -> dict[int
     return codes
 
 
+def _last_line(path: Path) -> str:
+    """The last line a replica printed (its error, as a rule)."""
+    try:
+        lines = [x for x in path.read_text(errors="replace").splitlines() if x.strip()]
+    except OSError:
+        return "no output"
+    return lines[-1].strip() if lines else "no output"
+
+
 def _values(study: Path, record: dict, observables) -> list[dict[str, list[float]]]:
     return [slip_values(replica_dir(study, i), observables)
             for i in range(1, len(record["replicas"]) + 1)]
@@ -281,6 +292,7 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None) -> int:
                     note(f"replicas: {len(jobs)} run(s) to slide step {slide}, {workers} at "
                          f"once, {nprocs} rank(s) each (logs: {study}/replica-*.log)")
                 seg.setdefault("started", _now())
+                seg["at_once"], seg["ranks_each"] = workers, nprocs
                 t0 = time.monotonic()
                 codes = _run_jobs(study, jobs, workers)
                 seg["wall_time"] = seg.get("wall_time", 0.0) + time.monotonic() - t0
@@ -289,7 +301,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None) -> int:
                 if failed:
                     i, c = sorted(failed.items())[0]
                     why = (f"replica {i} ({replica_dir(study, i).name}) exited with code {c} "
-                           f"at slide {slide}; see {replica_log(study, i)}")
+                           f"at slide {slide}: {_last_line(replica_log(study, i))} (see "
+                           f"{replica_log(study, i)})")
                     record.update(status="failed", stop={"reason": why, "met": False},
                                   finished=_now())
                     write_json(path, record)
