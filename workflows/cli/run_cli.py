@@ -230,6 +230,13 @@ def _study_inputs(args: argparse.Namespace):
     return args.replicas or 1, targets, budget
 
 
+def _workers(ranks: int) -> int:
+    """Replicas of ``ranks`` ranks each that run at once: as many as the usable CPUs hold."""
+    from ..inputs import cap_workers, usable_cpus
+
+    return cap_workers(max(1, usable_cpus() // ranks), "--replicas")
+
+
 def _is_study(path) -> bool:
     from ..md.replicas import is_study
 
@@ -252,7 +259,8 @@ def _run_study(args, replicas, targets, budget) -> int:
             raise UserError(f"--budget {args.budget}: below one restart interval "
                             f"(restart_every = {scene.parameters['restart_every']} steps)")
         study, code = run_study(scene, replicas=replicas, nprocs=args.np or 1,
-                                targets=targets, budget=budget, out=args.out, lmp=args.lmp)
+                                targets=targets, budget=budget, out=args.out, lmp=args.lmp,
+                                workers=_workers(args.np or 1))
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except KeyboardInterrupt as exc:
@@ -268,7 +276,7 @@ def _resume_study(args) -> int:
         raise UserError(f"--slide-to {args.slide_to}: continues one run; {args.resume} is a "
                         "study of replicas (its rule decides the slide)")
     try:
-        code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp)
+        code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp, workers=_workers)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except KeyboardInterrupt as exc:
@@ -302,7 +310,7 @@ def _study_done(args, study: Path, code: int) -> int:
         return 0
     from filmfriction.analysis.analyze import analyse_run
 
-    from ..rundir import replica_dir
+    from ..md.replicas import replica_dir
 
     for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
         try:

@@ -37,16 +37,15 @@ import numpy as np
 
 from filmfriction.analysis.ensemble import check_target, combine_replicas
 from filmfriction.analysis.util import write_atomic
-from filmfriction.md_inputs.contract import RUN_FILE, SCENE_FILE
-
-from ..rundir import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, STUDY_FILE, replica_dir,
-                      replica_log)
+from filmfriction.md_inputs.contract import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
+                                             REPLICA_LOG, RUN_FILE, SCENE_FILE, STUDY_FILE)
 from .locks import DirectoryLock
 from .run_record import OWN_SCRIPT, new_run_dir, scene_toml
 from .scene import Scene, SceneError
 from .target import OBSERVABLES, Budget, next_slide, slip_values
 
-__all__ = ["MAX_REPLICAS", "replica_seeds", "is_study", "run_study", "resume_study"]
+__all__ = ["MAX_REPLICAS", "replica_seeds", "replica_dir", "replica_log", "is_study",
+           "run_study", "resume_study", "combine_study"]
 
 SCHEMA = "filmfriction.replicas/1"
 #: the most replicas one study runs (more is a typo, or a job for the sweep)
@@ -72,6 +71,16 @@ def replica_seeds(seed: int, count: int) -> list[int]:
         if s not in seeds:
             seeds.append(s)
     return seeds
+
+
+def replica_dir(study: Path, index: int) -> Path:
+    """Replica ``index``'s run directory (1-based) in the study directory."""
+    return Path(study) / REPLICA_DIR.format(index=index)
+
+
+def replica_log(study: Path, index: int) -> Path:
+    """What replica ``index``'s runs printed (every segment appended)."""
+    return Path(study) / REPLICA_LOG.format(index=index)
 
 
 def is_study(path: Path) -> bool:
@@ -106,10 +115,11 @@ def _cli() -> list[str]:
 # ---------------------------------------------------------------- a new study
 def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
               budget: Budget | None = None, out: Path | None = None,
-              lmp: str | None = None, workers: int | None = None) -> tuple[Path, int]:
-    """Run ``replicas`` replicas of ``scene`` in a new study directory; return it and the
-    exit code (0 done, 1 a replica failed, 130 interrupted).  Inputs are the caller's to
-    check (the command line does, before this)."""
+              lmp: str | None = None, workers: int = 1) -> tuple[Path, int]:
+    """Run ``replicas`` replicas of ``scene`` in a new study directory, ``workers`` at
+    once; return it and the exit code (0 done, 1 a replica failed).  Inputs are the
+    caller's to check (the command line does, before this, and caps ``workers`` to the
+    usable CPUs)."""
     restart_every = int(scene.parameters["restart_every"])
     if targets and restart_every <= 0:
         raise SceneError("--target extends the slide from restart files: the scene has "
@@ -127,7 +137,6 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
     record = {
         "schema": SCHEMA, "status": "running", "scene": scene.name,
         "command": sys.argv[:], "np": nprocs, "lmp": lmp,
-        "workers": workers,
         "replicas": [{"dir": replica_dir(study, i + 1).name, "seed": s}
                      for i, s in enumerate(seeds)],
         "rule": None if not targets else {
@@ -142,11 +151,13 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
         "started": _now(),
     }
     write_json(study / STUDY_FILE, record)
-    return study, _drive(study, record, targets, budget)
+    return study, _drive(study, record, targets, budget, workers)
 
 
-def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None) -> int:
-    """Carry on an interrupted (or failed) study from where each replica stopped."""
+def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
+                 workers=None) -> int:
+    """Carry on an interrupted (or failed) study from where each replica stopped;
+    ``workers(ranks)`` says how many replicas of ``ranks`` ranks run at once."""
     from filmfriction.analysis.ensemble import TargetError
 
     study = Path(study)
@@ -168,7 +179,8 @@ def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None)
     if lmp:
         record["lmp"] = lmp
     record.setdefault("resumed", []).append(_now())
-    return _drive(study, record, targets, budget)
+    ranks = int(record.get("np") or 1)
+    return _drive(study, record, targets, budget, workers(ranks) if workers else 1)
 
 
 # ---------------------------------------------------------------- the segments
@@ -269,15 +281,13 @@ def _warnings(study: Path, record: dict) -> list[str]:
     return out
 
 
-def _drive(study: Path, record: dict, targets, budget: Budget | None) -> int:
-    from ..inputs import cap_workers, usable_cpus
+def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: int) -> int:
     from ..progress import note
     from .runner import _TerminationAsInterrupt
 
     path = study / STUDY_FILE
     nprocs = int(record.get("np") or 1)
-    workers = record.get("workers") or max(1, usable_cpus() // nprocs)
-    workers = min(cap_workers(workers, "--replicas"), len(record["replicas"]))
+    workers = max(1, min(int(workers), len(record["replicas"])))
     rule = record.get("rule") or {}
     with _TerminationAsInterrupt():
         lock = _lock(study).acquire()
