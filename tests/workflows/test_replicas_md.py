@@ -145,3 +145,27 @@ def test_study_interrupted_locked_and_resumed(tmp_path):
         assert run["status"] in ("completed", "completed_with_warnings")
         trace = np.genfromtxt(study / f"replica-{i}" / "trace.csv", delimiter=",", names=True)
         assert len(trace) == 40000 // 50 + 1 and np.all(np.diff(trace["step"]) == 50)
+
+
+def test_a_run_slid_further_is_the_longer_run(tmp_path, md):
+    """A completed run of 4000 steps continued to 8000 (``--slide-to``, what a target's
+    segments do) gives the trace of one 8000-step run byte for byte on the same single
+    rank (the thermostat is re-seeded at every restart boundary in both), and its record
+    says so."""
+    from filmfriction.workflows.md import runner
+
+    settings = {"equilibrate_steps": 500, "slide_steps": 8000, "trace_every": 20,
+                "restart_every": 2000}
+    whole = md.shared("stick-slip", **settings).path       # test_faults_md.py's run too
+    out = tmp_path / "extended"
+    md.execute(md.scene("stick-slip", **{**settings, "slide_steps": 4000}), out)
+    assert json.loads((out / "run.json").read_text())["status"].startswith("completed")
+    runner.resume(out, progress=False, slide_steps=8000)
+    record = json.loads((out / "run.json").read_text())
+    assert record["status"].startswith("completed") and record["np"] == 1
+    assert record["scene"]["parameters"]["slide_steps"] == 8000
+    assert record["derived"]["slide_time"] == pytest.approx(8000 * record["scene"]
+                                                            ["parameters"]["timestep"])
+    assert record["extensions"][0]["from"] == 4000 and record["resumed_from"] == "restart.4000"
+    assert "slide_steps = 8000" in (out / "scene.toml").read_text()
+    assert (out / "trace.csv").read_bytes() == (whole / "trace.csv").read_bytes()
