@@ -35,8 +35,8 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter (LJ units), e.g. --set drive_velocity=0.05")
     p.add_argument("--np", type=int, default=None,
-                   help="MPI ranks (default 2; with --resume, the ranks the run was started "
-                        "with)")
+                   help="MPI ranks (default 2; per replica with --replicas or --target, default "
+                        "1; with --resume, the ranks the run was started with)")
     p.add_argument("--out", type=Path, default=None,
                    help="run directory to create (default runs/<scene>-<time>)")
     p.add_argument("--resume", type=Path, default=None, metavar="DIR",
