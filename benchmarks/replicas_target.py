@@ -88,7 +88,9 @@ def paired(args) -> dict:
                 wall = _run([*common, "--np", "2"])
                 slips = _slips(d)
             row[side] = {"wall": wall, "slips": slips, "rate": slips / wall}
-        row["ratio"] = row["replicas"]["rate"] / row["ranks"]["rate"]
+        # no slip on the 2-rank side: no ratio (a slide too short for the scene)
+        row["ratio"] = (row["replicas"]["rate"] / row["ranks"]["rate"]
+                        if row["ranks"]["slips"] else float("nan"))
         rows.append(row)
         print(f"pair {k + 1}: 2 replicas x 1 rank {row['replicas']['slips']} slips in "
               f"{row['replicas']['wall']:.1f} s; 1 run x 2 ranks {row['ranks']['slips']} "

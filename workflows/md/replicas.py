@@ -57,9 +57,16 @@ STOP_GRACE = 60.0
 _DONE = ("completed", "completed_with_warnings")
 
 
+#: the largest seed drawn for a replica: LAMMPS's Marsaglia generator (fix langevin, seeded
+#: with the seed plus the rank, plus up to 4, plus 104729 per restart segment) refuses
+#: seeds above 900 000 000
+MAX_DRAWN_SEED = 800_000_000
+
+
 def replica_seeds(seed: int, count: int) -> list[int]:
     """The seeds of ``count`` replicas: the scene's own first, then distinct ones drawn
-    from it (reproducible: the same scene seed gives the same replicas).
+    from it in [1, :data:`MAX_DRAWN_SEED`] (reproducible: the same scene seed gives the
+    same replicas).
 
     >>> replica_seeds(4928459, 3)[0], len(set(replica_seeds(4928459, 50)))
     (4928459, 50)
@@ -67,7 +74,7 @@ def replica_seeds(seed: int, count: int) -> list[int]:
     rng = np.random.default_rng(np.random.SeedSequence(int(seed)))
     seeds = [int(seed)]
     while len(seeds) < count:
-        s = int(rng.integers(1, 2**31 - 5))
+        s = int(rng.integers(1, MAX_DRAWN_SEED + 1))
         if s not in seeds:
             seeds.append(s)
     return seeds
