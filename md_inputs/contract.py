@@ -28,7 +28,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
-__all__ = ["DATA_FILE", "RUN_FILE", "SCENE_FILE", "COMMAND_FILE", "LOG_FILE", "TRACE_DAT_FILE",
+__all__ = ["STUDY_FILE", "ENSEMBLE_FILE", "ENSEMBLE_REPORT_FILE", "REPLICA_DIR",
+           "REPLICA_LOG", "DATA_FILE", "RUN_FILE", "SCENE_FILE", "COMMAND_FILE", "LOG_FILE", "TRACE_DAT_FILE",
            "TRACE_FILE", "RESTARTS_FILE", "ANALYSIS_FILE", "CALIBRATION_FILE", "SFB_FILE",
            "SWEEP_FILE", "AGGREGATE_FILE", "SLIDE_ORIGIN_FILE", "RESUME_OFFSETS", "AtomType", "ATOM_TYPES", "FILM_TYPES", "BOTTOM_WALL_TYPES", "TOP_WALL_TYPES",
            "WALL_TYPES", "Column", "TRACE", "DAT_COLUMNS", "TRACE_COLUMNS", "TRACE_UNITS",
@@ -55,6 +56,11 @@ SFB_FILE = "sfb.json"                  #: the SFB check (``sfb_slips.csv`` besid
 SWEEP_FILE = "sweep.json"              #: a sweep directory's plan
 AGGREGATE_FILE = "aggregate.json"      #: a finished sweep's aggregate
 SLIDE_ORIGIN_FILE = "slide_origin.txt"  #: the wall's x and z at the slide's start (for a resume)
+STUDY_FILE = "study.json"              #: a study of replicas: seeds, rule, checks, why it stopped
+ENSEMBLE_FILE = "ensemble.json"        #: a study's observables combined over its replicas
+ENSEMBLE_REPORT_FILE = "ensemble.md"   #: the same as a report
+REPLICA_DIR = "replica-{index}"        #: replica ``index``'s run directory in a study (1-based)
+REPLICA_LOG = "replica-{index}.log"    #: what replica ``index``'s runs printed
 
 #: The energy ledger's running sums a resumed run continues from: the trace column at the
 #: restart step -> the script's variable that starts the sum there.

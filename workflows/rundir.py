@@ -24,14 +24,23 @@ from filmfriction.analysis.provenance import provenance
 from filmfriction.analysis.util import write_atomic
 from filmfriction.analysis.analyze import to_json
 from filmfriction.md_inputs.contract import (AGGREGATE_FILE, ANALYSIS_FILE, CALIBRATION_FILE,
-                                             SFB_FILE)
+                                             ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
+                                             REPLICA_LOG, SFB_FILE, STUDY_FILE)
 from filmfriction.reduced_model.sfb.rows import find_row
 
 from .sweep.aggregate import load_aggregate
 
-__all__ = ["CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
+__all__ = ["STUDY_FILE", "ENSEMBLE_FILE", "ENSEMBLE_REPORT_FILE", "REPLICA_DIR",
+           "REPLICA_LOG", "STUDY_FILES", "CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
            "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",
            "read_report_inputs", "split_sweeps"]
+
+#: A study of replicas (``filmfriction run --replicas N``): its record, the combined
+#: analysis and its report in the study directory, one run directory per replica
+#: (REPLICA_DIR) and each replica's output (REPLICA_LOG): the contract's names
+#: (md_inputs/contract.py), shared with the runner's modules (workflows/md/replicas.py).
+STUDY_FILES = (STUDY_FILE, ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR, REPLICA_LOG)
+
 
 #: The slips' traces go to ``<stem><suffix>`` beside ``sfb.json``.
 SFB_TRACES_SUFFIX = "_slips.csv"

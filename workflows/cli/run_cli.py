@@ -35,8 +35,8 @@ def register(subparsers) -> None:
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scene parameter (LJ units), e.g. --set drive_velocity=0.05")
     p.add_argument("--np", type=int, default=None,
-                   help="MPI ranks (default 2; with --resume, the ranks the run was started "
-                        "with)")
+                   help="MPI ranks (default 2; per replica with --replicas or --target, default "
+                        "1; with --resume, the ranks the run was started with)")
     p.add_argument("--out", type=Path, default=None,
                    help="run directory to create (default runs/<scene>-<time>)")
     p.add_argument("--resume", type=Path, default=None, metavar="DIR",
@@ -53,6 +53,26 @@ def register(subparsers) -> None:
                         "a package the scene needs; its path and version go into run.json")
     p.add_argument("--md-only", action="store_true",
                    help="run the MD only: no analysis, calibration or report")
+    e = p.add_argument_group(
+        "replicas and a target error",
+        "N independent runs (seeds recorded) in one study directory, combined into means "
+        "whose error includes the run-to-run scatter; with --target, slid segment by "
+        "segment until every target is met or --budget is spent (study.json records the "
+        "rule, each check and why it stopped)")
+    e.add_argument("--replicas", type=int, default=None, metavar="N",
+                   help="independent runs of the scene, --np ranks each (default 1 rank), "
+                        "as many at once as the CPUs hold")
+    e.add_argument("--target", action="append", default=[], metavar="OBS=REL",
+                   help="stop when the 68 %% half-width of OBS over |mean| is at most REL "
+                        "(over slips and replicas, start-up slip left out), e.g. "
+                        "static_force=0.05; several allowed")
+    e.add_argument("--budget", default=None, metavar="STEPS|DURATION",
+                   help="with --target: at most STEPS slide steps per replica, or a wall time "
+                        "(45s, 90m, 2h, 1d; checked between segments); default 10 times the "
+                        "scene's slide_steps")
+    e.add_argument("--slide-to", type=int, default=None, metavar="STEPS",
+                   help="with --resume DIR: continue the run, a completed one too, to a slide "
+                        "of STEPS steps in all (from its newest restart file)")
     p.set_defaults(func=run)
 
     s = subparsers.add_parser(
@@ -126,10 +146,24 @@ def run(args: argparse.Namespace) -> int:
     if args.resume and (args.overrides or args.fidelity or args.out):
         raise UserError("--resume continues a run as it was started: --set, --fidelity and "
                         "--out are not accepted with it")
+    study = _study_inputs(args)
+    if args.resume and _is_study(args.resume):
+        return _resume_study(args)
+    if study is not None:
+        return _run_study(args, *study)
 
     if args.resume:
         # the record read back is checked before the directory is locked
-        check_run_json(args.resume, "--resume", kind="run-resume")
+        record = check_run_json(args.resume, "--resume", kind="run-resume")
+        if args.slide_to is not None and record is not None:
+            import copy
+
+            from ..md.target import extend_record
+
+            try:
+                extend_record(args.resume, copy.deepcopy(record), args.slide_to)
+            except SceneError as exc:
+                raise UserError(str(exc)) from None
     if args.out is not None:
         check_writable(args.out, "--out", directory=True)
         check_not_in_run(args.out, "--out")
@@ -138,7 +172,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.resume:
             run_dir = resume(args.resume, nprocs=args.np, progress=not args.quiet,
-                             lmp=args.lmp)
+                             lmp=args.lmp, slide_steps=args.slide_to)
         else:
             run_dir = execute(_scene(args), out=args.out, nprocs=args.np or 2,
                               progress=not args.quiet, lmp=args.lmp)
@@ -162,6 +196,140 @@ def run(args: argparse.Namespace) -> int:
     if args.md_only:
         return 0
     return post_process(run_dir)
+
+
+def _study_inputs(args: argparse.Namespace):
+    """``(replicas, targets, budget)`` for a study of replicas or a target (None for a
+    plain run); UserError for any of them a study cannot take, before any compute."""
+    from ..md.replicas import MAX_REPLICAS
+    from ..md.target import TargetInputError, parse_budget, parse_targets
+
+    if args.slide_to is not None:
+        if not args.resume:
+            raise UserError(f"--slide-to {args.slide_to}: continues a run; give it with "
+                            "--resume DIR")
+        if args.slide_to < 1:
+            raise UserError(f"--slide-to {args.slide_to}: give slide steps >= 1")
+    if args.replicas is not None and not 1 <= args.replicas <= MAX_REPLICAS:
+        raise UserError(f"--replicas {args.replicas}: give between 1 and {MAX_REPLICAS} "
+                        "independent runs")
+    if args.budget is not None and not args.target:
+        raise UserError(f"--budget {args.budget}: limits a --target; give --target OBS=REL "
+                        "with it")
+    wants = args.replicas is not None or args.target
+    if args.resume and wants:
+        raise UserError("--resume continues a run or a study as it was started: --replicas, "
+                        "--target and --budget are not accepted with it")
+    if not wants:
+        return None
+    try:
+        targets = parse_targets(args.target)
+        budget = parse_budget(args.budget) if args.budget is not None else None
+    except TargetInputError as exc:
+        raise UserError(str(exc)) from None
+    return args.replicas or 1, targets, budget
+
+
+def _workers(ranks: int) -> int:
+    """Replicas of ``ranks`` ranks each that run at once: as many as the usable CPUs hold."""
+    from ..inputs import cap_workers, usable_cpus
+
+    return cap_workers(max(1, usable_cpus() // ranks), "--replicas")
+
+
+def _is_study(path) -> bool:
+    from ..md.replicas import is_study
+
+    return is_study(path)
+
+
+def _run_study(args, replicas, targets, budget) -> int:
+    from ..md.replicas import run_study
+    from ..md.scene import SceneError
+
+    if args.out is not None:
+        check_writable(args.out, "--out", directory=True)
+        check_not_in_run(args.out, "--out")
+    else:
+        check_writable(Path("runs"), "the default --out,", directory=True)
+    try:
+        scene = _scene(args)
+        if budget is not None and budget.steps is not None and \
+                budget.steps < scene.parameters["restart_every"]:
+            raise UserError(f"--budget {args.budget}: below one restart interval "
+                            f"(restart_every = {scene.parameters['restart_every']} steps)")
+        study, code = run_study(scene, replicas=replicas, nprocs=args.np or 1,
+                                targets=targets, budget=budget, out=args.out, lmp=args.lmp,
+                                workers=_workers(args.np or 1))
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    except KeyboardInterrupt as exc:
+        return _study_interrupted(exc)
+    return _study_done(args, study, code)
+
+
+def _resume_study(args) -> int:
+    from ..md.replicas import resume_study
+    from ..md.scene import SceneError
+
+    if args.slide_to is not None:
+        raise UserError(f"--slide-to {args.slide_to}: continues one run; {args.resume} is a "
+                        "study of replicas (its rule decides the slide)")
+    try:
+        code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp, workers=_workers)
+    except SceneError as exc:
+        raise UserError(str(exc)) from None
+    except KeyboardInterrupt as exc:
+        return _study_interrupted(exc)
+    return _study_done(args, Path(args.resume), code)
+
+
+def _study_interrupted(exc: KeyboardInterrupt) -> int:
+    if getattr(exc, "run_dir", None) is None:
+        raise exc
+    print(f"filmfriction run: interrupted ({str(exc) or 'SIGINT'}); resume with "
+          f"{exc.resume_command}", file=sys.stderr)
+    return 130
+
+
+def _study_done(args, study: Path, code: int) -> int:
+    import json
+
+    from ..md.replicas import combine_study
+    from ..rundir import ENSEMBLE_REPORT_FILE, STUDY_FILE
+
+    print(f"study directory: {study}")
+    record = json.loads((study / STUDY_FILE).read_text(encoding="utf-8"))
+    for line in record.get("warnings") or []:
+        print(f"filmfriction run: warning: {line}", file=sys.stderr)
+    if code != 0:
+        return code
+    if record.get("status") == "target_not_met":
+        print(f"filmfriction run: warning: {record['stop']['reason']}", file=sys.stderr)
+    if args.md_only:
+        return 0
+    from filmfriction.analysis.analyze import analyse_run
+
+    from ..md.replicas import replica_dir
+
+    for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
+        try:
+            analyse_run(replica_dir(study, i))
+        except Exception as exc:  # noqa: BLE001 -- one replica's analysis must not stop the rest
+            print(f"analysis of replica {i}: FAILED: {type(exc).__name__}: {exc}",
+                  file=sys.stderr)
+    doc = combine_study(study)
+    from filmfriction.analysis.util import format_pm
+
+    for name in [t["observable"] for t in (record.get("rule") or {}).get("targets", [])] \
+            or ["static_force"]:
+        e = doc["observables"][name]
+        if e["mean"] is not None and e["mean"] == e["mean"]:
+            print(f"{name}: {format_pm(e['mean'], e['half_width'])} (68 %, "
+                  f"{e['n_slips']} slips in {e['n_replicas']} runs; within "
+                  f"{e['within']:.3g}, between {e['between']:.3g})")
+    print(f"report: {study / ENSEMBLE_REPORT_FILE}")
+    return 0
 
 
 def _scene(args: argparse.Namespace):

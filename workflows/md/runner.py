@@ -415,7 +415,8 @@ def _finish(run_dir, record, scene, outcome, error, status=None):
 
 
 def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
-           lmp: str | Path | None = None, launcher: list[str] | None = None) -> Path:
+           lmp: str | Path | None = None, launcher: list[str] | None = None,
+           slide_steps: int | None = None) -> Path:
     """Continue an interrupted or failed run from its newest usable restart file.
 
     ``nprocs`` None: the ranks the run last ran on (``run.json``'s ``np``).
@@ -427,6 +428,9 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
     recorded one (version, packages or the executable's SHA-256), one line on
     stderr says so and ``run.json``'s ``notes`` keep it.
     The directory is locked for the whole resume: a second one is refused.
+    ``slide_steps``: continue to a longer slide (a completed run too), from the newest
+    restart file (:func:`filmfriction.workflows.md.target.extend_parameters` says what is
+    accepted); ``run.json`` and ``scene.toml`` then hold the longer slide.
     """
     run_dir = Path(run_dir)
     if not (run_dir / RUN_FILE).exists():
@@ -435,7 +439,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
         lock = RunLock(run_dir).acquire()
         state = {"record": None, "scene": None}
         try:
-            return _resume(run_dir, nprocs, progress, state, lmp, launcher)
+            return _resume(run_dir, nprocs, progress, state, lmp, launcher, slide_steps)
         except KeyboardInterrupt as exc:
             if state["record"] is not None:      # run.json was (being) set to running
                 _interrupted(run_dir, state["record"], state["scene"], exc)
@@ -451,7 +455,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
 
 
 def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
-            launcher: list[str] | None = None) -> Path:
+            launcher: list[str] | None = None, slide_steps: int | None = None) -> Path:
     from . import scene as scene_mod
 
     record_path = run_dir / RUN_FILE
@@ -467,7 +471,11 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
         check_document(record, "run-resume", record_path)
     except ValueError as exc:
         raise SceneError(str(exc)) from None
-    if record.get("status") in ("completed", "completed_with_warnings"):
+    if slide_steps is not None:
+        from .target import extend_record
+
+        extend_record(run_dir, record, slide_steps)
+    elif record.get("status") in ("completed", "completed_with_warnings"):
         raise SceneError(f"{run_dir} already completed; nothing to resume")
     good, bad = restarts.check(run_dir)
     if bad:
@@ -538,7 +546,11 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
     record["lammps"] = build.as_dict()
     record.setdefault("commands", [record["command"]]).append(cmd)
     state["record"], state["scene"] = record, scene
+    if slide_steps is not None:
+        record["derived"] = scene.derived()
     write_json(record_path, record)
+    if slide_steps is not None:
+        write_atomic(run_dir / SCENE_FILE, scene_toml(scene))
     rewrite_trace_dat(run_dir / TRACE_DAT_FILE, keep)
     return _drive(scene, run_dir, record, cmd, total,
                   scene.parameters["equilibrate_steps"] + step, progress)
