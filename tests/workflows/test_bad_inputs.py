@@ -274,6 +274,8 @@ CASES = {
     "sweep --set key twice": (lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2",
                                          "--set", "cells_x=8", "--set", "cells_x=9",
                                          "--dry-run", "--out", t / "s"], "given twice", 2),
+    "--set seed above fix langevin's limit": (lambda t: ["run", "--set", "seed=900000000",
+                                                          "--out", t / "r"], "899999990", 2),
     "--resume with --set": (lambda t: ["run", "--resume", t, "--set", "seed=1"],
                             "not accepted with it", 2),
     # -- replicas and a target error (workflows/md/replicas.py, target.py)

@@ -114,6 +114,10 @@ TWISTED_WALL_MAX_STRAIN = 0.05
 WCA_CUTOFF = 2.0 ** (1.0 / 6.0)
 
 P = Parameter
+#: the largest seed a scene takes: fix langevin refuses seeds above 900 000 000 and the
+#: flexible walls' thermostats use seed + 4 (film_slide.lmp's segment seeds stay below it)
+SEED_MAX = 899_999_990
+
 # Physics' own names: these are the user-facing contract.
 PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("drive_velocity", float, "sigma/tau", 0.02, 0.0, 5.0,
@@ -165,7 +169,7 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("mount_damping", float, "1/tau", 0.3, 0.0, 100.0,
       "mount dashpot: -gamma*M*(vx - V) in parallel with the spring, -gamma*M*vz along z"),
     # the script derives seed+1 .. seed+4 for the flexible walls: all stay a 32-bit int
-    P("seed", int, "-", 4928459, 1, 2**31 - 5, "random seed (velocities, thermostat)"),
+    P("seed", int, "-", 4928459, 1, SEED_MAX, "random seed (velocities, thermostat)"),
     P("equilibrate_steps", int, "steps", 10000, 0, 10**9,
       "loaded and thermostatted, spring off"),
     # LAMMPS's run command takes at most 2^31 - 1 steps
