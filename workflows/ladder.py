@@ -334,7 +334,7 @@ def _collect(args) -> int:
             rungs.append(got)
     print(table(rungs))
     if args.json:
-        from filmfriction.analysis.util import write_atomic
+        from filmfriction.analysis.files.util import write_atomic
         write_atomic(Path(args.json), json.dumps({"schema": "filmfriction.mass-ladder/1",
                                                   "rungs": rungs}, indent=1))
     return 0

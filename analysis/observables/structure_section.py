@@ -14,7 +14,7 @@ import numpy as np
 
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
-from ..trace import unit
+from ..files.trace import unit
 from .observable import Context, Observable, format_value, png_bytes, pyplot, shade_slips
 
 __all__ = ["Structure", "summarize_run", "universe", "fig_film"]

@@ -180,7 +180,7 @@ def load_setup(path) -> SFBSetup:
     """The :class:`SFBSetup` in the TOML file ``path`` (named after the file unless it
     says ``name``).  A ``[trace]`` table, how the instrument writes its traces, is not
     part of the set-up: ``filmfriction analyze`` reads it
-    (:func:`filmfriction.analysis.column_spec.trace_table`).
+    (:func:`filmfriction.analysis.files.column_spec.trace_table`).
 
     Raises
     ------

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.observables.sliding_section import sliding_section
-from filmfriction.analysis.trace import read_trace
+from filmfriction.analysis.files.trace import read_trace
 from filmfriction.workflows import sweep
 from filmfriction.workflows.md.scene import SceneError
 
@@ -374,7 +374,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
 @pytest.mark.parametrize("lo, hi, at_least", [(0.013, 0.062, 2), (8.0, 60.0, 2), (1e-3, 1.0, 4)])
 def test_a_log_axis_of_the_sweep_figures_is_labelled_over_any_range(lo, hi, at_least):
     """Under a decade there is no power of ten to label: the axis had no numbers at all."""
-    from filmfriction.analysis.util import pyplot
+    from filmfriction.analysis.files.util import pyplot
     from filmfriction.workflows.sweep.figures import _plain_log_axis
 
     plt = pyplot()

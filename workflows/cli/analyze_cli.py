@@ -38,8 +38,8 @@ MAX_MAGNITUDE = 1e100
 def _reading_options(args) -> None:
     """Check --column, --skip-rows, --comment and --log-run (one-line errors naming the
     option, its value and what is accepted); ``args`` gets their parsed values."""
-    from filmfriction.analysis.column_spec import parse_column
-    from filmfriction.analysis.lammps_log import parse_runs
+    from filmfriction.analysis.files.column_spec import parse_column
+    from filmfriction.analysis.files.lammps_log import parse_runs
 
     parsed = []
     for text in args.column:
@@ -144,7 +144,7 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     import numpy as np
 
     from filmfriction.analysis.analyze import analyze, to_json, write_outputs
-    from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
+    from filmfriction.analysis.files.trace import (BINARY_MIN_ROWS, read_trace,
                                              write_binary_copy)
 
     _reading_options(args)
@@ -168,7 +168,7 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
         check_writable(args.output, "--out")
     table = {}
     if args.setup is not None:
-        from filmfriction.analysis.column_spec import trace_table
+        from filmfriction.analysis.files.column_spec import trace_table
         from filmfriction.reduced_model.sfb.user_setup import load_setup
 
         try:
@@ -237,7 +237,7 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     except ValueError as exc:
         raise UserError(str(exc)) from None
     where = trace.path
-    from filmfriction.analysis.trace import trace_column_names
+    from filmfriction.analysis.files.trace import trace_column_names
 
     for name, column in trace.columns.items():
         if name not in trace_column_names():

@@ -184,7 +184,7 @@ def _scene(args: argparse.Namespace):
 
 
 def write_geometry(args: argparse.Namespace) -> int:
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     from ..md.scene import SceneError
 

@@ -64,7 +64,7 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
     when both V and K are swept, ``vk_map.png``, each atomically.  Returns the
     ``aggregate.json`` document (see :func:`.sweep_aggregate.build_aggregate`).
     """
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     sweep_dir = Path(sweep_dir)
     doc, rows = build_aggregate(sweep_dir)

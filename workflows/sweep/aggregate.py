@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.documents import read_document
-from filmfriction.analysis.provenance import provenance
-from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
+from filmfriction.analysis.files.documents import read_document
+from filmfriction.analysis.files.provenance import provenance
+from filmfriction.analysis.files.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime, sliding_steadily
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, SWEEP_FILE
 

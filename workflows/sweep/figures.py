@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from filmfriction.analysis.util import png_bytes, pyplot
+from filmfriction.analysis.files.util import png_bytes, pyplot
 
 from .aggregate import IRREGULAR, SMOOTH, STICK_SLIP, STUCK, _eta_points, _group_key, _majority
 from .plan import format_value

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import json_default, read_json_object, write_atomic
+from filmfriction.analysis.files.util import json_default, read_json_object, write_atomic
 from filmfriction.md_inputs.contract import SWEEP_FILE
 
 from ..md.locks import DirectoryLock

@@ -15,7 +15,7 @@ system (``column_units``, ``--column spring_force=F:uN``; the conversion is
 ``comments`` given) and the first ``skip_rows`` lines are skipped; when the first other
 line is numbers, the header is the comment line before it (LAMMPS's ``fix print`` and
 ``fix ave/time`` files).  A LAMMPS log is read by its thermo runs
-(:mod:`filmfriction.analysis.lammps_log`).  Rows with an empty, NaN or infinite cell in a
+(:mod:`filmfriction.analysis.files.lammps_log`).  Rows with an empty, NaN or infinite cell in a
 column the analysis reads are dropped and said, never interpolated.  The parameters a trace needs (spring constant, wall mass, contact
 area, film thickness, drive velocity) and the unit system come from the
 command line or, for a run directory, from ``run.json``'s ``trace_parameters``
@@ -616,7 +616,7 @@ def map_columns(names, mapping: dict | None, where="", aliases: dict | None = No
     """Check a column mapping (analysis name → the file's column name) against a header.
 
     ``aliases`` (the file's name → an analysis name, e.g. a LAMMPS log's thermo
-    keywords, :data:`~filmfriction.analysis.lammps_log.LAMMPS_NAMES`) name the
+    keywords, :data:`~filmfriction.analysis.files.lammps_log.LAMMPS_NAMES`) name the
     columns that the mapping leaves and the header does not name itself.
 
     Returns
@@ -776,7 +776,7 @@ def read_csv_trace(path, parameters: TraceParameters | None = None,
         What starts a comment line (skipped before the header and among the rows).
     log_run : str, optional
         The thermo run(s) of a LAMMPS log to read: ``N``, ``N-M``, ``N-``
-        (:func:`filmfriction.analysis.lammps_log.read_log_table`); a log is
+        (:func:`filmfriction.analysis.files.lammps_log.read_log_table`); a log is
         recognised by its first line, ``LAMMPS (...)``.
 
     Rows where a column the analysis reads is empty, NaN or infinite are dropped
