@@ -269,7 +269,7 @@ def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Pa
 def analyse_run(run_dir) -> dict:
     """Analyse the trace of ``run_dir`` and write its ``analysis.json`` (and
     ``analysis_cycles.csv``) there; returns the document."""
-    from .files.trace import read_trace
+    from .files.trace_reader import read_trace
 
     run_dir = Path(run_dir)
     doc, per_cycle = analyze(read_trace(run_dir))

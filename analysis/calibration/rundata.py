@@ -84,7 +84,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     """
     from filmfriction.analysis.files.cycles_csv import read_cycles_csv
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.files.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():

@@ -106,7 +106,7 @@ def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
     """``analyze`` (written out) and ``build_report`` on ``run_dir``: the document,
     the per-slip CSV's columns, report.html and report.md."""
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.files.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
     from filmfriction.workflows.report.render import build_report
 
     doc, per_cycle = analyze(read_trace(run_dir))

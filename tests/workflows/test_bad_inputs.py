@@ -149,7 +149,7 @@ def _analysed_file(tmp: Path, edit=None) -> Path:
     import json
 
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.files.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     d = tmp / "measured"
     d.mkdir()

@@ -18,8 +18,9 @@ import pytest
 
 from filmfriction.analysis.analyze import analyse_run
 from filmfriction.analysis.groundtruth.synthetic import run_directory
-from filmfriction.analysis.files.trace import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
-                                         read_trace, write_binary_copy)
+from filmfriction.analysis.files.trace_reader import read_trace
+from filmfriction.analysis.files.trace_cache import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
+                                                    write_binary_copy)
 
 
 def _sha(path: Path) -> str:

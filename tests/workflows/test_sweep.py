@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.observables.sliding_section import sliding_section
-from filmfriction.analysis.files.trace import read_trace
+from filmfriction.analysis.files.trace_reader import read_trace
 from filmfriction.workflows import sweep
 from filmfriction.workflows.md.scene import SceneError
 

@@ -144,8 +144,8 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     import numpy as np
 
     from filmfriction.analysis.analyze import analyze, to_json, write_outputs
-    from filmfriction.analysis.files.trace import (BINARY_MIN_ROWS, read_trace,
-                                             write_binary_copy)
+    from filmfriction.analysis.files.trace_reader import read_trace
+    from filmfriction.analysis.files.trace_cache import BINARY_MIN_ROWS, write_binary_copy
 
     _reading_options(args)
     record = check_run_json(args.path) if args.path.is_dir() else None

@@ -269,7 +269,7 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     """
     from filmfriction.analysis import energy
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.files.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     trace = read_trace(run_dir)
     if prefix < 1.0 or trace_stride > 1:
