@@ -73,7 +73,7 @@ def test_a_choice_axis_lists_names_and_plans_points():
     # the velocity is the map's x axis; a choice can only group the points
     doc = {"grid": [{"key": "wall_model", "values": ["rigid", "flexible"]},
                     {"key": "drive_velocity", "values": [0.02, 0.5]}]}
-    assert sweep._numeric_axes(doc) == ["drive_velocity"]
+    assert sweep.numeric_axes(doc) == ["drive_velocity"]
 
 
 @pytest.mark.parametrize("text, words", [

@@ -10,7 +10,8 @@ from filmfriction.workflows.inputs import (check_input_file, check_run_json, che
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
 
-def _positive(text: str) -> float:
+def positive_number(text: str) -> float:
+    """An argparse type: a finite number > 0."""
     try:
         v = float(text)
     except ValueError:
@@ -104,11 +105,11 @@ def register(subparsers) -> None:
                    help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
                         "constant, mass, contact area, film thickness and drive velocity, "
                         "unless given below; implies --units si")
-    p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
-    p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
-    p.add_argument("--area", type=_positive, help="contact area A")
-    p.add_argument("--thickness", type=_positive, help="film thickness D")
-    p.add_argument("--drive-velocity", type=_positive, help="spring-end velocity V")
+    p.add_argument("--spring-constant", type=positive_number, help="K of the drive spring")
+    p.add_argument("--mass", type=positive_number, help="M of the driven wall/surface")
+    p.add_argument("--area", type=positive_number, help="contact area A")
+    p.add_argument("--thickness", type=positive_number, help="film thickness D")
+    p.add_argument("--drive-velocity", type=positive_number, help="spring-end velocity V")
     p.add_argument("--units", choices=("lj", "si"), default=None,
                    help="unit system of the trace (default: run.json's, else lj)")
     p.add_argument("--skip", type=_count, default=None,

@@ -62,11 +62,11 @@ def register(subparsers) -> None:
                    help="the LJ time unit carried to SI: sigma*sqrt(m/eps) of the OMCTS molecule "
                         "(mass, default) or the one that maps the LJ liquid's eta onto OMCTS's "
                         "2.5 mPa s (viscosity; see docs/viscosity.md)")
-    from .analyze_cli import _positive
+    from .analyze_cli import positive_number
 
-    p.add_argument("--sigma-nm", type=_positive, default=None,
+    p.add_argument("--sigma-nm", type=positive_number, default=None,
                    help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
-    p.add_argument("--epsilon-K", type=_positive, default=None,
+    p.add_argument("--epsilon-K", type=positive_number, default=None,
                    help=f"override eps/k_B of the mapping (default {OMCTS.temperature:.1f} K)")
     p.set_defaults(func=run)
 

@@ -16,7 +16,8 @@ from pathlib import Path
 
 
 
-from .plan import SweepLock, SweepPlan, _user_error, write_plan
+from ..inputs import UserError as _user_error
+from .plan import SweepLock, SweepPlan, write_plan
 
 SNAKEFILE = Path(__file__).with_name("sweep.smk")
 PROFILES = Path(__file__).with_name("profiles")
