@@ -14,10 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .provenance import file_sha256
 from .trace import Trace, TraceLayout
 
-__all__ = ["write_binary_copy", "read_binary_copy", "binary_copy_path", "content_sha256",
-           "cache_digest", "BINARY_MIN_ROWS", "CACHE_DIR", "CACHE_MIN_BYTES"]
+__all__ = ["write_binary_copy", "read_binary_copy", "binary_copy_path", "cache_digest",
+           "BINARY_MIN_ROWS", "CACHE_DIR", "CACHE_MIN_BYTES"]
 
 #: A text trace of at least this many rows gets a binary copy when
 #: ``filmfriction analyze`` reads it (:func:`write_binary_copy`).
@@ -28,22 +29,11 @@ CACHE_MIN_BYTES = 1 << 20
 CACHE_DIR = ".filmfriction"
 
 
-def content_sha256(path) -> str:
-    """The SHA-256 of the file's bytes (hex)."""
-    import hashlib
-
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def cache_digest(path: Path) -> str | None:
     """The SHA-256 of a text trace large enough to have a binary copy
     (:data:`CACHE_MIN_BYTES` or more), else None (a smaller one is read as text)."""
     if path.is_file() and path.stat().st_size >= CACHE_MIN_BYTES:
-        return content_sha256(path)
+        return file_sha256(path)
     return None
 
 
@@ -52,7 +42,7 @@ def binary_copy_path(path, digest: str | None = None) -> Path:
     keyed by the text's content, ``.filmfriction/<name>.<sha256>.npy`` (``digest``: the
     SHA-256 already taken)."""
     path = Path(path)
-    digest = digest or content_sha256(path)
+    digest = digest or file_sha256(path)
     return path.parent / CACHE_DIR / f"{path.name}.{digest}.npy"
 
 

@@ -1,6 +1,5 @@
 """Sweeps through Snakemake: planning and validation, a tiny real sweep, the Slurm
 profile's dry run, kill-and-resume, and the per-directory lock."""
-import glob
 import json
 import math
 import os
@@ -40,18 +39,6 @@ def completed(out: Path) -> list[Path]:
     """``points/<point>/run.json`` of the finished points (pathlib's ``*`` also matches the
     hidden directories of runs in progress)."""
     return [p for p in out.glob("points/*/run.json") if not p.parent.name.startswith(".")]
-
-
-def processes_in(directory: Path) -> list[str]:
-    """Processes whose working directory is inside ``directory`` (LAMMPS runs in its run dir)."""
-    found = []
-    for proc in glob.glob("/proc/[0-9]*"):
-        try:
-            if os.readlink(f"{proc}/cwd").startswith(str(directory)):
-                found.append(Path(f"{proc}/cmdline").read_text().replace("\0", " "))
-        except OSError:
-            continue
-    return found
 
 
 # ---------------------------------------------------------------- planning
@@ -317,7 +304,8 @@ def test_tiny_sweep_runs_analyses_aggregates_and_is_incremental(tmp_path, cli, s
 
 
 @pytest.mark.md
-def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, filmfriction_command):
+def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, filmfriction_command,
+                                                    processes_in):
     out = tmp_path / "sweep"
     args = ["stick-slip", "--grid", "drive_velocity=0.05,0.2,0.5", "--np", "1",
             "--cores", "1", "--out", str(out), *small_args]
@@ -332,7 +320,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
             assert proc.poll() is None, proc.stdout.read()[-3000:]
             assert time.time() < deadline, "no point completed in 120 s"
             time.sleep(0.1)
-        assert any("lmp" in cmd for cmd in processes_in(out)), "an engine is running"
+        assert any("lmp" in cmd for cmd in processes_in(out).values()), "an engine is running"
         before = set(completed(out))
         # the point whose run is in progress: points/.<point>.tmp-<pid>/
         running = {p.parent.name[1:].rsplit(".tmp-", 1)[0]
@@ -355,7 +343,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, cli, small_args, 
     for p in done:
         assert json.loads(p.read_text())["status"] in ("completed", "completed_with_warnings")
     time.sleep(0.5)
-    assert processes_in(out) == [], "an engine was left running"
+    assert processes_in(out) == {}, "an engine was left running"
     assert not list(out.glob("points/.*")), "the interrupted run's directory is cleaned up"
     assert not (out / "failed").exists(), "an interrupt is not a failed run"
 
