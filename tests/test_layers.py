@@ -195,3 +195,15 @@ def test_the_kept_private_imports_still_exist():
         path = ROOT / Path(*module.split(".")[1:]).with_suffix(".py")
         text = path.read_text(encoding="utf-8")
         assert private in text and source.rsplit(".", 1)[1] in text, (module, private)
+
+
+def test_every_module_has_a_base_name_of_its_own():
+    # one name, one thing: the package's modules, the benchmarks and the tests
+    # (a package's __init__, __main__ and the tests' conftest excepted)
+    seen: dict[str, list[str]] = {}
+    for folder in (*LAYERS, "benchmarks", "tests"):
+        for path in (ROOT / folder).rglob("*.py"):
+            if path.name not in ("__init__.py", "__main__.py", "conftest.py"):
+                seen.setdefault(path.name, []).append(str(path.relative_to(ROOT)))
+    shared = {name: paths for name, paths in seen.items() if len(paths) > 1}
+    assert not shared, shared
