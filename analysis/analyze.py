@@ -1,7 +1,7 @@
 """The ``analysis.json`` document: every analysis that the inputs allow.
 
 :func:`analyze` finds the slips, tabulates them and decides the regime
-(:func:`context`) on a :class:`~filmfriction.analysis.trace.Trace`, then runs
+(:func:`context`) on a :class:`~filmfriction.analysis.files.trace.Trace`, then runs
 every registered observable (:mod:`filmfriction.analysis.observables`, one file
 each: the slips, the energy, the sliding state, the viscosity, the structure,
 the slip law ...; :func:`run_observable`) in their order, and returns a
@@ -22,13 +22,13 @@ import numpy as np
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
 from . import observables, stickslip
-from .cycles_csv import write_cycles_csv
+from .files.cycles_csv import write_cycles_csv
 from .observables.observable import Context, Observable
 from .results import AnalysisResult, trace_from_columns
 from .sliding import last_half, not_sliding, sliding_state
 from .stickslip import Regime
-from .trace import MissingInput, Trace, unit
-from .util import finite_or_none as _num, json_safe, write_atomic
+from .files.trace import MissingInput, Trace, unit
+from .files.util import finite_or_none as _num, json_safe, write_atomic
 
 SCHEMA = "filmfriction.analysis/1"
 
@@ -65,7 +65,7 @@ def _provenance(trace: Trace) -> dict:
     """The document's provenance: the package and the trace's (and run record's) SHA-256."""
     from filmfriction.md_inputs.contract import RUN_FILE
 
-    from .provenance import provenance
+    from .files.provenance import provenance
 
     inputs = {"trace": trace.path}
     if trace.run_dir is not None:
@@ -269,7 +269,7 @@ def write_outputs(doc: dict, per_cycle: dict, json_path: Path) -> tuple[Path, Pa
 def analyse_run(run_dir) -> dict:
     """Analyse the trace of ``run_dir`` and write its ``analysis.json`` (and
     ``analysis_cycles.csv``) there; returns the document."""
-    from .trace import read_trace
+    from .files.trace_reader import read_trace
 
     run_dir = Path(run_dir)
     doc, per_cycle = analyze(read_trace(run_dir))

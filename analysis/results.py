@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .trace import Trace
+from .files.trace import Trace
 
 __all__ = ["AnalysisResult"]
 
@@ -112,7 +112,7 @@ class AnalysisResult:
         """Static force and slip distance of each slip against its number, the start-up
         slips left out of the means marked; returns the matplotlib Axes (two, twinned)."""
         from .trace_figure import scaled_unit
-        from .util import pyplot
+        from .files.util import pyplot
 
         if ax is None:
             _, ax = pyplot().subplots(figsize=(6, 3.2))
@@ -141,7 +141,7 @@ def trace_from_columns(data, *, units: str = "lj", **parameters) -> Trace:
     """A :class:`Trace` of columns in memory: ``data`` maps the analysis' column names
     (``time``, ``spring_force``, ``drive_position``, ``wall_velocity`` ...) to arrays
     (a dict, or a pandas DataFrame); ``parameters`` are those of
-    :class:`~filmfriction.analysis.trace.TraceParameters` (``spring_constant``,
+    :class:`~filmfriction.analysis.files.trace.TraceParameters` (``spring_constant``,
     ``mass``, ``area``, ``thickness``, ``drive_velocity``, ``mount_damping``), in
     ``units`` (``"lj"`` or ``"si"``).
 
@@ -155,7 +155,7 @@ def trace_from_columns(data, *, units: str = "lj", **parameters) -> Trace:
     """
     from pathlib import Path
 
-    from .trace import PARAMETERS, TraceParameters, trace_column_names
+    from .files.trace import PARAMETERS, TraceParameters, trace_column_names
 
     names = list(data.keys())
     known = set(trace_column_names())

@@ -10,7 +10,7 @@ slips).  The ``sliding`` section of ``analysis.json`` is the observable
 Example
 -------
 >>> from filmfriction.analysis.groundtruth.synthetic import smooth_trace
->>> from filmfriction.analysis.trace import Trace, TraceParameters
+>>> from filmfriction.analysis.files.trace import Trace, TraceParameters
 >>> trace = Trace(smooth_trace(n=2000), TraceParameters(), path="smooth.csv")
 >>> state = sliding_state(trace)
 >>> round(state["mean_force"], 1), not_sliding(state) is None
@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from . import stickslip, viscosity
-from .trace import Trace
+from .files.trace import Trace
 
 __all__ = ["last_half", "sliding_state", "not_sliding"]
 

@@ -1,3 +1,5 @@
+# Over 500 lines as one module: the film's structure from a trajectory, MDAnalysis-style
+# analyses that share the layers (found once, here) and the trajectory's opening.
 """Structure of the confined film from a trajectory (MDAnalysis).
 
 * :class:`DensityProfile` — number density across the gap, layer count and
@@ -500,3 +502,21 @@ def open_trajectory(topology, trajectory, dt: float | None = None):
         return mda.Universe(str(topology), str(trajectory), format="DCD",
                             topology_format="DATA", atom_style="id type x y z",
                             **({"dt": dt} if dt else {}))
+
+
+def film_layers(topology, trajectory, film_types, step: int = 1):
+    """A run's trajectory opened (:func:`open_trajectory`), its film atoms (``film_types``)
+    and their :class:`DensityProfile` over every ``step``-th frame: ``(universe, film,
+    profile)``; ``profile.results.layers`` holds the layers and their ``edges``.
+
+    Raises
+    ------
+    ValueError
+        No atom of ``film_types`` in ``topology``.
+    """
+    u = open_trajectory(topology, trajectory)
+    film = select_types(u, film_types)
+    if film.n_atoms == 0:
+        raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "
+                         f"in {topology}")
+    return u, film, DensityProfile(film).run(step=step)

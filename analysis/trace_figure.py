@@ -9,7 +9,7 @@ and maximum of each of a few thousand bins), which keeps every peak and drop.
 Example
 -------
 >>> import numpy as np
->>> from filmfriction.analysis.trace import Trace, TraceParameters
+>>> from filmfriction.analysis.files.trace import Trace, TraceParameters
 >>> t = np.linspace(0.0, 1.0, 200)
 >>> tr = Trace({"time": t, "spring_force": 1e-5 * (t % 0.25)}, TraceParameters(units="si"), None)
 >>> fig = trace_figure(tr, [49, 99], [50, 100])
@@ -22,8 +22,8 @@ import math
 
 import numpy as np
 
-from .trace import Trace, unit
-from .util import png_bytes, pyplot, write_atomic
+from .files.trace import Trace, unit
+from .files.util import png_bytes, pyplot, write_atomic
 
 __all__ = ["trace_figure", "write_trace_figure", "scaled_unit"]
 

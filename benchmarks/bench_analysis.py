@@ -51,7 +51,8 @@ def bench_trace(n=1_000_000):
     from filmfriction.analysis import energy, stickslip, viscosity
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
-    from filmfriction.analysis.trace import read_trace, write_binary_copy
+    from filmfriction.analysis.files.trace_reader import read_trace
+    from filmfriction.analysis.files.trace_cache import write_binary_copy
 
     k, m, fs = 97.0, 1.47e-3, 9.7e-6
     tr = klein_trace(cycles=60, noise=0.005 * fs, dt=1e-5)      # ~0.7 s per cycle

@@ -183,7 +183,7 @@ def main(argv=None) -> int:
               f"{cells} | {low_text} |")
     doc = {"base": BASE, "models": table, "command": "python benchmarks/wall_load.py " +
            " ".join(argv if argv is not None else sys.argv[1:])}
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
     write_atomic(a.out / "wall_load.json", json.dumps(doc, indent=1))
     return 0
 

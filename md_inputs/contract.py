@@ -102,7 +102,7 @@ class Column:
     """One column of ``trace.dat`` / ``trace.csv``.
 
     ``unit`` is the LJ unit as ``run.json`` records it (``trace_units``);
-    ``quantity`` is its kind, a key of ``filmfriction.analysis.trace.UNITS``
+    ``quantity`` is its kind, a key of ``filmfriction.analysis.files.trace.UNITS``
     (for labels in either unit system); ``expression`` and ``format`` are how
     the script's ``fix print`` prints it (``$(expression:format)``).
     """

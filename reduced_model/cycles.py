@@ -7,7 +7,7 @@ point s, spring extension at yield x0, slip distance Δx0, slip duration τ_s
 One ruler for every trace: MD (LJ units), SFB (SI) and the reduced model's
 exact events (:meth:`SimulationResult.cycles`) all tabulate their slips with
 :func:`cycle_table`.  Reading and writing the table as CSV is
-:mod:`filmfriction.analysis.cycles_csv`.
+:mod:`filmfriction.analysis.files.cycles_csv`.
 """
 from __future__ import annotations
 

@@ -1,3 +1,5 @@
+# Over 500 lines as one module by the project's rule: every LJ <-> SI conversion lives
+# here (the mapping, its presets, the unit parser, the column factors), and nowhere else.
 """Lennard-Jones <-> SI conversions: the one place in filmfriction where they happen.
 
 MD runs in reduced Lennard-Jones units (σ, ε, m); experiments (the surface

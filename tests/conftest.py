@@ -39,7 +39,7 @@ import sys
 import threading
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pytest
@@ -220,8 +220,9 @@ def layered_run(md):
 
 
 # ---------------------------------------------------------------------------- command line
-@dataclass(frozen=True)
-class CliResult:
+class CliResult(NamedTuple):
+    """What ``filmfriction ARGS`` gave: ``code, out, err = run_cli(...)`` or ``r.code``."""
+
     code: int
     out: str
     err: str
@@ -237,7 +238,10 @@ def run_cli(capsys):
 
     def run(*args) -> CliResult:
         capsys.readouterr()                     # drop what the test printed before
-        code = main([str(a) for a in args])
+        try:
+            code = main([str(a) for a in args])
+        except SystemExit as exc:               # argparse's own refusals and --help
+            code = exc.code
         out, err = capsys.readouterr()
         return CliResult(code, out, err)
     return run

@@ -48,6 +48,12 @@ def test_wheel_ships_scripts_and_scenes(tmp_path):
                    "workflows/report/templates/report.html.j2", "workflows/report/templates/report.md.j2",
                    "workflows/report/templates/report.css", "workflows/report/templates/report.js"):
         assert f"filmfriction/{needed}" in names, needed
+    # every sub-package of the checkout is in the wheel (pyproject.toml lists them by name)
+    packages = {str(p.relative_to(ROOT)) for layer in ("md_inputs", "reduced_model", "analysis",
+                                                       "workflows")
+                for p in (ROOT / layer).rglob("__init__.py")}
+    missing = sorted(p for p in packages if f"filmfriction/{p}" not in names)
+    assert not missing, missing
     # one import name: nothing of ours at the top level of the wheel but filmfriction
     tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
     assert tops == {"filmfriction"}, tops

@@ -5,7 +5,8 @@ a lazy import is still a dependency.  No module imports a higher layer, and the
 module graph has no cycle.  Inside a layer the sub-folders are floors too
 (:data:`FLOORS`): a sub-folder imports no later one, and with each sub-folder taken
 as one node (the layer's own modules each a node of their own) the graph still has
-no cycle.  The command line (``workflows/cli/``) is imported by nothing outside it.
+no cycle.  The command line (``workflows/cli/``) is imported by nothing outside it.  No
+module imports another module's private (``_name``) names.
 """
 import ast
 from pathlib import Path
@@ -17,7 +18,7 @@ LAYERS = ("md_inputs", "reduced_model", "analysis", "workflows")
 #: the sub-folders of each layer, lowest first: a sub-folder imports no later one
 FLOORS = {
     "reduced_model": ("laws", "integrators", "sfb"),
-    "analysis": ("ensemble", "observables", "calibration", "groundtruth"),
+    "analysis": ("files", "ensemble", "observables", "calibration", "groundtruth"),
     "workflows": ("md", "sweep", "report", "cost", "cli"),
 }
 
@@ -152,3 +153,53 @@ def test_nothing_outside_the_command_line_imports_it():
              if (d == cli or d.startswith(cli + ".")) and not m.startswith(cli + ".")
              and m != cli]
     assert not users, "\n".join(sorted(users))
+
+
+#: private names one module still takes from another, each with its reason (none else)
+PRIVATE_IMPORTS_KEPT: set[tuple[str, str, str]] = set()
+
+
+def test_no_private_name_is_imported_from_another_module():
+    # a name with a leading underscore belongs to its module: a name another module
+    # needs is public there (or lives where both can reach it)
+    found = []
+    for layer in LAYERS:
+        for path in (ROOT / layer).rglob("*.py"):
+            name = _module_name(path)
+            package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if not isinstance(node, ast.ImportFrom):
+                    continue
+                if node.level:
+                    base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                    source = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    source = node.module or ""
+                if source != "filmfriction" and not source.startswith("filmfriction."):
+                    continue
+                for alias in node.names:
+                    private = alias.name.startswith("_") and not alias.name.startswith("__")
+                    if private and source != name \
+                            and (name, source, alias.name) not in PRIVATE_IMPORTS_KEPT:
+                        found.append(f"{name} imports {alias.name} from {source}")
+    assert not found, "\n".join(sorted(found))
+
+
+def test_the_kept_private_imports_still_exist():
+    # an entry of PRIVATE_IMPORTS_KEPT that no module needs any more is removed
+    for module, source, private in PRIVATE_IMPORTS_KEPT:
+        path = ROOT / Path(*module.split(".")[1:]).with_suffix(".py")
+        text = path.read_text(encoding="utf-8")
+        assert private in text and source.rsplit(".", 1)[1] in text, (module, private)
+
+
+def test_every_module_has_a_base_name_of_its_own():
+    # one name, one thing: the package's modules, the benchmarks and the tests
+    # (a package's __init__, __main__ and the tests' conftest excepted)
+    seen: dict[str, list[str]] = {}
+    for folder in (*LAYERS, "benchmarks", "tests"):
+        for path in (ROOT / folder).rglob("*.py"):
+            if path.name not in ("__init__.py", "__main__.py", "conftest.py"):
+                seen.setdefault(path.name, []).append(str(path.relative_to(ROOT)))
+    shared = {name: paths for name, paths in seen.items() if len(paths) > 1}
+    assert not shared, shared

@@ -10,7 +10,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from filmfriction.analysis.util import read_json_object
+from filmfriction.analysis.files.util import read_json_object
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, RUN_FILE, TRACE_FILE
 
 from .md.scene import SceneError, parse_assignment
@@ -64,12 +64,12 @@ def check_run_json(run_dir, flag: str = "", kind: str = "run") -> dict | None:
     """``RUN_DIR/run.json`` as a dict (None when absent); UserError when it is not
     UTF-8, not JSON, not a JSON object, or not of the form of a run record (``kind``:
     ``"run"``, or ``"run-resume"`` for what a resume reads;
-    :func:`filmfriction.analysis.documents.check_document`)."""
+    :func:`filmfriction.analysis.files.documents.check_document`)."""
     path = Path(run_dir) / RUN_FILE
     if not path.is_file():
         return None
     where = f"{flag} {path}" if flag else str(path)
-    from filmfriction.analysis.documents import check_document
+    from filmfriction.analysis.files.documents import check_document
 
     try:
         return check_document(read_json_object(path, where, what="a JSON object (a run record)"),

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.documents import check_document
-from filmfriction.analysis.provenance import provenance
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.documents import check_document
+from filmfriction.analysis.files.provenance import provenance
+from filmfriction.analysis.files.util import write_atomic
 from filmfriction.analysis.analyze import to_json
 from filmfriction.md_inputs.contract import (AGGREGATE_FILE, ANALYSIS_FILE, CALIBRATION_FILE,
                                              ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
@@ -107,7 +107,7 @@ def reference(row: dict):
 
 def read_json(path, kind: str | None = None):
     """The JSON document at ``path``, or ``None`` if there is no such file; checked as a
-    document of ``kind`` (:func:`filmfriction.analysis.documents.check_document`) when given.
+    document of ``kind`` (:func:`filmfriction.analysis.files.documents.check_document`) when given.
 
     Raises
     ------
@@ -222,7 +222,7 @@ def changed_inputs(doc: dict) -> list[str]:
     it was made from any more: the ``analysis.json`` of each run of a ``calibration.json``
     (read back by :func:`read_calibration`: its runs' paths as from here), compared by
     SHA-256.  File times are not looked at: a copied or moved run is not out of date."""
-    from filmfriction.analysis.provenance import file_sha256
+    from filmfriction.analysis.files.provenance import file_sha256
 
     recorded = ((doc.get("provenance") or {}).get("inputs") or {})
     out = []

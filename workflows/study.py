@@ -46,7 +46,7 @@ def finish_study(run_dir: Path) -> int:
     failures: dict = {}
     t0 = time.perf_counter()
 
-    from filmfriction.analysis.util import format_pm
+    from filmfriction.analysis.files.util import format_pm
 
     doc = _step("analysis", failures, analyse_run, run_dir)
     if doc is not None:

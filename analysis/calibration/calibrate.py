@@ -116,12 +116,12 @@ import numpy as np
 
 from .effective_viscosity import ViscosityChoice, choose
 from .estimators import Estimate, ageing, shear_stiffness, summary_estimate
-from ..util import finite_or_none as _num
+from ..files.util import finite_or_none as _num
 from .md_estimates import md_calibration
 from .replay import Replay, no_restick_reason, replay
 from .rundata import RunData, load_run
 from .slipfit import SlipLawFit, coulomb_slip_force, fit_slip_law
-from ..trace import UNITS
+from ..files.trace import UNITS
 
 __all__ = ["Estimate", "RunData", "SlipLawFit", "Replay", "RunCalibration", "Calibration",
            "load_run", "coulomb_slip_force", "fit_slip_law", "replay", "calibrate_run",
@@ -441,10 +441,10 @@ def write_calibration(cal: Calibration, path=None) -> Path:
     Path
         The JSON file.
     """
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
     from filmfriction.analysis.analyze import to_json
 
-    from filmfriction.analysis.provenance import provenance
+    from filmfriction.analysis.files.provenance import provenance
     from filmfriction.md_inputs.contract import ANALYSIS_FILE, TRACE_FILE
 
     path = Path(path) if path is not None else cal.main.run.run_dir / "calibration.json"

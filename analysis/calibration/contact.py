@@ -28,7 +28,7 @@ from pathlib import Path
 from filmfriction.reduced_model.sfb.similarity import SlidingContact
 from filmfriction.md_inputs.contract import ANALYSIS_FILE, RUN_FILE
 
-from ..util import read_json_object
+from ..files.util import read_json_object
 
 __all__ = ["contact_from_analysis", "contact_from_run"]
 

@@ -44,8 +44,8 @@ import math
 from dataclasses import dataclass, field
 
 from .estimators import Estimate
-from ..trace import UNITS
-from ..util import finite_or_none
+from ..files.trace import UNITS
+from ..files.util import finite_or_none
 
 __all__ = ["CrossCheck", "ViscosityChoice", "choose", "choice_note", "RESOLVED_SIGMAS", "RESTS_ON"]
 

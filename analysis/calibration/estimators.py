@@ -21,8 +21,8 @@ import numpy as np
 from filmfriction.reduced_model.cycles import cycle_table
 
 from .rundata import RunData
-from ..trace import UNITS
-from ..util import finite_or_none as _num
+from ..files.trace import UNITS
+from ..files.util import finite_or_none as _num
 
 __all__ = ["Estimate", "summary_estimate", "ageing", "shear_stiffness"]
 

@@ -18,7 +18,7 @@ import numpy as np
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
-from ..util import finite_or_none as _num
+from ..files.util import finite_or_none as _num
 from .rundata import RunData
 
 __all__ = ["Replay", "replay"]

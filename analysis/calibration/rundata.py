@@ -27,7 +27,7 @@ class RunData:
     Attributes
     ----------
     run_dir : Path
-    trace : analysis.trace.Trace
+    trace : analysis.files.trace.Trace
     analysis : dict
         ``analysis.json`` content.
     cycles : dict of str -> ndarray
@@ -82,9 +82,9 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
         No run directory, no trace, an unreadable analysis, or (``analyse=False``)
         no analysis.
     """
-    from filmfriction.analysis.cycles_csv import read_cycles_csv
+    from filmfriction.analysis.files.cycles_csv import read_cycles_csv
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
@@ -92,7 +92,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     apath = run_dir / ANALYSIS_FILE
     cpath = run_dir / "analysis_cycles.csv"
     if apath.exists() and cpath.exists():
-        from filmfriction.analysis.documents import read_document
+        from filmfriction.analysis.files.documents import read_document
 
         doc = read_document(apath, "analysis")
         cycles = read_cycles_csv(cpath)

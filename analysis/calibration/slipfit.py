@@ -36,7 +36,7 @@ from filmfriction.reduced_model.integrators.oscillator import DampedOscillator
 
 from .estimators import Estimate
 from .rundata import RunData
-from ..trace import UNITS
+from ..files.trace import UNITS
 from ..viscosity import slip_force
 
 __all__ = ["coulomb_slip_force", "SlipLawFit", "fit_slips", "fit_slip_law", "LEAD_SAMPLES"]
@@ -189,7 +189,7 @@ class SlipLawFit:
         return float(err[0]), float(err[1])
 
     def as_dict(self) -> dict:
-        from ..util import finite_or_none as num
+        from ..files.util import finite_or_none as num
         return {"kinetic_force": self.kinetic_force.as_dict(),
                 "film_damping": self.film_damping.as_dict(),
                 "freeze_force": None if self.freeze_force is None else self.freeze_force.as_dict(),

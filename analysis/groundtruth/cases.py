@@ -37,7 +37,7 @@ from scipy.signal import lfilter
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.integrators.closed_form import freeze_velocity_for
 
-from ..trace import Trace, TraceParameters
+from ..files.trace import Trace, TraceParameters
 
 __all__ = ["FAMILIES", "Case", "Truth", "random_case", "simulate", "truth", "sample",
            "Score", "score", "OBSERVABLES"]

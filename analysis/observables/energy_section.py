@@ -15,9 +15,9 @@ import numpy as np
 
 from .. import energy as _energy
 from .. import stickslip
-from ..trace import MissingInput, unit
+from ..files.trace import MissingInput, unit
 from ..trace_figure import scaled_unit
-from ..util import finite_or_none
+from ..files.util import finite_or_none
 from .observable import (Context, Observable, entry, format_estimate, format_value, png_bytes,
                          pyplot, shade_slips)
 

@@ -11,7 +11,7 @@ report, declared in one file of this package:
   trace, the slips, the regime, the unit labels, the sections computed before
   it ...) and returns its section of ``analysis.json`` and its per-slip columns
   for ``analysis_cycles.csv``.  A need that only the run can reveal (no slips
-  at all) is a :class:`~filmfriction.analysis.trace.MissingInput` raised from
+  at all) is a :class:`~filmfriction.analysis.files.trace.MissingInput` raised from
   ``compute``: the analysis records it in ``skipped`` too; a part of the
   section that cannot be computed is recorded with :meth:`Context.skip_part`;
 * where it comes -- :attr:`~Observable.order` (the slips 10, the energy 20,
@@ -69,8 +69,8 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CycleTable, stats
 
-from ..trace import PARAMETERS, MissingInput, Trace, unit
-from ..util import finite_or_none, format_estimate, format_value, png_bytes, pyplot
+from ..files.trace import PARAMETERS, MissingInput, Trace, unit
+from ..files.util import finite_or_none, format_estimate, format_value, png_bytes, pyplot
 
 __all__ = ["Observable", "Context", "Need", "column", "parameter", "REGISTRY", "registered",
            "BUILT_IN", "entry", "value", "MissingInput",
@@ -115,7 +115,7 @@ class Need:
     ----------
     kind : str
         ``"column"`` (a column of the trace CSV) or ``"parameter"`` (a
-        :class:`~filmfriction.analysis.trace.TraceParameters` field).
+        :class:`~filmfriction.analysis.files.trace.TraceParameters` field).
     name : str
         The column's or the parameter's name (``wall_velocity``, ``mass``).
     needed_for : str
@@ -164,7 +164,7 @@ class Context:
     Attributes
     ----------
     trace : Trace
-        The trace (its columns, :class:`~filmfriction.analysis.trace.TraceParameters`,
+        The trace (its columns, :class:`~filmfriction.analysis.files.trace.TraceParameters`,
         ``drive_velocity()``, ``film_thickness()``, ``wall_position()``).
     all_slips : CycleTable
         Every slip detected (the start-up slips included).
@@ -215,7 +215,7 @@ class Context:
 
     def unit(self, quantity: str) -> str:
         """The label of ``quantity`` (``"force"``, ``"temperature"`` ...; see
-        :data:`~filmfriction.analysis.trace.UNITS`) in this trace's unit system."""
+        :data:`~filmfriction.analysis.files.trace.UNITS`) in this trace's unit system."""
         return unit(self.units, quantity)
 
     def value(self, mean, stderr, quantity: str, **extra) -> dict:

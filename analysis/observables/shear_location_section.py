@@ -197,9 +197,8 @@ class ShearLocation(Observable):
             ctx.skip_part(self.key, f"no {TRAJECTORY} + {TOPOLOGY} or no slips")
             return None, {}
         try:
-            u = st.open_trajectory(topo, traj)
-            film = st.select_types(u, FILM_TYPES)
-            layers = st.DensityProfile(film).run().results.layers
+            u, _, profile = st.film_layers(topo, traj, FILM_TYPES)
+            layers = profile.results.layers
             if not layers["count"]:
                 raise ValueError("no film layers found")
             windows = list(zip(np.asarray(table.yield_time, float),

@@ -9,8 +9,8 @@ drive's.  A sweep reads friction against velocity from it.
 from __future__ import annotations
 
 from ..sliding import sliding_state
-from ..trace import Trace, unit
-from ..util import finite_or_none
+from ..files.trace import Trace, unit
+from ..files.util import finite_or_none
 from .observable import Context, Observable, format_estimate, format_value, value
 
 __all__ = ["Sliding", "sliding_section"]

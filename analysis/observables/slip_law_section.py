@@ -23,9 +23,9 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
 
 from ..slip_law import BRANCHES, film_force, fit_film_force
-from ..trace import unit
+from ..files.trace import unit
 from ..trace_figure import scaled_unit
-from ..util import finite_or_none
+from ..files.util import finite_or_none
 from .observable import (Context, MissingInput, Observable, column, format_estimate, format_value,
                          parameter, png_bytes, pyplot)
 

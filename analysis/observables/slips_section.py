@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..trace_figure import scaled_unit
-from ..trace import MissingInput, unit
+from ..files.trace import MissingInput, unit
 from .observable import Context, Observable, entry, format_estimate, png_bytes, pyplot, shade_slips
 
 __all__ = ["Slips", "SLIP_QUANTITIES"]

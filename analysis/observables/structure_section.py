@@ -14,7 +14,7 @@ import numpy as np
 
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
-from ..trace import unit
+from ..files.trace import unit
 from .observable import Context, Observable, format_value, png_bytes, pyplot, shade_slips
 
 __all__ = ["Structure", "summarize_run", "universe", "fig_film"]
@@ -42,12 +42,7 @@ def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
     """
     from .. import structure as st
 
-    u = st.open_trajectory(topology, trajectory)
-    film = st.select_types(u, film_types)
-    if film.n_atoms == 0:
-        raise ValueError(f"no film atoms (type {' '.join(map(str, map(int, film_types)))}) "
-                         f"in {topology}")
-    prof = st.DensityProfile(film).run(step=step)
+    u, film, prof = st.film_layers(topology, trajectory, film_types, step)
     layers = prof.results.layers
     out = {"frames": int(prof.n_frames), "units": units,
            "layers": {"count": layers["count"],

@@ -35,7 +35,7 @@ import re
 
 import numpy as np
 
-from ..trace import MissingInput
+from ..files.trace import MissingInput
 from .observable import Context, Observable, format_value
 
 __all__ = ["UnitsCheck", "RAMP_BAND", "DRIVE_BAND", "stick_ramp_slopes", "likely_units",

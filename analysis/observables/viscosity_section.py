@@ -23,8 +23,8 @@ import numpy as np
 
 from .. import viscosity
 from ..stickslip import Regime
-from ..trace import MissingInput, unit
-from ..util import finite_or_none
+from ..files.trace import MissingInput, unit
+from ..files.util import finite_or_none
 from .observable import Context, Observable, format_estimate, format_value, png_bytes, pyplot
 
 __all__ = ["Viscosity", "read_profiles", "averaged_profile"]

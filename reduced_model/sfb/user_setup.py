@@ -68,6 +68,15 @@ def _number(name: str, value, *, error: bool = False) -> float:
     return value
 
 
+def _check_numbers(record, *, text_field: str) -> None:
+    """Every field of the dataclass ``record`` but ``text_field`` a positive finite
+    number, each ``*_err`` field one of 0 or more (:func:`_number`)."""
+    for f in fields(record):
+        if f.name != text_field:
+            _number(f.name.removesuffix("_err"), getattr(record, f.name),
+                    error=f.name.endswith("_err"))
+
+
 @dataclass(frozen=True)
 class SFBSetup:
     """An SFB's set-up in SI units, each quantity with its one-sigma error (0: exact).
@@ -100,10 +109,7 @@ class SFBSetup:
     name: str = "SFB set-up"
 
     def __post_init__(self):
-        for f in fields(self):
-            if f.name != "name":
-                _number(f.name.removesuffix("_err"), getattr(self, f.name),
-                        error=f.name.endswith("_err"))
+        _check_numbers(self, text_field="name")
 
     @classmethod
     def from_dict(cls, data: dict, name: str = "SFB set-up") -> "SFBSetup":
@@ -180,7 +186,7 @@ def load_setup(path) -> SFBSetup:
     """The :class:`SFBSetup` in the TOML file ``path`` (named after the file unless it
     says ``name``).  A ``[trace]`` table, how the instrument writes its traces, is not
     part of the set-up: ``filmfriction analyze`` reads it
-    (:func:`filmfriction.analysis.column_spec.trace_table`).
+    (:func:`filmfriction.analysis.files.column_spec.trace_table`).
 
     Raises
     ------
@@ -229,10 +235,7 @@ class MeasuredSlip:
     source: str = ""
 
     def __post_init__(self):
-        for f in fields(self):
-            if f.name != "source":
-                _number(f.name.removesuffix("_err"), getattr(self, f.name),
-                        error=f.name.endswith("_err"))
+        _check_numbers(self, text_field="source")
 
 
 # the scale of Klein's film energy dE_f ~ K x0 delta; any delta gives the same x0

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.groundtruth.synthetic import klein_trace, smooth_trace, write_csv
-from filmfriction.analysis.trace import MissingInput, TraceParameters, read_trace
+from filmfriction.analysis.files.trace import MissingInput, TraceParameters
+from filmfriction.analysis.files.trace_reader import read_trace
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
 

@@ -146,7 +146,7 @@ def test_cli(stick_slip, calibration, run_cli, tmp_path):
 def test_an_overdamped_calibration_says_why_its_replay_has_no_cycles():
     from types import SimpleNamespace
 
-    from filmfriction.analysis.trace import TraceParameters
+    from filmfriction.analysis.files.trace import TraceParameters
     from filmfriction.analysis.calibration.replay import no_restick_reason
 
     def run(mass, mount=None):

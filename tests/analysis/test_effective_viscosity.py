@@ -9,7 +9,7 @@ import pytest
 
 from filmfriction.analysis.calibration.effective_viscosity import choose
 from filmfriction.analysis.calibration.estimators import Estimate
-from filmfriction.analysis.util import json_schema
+from filmfriction.analysis.files.util import json_schema
 
 U = "ετ/σ³"
 

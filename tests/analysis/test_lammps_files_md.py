@@ -47,7 +47,7 @@ def lammps_run(md, tmp_path_factory):
 
 def _analysed(path, parameters, **reading):
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     trace = read_trace(path, **reading, **parameters)
     doc, per_cycle = analyze(trace, structure=False)
@@ -103,7 +103,7 @@ def test_analyze_reads_the_log_and_asks_which_run(lammps_run, run_cli, tmp_path)
     assert csv.code == 0, csv.err
     assert doc["slips"] == csv.json()["slips"]
     # the analysed log's directory reads the log again, with the runs recorded
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     again = read_trace(tmp_path)
     assert again.layout.kind == "lammps-log" and again.layout.log_run == "2-4"

@@ -106,7 +106,7 @@ def analyse_and_report(run_dir: Path) -> tuple[dict, dict, str, str]:
     """``analyze`` (written out) and ``build_report`` on ``run_dir``: the document,
     the per-slip CSV's columns, report.html and report.md."""
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
     from filmfriction.workflows.report.render import build_report
 
     doc, per_cycle = analyze(read_trace(run_dir))
@@ -243,7 +243,7 @@ def test_a_trace_of_its_needs_alone_gives_its_section_or_a_reason(observable, st
     """No column or parameter read that ``needs`` does not declare: on ``time``,
     ``spring_force`` and the needs, the observable computes or says what is missing."""
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import Trace, TraceParameters
+    from filmfriction.analysis.files.trace import Trace, TraceParameters
 
     full = study["run"].trace
     cols = {c: full.columns[c] for c in ("time", "spring_force")}

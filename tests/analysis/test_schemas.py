@@ -9,8 +9,8 @@ import json
 import jsonschema
 import pytest
 
-from filmfriction.analysis.trace import UNITS
-from filmfriction.analysis.util import json_schema
+from filmfriction.analysis.files.trace import UNITS
+from filmfriction.analysis.files.util import json_schema
 from filmfriction.workflows.cli.main import main
 
 

@@ -17,7 +17,7 @@ SLIPS = {"equilibrate_steps": 2000, "slide_steps": 60000, "restart_every": 0}
 @pytest.fixture(scope="module")
 def analysed(md, tmp_path_factory):
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     run = md.shared("stick-slip", **SLIPS)
     doc, per_cycle = analyze(read_trace(run.path), structure=False)
@@ -62,7 +62,7 @@ def _shifted_tally(shift, yield_index):
 
 def _checks(run, spoil):
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     doc, _ = analyze(spoil(read_trace(run.path)), structure=False)
     return doc["energy"]["heat_check"]
@@ -84,7 +84,7 @@ def test_an_error_beyond_the_stated_resolution_is_flagged_on_a_real_run(analysed
 def test_old_dashpot_formula_would_break_the_balance(analysed):
     # the film's work with the dashpot's heat (v - V)^2 in place of its work (v - V) v on the
     # wall: the balance above is sensitive to that choice
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
     from scipy.integrate import trapezoid
 
     run, doc, per_cycle = analysed

@@ -46,7 +46,7 @@ def test_cycle_table_rejects_bad_pairs():
 
 def test_cycle_table_csv_and_dict(slip_table, tmp_path):
     tab, _ = slip_table(sawtooth(cycles=4), K)
-    from filmfriction.analysis.cycles_csv import read_cycles_csv, write_cycles_csv
+    from filmfriction.analysis.files.cycles_csv import read_cycles_csv, write_cycles_csv
     path = write_cycles_csv(tab.as_dict(), tmp_path / "c.csv")
     rows = path.read_text().splitlines()
     assert len(rows) == 1 + len(tab)

@@ -36,7 +36,7 @@ def test_flexible_walls_gap_is_the_trace_gap(tmp_path):
     """A real small run with flexible walls (the small settings of tests/test_md_walls.py):
     the gap measured from the trajectory is the gap LAMMPS traces, the distance between
     the innermost wall planes (types 4 and 5 here, not the rigid backing planes 2 and 3)."""
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
     from filmfriction.workflows.md import runner
     from filmfriction.workflows.md.scene import load
 

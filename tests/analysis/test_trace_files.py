@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.groundtruth.synthetic import klein_trace
-from filmfriction.analysis.trace import (binary_copy_path, map_columns, read_trace,
-                                         write_binary_copy)
+from filmfriction.analysis.files.trace_reader import map_columns, read_trace
+from filmfriction.analysis.files.trace_cache import binary_copy_path, write_binary_copy
 
 NAMES = {"time": "t_s", "spring_force": "F_N", "drive_position": "x_m"}
 
@@ -98,7 +98,7 @@ def test_an_unmapped_file_says_how_to_map(tmp_path, columns):
 
 
 def test_the_binary_copy_is_read_only_while_fresh(tmp_path, columns, monkeypatch):
-    import filmfriction.analysis.trace as trace_mod
+    import filmfriction.analysis.files.trace_cache as trace_mod
 
     monkeypatch.setattr(trace_mod, "CACHE_MIN_BYTES", 0)      # this short file too
     path = _write(tmp_path / "trace.tsv", columns, "\t")

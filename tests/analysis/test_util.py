@@ -1,4 +1,4 @@
-"""One set of small helpers (analysis/util.py): JSON-safe numbers, atomic writes."""
+"""One set of small helpers (analysis/files/util.py): JSON-safe numbers, atomic writes."""
 import ast
 import json
 import math
@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filmfriction.analysis import util
+from filmfriction.analysis.files import util
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -52,7 +52,7 @@ def test_write_atomic_replaces_whole_or_not_at_all(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]   # no temporary left
 
 
-# helpers that live in analysis/util.py only
+# helpers that live in analysis/files/util.py only
 HELPERS = {"write_atomic", "_num", "_finite", "_clean", "_json_default", "finite_or_none",
            "json_safe", "json_default"}
 PENDING: dict = {}
@@ -63,21 +63,21 @@ def test_no_module_defines_its_own_copy_of_a_helper():
     for layer in ("md_inputs", "reduced_model", "analysis", "workflows"):
         for path in (ROOT / layer).glob("*.py"):
             rel = path.relative_to(ROOT).as_posix()
-            if rel == "analysis/util.py":
+            if rel == "analysis/files/util.py":
                 continue
             names = {n.name for n in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
                      if isinstance(n, ast.FunctionDef)} & HELPERS
             names -= PENDING.get(rel, set())
             if names:
                 copies[rel] = sorted(names)
-    assert not copies, f"use filmfriction.analysis.util instead: {copies}"
+    assert not copies, f"use filmfriction.analysis.files.util instead: {copies}"
 
 
 def test_write_atomic_keeps_the_umask(tmp_path):
     import os
     import stat
 
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     for mask, expected in ((0o022, 0o644), (0o002, 0o664), (0o077, 0o600)):
         old = os.umask(mask)

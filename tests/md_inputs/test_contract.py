@@ -73,7 +73,8 @@ def test_every_printed_variable_is_defined_in_the_script():
 
 
 def test_the_runner_and_the_analysis_take_the_columns_from_the_contract():
-    from filmfriction.analysis import energy, trace
+    from filmfriction.analysis import energy
+    from filmfriction.analysis.files import trace
 
     assert runner.DAT_COLUMNS == contract.DAT_COLUMNS
     assert runner.TRACE_COLUMNS == contract.TRACE_COLUMNS

@@ -106,7 +106,7 @@ def test_without_a_mount_dashpot_the_film_takes_the_slip_energy(tmp_path, md):
     # a real run; that the light slider keeps the slips regular needs long runs
     # (README, "energy-partition").
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     area = 15 / 28  # the 5 x 3 box against the scene's 7 x 4: same drive per area
     scene = md.scene("energy-partition", spring_constant=100.0 * area, wall_mass=20.0 * area,

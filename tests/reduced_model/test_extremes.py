@@ -19,7 +19,7 @@ import pytest
 from scipy.interpolate import CubicHermiteSpline
 
 from filmfriction.analysis.analyze import analyze, to_json
-from filmfriction.analysis.trace import Trace, TraceParameters
+from filmfriction.analysis.files.trace import Trace, TraceParameters
 from filmfriction.reduced_model import SimulationLimitError, SpringBlock, laws
 
 FS, FK, K, M, V = 1.0, 0.5, 1.0, 1.0, 0.1

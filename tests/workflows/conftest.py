@@ -253,3 +253,38 @@ def _lock_held(run_dir: Path) -> bool:
 def lock_held():
     """``lock_held(run_dir)``: whether some process still holds the run directory's lock."""
     return _lock_held
+
+
+def _processes_in(directory: Path, *, kill: bool = False) -> dict[int, str]:
+    """Live processes whose working directory is ``directory`` or inside it (a run's
+    launcher, proxy and ranks; the runs of a sweep's points): pid -> command line.
+    ``kill``: each one found is sent SIGKILL (a test's leftovers)."""
+    import os
+    import signal
+
+    target = str(Path(directory).resolve())
+    found = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            cwd = os.readlink(entry / "cwd")
+            if cwd != target and not cwd.startswith(target + os.sep):
+                continue
+            # the command name may hold spaces: the state is the field after the last ')'
+            if (entry / "stat").read_text().rsplit(")", 1)[1].split()[0] in ("Z", "X"):
+                continue
+            found[int(entry.name)] = (entry / "cmdline").read_bytes().decode(
+                errors="replace").replace("\0", " ")
+            if kill:
+                os.kill(int(entry.name), signal.SIGKILL)
+        except OSError:
+            continue
+    return found
+
+
+@pytest.fixture
+def processes_in():
+    """``processes_in(directory, kill=False)``: the live processes working in
+    ``directory`` or below it, pid -> command line; with ``kill=True`` each is killed."""
+    return _processes_in

@@ -57,7 +57,7 @@ def test_units_on_the_command_line_and_in_the_setup_agree(example, run_cli):
 
     assert load_setup(d / "with_trace.toml").spring_constant == 97.0
     # calibrate and report read the file again the recorded way
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     again = read_trace(d)
     assert again.layout.column_units == doc["source"]["column_units"]

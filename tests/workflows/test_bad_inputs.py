@@ -163,7 +163,7 @@ def _analysed_file(tmp: Path, edit=None) -> Path:
     import json
 
     from filmfriction.analysis.analyze import analyze, write_outputs
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     d = tmp / "measured"
     d.mkdir()
@@ -528,19 +528,6 @@ def _snapshot(root: Path) -> dict:
             if p.is_file() else "dir" for p in root.rglob("*")}
 
 
-def _cli(capsys, *args):
-    """``filmfriction ARGS`` in process; argparse's own refusals exit via SystemExit."""
-    from filmfriction.workflows.cli.main import main
-
-    capsys.readouterr()
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 # environment overrides: id -> (variable, value, command line from tmp, message fragment)
 ENV_CASES = {
     "FILMFRICTION_MAX_POINTS=abc": (
@@ -569,13 +556,13 @@ ENV_CASES = {
 
 
 @pytest.mark.parametrize("case", list(ENV_CASES))
-def test_bad_environment(case, tmp_path, monkeypatch, capsys):
+def test_bad_environment(case, tmp_path, monkeypatch, run_cli):
     name, value, build, fragment = ENV_CASES[case]
     monkeypatch.setenv(name, value)
-    _refused(build, fragment, 2, tmp_path, monkeypatch, capsys)
+    _refused(build, fragment, 2, tmp_path, monkeypatch, run_cli)
 
 
-def _refused(build, fragment, code, tmp_path, monkeypatch, capsys):
+def _refused(build, fragment, code, tmp_path, monkeypatch, run_cli):
     inputs = tmp_path / "in"
     inputs.mkdir()
     work = tmp_path / "work"            # the working directory: runs/, sweeps/ go here
@@ -583,7 +570,7 @@ def _refused(build, fragment, code, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(work)
     args = build(inputs)
     before = _snapshot(tmp_path)
-    rc, out, err = _cli(capsys, *args)
+    rc, out, err = run_cli(*args)
     assert rc == code, (rc, err)
     assert fragment in err, err
     assert "Traceback" not in err + out
@@ -593,8 +580,8 @@ def _refused(build, fragment, code, tmp_path, monkeypatch, capsys):
 
 
 @pytest.mark.parametrize("case", list(CASES))
-def test_bad_input(case, tmp_path, monkeypatch, capsys):
-    _refused(*CASES[case], tmp_path, monkeypatch, capsys)
+def test_bad_input(case, tmp_path, monkeypatch, run_cli):
+    _refused(*CASES[case], tmp_path, monkeypatch, run_cli)
 
 
 
@@ -649,13 +636,13 @@ def read_only_dir(tmpfs):
     lambda ro, t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", ro / "s"],
     lambda ro, t: ["map", "velocity-stiffness", "--out", ro / "m"],
 ], ids=["run", "analyze", "sweep", "map"])
-def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, capsys):
+def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, capsys, run_cli):
     inputs = tmp_path / "in"
     inputs.mkdir()
     monkeypatch.chdir(inputs)
     args = command(read_only_dir, inputs)
     before = _snapshot(tmp_path)
-    rc, out, err = _cli(capsys, *args)
+    rc, out, err = run_cli(*args)
     assert rc == 2 and "Read-only file system" in err and "Traceback" not in err, err
     # refused by the check before any compute, which names the option
     flag = next(a for a in args if str(a).startswith("--o"))
@@ -667,14 +654,15 @@ def test_read_only_file_system(command, read_only_dir, tmp_path, monkeypatch, ca
     lambda t: ["bench", "--np", "1", "--steps", "10", "--repeat", "1"],
     lambda t: ["sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run", "--out", t / "s"],
 ], ids=["bench", "sweep"])
-def test_a_bad_filmfriction_lmp_is_refused_before_any_run(command, tmp_path, monkeypatch, capsys):
+def test_a_bad_filmfriction_lmp_is_refused_before_any_run(command, tmp_path, monkeypatch, capsys,
+                                                           run_cli):
     """bench started its first run, a sweep its points, before the executable was looked at."""
     inputs = tmp_path / "in"
     inputs.mkdir()
     monkeypatch.chdir(inputs)
     monkeypatch.setenv("FILMFRICTION_LMP", str(tmp_path / "no-lmp"))
     before = _snapshot(tmp_path)
-    rc, out, err = _cli(capsys, *command(inputs))
+    rc, out, err = run_cli(*command(inputs))
     assert rc == 2 and f"FILMFRICTION_LMP {tmp_path / 'no-lmp'}: no such file" in err, err
     assert "[1/" not in out and "Traceback" not in err
     assert _snapshot(tmp_path) == before

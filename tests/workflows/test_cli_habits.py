@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from filmfriction.workflows.cli.main import build_parser, main
+from filmfriction.workflows.cli.main import build_parser
 
 PARSERS = build_parser()._subparsers._group_actions[0].choices
 COMMANDS = sorted(PARSERS)
@@ -30,24 +30,14 @@ def _needs_arguments(parser: argparse.ArgumentParser) -> bool:
                for a in parser._actions)
 
 
-def _cli(capsys, *args):
-    capsys.readouterr()
-    try:
-        code = main([str(a) for a in args])
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 def test_the_walk_sees_every_command():
     assert {"run", "scenes", "geometry", "bench", "analyze", "map", "calibrate", "sfb",
             "report", "tradeoff", "sweep", "viscosity"} <= set(COMMANDS)
 
 
-def test_filmfriction_alone_prints_a_short_help(tmp_path, monkeypatch, capsys):
+def test_filmfriction_alone_prints_a_short_help(tmp_path, monkeypatch, capsys, run_cli):
     monkeypatch.chdir(tmp_path)
-    code, out, err = _cli(capsys)
+    code, out, err = run_cli()
     assert code == 2
     assert "filmfriction run" in out and "usage:" in out and "--help" in out
     assert len(out.splitlines()) <= 15, out
@@ -55,30 +45,30 @@ def test_filmfriction_alone_prints_a_short_help(tmp_path, monkeypatch, capsys):
 
 
 @pytest.mark.parametrize("command", COMMANDS)
-def test_quiet_and_verbose_everywhere(command, capsys):
+def test_quiet_and_verbose_everywhere(command, capsys, run_cli):
     parser = PARSERS[command]
     assert {"-q", "--quiet", "-v", "--verbose"} <= _options(parser)
     # both accepted, and not together (argparse refuses the pair as it reads it)
-    code, out, err = _cli(capsys, command, "--quiet", "--verbose")
+    code, out, err = run_cli(command, "--quiet", "--verbose")
     assert code == 2 and "not allowed with argument -q/--quiet" in err, err
-    code, out, err = _cli(capsys, command, "--help")
+    code, out, err = run_cli(command, "--help")
     assert code == 0 and "--quiet" in out and "--verbose" in out
 
 
 @pytest.mark.parametrize("command", COMMANDS)
-def test_out_where_the_command_writes(command, capsys):
+def test_out_where_the_command_writes(command, capsys, run_cli):
     parser = PARSERS[command]
     writes = parser.get_default("writes") is not False
     assert ("--out" in _options(parser)) == writes, command
     if writes:
-        code, out, err = _cli(capsys, command, "--help")
+        code, out, err = run_cli(command, "--help")
         assert "--out" in out
 
 
 @pytest.mark.parametrize("command", [c for c in COMMANDS if _needs_arguments(PARSERS[c])])
-def test_bare_command_prints_its_usage(command, tmp_path, monkeypatch, capsys):
+def test_bare_command_prints_its_usage(command, tmp_path, monkeypatch, capsys, run_cli):
     monkeypatch.chdir(tmp_path)
-    code, out, err = _cli(capsys, command)
+    code, out, err = run_cli(command)
     assert code == 2 and f"usage: filmfriction {command}" in err and "Traceback" not in err
     assert os.listdir(tmp_path) == []
 
@@ -132,8 +122,8 @@ def test_progress_without_a_terminal_is_lines(level, shown, tmp_path, capsys):
         assert tenths == [] and len(lines) == 6
 
 
-def test_quiet_drops_notes_not_results(tmp_path, capsys):
-    code, out, err = _cli(capsys, "map", "lambda-zeta", "--resolution", "4", "--processes",
+def test_quiet_drops_notes_not_results(tmp_path, capsys, run_cli):
+    code, out, err = run_cli("map", "lambda-zeta", "--resolution", "4", "--processes",
                           "100000", "--quiet", "--out", tmp_path)
     assert code == 0 and err == "" and "lambda_zeta.csv" in out
 
@@ -151,62 +141,62 @@ def _trace(folder: Path) -> Path:
     return path
 
 
-def test_report_out_creates_its_folder(synthetic_run, tmp_path, capsys):
-    assert _cli(capsys, "analyze", synthetic_run, "--no-structure", "--no-figure")[0] == 0
+def test_report_out_creates_its_folder(synthetic_run, tmp_path, capsys, run_cli):
+    assert run_cli("analyze", synthetic_run, "--no-structure", "--no-figure")[0] == 0
     out = tmp_path / "new" / "deeper" / "x.html"
-    code, stdout, err = _cli(capsys, "report", synthetic_run, "--out", out)
+    code, stdout, err = run_cli("report", synthetic_run, "--out", out)
     assert code == 0, err
     assert out.is_file() and out.with_suffix(".md").is_file()
 
 
-def test_analyze_output_is_an_alias_of_out(tmp_path, capsys):
+def test_analyze_output_is_an_alias_of_out(tmp_path, capsys, run_cli):
     trace = _trace(tmp_path)
     for flag in ("--out", "--output"):
         target = tmp_path / flag.strip("-") / "a.json"
-        code, out, err = _cli(capsys, "analyze", trace, flag, target, "--no-figure")
+        code, out, err = run_cli("analyze", trace, flag, target, "--no-figure")
         assert code == 0 and target.is_file(), err
 
 
-def test_calibrate_out(synthetic_run, tmp_path, capsys):
-    assert _cli(capsys, "analyze", synthetic_run, "--no-structure", "--no-figure")[0] == 0
+def test_calibrate_out(synthetic_run, tmp_path, capsys, run_cli):
+    assert run_cli("analyze", synthetic_run, "--no-structure", "--no-figure")[0] == 0
     target = tmp_path / "cal" / "c.json"
-    code, out, err = _cli(capsys, "calibrate", synthetic_run, "--out", target)
+    code, out, err = run_cli("calibrate", synthetic_run, "--out", target)
     assert code == 0, err
     assert target.is_file() and not (synthetic_run / "calibration.json").exists()
 
 
 # ------------------------------------------------------------------- worker counts, streams
-def test_map_processes_capped_to_the_cpus(tmp_path, capsys):
+def test_map_processes_capped_to_the_cpus(tmp_path, capsys, run_cli):
     from filmfriction.workflows.inputs import usable_cpus
 
     cpus = usable_cpus()
-    code, out, err = _cli(capsys, "map", "lambda-zeta", "--resolution", "4", "--processes",
+    code, out, err = run_cli("map", "lambda-zeta", "--resolution", "4", "--processes",
                           "100000", "--out", tmp_path)
     assert code == 0, err
     assert f"--processes 100000: capped to {cpus}" in err
     assert f"on {cpus} process(es)" in out and "100000" not in out
 
 
-def test_sweep_cores_capped_to_the_cpus(tmp_path, monkeypatch, capsys):
+def test_sweep_cores_capped_to_the_cpus(tmp_path, monkeypatch, capsys, run_cli):
     from filmfriction.workflows.cli import sweep_cli
     from filmfriction.workflows.inputs import usable_cpus
 
     given = {}
     monkeypatch.setattr(sweep_cli, "run_sweep",
                         lambda plan, out, cores, **kw: given.setdefault("cores", cores) and 0)
-    code, out, err = _cli(capsys, "sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run",
+    code, out, err = run_cli("sweep", "stick-slip", "--grid", "seed=1,2", "--dry-run",
                           "--cores", "100000", "--out", tmp_path / "s")
     assert code == 0, err
     assert f"--cores 100000: capped to {usable_cpus()}" in err
     assert given["cores"] == usable_cpus()
 
 
-def test_a_stream_is_read_once(tmp_path, capsys):
+def test_a_stream_is_read_once(tmp_path, capsys, run_cli):
     """`analyze <(cat t.csv)`: a pipe, read once; the same analysis as of the file."""
     import json
 
     trace = _trace(tmp_path)
-    assert _cli(capsys, "analyze", trace, "--out", tmp_path / "file.json",
+    assert run_cli("analyze", trace, "--out", tmp_path / "file.json",
                 "--no-figure")[0] == 0
     read, write = os.pipe()
 
@@ -217,7 +207,7 @@ def test_a_stream_is_read_once(tmp_path, capsys):
     feeder = threading.Thread(target=feed)
     feeder.start()
     try:
-        code, out, err = _cli(capsys, "analyze", f"/dev/fd/{read}", "--out",
+        code, out, err = run_cli("analyze", f"/dev/fd/{read}", "--out",
                               tmp_path / "stream.json", "--no-figure")
     finally:
         feeder.join()

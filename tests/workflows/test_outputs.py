@@ -18,8 +18,9 @@ import pytest
 
 from filmfriction.analysis.analyze import analyse_run
 from filmfriction.analysis.groundtruth.synthetic import run_directory
-from filmfriction.analysis.trace import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
-                                         read_trace, write_binary_copy)
+from filmfriction.analysis.files.trace_reader import read_trace
+from filmfriction.analysis.files.trace_cache import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
+                                                    write_binary_copy)
 
 
 def _sha(path: Path) -> str:
@@ -136,7 +137,7 @@ def test_writing_again_over_the_projects_own_files_is_accepted(calibrated_run, r
 # ------------------------------------------------------------------------ provenance
 def test_every_document_carries_its_provenance(calibrated_run, run_cli):
     from filmfriction import __version__
-    from filmfriction.analysis.provenance import git_state
+    from filmfriction.analysis.files.provenance import git_state
 
     cal = calibrated_run / "calibration.json"
     assert run_cli("sfb", "--calibration", cal, "--out", calibrated_run / "sfb.json").code == 0
@@ -154,7 +155,7 @@ def test_every_document_carries_its_provenance(calibrated_run, run_cli):
 
 def test_the_documents_with_provenance_match_their_schemas(calibrated_run, run_cli):
     jsonschema = pytest.importorskip("jsonschema")
-    from filmfriction.analysis.util import json_schema
+    from filmfriction.analysis.files.util import json_schema
 
     assert run_cli("sfb", "--calibration", calibrated_run / "calibration.json",
                    "--out", calibrated_run / "sfb.json").code == 0
@@ -164,7 +165,7 @@ def test_the_documents_with_provenance_match_their_schemas(calibrated_run, run_c
 
 
 def test_the_git_commit_is_the_checkouts_and_none_outside_one(tmp_path):
-    from filmfriction.analysis.provenance import checkout_state, git_state
+    from filmfriction.analysis.files.provenance import checkout_state, git_state
 
     assert checkout_state(tmp_path) == (None, None)
     root = Path(__file__).resolve().parents[2]

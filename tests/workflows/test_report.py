@@ -65,7 +65,7 @@ def _analysed_synthetic_run(directory):
     """A synthetic run directory (no LAMMPS) with its analysis written, as `filmfriction analyze` does."""
     from filmfriction.analysis.analyze import analyze, write_outputs
     from filmfriction.analysis.groundtruth.synthetic import run_directory
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     d = run_directory(directory, trajectory=False)
     doc, per_cycle = analyze(read_trace(d))

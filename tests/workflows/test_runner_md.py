@@ -157,7 +157,7 @@ def test_interrupted_run_resumes(tmp_path, md, filmfriction_command):
 def test_analysis_of_a_real_run(film_run):
     """The analysis on a real small run: slips found, ledger closed, n layers in the DCD."""
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     doc, per_cycle = analyze(read_trace(film_run.path))
     assert doc["slips"]["count"] >= 2

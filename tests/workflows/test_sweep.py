@@ -1,6 +1,5 @@
 """Sweeps through Snakemake: planning and validation, a tiny real sweep, the Slurm
 profile's dry run, kill-and-resume, and the per-directory lock."""
-import glob
 import json
 import math
 import os
@@ -13,7 +12,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.observables.sliding_section import sliding_section
-from filmfriction.analysis.trace import read_trace
+from filmfriction.analysis.files.trace_reader import read_trace
 from filmfriction.workflows import sweep
 from filmfriction.workflows.md.scene import SceneError
 
@@ -42,18 +41,6 @@ def completed(out: Path) -> list[Path]:
     return [p for p in out.glob("points/*/run.json") if not p.parent.name.startswith(".")]
 
 
-def processes_in(directory: Path) -> list[str]:
-    """Processes whose working directory is inside ``directory`` (LAMMPS runs in its run dir)."""
-    found = []
-    for proc in glob.glob("/proc/[0-9]*"):
-        try:
-            if os.readlink(f"{proc}/cwd").startswith(str(directory)):
-                found.append(Path(f"{proc}/cmdline").read_text().replace("\0", " "))
-        except OSError:
-            continue
-    return found
-
-
 # ---------------------------------------------------------------- planning
 def test_grid_linear_log_and_list():
     assert sweep.parse_grid("drive_velocity=0.005:0.5:5:log").values == (
@@ -73,7 +60,7 @@ def test_a_choice_axis_lists_names_and_plans_points():
     # the velocity is the map's x axis; a choice can only group the points
     doc = {"grid": [{"key": "wall_model", "values": ["rigid", "flexible"]},
                     {"key": "drive_velocity", "values": [0.02, 0.5]}]}
-    assert sweep._numeric_axes(doc) == ["drive_velocity"]
+    assert sweep.numeric_axes(doc) == ["drive_velocity"]
 
 
 @pytest.mark.parametrize("text, words", [
@@ -349,7 +336,7 @@ def _newest_restart(run_dir: Path) -> int:
 
 @pytest.mark.md
 def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_command,
-                                                     lock_held):
+                                                     lock_held, processes_in):
     """Kill a sweep while a point runs, kill its resume, then let it finish: the
     finished point is never redone, the interrupted one keeps its partial run (restart
     files included) and is continued from it, and its trace is whole."""
@@ -381,7 +368,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_
     assert first_stop > 0, "the partial run and its restart files are kept"
     assert f"partial run kept in points/{partial.name} (newest usable restart " in log, log
     time.sleep(0.5)
-    assert processes_in(out) == [], "an engine was left running"
+    assert processes_in(out) == {}, "an engine was left running"
     assert not lock_held(partial)
     assert not (out / "failed").exists(), "an interrupt is not a failed run"
 
@@ -395,7 +382,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_
     assert second_stop > first_stop, "the resume's own progress is kept"
     assert not (out / "points" / name / "run.json").exists() and not (out / "failed").exists()
     time.sleep(0.5)
-    assert processes_in(out) == [], "an engine was left running"
+    assert processes_in(out) == {}, "an engine was left running"
 
     # 3. the third sweep finishes it from there
     r = subprocess.run([filmfriction_command, "sweep", *args], capture_output=True, text=True,
@@ -425,7 +412,7 @@ def test_killed_sweep_resumes_without_losing_a_point(tmp_path, md, filmfriction_
 @pytest.mark.parametrize("lo, hi, at_least", [(0.013, 0.062, 2), (8.0, 60.0, 2), (1e-3, 1.0, 4)])
 def test_a_log_axis_of_the_sweep_figures_is_labelled_over_any_range(lo, hi, at_least):
     """Under a decade there is no power of ten to label: the axis had no numbers at all."""
-    from filmfriction.analysis.util import pyplot
+    from filmfriction.analysis.files.util import pyplot
     from filmfriction.workflows.sweep.figures import _plain_log_axis
 
     plt = pyplot()

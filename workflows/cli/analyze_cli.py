@@ -10,7 +10,8 @@ from filmfriction.workflows.inputs import (check_input_file, check_run_json, che
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
 
-def _positive(text: str) -> float:
+def positive_number(text: str) -> float:
+    """An argparse type: a finite number > 0."""
     try:
         v = float(text)
     except ValueError:
@@ -38,8 +39,8 @@ MAX_MAGNITUDE = 1e100
 def _reading_options(args) -> None:
     """Check --column, --skip-rows, --comment and --log-run (one-line errors naming the
     option, its value and what is accepted); ``args`` gets their parsed values."""
-    from filmfriction.analysis.column_spec import parse_column
-    from filmfriction.analysis.lammps_log import parse_runs
+    from filmfriction.analysis.files.column_spec import parse_column
+    from filmfriction.analysis.files.lammps_log import parse_runs
 
     parsed = []
     for text in args.column:
@@ -104,11 +105,11 @@ def register(subparsers) -> None:
                    help="an SFB set-up (SI; as for 'filmfriction sfb --setup'): its spring "
                         "constant, mass, contact area, film thickness and drive velocity, "
                         "unless given below; implies --units si")
-    p.add_argument("--spring-constant", type=_positive, help="K of the drive spring")
-    p.add_argument("--mass", type=_positive, help="M of the driven wall/surface")
-    p.add_argument("--area", type=_positive, help="contact area A")
-    p.add_argument("--thickness", type=_positive, help="film thickness D")
-    p.add_argument("--drive-velocity", type=_positive, help="spring-end velocity V")
+    p.add_argument("--spring-constant", type=positive_number, help="K of the drive spring")
+    p.add_argument("--mass", type=positive_number, help="M of the driven wall/surface")
+    p.add_argument("--area", type=positive_number, help="contact area A")
+    p.add_argument("--thickness", type=positive_number, help="film thickness D")
+    p.add_argument("--drive-velocity", type=positive_number, help="spring-end velocity V")
     p.add_argument("--units", choices=("lj", "si"), default=None,
                    help="unit system of the trace (default: run.json's, else lj)")
     p.add_argument("--skip", type=_count, default=None,
@@ -144,8 +145,8 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     import numpy as np
 
     from filmfriction.analysis.analyze import analyze, to_json, write_outputs
-    from filmfriction.analysis.trace import (BINARY_MIN_ROWS, read_trace,
-                                             write_binary_copy)
+    from filmfriction.analysis.files.trace_reader import read_trace
+    from filmfriction.analysis.files.trace_cache import BINARY_MIN_ROWS, write_binary_copy
 
     _reading_options(args)
     record = check_run_json(args.path) if args.path.is_dir() else None
@@ -168,7 +169,7 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
         check_writable(args.output, "--out")
     table = {}
     if args.setup is not None:
-        from filmfriction.analysis.column_spec import trace_table
+        from filmfriction.analysis.files.column_spec import trace_table
         from filmfriction.reduced_model.sfb.user_setup import load_setup
 
         try:
@@ -237,7 +238,7 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
     except ValueError as exc:
         raise UserError(str(exc)) from None
     where = trace.path
-    from filmfriction.analysis.trace import trace_column_names
+    from filmfriction.analysis.files.trace import trace_column_names
 
     for name, column in trace.columns.items():
         if name not in trace_column_names():

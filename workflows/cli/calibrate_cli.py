@@ -47,8 +47,8 @@ def _fmt(e) -> str:
 def format_calibration(cal) -> str:
     """Human-readable summary of a :class:`filmfriction.analysis.calibration.calibrate.Calibration`:
     an MD run's (LJ units) or a measured trace's (SI units, "trace" for "MD")."""
-    from filmfriction.analysis.trace import unit
-    from filmfriction.analysis.util import format_pm
+    from filmfriction.analysis.files.trace import unit
+    from filmfriction.analysis.files.util import format_pm
 
     source = "MD" if cal.units == "lj" else "trace"
     out = []

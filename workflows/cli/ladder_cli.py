@@ -156,7 +156,7 @@ def main_collect(args: argparse.Namespace) -> int:
         rungs.append(got)
     print(ladder.table(rungs))
     if args.out is not None:
-        from filmfriction.analysis.util import write_atomic
+        from filmfriction.analysis.files.util import write_atomic
 
         write_atomic(Path(args.out), json.dumps({"schema": "filmfriction.mass-ladder/1",
                                                  "rungs": rungs}, indent=1))

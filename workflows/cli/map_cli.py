@@ -100,7 +100,7 @@ def run(args) -> int:
         result = maps.velocity_stiffness_map(np.logspace(-3, 0, n), np.logspace(-1, 2, n),
                                              processes=processes)
     stem = args.kind.replace("-", "_")
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     csv_path = write_atomic(out / f"{stem}.csv", result.csv_text())
     png_path = _plot(result, args.kind, out / f"{stem}.png")
@@ -119,7 +119,7 @@ def _plot(result, kind, path) -> str:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
     ax.pcolormesh(result.x, result.y, result.stick_slip.astype(float), shading="nearest",

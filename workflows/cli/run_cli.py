@@ -319,7 +319,7 @@ def _study_done(args, study: Path, code: int) -> int:
             print(f"analysis of replica {i}: FAILED: {type(exc).__name__}: {exc}",
                   file=sys.stderr)
     doc = combine_study(study)
-    from filmfriction.analysis.util import format_pm
+    from filmfriction.analysis.files.util import format_pm
 
     for name in [t["observable"] for t in (record.get("rule") or {}).get("targets", [])] \
             or ["static_force"]:
@@ -352,7 +352,7 @@ def _scene(args: argparse.Namespace):
 
 
 def write_geometry(args: argparse.Namespace) -> int:
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     from ..md.scene import SceneError
 

@@ -62,11 +62,11 @@ def register(subparsers) -> None:
                    help="the LJ time unit carried to SI: sigma*sqrt(m/eps) of the OMCTS molecule "
                         "(mass, default) or the one that maps the LJ liquid's eta onto OMCTS's "
                         "2.5 mPa s (viscosity; see docs/viscosity.md)")
-    from .analyze_cli import _positive
+    from .analyze_cli import positive_number
 
-    p.add_argument("--sigma-nm", type=_positive, default=None,
+    p.add_argument("--sigma-nm", type=positive_number, default=None,
                    help=f"override sigma of the LJ->SI mapping (default {OMCTS.sigma * 1e9:g} nm)")
-    p.add_argument("--epsilon-K", type=_positive, default=None,
+    p.add_argument("--epsilon-K", type=positive_number, default=None,
                    help=f"override eps/k_B of the mapping (default {OMCTS.temperature:.1f} K)")
     p.set_defaults(func=run)
 
@@ -94,7 +94,7 @@ def _calibration(path: Path | None):
     if path is None:
         return None, False
     from filmfriction.reduced_model import MDCalibration
-    from filmfriction.analysis.util import read_json_object
+    from filmfriction.analysis.files.util import read_json_object
 
     if path.is_dir():
         raise UserError(f"--calibration {path}: a directory; give its calibration.json "
@@ -107,7 +107,7 @@ def _calibration(path: Path | None):
         raise UserError(f"cannot read calibration file {path}: {exc}") from None
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    from filmfriction.analysis.documents import check_document
+    from filmfriction.analysis.files.documents import check_document
 
     calibration_json = str(data.get("schema", "")).startswith("filmfriction.calibration/")
     try:
@@ -138,7 +138,7 @@ def _setup(args):
         raise UserError("--setup FILE.toml and --measured DIR go together: the set-up of your "
                         "SFB and the analysed trace whose slip it measured")
     from filmfriction.analysis.calibration.measured import measured_slip
-    from filmfriction.analysis.util import read_json_object
+    from filmfriction.analysis.files.util import read_json_object
     from filmfriction.reduced_model.sfb.user_setup import load_setup
 
     try:
@@ -150,7 +150,7 @@ def _setup(args):
         raise UserError(f"--measured {args.measured}: no analysis.json there (run 'filmfriction "
                         "analyze TRACE_FILE --units si ...' first)")
     try:
-        from filmfriction.analysis.documents import check_document
+        from filmfriction.analysis.files.documents import check_document
 
         doc = check_document(read_json_object(doc_path, f"--measured {doc_path}"), "analysis",
                              f"--measured {doc_path}")

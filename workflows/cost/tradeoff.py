@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import json_safe, write_atomic
+from filmfriction.analysis.files.util import json_safe, write_atomic
 from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 
 from ..md.scene import WCA_CUTOFF as WCA
@@ -269,7 +269,7 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     """
     from filmfriction.analysis import energy
     from filmfriction.analysis.analyze import analyze
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     trace = read_trace(run_dir)
     if prefix < 1.0 or trace_stride > 1:

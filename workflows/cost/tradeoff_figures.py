@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.util import write_atomic
 
 from .tradeoff_reduced import REDUCED_KNOB
 from .tradeoff_table import OBSERVABLES

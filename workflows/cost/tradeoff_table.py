@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.util import write_atomic
 
 
 # name -> unit; the order is the order of the table's columns

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.ensemble import check_target, combine_replicas
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs.contract import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
                                              REPLICA_LOG, RUN_FILE, SCENE_FILE, STUDY_FILE)
 from .locks import DirectoryLock
@@ -103,7 +103,7 @@ def _lock(study: Path) -> DirectoryLock:
 
 def write_json(path: Path, doc: dict) -> None:
     """Strict JSON (NaN → null), written atomically."""
-    from filmfriction.analysis.util import json_default, json_safe
+    from filmfriction.analysis.files.util import json_default, json_safe
 
     write_atomic(path, json.dumps(json_safe(doc), indent=2, default=json_default,
                                   allow_nan=False) + "\n")
@@ -396,7 +396,7 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
 def combine_study(study: Path) -> dict:
     """Every per-slip observable combined over the replicas (start-up slip left out of
     each), written to ``ensemble.json`` and ``ensemble.md``; returns the document."""
-    from filmfriction.analysis.provenance import provenance
+    from filmfriction.analysis.files.provenance import provenance
 
     study = Path(study)
     record = json.loads((study / STUDY_FILE).read_text(encoding="utf-8"))

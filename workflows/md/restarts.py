@@ -38,7 +38,7 @@ import hashlib
 import json
 from pathlib import Path
 
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.util import write_atomic
 
 __all__ = ["MAGIC", "LEDGER", "RestartLedger", "restart_files", "usable", "unusable", "prune"]
 

@@ -7,7 +7,7 @@ import platform
 from datetime import datetime, timezone
 from pathlib import Path
 
-from filmfriction.analysis.util import json_default, write_atomic
+from filmfriction.analysis.files.util import json_default, write_atomic
 
 from .scene import Scene, SceneError
 

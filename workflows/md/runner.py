@@ -27,8 +27,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from filmfriction import md_inputs
-from filmfriction.analysis.provenance import provenance
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.provenance import provenance
+from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import (COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE,
                                              RESUME_OFFSETS, TRACE_DAT_FILE, TRACE_FILE)
@@ -465,7 +465,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
         raise SceneError(f"{record_path}: not a readable run record ({exc})") from None
     if not isinstance(record, dict) or not isinstance(record.get("scene"), dict):
         raise SceneError(f"{record_path}: not a run record (a JSON object with a scene)")
-    from filmfriction.analysis.documents import check_document
+    from filmfriction.analysis.files.documents import check_document
 
     try:
         check_document(record, "run-resume", record_path)

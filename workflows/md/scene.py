@@ -1,3 +1,5 @@
+# Over 500 lines as one module: the parameter table (about 40 entries with ranges and
+# help) and the checks between parameters are one contract, read together.
 """Scenes: what a run models, its parameters, and their validation.
 
 A scene is a TOML file (see ``workflows/md/scenes/``)::

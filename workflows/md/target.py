@@ -119,7 +119,7 @@ def slip_values(run_dir: Path, observables) -> dict[str, list[float]]:
     """Each observable's per-slip values in ``run_dir``'s trace, the start-up slip (the
     first one) left out; empty lists for a trace too short to analyse."""
     from filmfriction.analysis.analyze import MIN_ROWS, context
-    from filmfriction.analysis.trace import read_trace
+    from filmfriction.analysis.files.trace_reader import read_trace
 
     trace = read_trace(Path(run_dir))
     if len(trace.time) < MIN_ROWS:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs.contract import DAT_COLUMNS, SLIDE_ORIGIN_FILE, TRACE_COLUMNS
 
 from .scene import SceneError

@@ -18,8 +18,8 @@ import numpy as np
 
 from filmfriction import md_inputs
 from filmfriction.analysis import green_kubo as gk
-from filmfriction.analysis.provenance import provenance
-from filmfriction.analysis.util import write_atomic
+from filmfriction.analysis.files.provenance import provenance
+from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs.contract import COMMAND_FILE, LOG_FILE
 from filmfriction.reduced_model import units as U
 

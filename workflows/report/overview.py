@@ -8,7 +8,7 @@ import json
 import math
 from pathlib import Path
 
-from filmfriction.analysis.util import format_value as _fmt
+from filmfriction.analysis.files.util import format_value as _fmt
 from filmfriction.md_inputs.contract import RUN_FILE
 
 from ..rundir import reference

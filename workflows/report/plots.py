@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from filmfriction.analysis.trace import unit as _unit
+from filmfriction.analysis.files.trace import unit as _unit
 from filmfriction.analysis.trace_figure import scaled_unit
-from filmfriction.analysis.util import png_bytes as _png, pyplot as _plt
+from filmfriction.analysis.files.util import png_bytes as _png, pyplot as _plt
 
 from ..rundir import reference
 from .document import fixed_decimals, trace_source

@@ -28,7 +28,7 @@ import os
 from pathlib import Path
 
 from filmfriction.analysis.observables import registered as registered_observables
-from filmfriction.analysis.util import write_atomic as _write_atomic
+from filmfriction.analysis.files.util import write_atomic as _write_atomic
 from filmfriction.reduced_model.units import OMCTS
 
 from ..rundir import read_report_inputs, split_sweeps

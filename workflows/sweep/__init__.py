@@ -44,7 +44,7 @@ from .aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, Aggregate, Critica
                         write_aggregate)
 from filmfriction.analysis.stickslip import STEADY_VELOCITY_TOLERANCE
 
-from .figures import _numeric_axes, fig_velocity_map, fig_vk_map
+from .figures import numeric_axes, fig_velocity_map, fig_vk_map
 from .jobs import (PROFILES, SNAKEFILE, analyse_point, profile_path, run_point,
                    run_sweep, snakemake_command)
 from .plan import (GridAxis, SweepLock, SweepPlan, SweepPoint, format_value,
@@ -54,7 +54,7 @@ __all__ = ["GridAxis", "SweepPoint", "SweepPlan", "CriticalVelocity", "Aggregate
            "parse_grid", "plan_sweep", "write_plan", "SweepLock", "snakemake_command",
            "run_sweep", "run_point", "analyse_point", "critical_velocity",
            "reduced_model_boundary", "aggregate", "load_aggregate", "summary", "SNAKEFILE",
-           "PROFILES", "profile_path", "format_value", "fig_velocity_map", "fig_vk_map", "_numeric_axes"]
+           "PROFILES", "profile_path", "format_value", "fig_velocity_map", "fig_vk_map", "numeric_axes"]
 
 
 def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
@@ -64,11 +64,11 @@ def aggregate(sweep_dir: Path, *, figures: bool = True) -> dict:
     when both V and K are swept, ``vk_map.png``, each atomically.  Returns the
     ``aggregate.json`` document (see :func:`.sweep_aggregate.build_aggregate`).
     """
-    from filmfriction.analysis.util import write_atomic
+    from filmfriction.analysis.files.util import write_atomic
 
     sweep_dir = Path(sweep_dir)
     doc, rows = build_aggregate(sweep_dir)
-    if figures and not _numeric_axes(doc):
+    if figures and not numeric_axes(doc):
         doc["notes"].append("no velocity_map.png: every grid axis is a choice (e.g. "
                             "wall_model); the table compares the points")
     elif figures:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from . import aggregate, analyse_point, load_aggregate, run_point, summary
-from .jobs import _interrupt
+from .jobs import interrupt
 
 
 def _job_main(argv: list[str]) -> int:
@@ -26,8 +26,8 @@ def _job_main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     # Snakemake stops jobs with SIGTERM or SIGINT: both become an interrupt, so the runner
     # stops its LAMMPS child (which runs in its own session) instead of leaving it behind
-    signal.signal(signal.SIGTERM, _interrupt)
-    signal.signal(signal.SIGINT, _interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
+    signal.signal(signal.SIGINT, interrupt)
     if args.job == "point":
         from ..md.runner import RunFailed
 

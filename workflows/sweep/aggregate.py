@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.documents import read_document
-from filmfriction.analysis.provenance import provenance
-from filmfriction.analysis.util import finite_or_none, json_safe, write_atomic
+from filmfriction.analysis.files.documents import read_document
+from filmfriction.analysis.files.provenance import provenance
+from filmfriction.analysis.files.util import finite_or_none, json_safe, write_atomic
 from filmfriction.analysis.stickslip import Regime, sliding_steadily
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, SWEEP_FILE
 
-from .plan import _dumps, format_value
+from .plan import format_value, json_text
 
 AGGREGATE_SCHEMA = "filmfriction.sweep-aggregate/1"
 # regimes of the analysis (filmfriction.analysis.stickslip.Regime)
@@ -62,7 +62,7 @@ class CriticalVelocity:
                 "note": self.note}
 
 
-def _majority(regimes: list[str]) -> str:
+def majority_regime(regimes: list[str]) -> str:
     """A velocity's regime over its points (seeds): the majority, else irregular."""
     for r in (STICK_SLIP, SMOOTH):
         if 2 * regimes.count(r) > len(regimes):
@@ -93,7 +93,7 @@ def critical_velocity(velocities, regimes) -> CriticalVelocity:
     by_v: dict = {}
     for v, r in zip(velocities, regimes):
         by_v.setdefault(float(v), []).append(r)
-    per_v = {v: _majority(rs) for v, rs in sorted(by_v.items())}
+    per_v = {v: majority_regime(rs) for v, rs in sorted(by_v.items())}
     vs = list(per_v)
     ss = [v for v in vs if per_v[v] == STICK_SLIP]
     sm = [v for v in vs if per_v[v] == SMOOTH]
@@ -177,13 +177,14 @@ def point_summary(sweep_dir: Path, point: dict) -> dict:
     return row
 
 
-def _eta_points(rows: list[dict]) -> list[dict]:
+def eta_points(rows: list[dict]) -> list[dict]:
     """Points with a positive η_eff and γ̇; a stuck wall has no shear rate to speak of."""
     return [r for r in rows if r["eta_eff"] and r["shear_rate"] and r["eta_eff"] > 0
             and r["shear_rate"] > 0 and r["sweep_regime"] != STUCK]
 
 
-def _group_key(row: dict, keys: list[str]) -> tuple:
+def group_key(row: dict, keys: list[str]) -> tuple:
+    """A point's values of the grid ``keys`` (the group it is compared within)."""
     return tuple(row[f"grid.{k}"] for k in keys)
 
 
@@ -275,7 +276,7 @@ def build_aggregate(sweep_dir: Path) -> tuple[dict, list[dict]]:
     if "drive_velocity" in keys:
         groups: dict = {}
         for r in rows:
-            groups.setdefault(_group_key(r, group_keys), []).append(r)
+            groups.setdefault(group_key(r, group_keys), []).append(r)
         for g, members in groups.items():
             cv = critical_velocity([r["drive_velocity"] for r in members],
                                    [r["sweep_regime"] for r in members])
@@ -284,7 +285,7 @@ def build_aggregate(sweep_dir: Path) -> tuple[dict, list[dict]]:
         doc["notes"].append("drive_velocity is not swept: no critical velocity")
     doc["critical_velocity"] = crit
     # η_eff vs γ̇ across runs
-    pts = _eta_points(rows)
+    pts = eta_points(rows)
     # one definition at a time: steady sliding, (F/A)/(V/D), when it has enough points;
     # the slip fits measure a different rate (the slip's) and scatter much more
     steady = [r for r in pts if r["eta_source"] == "steady"]
@@ -338,7 +339,7 @@ def write_aggregate(sweep_dir: Path, doc: dict, rows: list[dict]) -> dict:
     """Write ``aggregate.csv`` and ``aggregate.json`` atomically; returns the document."""
     sweep_dir = Path(sweep_dir)
     write_atomic(sweep_dir / "aggregate.csv", _csv(rows).encode())
-    write_atomic(sweep_dir / AGGREGATE_FILE, _dumps(json_safe(doc)).encode())
+    write_atomic(sweep_dir / AGGREGATE_FILE, json_text(json_safe(doc)).encode())
     return doc
 
 

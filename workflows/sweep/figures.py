@@ -6,9 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from filmfriction.analysis.util import png_bytes, pyplot
+from filmfriction.analysis.files.util import png_bytes, pyplot
 
-from .aggregate import IRREGULAR, SMOOTH, STICK_SLIP, STUCK, _eta_points, _group_key, _majority
+from .aggregate import (IRREGULAR, SMOOTH, STICK_SLIP, STUCK, eta_points, group_key,
+                        majority_regime)
 from .plan import format_value
 
 
@@ -28,7 +29,7 @@ def _err(x):
     return 0.0 if x is None else x
 
 
-def _numeric_axes(doc: dict) -> list[str]:
+def numeric_axes(doc: dict) -> list[str]:
     """Grid keys with numbers for values (a choice such as wall_model cannot be an x axis)."""
     return [a["key"] for a in doc["grid"]
             if all(isinstance(v, (int, float)) for v in a["values"])]
@@ -61,12 +62,12 @@ def fig_velocity_map(doc: dict) -> bytes:
     plt = _plt()
     rows = doc["points"]
     keys = [a["key"] for a in doc["grid"]]
-    xkey = "drive_velocity" if "drive_velocity" in keys else _numeric_axes(doc)[0]
+    xkey = "drive_velocity" if "drive_velocity" in keys else numeric_axes(doc)[0]
     group_keys = [k for k in keys if k not in (xkey, "seed")]
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     groups: dict = {}
     for r in rows:
-        groups.setdefault(_group_key(r, group_keys), []).append(r)
+        groups.setdefault(group_key(r, group_keys), []).append(r)
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 9))
     handles = []
     for i, (g, members) in enumerate(groups.items()):
@@ -119,7 +120,7 @@ def fig_velocity_map(doc: dict) -> bytes:
     ax.set_ylabel("friction force (ε/σ)")
     ax.set_title(f"{doc['scene']}: friction vs {xkey} ({len(rows)} runs, ± standard error; "
                  "shaded: stick-slip → smooth)", fontsize=9)
-    pts = _eta_points(rows)
+    pts = eta_points(rows)
     for r in pts:
         steady = r["eta_source"] == "steady"
         bx.errorbar(r["shear_rate"], r["eta_eff"], yerr=_err(r["eta_eff_stderr"]),
@@ -162,7 +163,7 @@ def fig_vk_map(doc: dict) -> bytes:
         cells.setdefault((r["drive_velocity"], r["spring_constant"]), []).append(
             r["sweep_regime"])
     for (v, k), regs in cells.items():
-        regime = _majority(regs) if STUCK not in regs else STUCK
+        regime = majority_regime(regs) if STUCK not in regs else STUCK
         ax.plot(v, k, marker=REGIME_MARKER.get(regime, "x"), color=REGIME_COLOUR.get(regime),
                 ms=10, ls="none")
     for cv in doc.get("critical_velocity", []):

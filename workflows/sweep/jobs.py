@@ -18,7 +18,8 @@ from pathlib import Path
 
 from filmfriction.md_inputs.contract import RUN_FILE
 
-from .plan import SweepLock, SweepPlan, _user_error, write_plan
+from ..inputs import UserError as _user_error
+from .plan import SweepLock, SweepPlan, write_plan
 
 SNAKEFILE = Path(__file__).with_name("sweep.smk")
 PROFILES = Path(__file__).with_name("profiles")
@@ -27,7 +28,8 @@ PROFILES = Path(__file__).with_name("profiles")
 _INTERRUPTED = False
 
 
-def _interrupt(signum, frame):
+def interrupt(signum, frame):
+    """The sweep job's SIGTERM/SIGINT handler: remember the interrupt, then stop as Ctrl-C."""
     global _INTERRUPTED
     _INTERRUPTED = True
     raise KeyboardInterrupt

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.util import json_default, read_json_object, write_atomic
+from filmfriction.analysis.files.util import json_default, read_json_object, write_atomic
 from filmfriction.md_inputs.contract import SWEEP_FILE
 
 from ..md.locks import DirectoryLock
@@ -34,10 +34,6 @@ def max_points() -> int:
     from ..inputs import env_count
 
     return env_count("FILMFRICTION_MAX_POINTS", MAX_POINTS)
-
-
-def _user_error(message: str) -> Exception:
-    return UserError(message)
 
 
 # ---------------------------------------------------------------------------
@@ -305,7 +301,8 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
 # ---------------------------------------------------------------------------
 # the sweep directory
 # ---------------------------------------------------------------------------
-def _dumps(doc) -> str:
+def json_text(doc) -> str:
+    """A sweep document as the sweep directory holds it: indented, keys sorted."""
     return json.dumps(doc, indent=2, sort_keys=True, default=json_default) + "\n"
 
 
@@ -326,9 +323,9 @@ def write_plan(plan: SweepPlan, out: Path) -> list[str]:
     for p in plan.points:
         doc = {"schema": POINT_SCHEMA, "scene": plan.scene, "scene_source": plan.scene_source,
                "overrides": {**plan.fixed, **p.values}, "parameters": plan.parameters[p.name]}
-        if _write_if_changed(out / "inputs" / f"{p.name}.json", _dumps(doc)):
+        if _write_if_changed(out / "inputs" / f"{p.name}.json", json_text(doc)):
             changed.append(p.name)
-    _write_if_changed(out / SWEEP_FILE, _dumps(plan.as_dict()))
+    _write_if_changed(out / SWEEP_FILE, json_text(plan.as_dict()))
     return changed
 
 
@@ -336,7 +333,7 @@ def SweepLock(directory: Path) -> DirectoryLock:
     """The lock on ``<sweep>/.sweep.lock``: one sweep per directory.  Its descriptor is
     passed to the Snakemake child, so the lock lasts as long as either process does."""
     directory = Path(directory)
-    return DirectoryLock(directory / ".sweep.lock", lambda holder: _user_error(
+    return DirectoryLock(directory / ".sweep.lock", lambda holder: UserError(
         f"another sweep is running in {directory} ({holder}); wait for it, "
         "or give this sweep its own --out"), inheritable=True)
 

@@ -1,7 +1,7 @@
 """The slip law's MD positive control (docs/results/slip-law.md): liquid-release runs fitted.
 
     filmfriction run liquid-release --np 1 --md-only --set seed=S --out RUN_S   # per seed
-    python benchmarks/release_control.py --viscosity ETA ETA_ERR RUN_1 RUN_2 ...
+    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR RUN_1 RUN_2 ...
 
 Prints the slip law fitted to the runs' release slips together
 (:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict,

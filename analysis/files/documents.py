@@ -17,11 +17,11 @@ Examples
 >>> check_document({"trace_parameters": {"spring_constant": True}}, "run", "r/run.json")
 Traceback (most recent call last):
 ...
-filmfriction.analysis.documents.DocumentError: r/run.json: trace_parameters.spring_constant = true: expected a positive number or null
+filmfriction.analysis.files.documents.DocumentError: r/run.json: trace_parameters.spring_constant = true: expected a positive number or null
 >>> check_document({"scene": {"parameters": {}}}, "run", "r/run.json")
 Traceback (most recent call last):
 ...
-filmfriction.analysis.documents.DocumentError: r/run.json: scene.name missing: expected a string (the scene's name)
+filmfriction.analysis.files.documents.DocumentError: r/run.json: scene.name missing: expected a string (the scene's name)
 """
 from __future__ import annotations
 

@@ -215,7 +215,7 @@ def json_schema(name: str) -> dict:
     """
     import json
 
-    path = Path(__file__).parent / "schemas" / f"{name}.schema.json"
+    path = Path(__file__).parents[1] / "schemas" / f"{name}.schema.json"
     if not path.is_file():
         known = sorted(p.name.removesuffix(".schema.json")
                        for p in path.parent.glob("*.schema.json"))

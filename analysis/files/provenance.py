@@ -47,7 +47,7 @@ def file_sha256(path) -> str:
 def git_state() -> tuple[str | None, bool | None]:
     """``(commit, dirty)`` of the git checkout the package runs from, ``(None, None)``
     when it does not run from one (or git is missing or fails)."""
-    return checkout_state(Path(__file__).resolve().parent.parent)
+    return checkout_state(Path(__file__).resolve().parents[2])
 
 
 def checkout_state(root: Path) -> tuple[str | None, bool | None]:
