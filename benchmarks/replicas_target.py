@@ -138,7 +138,7 @@ def coverage(args) -> dict:
 
     from filmfriction.analysis.ensemble import combine_replicas
     from filmfriction.analysis.ensemble.replicas import ONE_SIGMA
-    from filmfriction.workflows.md.replicas import replica_seeds
+    from filmfriction.workflows.md.replica_study import replica_seeds
     from filmfriction.workflows.md.scene import load
     from filmfriction.workflows.md.target import slip_values
 
@@ -210,7 +210,7 @@ def main(argv=None) -> int:
     Path(args.out).mkdir(parents=True, exist_ok=True)
     result = paired(args) if args.part == "paired" else coverage(args)
 
-    from filmfriction.workflows.md.replicas import write_json
+    from filmfriction.workflows.md.replica_study import write_json
 
     write_json(Path(args.out) / f"{args.part}.json", result)
     print(f"-> {Path(args.out) / f'{args.part}.json'}")

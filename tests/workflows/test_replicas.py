@@ -1,4 +1,4 @@
-"""Replicas and a target error (workflows/md/replicas.py, target.py): the parts without LAMMPS.
+"""Replicas and a target error (workflows/md/replica_study.py, target.py): the parts without LAMMPS.
 
 The statistics (combine_replicas, check_target) are tested on ground truth in
 tests/analysis/test_ensemble.py; the command on real LAMMPS in test_replicas_md.py.
@@ -10,7 +10,7 @@ import copy
 import pytest
 
 from filmfriction.analysis.ensemble import TargetError
-from filmfriction.workflows.md.replicas import MAX_REPLICAS, ensemble_markdown, replica_seeds
+from filmfriction.workflows.md.replica_study import MAX_REPLICAS, ensemble_markdown, replica_seeds
 from filmfriction.workflows.md.scene import SceneError
 from filmfriction.workflows.md.target import (OBSERVABLES, Budget, TargetInputError,
                                               extend_record, next_slide, parse_budget,

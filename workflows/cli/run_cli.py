@@ -201,7 +201,7 @@ def run(args: argparse.Namespace) -> int:
 def _study_inputs(args: argparse.Namespace):
     """``(replicas, targets, budget)`` for a study of replicas or a target (None for a
     plain run); UserError for any of them a study cannot take, before any compute."""
-    from ..md.replicas import MAX_REPLICAS
+    from ..md.replica_study import MAX_REPLICAS
     from ..md.target import TargetInputError, parse_budget, parse_targets
 
     if args.slide_to is not None:
@@ -238,13 +238,13 @@ def _workers(ranks: int) -> int:
 
 
 def _is_study(path) -> bool:
-    from ..md.replicas import is_study
+    from ..md.replica_study import is_study
 
     return is_study(path)
 
 
 def _run_study(args, replicas, targets, budget) -> int:
-    from ..md.replicas import run_study
+    from ..md.replica_study import run_study
     from ..md.scene import SceneError
 
     if args.out is not None:
@@ -269,7 +269,7 @@ def _run_study(args, replicas, targets, budget) -> int:
 
 
 def _resume_study(args) -> int:
-    from ..md.replicas import resume_study
+    from ..md.replica_study import resume_study
     from ..md.scene import SceneError
 
     if args.slide_to is not None:
@@ -295,7 +295,7 @@ def _study_interrupted(exc: KeyboardInterrupt) -> int:
 def _study_done(args, study: Path, code: int) -> int:
     import json
 
-    from ..md.replicas import combine_study
+    from ..md.replica_study import combine_study
     from ..rundir import ENSEMBLE_REPORT_FILE, STUDY_FILE
 
     print(f"study directory: {study}")
@@ -310,7 +310,7 @@ def _study_done(args, study: Path, code: int) -> int:
         return 0
     from filmfriction.analysis.analyze import analyse_run
 
-    from ..md.replicas import replica_dir
+    from ..md.replica_study import replica_dir
 
     for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
         try:

@@ -89,14 +89,14 @@ def _raise_terminated(signum, frame):
     # the first signal only: a second one (a second Ctrl-C included) while the runner
     # stops LAMMPS and records the interruption is ignored (the context restores the
     # handlers at its end)
-    for sig in _TerminationAsInterrupt.SIGNALS:
+    for sig in TerminationAsInterrupt.SIGNALS:
         signal.signal(sig, signal.SIG_IGN)
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise Terminated(signal.Signals(signum).name)
 
 
-class _TerminationAsInterrupt:
+class TerminationAsInterrupt:
     """While active, SIGTERM and SIGHUP raise :class:`Terminated` and SIGINT raises
     KeyboardInterrupt, the first of them only (main thread only).
 
@@ -191,7 +191,7 @@ def execute(scene: Scene, out: Path | None = None, nprocs: int = 2,
     scene needs before the run directory is created.
     """
     script = Path(scene.script) if scene.script else md_inputs.script(SCRIPT)
-    with _TerminationAsInterrupt():
+    with TerminationAsInterrupt():
         build, launcher = _lammps(lmp, "--lmp", scene, nprocs, launcher, script, threads)
         run_dir = new_run_dir(scene.name, out)
         state = {"record": None}
@@ -435,7 +435,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
     run_dir = Path(run_dir)
     if not (run_dir / RUN_FILE).exists():
         raise SceneError(f"{run_dir} is not a run directory (no run.json)")
-    with _TerminationAsInterrupt():
+    with TerminationAsInterrupt():
         lock = RunLock(run_dir).acquire()
         state = {"record": None, "scene": None}
         try:

@@ -290,13 +290,13 @@ def _warnings(study: Path, record: dict) -> list[str]:
 
 def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: int) -> int:
     from ..progress import note
-    from .runner import _TerminationAsInterrupt
+    from .runner import TerminationAsInterrupt
 
     path = study / STUDY_FILE
     nprocs = int(record.get("np") or 1)
     workers = max(1, min(int(workers), len(record["replicas"])))
     rule = record.get("rule") or {}
-    with _TerminationAsInterrupt():
+    with TerminationAsInterrupt():
         lock = _lock(study).acquire()
         try:
             record["status"] = "running"
