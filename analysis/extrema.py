@@ -10,6 +10,9 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CycleTable
 
+from .noise import cycle_noise, noise_correlation
+from .noisy_extremum import noisy_extremum
+
 __all__ = ["refine_extrema", "EXTREMUM_WINDOW_SIGMAS", "PLATEAU_SIGMAS"]
 
 
@@ -131,74 +134,7 @@ def _kink_extremum(t, g, i, lo, hi, tol):
     return edge + joint, float(line(edge + joint))
 
 
-#: the window of a noisy extremum's fit reaches where the (lightly smoothed) force
-#: has fallen this many noise standard deviations below it, at most
-#: ``NOISY_WINDOW_MAX`` samples on each side
-NOISY_WINDOW_SIGMAS = 6.0
-NOISY_WINDOW_MAX = 120
-
-
-def _design(u, model, knot):
-    one = np.ones_like(u)
-    if model == "quadratic":
-        return np.column_stack([one, u, u * u])
-    d = np.clip(u - knot, 0.0, None) if model == "slip-after" else np.clip(knot - u, 0.0, None)
-    return np.column_stack([one, u, d, d * d])
-
-
-def _noisy_extremum(t, g, i, lo, hi, sigma, lag):
-    """Maximum of g about sample i on a noisy trace, from a least-squares fit.
-
-    The window reaches where the force, smoothed over ``lag`` samples, has fallen
-    :data:`NOISY_WINDOW_SIGMAS` σ below the extremum on each side.  Two shapes are
-    fitted: a parabola (a smooth turn), and a stick ramp that a slip leaves (or
-    joins) at a knot, a line on one side and a line plus a parabola on the other
-    (the knot scanned over the window); the one with the lower Bayesian
-    information criterion gives the extremum (the highest point of the fitted
-    curve).  Returns (time, value, value's noise error)."""
-    from scipy.ndimage import uniform_filter1d
-
-    m = max(1, int(lag))
-    seg = g[lo:hi + 1]
-    sm = uniform_filter1d(seg, size=2 * m + 1, mode="nearest") if m > 1 or seg.size > 4 else seg
-    k = i - lo
-    top = sm[max(k - m, 0):k + m + 1].max()
-    floor = top - NOISY_WINDOW_SIGMAS * sigma
-    left = np.flatnonzero(sm[:k] < floor)
-    right = np.flatnonzero(sm[k + 1:] < floor)
-    a = max(k - NOISY_WINDOW_MAX, (int(left[-1]) if left.size else 0), k - seg.size)
-    b = min(k + NOISY_WINDOW_MAX, (k + 1 + int(right[0])) if right.size else seg.size - 1)
-    a, b = max(0, min(a, k - 2)), min(seg.size - 1, max(b, k + 2))
-    u = t[lo + a:lo + b + 1] - t[i]
-    h = float(np.max(np.abs(u))) or 1.0
-    u = u / h             # the window's own time scale: the fit is the same in any unit
-    y = seg[a:b + 1]
-    n = u.size
-    best = None
-    candidates = [("quadratic", 0.0)]
-    if n >= 6:
-        knots = u[1:-1]
-        candidates += [(side, kn) for side in ("slip-after", "slip-before") for kn in knots]
-    for model, knot in candidates:
-        x = _design(u, model, knot)
-        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-        rss = float(np.sum((y - x @ coef) ** 2))
-        p = x.shape[1] + (0 if model == "quadratic" else 1)
-        bic = n * math.log(max(rss, 1e-300) / n) + p * math.log(n)
-        if best is None or bic < best[0]:
-            best = (bic, model, knot, coef, x)
-    _, model, knot, coef, x = best
-    fine = np.linspace(u[0], u[-1], 4 * n + 1)
-    xf = _design(fine, model, knot)
-    curve = xf @ coef
-    j = int(np.argmax(curve))
-    row = xf[j]
-    cov = np.linalg.pinv(x.T @ x)
-    err = sigma * math.sqrt(max(float(row @ cov @ row), 0.0) * m)
-    return t[i] + float(fine[j]) * h, float(curve[j]), err
-
-
-def _extremum(t, g, i, lo, hi, sigma, lag):
+def _extremum(t, g, i, lo, hi, sigma, lag, rho):
     """Refined maximum of g about sample i (the highest in [lo, hi]).
 
     Returns (time, value, noise error of value, noise error of time, sampling
@@ -219,8 +155,8 @@ def _extremum(t, g, i, lo, hi, sigma, lag):
     uneven = max(gaps) > 3.0 * min(gaps)
     w = 1 if sigma == 0.0 or uneven or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
     if w > 1:      # the noise is comparable to the turn over three samples
-        tp, vp, ev = _noisy_extremum(t, g, i, lo, hi, sigma, lag)
-        return tp, vp, ev, 0.0, 0.0, 0.0
+        e = noisy_extremum(t, g, i, lo, hi, sigma, lag=lag, correlation=rho)
+        return e.time, e.value, e.value_error, e.time_error, 0.0, 0.0
     a, b, c = coef
     u_lo, u_hi = t[a_] - t[i], t[b_] - t[i]
     if a < 0 and u_lo <= -b / (2 * a) <= u_hi:
@@ -294,6 +230,15 @@ def refine_extrema(time, spring_force, table: CycleTable, *, noise: float = 0.0,
     yi, si = table.yield_index, table.stick_index
     m = len(table)
     sigma = float(noise)
+    rho = 0.0
+    if sigma > 0.0:
+        # the local estimate overstates noise correlated over many samples (its longer
+        # lags straddle the slips), the cycle-to-cycle one a trace whose cycles differ:
+        # the noise is at most either
+        cyc = cycle_noise(t, f, yi) if m >= 2 else 0.0
+        sigma = min(sigma, cyc) if cyc > 0.0 else sigma
+        rho = noise_correlation(f, sigma, time=t)
+        lag = min(max(int(lag), 1), math.ceil((1.0 + rho) / (1.0 - rho)))
     cols = {n: np.full(m, math.nan) for n in ("ty", "fy", "ts", "fs")}
     errs = {n: np.zeros(m) for n in ("ty_n", "fy_n", "ts_n", "fs_n",
                                      "ty_r", "fy_r", "ts_r", "fs_r")}
@@ -308,8 +253,8 @@ def refine_extrema(time, spring_force, table: CycleTable, *, noise: float = 0.0,
             band = PLATEAU_SIGMAS * sigma
             y = y + int(np.flatnonzero(f[y:s + 1] >= f[y] - band)[-1])
             s = y + int(np.flatnonzero(f[y:s + 1] <= f[s] + band)[0])
-        ty, vy, evy, ety, rvy, rty = _extremum(t, f, y, lo_y, s, sigma, lag)
-        ts, vs, evs, ets, rvs, rts = _extremum(t, -f, s, y, hi_s, sigma, lag)
+        ty, vy, evy, ety, rvy, rty = _extremum(t, f, y, lo_y, s, sigma, lag, rho)
+        ts, vs, evs, ets, rvs, rts = _extremum(t, -f, s, y, hi_s, sigma, lag, rho)
         cols["ty"][j], cols["fy"][j], cols["ts"][j], cols["fs"][j] = ty, vy, ts, -vs
         for key, val in (("ty_n", ety), ("fy_n", evy), ("ts_n", ets), ("fs_n", evs),
                          ("ty_r", rty), ("fy_r", rvy), ("ts_r", rts), ("fs_r", rvs)):

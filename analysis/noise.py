@@ -12,7 +12,8 @@ import math
 
 import numpy as np
 
-__all__ = ["noise_level", "cycle_noise", "NOISE_QUANTILE", "CYCLE_NOISE_FACTOR"]
+__all__ = ["noise_level", "noise_correlation", "cycle_noise", "NOISE_QUANTILE",
+           "CYCLE_NOISE_FACTOR"]
 
 # s(2L)/s(L) beyond what stationary noise gives to second differences (at most 4, for a
 # smooth process): the windows at 2L straddle slips
@@ -122,15 +123,12 @@ def _noise_level(spring_force, *, max_lag=None, plateau=1.15, time=None):
     t = np.arange(n, dtype=float) if time is None else np.asarray(time, float)
 
     def s(lag, residuals):
-        r = np.abs(residuals(t, f, lag))
-        return float(np.quantile(r, NOISE_QUANTILE)) / _Q_NORMAL if r.size else 0.0
+        return _residual_scale(t, f, lag, residuals)
 
     max_lag = max(1, n // 20) if max_lag is None else max_lag
-    # a trace whose second differences at lag 1 are mostly a smooth curve's (a slip
-    # sampled finely, or by the model's own output) has fourth differences far below them
-    smooth = s(1, _line_residuals) < SMOOTH_RATIO * s(1, _chord_residuals)
-    residuals, straddle = ((_line_residuals, STRADDLE_RATIO_SMOOTH) if smooth
-                           else (_chord_residuals, STRADDLE_RATIO))
+    residuals = _lag_one_residuals(t, f)
+    smooth = residuals is _line_residuals
+    straddle = STRADDLE_RATIO_SMOOTH if smooth else STRADDLE_RATIO
     lag, prev = 1, s(1, residuals)
     while 2 * lag <= max_lag and 8 * lag < n:
         cur = s(2 * lag, residuals)
@@ -142,6 +140,75 @@ def _noise_level(spring_force, *, max_lag=None, plateau=1.15, time=None):
     # the search ended at its longest lag still growing: the noise is correlated over
     # longer than the estimate sees (a lower bound, as on a smooth trace)
     return prev, lag, True
+
+
+def _residual_scale(t, f, lag, residuals):
+    """s(L): the lower quartile of |residual| at lag L, scaled to a Gaussian's σ."""
+    r = np.abs(residuals(t, f, lag))
+    return float(np.quantile(r, NOISE_QUANTILE)) / _Q_NORMAL if r.size else 0.0
+
+
+def _lag_one_residuals(t, f):
+    """The residuals the noise is read from: the fourth differences' on a trace whose
+    second differences at lag 1 are mostly a smooth curve's (a slip sampled finely, or
+    by the model's own output: its fourth differences are far below them), else the
+    second differences'."""
+    smooth = (_residual_scale(t, f, 1, _line_residuals)
+              < SMOOTH_RATIO * _residual_scale(t, f, 1, _chord_residuals))
+    return _line_residuals if smooth else _chord_residuals
+
+
+def noise_correlation(spring_force, sigma: float, *, time=None) -> float:
+    """The noise's correlation from one sample to the next, as an AR(1) coefficient ρ.
+
+    AR(1) noise of standard deviation σ and coefficient ρ gives the residuals of
+    :func:`noise_level` at lag 1 a scale s(1) below σ: the neighbours it is compared
+    with share part of its noise.  For the second differences (uniform sampling)
+    s(1)²/σ² = (1 − ρ)(3 − ρ)/3, so ρ = 2 − √(1 + 3 s(1)²/σ²); for the fourth
+    differences (a trace smooth at its sampling) the same relation is solved
+    numerically.  White noise gives 0; ρ is at most 0.99.  Noise that is not AR(1)
+    (an MD wall's thermal vibration) gets the AR(1) with its lag-1 correlation.
+
+    Parameters
+    ----------
+    spring_force : array_like
+    sigma : float
+        The noise's standard deviation (:func:`noise_level`).
+    time : array_like, optional
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from scipy.signal import lfilter
+    >>> e = np.random.default_rng(2).normal(0.0, 1.0, 20000)
+    >>> round(noise_correlation(e, 1.0), 1)
+    0.0
+    >>> ar = lfilter([1.0], [1.0, -0.9], e) * np.sqrt(1 - 0.81)
+    >>> round(noise_correlation(ar, 1.0), 1)
+    0.9
+    """
+    f = np.asarray(spring_force, float)
+    if not sigma > 0.0 or f.size < 9:
+        return 0.0
+    t = np.arange(f.size, dtype=float) if time is None else np.asarray(time, float)
+    residuals = _lag_one_residuals(t, f)
+    ratio2 = min((_residual_scale(t, f, 1, residuals) / float(sigma)) ** 2, 1.0)
+    if residuals is _chord_residuals:
+        rho = 2.0 - math.sqrt(1.0 + 3.0 * ratio2)
+    else:
+        # the cubic through the neighbours at ±1, ±2 at the centre: weights (−1, 4, 4, −1)/6
+        c = np.array([1.0, -4.0, 6.0, -4.0, 1.0]) / 6.0
+        lags = np.abs(np.subtract.outer(np.arange(5), np.arange(5)))
+
+        def share(r):
+            return float(c @ (r ** lags) @ c) / float(c @ c) - ratio2
+        from scipy.optimize import brentq
+        rho = brentq(share, 0.0, 0.999999) if share(0.0) > 0.0 > share(0.999999) else (
+            0.0 if share(0.0) <= 0.0 else 1.0)
+    return min(max(rho, 0.0), 0.99)
 
 
 #: the cycle-to-cycle noise sets the threshold where it exceeds the local noise
