@@ -137,8 +137,12 @@ def _kink_extremum(t, g, i, lo, hi, tol):
 def _extremum(t, g, i, lo, hi, sigma, lag, rho):
     """Refined maximum of g about sample i (the highest in [lo, hi]).
 
-    Returns (time, value, noise error of value, noise error of time, sampling
-    error of value, sampling error of time)."""
+    Returns (time, value, noise error of value, noise error of time, systematic
+    error of value, systematic error of time).  The systematic error is the one the
+    same on every slip, which does not average out: on a noise-free trace the
+    sampling's (the range the samples leave open), on a noisy one half the bias the
+    bootstrap corrected (:mod:`filmfriction.analysis.noisy_extremum`: the correction
+    rests on the fitted shape, which the true one may differ from)."""
     n_lo, n_hi = i - lo, hi - i
     if n_lo < 1 or n_hi < 1:              # at the end of its range: the sample itself
         dt = t[min(i + 1, hi)] - t[max(i - 1, lo)]
@@ -156,7 +160,8 @@ def _extremum(t, g, i, lo, hi, sigma, lag, rho):
     w = 1 if sigma == 0.0 or uneven or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
     if w > 1:      # the noise is comparable to the turn over three samples
         e = noisy_extremum(t, g, i, lo, hi, sigma, lag=lag, correlation=rho)
-        return e.time, e.value, e.value_error, e.time_error, 0.0, 0.0
+        return (e.time, e.value, e.value_error, e.time_error, 0.5 * abs(e.value_bias),
+                0.5 * abs(e.time_bias))
     a, b, c = coef
     u_lo, u_hi = t[a_] - t[i], t[b_] - t[i]
     if a < 0 and u_lo <= -b / (2 * a) <= u_hi:
