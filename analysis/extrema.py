@@ -209,15 +209,25 @@ def refine_extrema(time, spring_force, table: CycleTable, *, noise: float = 0.0,
     """The yield and re-stick points between the samples: each slip's force maximum
     (y, F_s) and minimum (s, F_b), with their errors.
 
-    The detector's y and s are the highest and lowest samples.  The extremum is
-    refined by a least-squares parabola about that sample: through it and its two
-    neighbours on a noise-free trace (the value kept between the highest sample
-    and the bound of the neighbouring secants, which a concave peak cannot
-    exceed), over a window whose ends lie :data:`EXTREMUM_WINDOW_SIGMAS` noise
-    standard deviations below the peak on a noisy one.  Its errors: on a
-    noise-free trace the sampling's (the range the samples allow, as a uniform
-    distribution), on a noisy one the fit's (σ² × ``lag`` per sample, the noise's
-    decorrelation).
+    The detector's y and s are the highest and lowest samples.  On a noise-free
+    trace (the extreme sample stands more than :data:`EXTREMUM_WINDOW_SIGMAS` noise
+    standard deviations above the chord of its neighbours) the extremum is the
+    parabola's through it and its two neighbours, or, next to a straight stick
+    ramp, where the ramp's line and the slip's parabola meet or turn (the value kept
+    between the highest sample and the bound of the neighbouring secants, which a
+    concave peak cannot exceed); its errors are the sampling's (the range the
+    samples leave open, as a uniform distribution).  On a noisy trace it is a
+    least-squares fit of the turn's shape, its bias corrected and its errors of
+    value and time from a parametric bootstrap with the trace's own noise
+    (:func:`filmfriction.analysis.noisy_extremum.noisy_extremum`; half the corrected
+    bias is kept as a systematic error).  The noise is the smaller of ``noise``
+    (the local estimate, which overstates noise correlated over many samples) and
+    the cycle-to-cycle one (:func:`filmfriction.analysis.noise.cycle_noise`, which
+    overstates it on a trace whose cycles differ), its correlation from sample to
+    sample :func:`filmfriction.analysis.noise.noise_correlation`.
+
+    The times' errors enter the durations (slip, stick, period) and, with the
+    forces', the slip distance.
 
     Slip distance: the wall's displacement x(s) − x(y) = (F_s − F_b)/K + V τ_s
     with K and V; else from ``wall_position`` interpolated at the refined times;
@@ -228,7 +238,8 @@ def refine_extrema(time, spring_force, table: CycleTable, *, noise: float = 0.0,
     CycleTable
         With the refined times and forces, the durations between the refined
         times, and ``uncertainty``: per column, the per-slip noise error and
-        sampling error (see :meth:`CycleTable.summary`).
+        systematic error (the sampling's, or the noisy fit's; see
+        :meth:`CycleTable.summary`).
     """
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
