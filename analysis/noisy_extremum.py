@@ -38,8 +38,8 @@ class NoisyExtremum:
     time, value : float
         Where the fitted curve is highest and its value there, less the fit's bias.
     time_error, value_error : float
-        Their standard errors from the noise (the bootstrap's spread, with the
-        bias' own error).
+        Their standard errors from the noise (the half-width of the bootstrap's
+        central 68 %, with the bias' own error).
     time_bias, value_bias : float
         The bias subtracted (the bootstrap's mean extremum less the curve's).
     shape : str
@@ -160,8 +160,8 @@ def noisy_extremum(t, g, i, lo, hi, sigma, *, lag=1, correlation=0.0,
     standard deviation ``sigma`` and coefficient ``correlation`` per sample (the
     trace's own, :func:`filmfriction.analysis.noise.noise_correlation`), each fitted
     the same way.  The mean of their extrema less the curve's own is the fit's bias
-    (subtracted from value and time), their standard deviation the noise error
-    (with the bias' own error, 1/√R of it).  The draws are seeded by ``i``: the same
+    (subtracted from value and time), the half-width of their central 68 % the noise
+    error (with the bias' own error, 1/√R of it).  The draws are seeded by ``i``: the same
     trace gives the same answer.
 
     Parameters
@@ -213,9 +213,11 @@ def noisy_extremum(t, g, i, lo, hi, sigma, *, lag=1, correlation=0.0,
         e = lfilter([1.0], [1.0, -rho], e, axis=0)
     _, _, boot_u, boot_v = _fit(x, pinv, params, kinds, knots, curve[:, None] + e, u0, u1)
     bias_u, bias_v = float(np.mean(boot_u) - top_u[0]), float(np.mean(boot_v) - top_v[0])
+    # the half-width of the replicates' central 68 % (a spread that heavy tails -- a
+    # replicate whose knot jumps -- do not inflate), with the bias' own error
     inflate = math.sqrt(1.0 + 1.0 / replicates)
-    err_u = float(np.std(boot_u, ddof=1)) * inflate
-    err_v = float(np.std(boot_v, ddof=1)) * inflate
+    err_u = 0.5 * float(np.subtract(*np.percentile(boot_u, [84.13, 15.87]))) * inflate
+    err_v = 0.5 * float(np.subtract(*np.percentile(boot_v, [84.13, 15.87]))) * inflate
     shape = ("turn", "slip-after", "slip-before")[int(kinds[best[0]])]
     return NoisyExtremum(time=t[i] + (float(top_u[0]) - bias_u) * h,
                          value=y0 + (float(top_v[0]) - bias_v) * sigma,
