@@ -266,15 +266,24 @@ def cycle_noise(time, spring_force, yield_index) -> float:
     # the period of a noisy trace's yields is uncertain by a few samples: the shift
     # that aligns the cycles best, within two median sample spacings
     step = float(np.median(np.diff(t)))
-    shifts = period + step * np.linspace(-2.0, 2.0, 9)
-    best = min(_unrepeated(t, f, p) for p in shifts if p > 0.0)
+    if np.all(np.abs(np.diff(t) - step) <= 1e-4 * step):
+        # uniform sampling: shifts of whole and half sample spacings on the sample grid,
+        # whatever the last digits of the times (a unit's rounding must not move them)
+        k = round(2.0 * period / step) / 2.0
+        idx = np.arange(f.size, dtype=float)
+        best = min(_unrepeated(idx, f, k + s) for s in np.linspace(-2.0, 2.0, 9) if k + s > 0)
+    else:
+        shifts = period + step * np.linspace(-2.0, 2.0, 9)
+        best = min(_unrepeated(t, f, p) for p in shifts if p > 0.0)
     return best if math.isfinite(best) else 0.0
 
 
 def _unrepeated(t, f, period):
     """The scale of f(t + period) − f(t) (see :func:`cycle_noise`); inf when fewer
     than 8 samples overlap."""
-    ok = t + period <= t[-1]
+    # a sample whose shifted time lands on the last one (a period of whole sample
+    # spacings) is in, however the times round in the trace's unit
+    ok = t + period <= t[-1] + 1e-6 * (t[-1] - t[0]) / max(t.size - 1, 1)
     if np.count_nonzero(ok) < 8:
         return math.inf
     x = t[ok] + period

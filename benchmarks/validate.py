@@ -339,8 +339,9 @@ def main(argv=None):
         (f" --seed {args.seed}" if args.seed != 2024 else "") + \
         (f" --calibration-cases {args.calibration_cases}" if args.calibration_cases != 20 else "")
     lines = ["# Ground-truth validation of the slip analysis", "",
-             f"Command: `{cmd}`; commit {commit}; seed {args.seed}. A correctness table: "
-             "biases and coverages only, no timing (it may run beside other work).", "",
+             f"Command: `{cmd}`; commit {commit}; {os.cpu_count()} cores (one used); seed "
+             f"{args.seed}. A correctness table: biases and coverages only, no timing (it may "
+             "run beside other work).", "",
              "Random spring-blocks of six friction laws (Coulomb, Coulomb + viscous, Coulomb "
              "with an elastic film, Stribeck, rate-and-state, Klein's Eq. 1), half in LJ and "
              "half in SI numbers, analysed as `filmfriction analyze` does; the truth is the "
