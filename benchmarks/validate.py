@@ -286,9 +286,8 @@ def reading(exact, noisy):
                    + ".")
     missed = sum(s.detected != s.expected for s in noisy)
     out.append(f"- Noisy traces whose slip count differs from the model's: {missed} of "
-               f"{len(noisy)} (mostly AR(1) noise at 3-10 % of the drop, where correlated "
-               "excursions are missed or split as slips); their observables are scored on the "
-               "slips matched by time.")
+               f"{len(noisy)} (per noise level: the list under the noisy table); their "
+               "observables are scored on the slips matched by time.")
     return out
 
 
