@@ -1,5 +1,4 @@
-"""Why the noisy error bars undercover: the coverage of ±1 s.e. on noisy model traces,
-split by what enters the error.
+"""The coverage of ±1 s.e. on noisy model traces, split by what enters the error.
 
     .venv/bin/python benchmarks/coverage_parts.py [--seed 99] [--per-cell 2]
 
@@ -7,7 +6,8 @@ Random blocks of every friction law (:mod:`filmfriction.analysis.groundtruth.cas
 50 samples per slip, white or AR(1) (ρ = 0.9) noise of 0.3, 1, 3 and 10 % of the force
 drop, ``per-cell`` cases per law, noise level and correlation, half LJ and half SI;
 each analysed as ``filmfriction analyze`` does.  Over the cases with at least 3 slips,
-per observable: the coverage of the reported s.e. (s/√n with the sampling's resolution),
+per observable: the coverage of the reported s.e. (s/√n with the mean systematic error:
+the sampling's resolution, or half the bias the noisy fit corrected),
 of the same scaled by Student's t for n − 1 degrees of freedom (what ±1 s.e. of a mean
 of n values covers 68 % with), and of the s.e. with each slip's own noise error added
 (s² + e²)/n; the mean and median |z| of z = error/(s/√n) (for n = 7 slips and unbiased

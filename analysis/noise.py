@@ -1,0 +1,295 @@
+"""The noise of a spring-force trace: its standard deviation and decorrelation lag from
+the trace's own local differences (:func:`noise_level`), and what does not repeat from
+one stick-slip cycle to the next (:func:`cycle_noise`).
+
+Both serve the slip detector (:func:`filmfriction.analysis.stickslip.detect_slips`),
+whose threshold they set, and the error bars of the yield and re-stick points
+(:mod:`filmfriction.analysis.extrema`).  Nothing here depends on the unit system.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["noise_level", "noise_correlation", "cycle_noise", "NOISE_QUANTILE",
+           "CYCLE_NOISE_FACTOR"]
+
+# s(2L)/s(L) beyond what stationary noise gives to second differences (at most 4, for a
+# smooth process): the windows at 2L straddle slips
+STRADDLE_RATIO = 4.5
+# the same for fourth differences, which grow as L⁴ (16 per doubling) on a smooth curve;
+# white noise gives 1, AR(1) noise about √2, an MD wall's thermal motion 2-4
+STRADDLE_RATIO_SMOOTH = 8.0
+# fourth differences below this share of the second differences at lag 1: the trace is
+# smooth at its sampling (a noise-free slip), not noisy
+SMOOTH_RATIO = 0.25
+
+
+def _chord_residuals(t, f, lag):
+    """Residuals of f[i] from the straight line through f[i − lag] and f[i + lag], scaled
+    to the noise's standard deviation: zero on a straight ramp however it is sampled,
+    ∝ lag² on a smooth curve, of standard deviation σ for white noise σ."""
+    t0, t1, t2 = t[:-2 * lag], t[lag:-lag], t[2 * lag:]
+    w = (t1 - t0) / (t2 - t0)
+    r = f[lag:-lag] - (1.0 - w) * f[:-2 * lag] - w * f[2 * lag:]
+    return r / np.sqrt(1.0 + w ** 2 + (1.0 - w) ** 2)
+
+
+def _line_residuals(t, f, lag):
+    """Residuals of f[i] from the cubic through f[i − 2 lag], f[i − lag], f[i + lag] and
+    f[i + 2 lag], scaled to the noise's standard deviation: zero on a straight ramp
+    however it is sampled, ∝ lag⁴ on a smooth curve, of standard deviation σ for
+    white noise σ (uniform sampling or not)."""
+    n = t.size
+    c = slice(2 * lag, n - 2 * lag)
+    if c.stop - c.start <= 0:
+        return np.empty(0)
+    nodes = [slice(0, n - 4 * lag), slice(lag, n - 3 * lag), slice(3 * lag, n - lag),
+             slice(4 * lag, n)]
+    x = t[c]
+    r = f[c].copy()
+    norm = np.ones_like(x)
+    for j, sj in enumerate(nodes):
+        w = np.ones_like(x)
+        for k, sk in enumerate(nodes):
+            if k != j:
+                w *= (x - t[sk]) / (t[sj] - t[sk])
+        r -= w * f[sj]
+        norm += w * w
+    return r / np.sqrt(norm)
+
+
+#: the quantile of |residual| the noise is read from (see :func:`noise_level`)
+NOISE_QUANTILE = 0.25
+# 0.25 quantile of |N(0, 1)|
+_Q_NORMAL = 0.31863936396437514
+
+
+def noise_level(spring_force, *, max_lag: int | None = None,
+                plateau: float = 1.15, time=None) -> tuple[float, int]:
+    """Robust standard deviation of the fluctuations of a trace.
+
+    Uses the residual of each sample from the straight line through its
+    neighbours at lag L (a second difference, weighted by the sample times when
+    they are not uniform), which vanishes on straight stick ramps of any slope.
+    s(L) is read from the lower quartile of |residual| (``NOISE_QUANTILE``,
+    scaled to a Gaussian's σ): the curved slips, however much of the trace they
+    take, give the large residuals, and the straight ramps, as long as they are
+    a quarter of the trace, set the quartile.  For white noise s(L) = σ at every
+    L; for correlated (thermal) noise s(L) grows with L until L exceeds the
+    correlation time.  The estimate is s(2L) at the first lag with
+    s(2L)/s(L) < ``plateau``.  A ratio above 4.5 (``STRADDLE_RATIO``) stops the
+    search at s(L): no stationary noise grows that fast (a smooth process at
+    most as L², 4×), so at 2L most windows straddle a slip or its ringing.
+
+    A trace that is smooth at its sampling (a noise-free slip sampled finely, or
+    by the model's own output with a handful of samples per stick) has fourth
+    differences (the residual from the cubic through the neighbours at ±L and
+    ±2L) far below its second differences at lag 1 (below ``SMOOTH_RATIO``):
+    its second differences are the slip's curvature, not noise.  The same search
+    then runs on the fourth differences, which grow as L⁴ on a smooth curve
+    (stop above ``STRADDLE_RATIO_SMOOTH`` = 8× per doubling; s(L) is then an
+    upper bound of the noise).
+
+    Parameters
+    ----------
+    spring_force : array_like
+    max_lag : int, optional
+        Largest lag tried (default N/20).
+    plateau : float
+    time : array_like, optional
+        Sample times (default: uniform).
+
+    Returns
+    -------
+    sigma : float
+        Noise standard deviation (0 for a noise-free piecewise-linear trace).
+    lag : int
+        Decorrelation lag in samples (1 for white noise).
+    """
+    sigma, lag, _ = _noise_level(spring_force, max_lag=max_lag, plateau=plateau, time=time)
+    return sigma, lag
+
+
+def _noise_level(spring_force, *, max_lag=None, plateau=1.15, time=None):
+    """:func:`noise_level`, and whether the estimate is a lower bound of correlated
+    noise: the trace is smooth at its sampling (the fourth differences' search), or
+    the search reached its longest lag with s(L) still growing."""
+    f = np.asarray(spring_force, float)
+    n = f.size
+    if n < 9:
+        return 0.0, 1, False
+    t = np.arange(n, dtype=float) if time is None else np.asarray(time, float)
+
+    def s(lag, residuals):
+        return _residual_scale(t, f, lag, residuals)
+
+    max_lag = max(1, n // 20) if max_lag is None else max_lag
+    residuals = _lag_one_residuals(t, f)
+    smooth = residuals is _line_residuals
+    straddle = STRADDLE_RATIO_SMOOTH if smooth else STRADDLE_RATIO
+    lag, prev = 1, s(1, residuals)
+    while 2 * lag <= max_lag and 8 * lag < n:
+        cur = s(2 * lag, residuals)
+        if prev == 0.0 or cur < plateau * prev:
+            return (cur if prev else 0.0), lag, smooth
+        if cur > straddle * prev:
+            return prev, lag, smooth
+        lag, prev = 2 * lag, cur
+    # the search ended at its longest lag still growing: the noise is correlated over
+    # longer than the estimate sees (a lower bound, as on a smooth trace)
+    return prev, lag, True
+
+
+def _residual_scale(t, f, lag, residuals):
+    """s(L): the lower quartile of |residual| at lag L, scaled to a Gaussian's σ."""
+    r = np.abs(residuals(t, f, lag))
+    return float(np.quantile(r, NOISE_QUANTILE)) / _Q_NORMAL if r.size else 0.0
+
+
+def _lag_one_residuals(t, f):
+    """The residuals the noise is read from: the fourth differences' on a trace whose
+    second differences at lag 1 are mostly a smooth curve's (a slip sampled finely, or
+    by the model's own output: its fourth differences are far below them), else the
+    second differences'."""
+    smooth = (_residual_scale(t, f, 1, _line_residuals)
+              < SMOOTH_RATIO * _residual_scale(t, f, 1, _chord_residuals))
+    return _line_residuals if smooth else _chord_residuals
+
+
+def noise_correlation(spring_force, sigma: float, *, time=None) -> float:
+    """The noise's correlation from one sample to the next, as an AR(1) coefficient ρ.
+
+    AR(1) noise of standard deviation σ and coefficient ρ gives the residuals of
+    :func:`noise_level` at lag 1 a scale s(1) below σ: the neighbours it is compared
+    with share part of its noise.  For the second differences (uniform sampling)
+    s(1)²/σ² = (1 − ρ)(3 − ρ)/3, so ρ = 2 − √(1 + 3 s(1)²/σ²); for the fourth
+    differences (a trace smooth at its sampling) the same relation is solved
+    numerically.  White noise gives 0; ρ is at most 0.99.  Noise that is not AR(1)
+    (an MD wall's thermal vibration) gets the AR(1) with its lag-1 correlation.
+
+    Parameters
+    ----------
+    spring_force : array_like
+    sigma : float
+        The noise's standard deviation (:func:`noise_level`).
+    time : array_like, optional
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> from scipy.signal import lfilter
+    >>> e = np.random.default_rng(2).normal(0.0, 1.0, 20000)
+    >>> round(noise_correlation(e, 1.0), 1)
+    0.0
+    >>> ar = lfilter([1.0], [1.0, -0.9], e) * np.sqrt(1 - 0.81)
+    >>> round(noise_correlation(ar, 1.0), 1)
+    0.9
+    """
+    f = np.asarray(spring_force, float)
+    if not sigma > 0.0 or f.size < 9:
+        return 0.0
+    t = np.arange(f.size, dtype=float) if time is None else np.asarray(time, float)
+    residuals = _lag_one_residuals(t, f)
+    ratio2 = min((_residual_scale(t, f, 1, residuals) / float(sigma)) ** 2, 1.0)
+    if residuals is _chord_residuals:
+        rho = 2.0 - math.sqrt(1.0 + 3.0 * ratio2)
+    else:
+        # the cubic through the neighbours at ±1, ±2 at the centre: weights (−1, 4, 4, −1)/6
+        c = np.array([1.0, -4.0, 6.0, -4.0, 1.0]) / 6.0
+        lags = np.abs(np.subtract.outer(np.arange(5), np.arange(5)))
+
+        def share(r):
+            return float(c @ (r ** lags) @ c) / float(c @ c) - ratio2
+        from scipy.optimize import brentq
+        rho = brentq(share, 0.0, 0.999999) if share(0.0) > 0.0 > share(0.999999) else (
+            0.0 if share(0.0) <= 0.0 else 1.0)
+    return min(max(rho, 0.0), 0.99)
+
+
+#: the cycle-to-cycle noise sets the threshold where it exceeds the local noise
+#: estimate by more than this factor (it also holds the slips' own cycle-to-cycle
+#: variation, so it is an upper estimate of the noise: within the factor the two agree)
+CYCLE_NOISE_FACTOR = 2.0
+
+
+def cycle_noise(time, spring_force, yield_index) -> float:
+    """Robust standard deviation of what does not repeat from one cycle to the next.
+
+    The trace is compared with itself one period P later (P the median time
+    between the yields, adjusted within ±2 sample spacings to the shift that
+    aligns the cycles best; the later trace interpolated linearly at t + P):
+    d(t) = f(t + P) − f(t), less its median (a drift of the force levels).  A
+    periodic trace of any shape, however smooth or coarsely sampled, repeats
+    (d ≈ 0); noise does not, white or correlated over any time shorter than
+    P, and neither does a trace that only fluctuates (a stuck wall's thermal
+    vibration, sampled so finely that it is smooth at its sampling and the
+    local estimate of :func:`noise_level` sees no noise).  The scale is read
+    from the lower quartile of |d| as in :func:`noise_level` (the slips, where
+    cycles differ in timing, give the large |d|), each d scaled by its
+    variance for white noise of standard deviation σ (1 + w² + (1 − w)², w the
+    interpolation weight), so that white noise gives σ; correlated noise gives
+    up to 15 % more.
+
+    Parameters
+    ----------
+    time, spring_force : array_like
+    yield_index : array_like of int
+        The yields (at least 2; else 0 is returned).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 40.0, 0.05)
+    >>> saw = t % 5.0
+    >>> round(cycle_noise(t, saw, np.flatnonzero(np.diff(saw) < 0)), 12)
+    0.0
+    >>> noisy = saw + np.random.default_rng(1).normal(0, 0.1, t.size)
+    >>> round(cycle_noise(t, noisy, np.flatnonzero(np.diff(saw) < 0)), 1)
+    0.1
+    """
+    t = np.asarray(time, float)
+    f = np.asarray(spring_force, float)
+    yi = np.asarray(yield_index, np.int64)
+    if yi.size < 2:
+        return 0.0
+    period = float(np.median(np.diff(t[yi])))
+    if period <= 0.0 or np.count_nonzero(t + period <= t[-1]) < 8:
+        return 0.0
+    # the period of a noisy trace's yields is uncertain by a few samples: the shift
+    # that aligns the cycles best, within two median sample spacings
+    step = float(np.median(np.diff(t)))
+    if np.all(np.abs(np.diff(t) - step) <= 1e-4 * step):
+        # uniform sampling: shifts of whole and half sample spacings on the sample grid,
+        # whatever the last digits of the times (a unit's rounding must not move them)
+        k = round(2.0 * period / step) / 2.0
+        idx = np.arange(f.size, dtype=float)
+        best = min(_unrepeated(idx, f, k + s) for s in np.linspace(-2.0, 2.0, 9) if k + s > 0)
+    else:
+        shifts = period + step * np.linspace(-2.0, 2.0, 9)
+        best = min(_unrepeated(t, f, p) for p in shifts if p > 0.0)
+    return best if math.isfinite(best) else 0.0
+
+
+def _unrepeated(t, f, period):
+    """The scale of f(t + period) − f(t) (see :func:`cycle_noise`); inf when fewer
+    than 8 samples overlap."""
+    # a sample whose shifted time lands on the last one (a period of whole sample
+    # spacings) is in, however the times round in the trace's unit
+    ok = t + period <= t[-1] + 1e-6 * (t[-1] - t[0]) / max(t.size - 1, 1)
+    if np.count_nonzero(ok) < 8:
+        return math.inf
+    x = t[ok] + period
+    j = np.clip(np.searchsorted(t, x), 1, t.size - 1)
+    w = (x - t[j - 1]) / (t[j] - t[j - 1])
+    d = (1.0 - w) * f[j - 1] + w * f[j] - f[ok]
+    d = (d - np.median(d)) / np.sqrt(1.0 + w * w + (1.0 - w) ** 2)
+    return float(np.quantile(np.abs(d), NOISE_QUANTILE)) / _Q_NORMAL
+
