@@ -108,12 +108,12 @@ def noise_level(spring_force, *, max_lag: int | None = None,
     lag : int
         Decorrelation lag in samples (1 for white noise).
     """
-    sigma, lag, _ = _noise_level(spring_force, max_lag=max_lag, plateau=plateau, time=time)
+    sigma, lag, _ = noise_level_and_bound(spring_force, max_lag=max_lag, plateau=plateau, time=time)
     return sigma, lag
 
 
-def _noise_level(spring_force, *, max_lag=None, plateau=1.15, time=None):
-    """:func:`noise_level`, and whether the estimate is a lower bound of correlated
+def noise_level_and_bound(spring_force, *, max_lag=None, plateau=1.15, time=None):
+    """:func:`noise_level`, and whether the estimate is only a lower bound of correlated
     noise: the trace is smooth at its sampling (the fourth differences' search), or
     the search reached its longest lag with s(L) still growing."""
     f = np.asarray(spring_force, float)

@@ -32,7 +32,7 @@ from filmfriction.reduced_model.cycles import CycleTable, cycle_table, stats
 # the yield and re-stick points between samples, the noise, the stick ramps: each in its
 # own module, named here too (the analysis' one entry point for a trace's slips)
 from .extrema import refine_extrema
-from .noise import CYCLE_NOISE_FACTOR, _noise_level, cycle_noise, noise_level
+from .noise import CYCLE_NOISE_FACTOR, noise_level_and_bound, cycle_noise, noise_level
 from .stick_ramps import StickStiffness, ramp_forces, stick_stiffness
 
 __all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTable", "SlipEvents",
@@ -214,7 +214,7 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         return SlipEvents(empty, empty, math.inf, 0.0)
     lag, blind = 1, False
     if noise is None:
-        noise, lag, blind = _noise_level(f, time=t)
+        noise, lag, blind = noise_level_and_bound(f, time=t)
     n_eff = max(f.size / lag, 2.0)
     kk = (2.0 * math.sqrt(2.0 * math.log(n_eff)) + 1.0) if k is None else k
     threshold_given = threshold
