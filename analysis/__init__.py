@@ -19,9 +19,9 @@ Modules (one sitting each):
   :mod:`~filmfriction.analysis.calibration.replay` and :mod:`~filmfriction.analysis.calibration.md_estimates`.
 """
 
+from .calibration.calibrate import Calibration, calibrate, load_run, write_calibration
+
 if __name__ != "filmfriction.analysis":  # one name only: two would give two copies of every class
     raise ImportError(f"import filmfriction.analysis, not {__name__}")
-
-from .calibration.calibrate import Calibration, calibrate, load_run, write_calibration  # noqa: E402
 
 __all__ = ["calibrate", "Calibration", "load_run", "write_calibration"]

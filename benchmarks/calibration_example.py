@@ -18,12 +18,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from filmfriction.analysis.calibration import calibrate as cal_mod  # noqa: E402
-from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv  # noqa: E402
+from filmfriction.analysis.calibration import calibrate as cal_mod
+from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
 
 K, M, V, FS, FK, B = 97.0, 1.47e-3, 1.0e-7, 9.7e-6, 2.0e-6, 1.5      # SI
 AREA, GAP = 4.0e-10, 3.5e-9

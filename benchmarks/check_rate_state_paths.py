@@ -19,14 +19,11 @@ import math
 import sys
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
 from filmfriction.reduced_model import SpringBlock, laws
-from filmfriction.reduced_model.integrators import limit_cycle  # noqa: E402
+from filmfriction.reduced_model.integrators import limit_cycle
 
 
 def draw(rng):

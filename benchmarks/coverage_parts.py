@@ -19,15 +19,12 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+from scipy import stats
 
-import numpy as np  # noqa: E402
-from scipy import stats  # noqa: E402
-
-from filmfriction.analysis.analyze import context  # noqa: E402
-from filmfriction.analysis.groundtruth import cases as gt  # noqa: E402
+from filmfriction.analysis.analyze import context
+from filmfriction.analysis.groundtruth import cases as gt
 
 NAMES = ("static_force", "backward_force", "slip_distance", "slip_duration")
 

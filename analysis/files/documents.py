@@ -28,7 +28,6 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 __all__ = ["DocumentError", "Field", "SPECS", "MD_CALIBRATION", "check_document", "read_document"]
 

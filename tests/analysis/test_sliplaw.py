@@ -50,28 +50,28 @@ def test_without_the_wall_position_the_integrated_velocity_does():
     assert fit.kinetic_force == pytest.approx(0.4, abs=5e-3)
 
 
-def test_a_pure_law_is_called_by_its_name_when_the_other_term_is_absent():
-    # Klein's slip (F_k = 0) at a small noise: viscous; a Coulomb slip (B = 0): kinetic
-    tr = klein_trace(spring_constant=2.0, mass=30.0, damping=62.0, drive_velocity=0.1,
-                     static_force=48.0, backward_force=24.0, cycles=8, dt=0.25)
+def _fit_noisy(tr):
+    """The film-force fit of a model trace's slips (the start-up slip left out), the wall's
+    velocity and the spring force with a small measurement noise."""
     noisy = with_wall_noise(tr, velocity_noise=0.02, seed=1)
     t, f = tr["time"], tr["spring_force"]
     ev = detect_slips(t, f)
     tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=2.0)[1:]
-    fit = fit_film_force(t, noisy["spring_force"], noisy["wall_velocity"], tab, mass=30.0,
-                         drive_velocity=0.1, wall_position=tr["wall_position"])
+    return fit_film_force(t, noisy["spring_force"], noisy["wall_velocity"], tab, mass=30.0,
+                          drive_velocity=0.1, wall_position=tr["wall_position"])
+
+
+def test_a_pure_law_is_called_by_its_name_when_the_other_term_is_absent():
+    # Klein's slip (F_k = 0) at a small noise: viscous; a Coulomb slip (B = 0): kinetic
+    fit = _fit_noisy(klein_trace(spring_constant=2.0, mass=30.0, damping=62.0,
+                                 drive_velocity=0.1, static_force=48.0, backward_force=24.0,
+                                 cycles=8, dt=0.25))
     assert fit.verdict == "viscous", fit.reason
     assert fit.damping == pytest.approx(62.0, rel=0.03)
     assert fit.decelerating.exponent == pytest.approx(1.0, abs=0.05)
     block = SpringBlock(mass=30.0, stiffness=2.0, drive_velocity=0.1,
                         law=laws.Coulomb(static=48.0, kinetic=36.0))
-    tr = block_trace(block, 1200.0, 0.25)
-    noisy = with_wall_noise(tr, velocity_noise=0.02, seed=1)
-    t, f = tr["time"], tr["spring_force"]
-    ev = detect_slips(t, f)
-    tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=2.0)[1:]
-    fit = fit_film_force(t, noisy["spring_force"], noisy["wall_velocity"], tab, mass=30.0,
-                         drive_velocity=0.1, wall_position=tr["wall_position"])
+    fit = _fit_noisy(block_trace(block, 1200.0, 0.25))
     assert fit.verdict == "kinetic", fit.reason
     assert abs(fit.decelerating.exponent) < 0.05
 

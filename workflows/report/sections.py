@@ -11,7 +11,6 @@ from filmfriction.analysis.observables import Observable
 from filmfriction.analysis.files.trace import unit as _unit
 from filmfriction.analysis.files.util import format_estimate as _pm, format_pm as _pm_plain
 from filmfriction.analysis.files.util import format_value as _fmt
-from filmfriction.analysis.files.util import png_bytes as _png, pyplot as _plt
 from filmfriction.md_inputs.contract import RUN_FILE, SFB_FILE
 from filmfriction.reduced_model.units import OMCTS
 

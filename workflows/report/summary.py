@@ -18,7 +18,6 @@ import math
 import re
 from dataclasses import dataclass
 
-from filmfriction.analysis.files.trace import unit as _unit
 from filmfriction.analysis.trace_figure import scaled_unit
 from filmfriction.analysis.files.util import format_value as _fmt
 
