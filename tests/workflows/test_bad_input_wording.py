@@ -68,7 +68,7 @@ CASES = {
         "--column time=t and --column spring_force=t: one column given for two names"),
     "set-up errors of 100 % and more": (
         lambda t, _: _setup_with_big_errors(t),
-        "relative error of 143% (eta_eff 27.14 +- 0.12 Pa s, contact area 4.011e-10 +- "
+        "relative error of 143% (eta_eff 27.49 +- 0.48 Pa s, contact area 4.011e-10 +- "
         "3.5e-11 m2, film thickness 3.5e-09 +- 5e-09 m)"),
     "a run's trace.dat not UTF-8": (
         _resume_of_a_bad_trace_dat, "trace.dat, line 6: not UTF-8 text (invalid start byte: "

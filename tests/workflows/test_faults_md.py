@@ -80,7 +80,10 @@ def test_termination_is_an_interruption(tmp_path, md, filmfriction_command, sig,
 
 def test_second_resume_is_refused(tmp_path, md, filmfriction_command):
     out = tmp_path / "run"
-    proc = _start(filmfriction_command, out, md)
+    # a slide long enough that the first resume still runs while the second one starts
+    # (a Python start-up on an idle machine outlasts the 10 000 steps of SMALL)
+    slide = 80000
+    proc = _start(filmfriction_command, out, md, slide_steps=slide)
     assert _wait_for(lambda: (out / "restart.2000").exists()), "no restart file"
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait()
@@ -103,7 +106,7 @@ def test_second_resume_is_refused(tmp_path, md, filmfriction_command):
     record = json.loads((out / "run.json").read_text())
     assert record["status"] in ("completed", "completed_with_warnings")
     d = md.trace(out)
-    assert d["step"][-1] == SMALL["slide_steps"]
+    assert d["step"][-1] == slide
     assert np.allclose(np.diff(d["step"]), SMALL["trace_every"])
 
 
