@@ -198,7 +198,7 @@ def test_a_real_stuck_md_wall_is_no_slip():
     from pathlib import Path
     from scipy.signal import argrelextrema, savgol_filter
     from filmfriction.analysis.groundtruth.release_control import fit_releases
-    path = Path(__file__).parent / "data" / "stuck_wall_trace.csv"
+    path = Path(__file__).resolve().parents[1] / "data" / "stuck_wall_trace.csv"
     tr = np.genfromtxt(path, delimiter=",", names=True, skip_header=2)
     t, f, x, v = tr["time"], tr["spring_force"], tr["wall_position"], tr["wall_velocity"]
     xs = savgol_filter(x, 101, 2)
