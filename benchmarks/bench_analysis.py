@@ -48,7 +48,8 @@ def _cpu() -> str:
 
 
 def bench_trace(n=1_000_000):
-    from filmfriction.analysis import energy, stickslip, viscosity
+    from filmfriction.analysis import stickslip, viscosity
+    from filmfriction.analysis.energy.partition import energy_table
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
     from filmfriction.analysis.files.trace_reader import read_trace
@@ -63,7 +64,7 @@ def bench_trace(n=1_000_000):
         ev = stickslip.detect_slips(t, f)
         tab = stickslip.cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k)
         tab = stickslip.ramp_forces(t, f, tab)
-        et = energy.energy_table(t, f, tab, k, mass=m, noise=ev.noise)
+        et = energy_table(t, f, tab, k, mass=m, noise=ev.noise)
         return ev, tab, et
 
     dt, (ev, tab, et) = _best(pipeline)
@@ -139,7 +140,8 @@ def _print_rates(name, rates, target=""):
 def bench_trajectory(frames=400, repeat=7):
     import MDAnalysis as mda
 
-    from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder
+    from filmfriction.analysis.structure.hexatic import HexaticOrder
+    from filmfriction.analysis.structure.layering import DensityProfile, FilmThickness
     from filmfriction.analysis.groundtruth.synthetic import layered_film
 
     with tempfile.TemporaryDirectory() as d:

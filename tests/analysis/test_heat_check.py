@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from filmfriction.analysis.energy import compare_heat, energy_table
+from filmfriction.analysis.energy.heat_check import compare_heat
+from filmfriction.analysis.energy.partition import energy_table
 from filmfriction.analysis.groundtruth.synthetic import klein_trace
 
 # Klein's SFB numbers (SI): overdamped viscous slips

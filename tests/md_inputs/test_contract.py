@@ -73,7 +73,7 @@ def test_every_printed_variable_is_defined_in_the_script():
 
 
 def test_the_runner_and_the_analysis_take_the_columns_from_the_contract():
-    from filmfriction.analysis import energy
+    from filmfriction.analysis.energy.ledger import LEDGER_COLUMNS
     from filmfriction.analysis.files import trace
 
     assert runner.DAT_COLUMNS == contract.DAT_COLUMNS
@@ -83,7 +83,7 @@ def test_the_runner_and_the_analysis_take_the_columns_from_the_contract():
     assert contract.TRACE_COLUMNS[:2] == ("time", "step")
     assert sorted(contract.TRACE_COLUMNS) == sorted(contract.DAT_COLUMNS)
     assert list(contract.TRACE_UNITS) == list(contract.TRACE_COLUMNS)
-    assert set(energy.LEDGER_COLUMNS + ("mount_heat",)) <= set(contract.DAT_COLUMNS)
+    assert set(LEDGER_COLUMNS + ("mount_heat",)) <= set(contract.DAT_COLUMNS)
     # the analysis labels every column: its quantity has a label in both unit systems,
     # and the LJ label is the contract's unit
     ascii_of = {"τ": "tau", "σ": "sigma", "ε": "epsilon", "1": "-"}

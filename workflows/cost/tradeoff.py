@@ -267,7 +267,7 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     trace_stride : int
         Keep every n-th trace row (a coarser ``trace_every``).
     """
-    from filmfriction.analysis import energy
+    from filmfriction.analysis.energy.ledger import LEDGER_COLUMNS, ledger
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.files.trace_reader import read_trace
 
@@ -286,8 +286,8 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
         "period": value_and_error(slips["period"]),
         "eta_eff": value_and_error(doc["viscosity"].get("from_slip", {}).get("eta_eff")),
     }
-    led = energy.ledger({c: trace.columns[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)
-                         if trace.has(c)})
+    led = ledger({c: trace.columns[c] for c in LEDGER_COLUMNS + ("mount_heat",)
+                  if trace.has(c)})
     slope, slope_se = drift(trace.time, led["residual"])
     duration = float(trace.time[-1] - trace.time[0])
     values["ledger_closure"] = (led["closure"],

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from filmfriction.analysis.structure import (DensityProfile, HexaticOrder, LayerNeighbours,
-                                             psi6_per_layer)
+from filmfriction.analysis.structure.hexatic import HexaticOrder, LayerNeighbours, psi6_per_layer
+from filmfriction.analysis.structure.layering import DensityProfile
 from filmfriction.analysis.groundtruth.synthetic import layered_film
 
 freud = pytest.importorskip("freud")
