@@ -11,7 +11,8 @@ from filmfriction import md_inputs
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import AtomType
 from filmfriction.workflows.md import runner
-from filmfriction.workflows.md.scene import PARAMETERS, Scene, resolve
+from filmfriction.workflows.md.scene import Scene
+from filmfriction.workflows.md.scenes.parameters import PARAMETERS, resolve
 
 SCRIPT = md_inputs.script("film_slide.lmp")
 
@@ -157,7 +158,7 @@ def test_the_script_defaults_are_the_scene_defaults():
         f"{sorted(set(python) - set(script))}")
     differ = {name: (script[name], value) for name, value in python.items()
               if float(script[name]) != float(value)}
-    assert not differ, f"film_slide.lmp default vs workflows/md/scene.py: {differ}"
+    assert not differ, f"film_slide.lmp default vs workflows/md/scenes/parameters.py: {differ}"
     # each scene parameter's own default, but for the outputs a scene must ask for
     for name, spec in PARAMETERS.items():
         expected = (spec.choices.index(spec.default) if spec.choices

@@ -65,7 +65,7 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 def lost_atoms_hint(scene: Scene) -> str:
     """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
     likely causes found in the actual parameters, most likely first."""
-    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
+    from .scenes.parameters import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
 
     p = scene.parameters
     d = derived_quantities(p)

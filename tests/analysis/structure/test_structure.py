@@ -79,7 +79,8 @@ def test_a_lammps_trajectory_time_is_the_trace_time(tmp_path):
     from filmfriction.analysis.structure.trajectory_reader import open_trajectory
     from filmfriction.md_inputs.contract import DATA_FILE
     from filmfriction.workflows.md import engine
-    from filmfriction.workflows.md.scene import Scene, resolve
+    from filmfriction.workflows.md.scene import Scene
+    from filmfriction.workflows.md.scenes.parameters import resolve
 
     p = resolve({"timestep": 0.004, "equilibrate_steps": 0, "slide_steps": 60,
                  "dump_every": 20, "trace_every": 10, "restart_every": 0})
