@@ -1,4 +1,4 @@
-"""ψ6 per layer (analysis/structure.py) against the field's tool, freud's ``order.Hexatic``,
+"""ψ6 per layer (analysis/structure/hexatic.py) against the field's tool, freud's ``order.Hexatic``,
 and the Verlet list it uses against a fresh neighbour search in every frame."""
 import warnings
 
