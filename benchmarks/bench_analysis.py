@@ -51,6 +51,8 @@ def _cpu() -> str:
 
 def bench_trace(n=1_000_000):
     from filmfriction.analysis import stickslip, viscosity
+    from filmfriction.analysis.stick_ramps import ramp_forces
+    from filmfriction.reduced_model.cycles import cycle_table
     from filmfriction.analysis.energy.partition import energy_table
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
@@ -64,8 +66,8 @@ def bench_trace(n=1_000_000):
 
     def pipeline():
         ev = stickslip.detect_slips(t, f)
-        tab = stickslip.cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k)
-        tab = stickslip.ramp_forces(t, f, tab)
+        tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k)
+        tab = ramp_forces(t, f, tab)
         et = energy_table(t, f, tab, k, mass=m, noise=ev.noise)
         return ev, tab, et
 

@@ -215,7 +215,7 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     mount_damping : float
         γM of an MD run's mount dashpot on v − V (force per velocity), 0 for none.
     film_stiffness : float, optional
-        k_f of the stuck film (:func:`.stickslip.stick_stiffness`).
+        k_f of the stuck film (:func:`filmfriction.analysis.stick_ramps.stick_stiffness`).
     ringing : {"auto", "wall-kinetic", "force-amplitude"}
         How the ringing energy is measured (module text); ``auto`` takes the
         wall's kinetic energy when the wall velocity and mass are known.

@@ -390,7 +390,7 @@ def score(case: Case) -> Score:
     """Analyse ``case``'s trace and score every observable against :func:`truth`."""
     from ..energy.partition import energy_table
     from ..analyze import context
-    from ..stickslip import stick_stiffness
+    from ..stick_ramps import stick_stiffness
 
     r = simulate(case)
     tr = truth(case, r)

@@ -38,8 +38,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import savgol_filter
 
+from filmfriction.reduced_model.cycles import cycle_table
+
 from ..slip_law import FilmForceFit, fit_film_force
-from ..stickslip import cycle_table
 
 __all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
 

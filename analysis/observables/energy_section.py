@@ -16,7 +16,7 @@ import numpy as np
 from ..energy.heat_check import compare_heat
 from ..energy.ledger import LEDGER_COLUMNS, ledger
 from ..energy.partition import energy_table
-from .. import stickslip
+from ..stick_ramps import stick_stiffness
 from ..files.trace import MissingInput, unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
@@ -80,7 +80,7 @@ class Energy(Observable):
                 raise MissingInput("slips", "the energy per slip")
             k = p.require("spring_constant", "the spring energy")
             v_drive, _ = trace.drive_velocity()
-            stiff = (stickslip.stick_stiffness(t, f, table, spring_constant=k,
+            stiff = (stick_stiffness(t, f, table, spring_constant=k,
                                                drive_velocity=v_drive) if v_drive else None)
             et = energy_table(
                 t, f, table, k, mass=p.mass,

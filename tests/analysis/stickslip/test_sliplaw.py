@@ -8,7 +8,8 @@ import pytest
 from filmfriction.analysis.slip_law import (VERDICTS, detectable, film_force, fit_film_force,
                                             sigmas)
 from filmfriction.analysis.groundtruth.synthetic import block_trace, klein_trace, with_wall_noise
-from filmfriction.analysis.stickslip import cycle_table, detect_slips
+from filmfriction.analysis.stickslip import detect_slips
+from filmfriction.reduced_model.cycles import cycle_table
 from filmfriction.reduced_model import SpringBlock, laws
 
 
