@@ -4,7 +4,7 @@ Modules (one sitting each):
 
 * :mod:`filmfriction.analysis.stickslip` — yield/re-stick detection, cycle table, regime;
 * :mod:`filmfriction.analysis.files.trace_reader` — reading run directories and CSV traces;
-* :mod:`filmfriction.analysis.energy` — energy partition per slip (Klein), MD ledger;
+* :mod:`filmfriction.analysis.energy` — energy partition per slip (Klein), the heat check, MD ledger;
 * :mod:`filmfriction.analysis.viscosity` — η_eff from steady sliding, velocity profiles,
   power-law fits across runs, and Klein's slip equation;
 * :mod:`filmfriction.analysis.structure` — layers, hexatic order, gap (MDAnalysis);

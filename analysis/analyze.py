@@ -21,7 +21,10 @@ import numpy as np
 
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 
+from filmfriction.reduced_model.cycles import cycle_table
+
 from . import observables, stickslip
+from .extrema import refine_extrema
 from .files.cycles_csv import write_cycles_csv
 from .observables.observable import Context, Observable
 from .results import AnalysisResult, trace_from_columns
@@ -82,11 +85,11 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     t, f = trace.time, trace.spring_force
     events = stickslip.detect_slips(t, f)
     wall = trace.wall_position()
-    table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
+    table = cycle_table(t, f, events.yield_index, events.stick_index,
                                   spring_constant=trace.parameters.spring_constant,
                                   wall_position=wall)
     v_drive, _ = trace.drive_velocity()
-    table = stickslip.refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
+    table = refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
                                      spring_constant=trace.parameters.spring_constant,
                                      drive_velocity=v_drive, wall_position=wall)
     regime = stickslip.classify_regime(table)
@@ -165,7 +168,7 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
                f"slip need at least {MIN_ROWS})")
         doc.update(regime=Regime.UNRESOLVED, regime_criterion=REGIME_CRITERION, regime_note=why)
         skipped["detection"] = why
-        none = stickslip.cycle_table(trace.time, trace.spring_force, [], [])
+        none = cycle_table(trace.time, trace.spring_force, [], [])
         ctx = Context(trace=trace, all_slips=none, skip=0, events=None, regime=Regime.UNRESOLVED,
                       regime_note=why, trajectory_analyses=structure)
         for obs in observables.registered():

@@ -27,17 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from filmfriction.reduced_model.cycles import CycleTable, cycle_table, stats
+from filmfriction.reduced_model.cycles import CycleTable, stats
 
-# the yield and re-stick points between samples, the noise, the stick ramps: each in its
-# own module, named here too (the analysis' one entry point for a trace's slips)
-from .extrema import refine_extrema
 from .noise import CYCLE_NOISE_FACTOR, noise_level_and_bound, cycle_noise, noise_level
-from .stick_ramps import StickStiffness, ramp_forces, stick_stiffness
 
-__all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "CycleTable", "SlipEvents",
-           "StickStiffness", "stick_stiffness", "cycle_table", "detect_slips",
-           "noise_level", "cycle_noise", "classify_regime", "ramp_forces", "refine_extrema", "REGIME_CV_MAX"]
+__all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "SlipEvents", "detect_slips",
+           "classify_regime", "REGIME_CV_MAX"]
 
 class Regime(enum.StrEnum):
     """The sliding regime of a run (the one rule: :func:`classify_regime`, then the

@@ -22,9 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import curve_fit
 
+from filmfriction.reduced_model.cycles import CycleTable
 from filmfriction.reduced_model.integrators.oscillator import DampedOscillator
-
-from .stickslip import CycleTable
 
 __all__ = ["SteadyViscosity", "steady_viscosity", "ProfileShear", "profile_shear",
            "PowerLaw", "power_law_fit", "slip_force", "SlipFit", "fit_slip",

@@ -10,7 +10,9 @@
   processes through MDAnalysis's ``multiprocessing`` backend (wall time).
 
 Run: ``.venv/bin/python benchmarks/bench_analysis.py`` (``--trajectory-only``:
-the trajectory part alone)
+the trajectory part alone).  BLAS and OpenMP run one thread each (``OMP_NUM_THREADS``,
+when set, gives another count), set through ``threadpoolctl`` (a dependency of
+MDAnalysis) once numpy is loaded.
 """
 from __future__ import annotations
 
@@ -21,10 +23,10 @@ import time
 import warnings
 from pathlib import Path
 
-os.environ.setdefault("OMP_NUM_THREADS", "1")
-warnings.filterwarnings("ignore", category=DeprecationWarning)
+import numpy as np
+from threadpoolctl import threadpool_limits
 
-import numpy as np  # noqa: E402
+warnings.filterwarnings("ignore", category=DeprecationWarning)
 
 
 CPU = {}
@@ -48,7 +50,10 @@ def _cpu() -> str:
 
 
 def bench_trace(n=1_000_000):
-    from filmfriction.analysis import energy, stickslip, viscosity
+    from filmfriction.analysis import stickslip, viscosity
+    from filmfriction.analysis.stick_ramps import ramp_forces
+    from filmfriction.reduced_model.cycles import cycle_table
+    from filmfriction.analysis.energy.partition import energy_table
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.groundtruth.synthetic import klein_trace, write_csv
     from filmfriction.analysis.files.trace_reader import read_trace
@@ -61,9 +66,9 @@ def bench_trace(n=1_000_000):
 
     def pipeline():
         ev = stickslip.detect_slips(t, f)
-        tab = stickslip.cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k)
-        tab = stickslip.ramp_forces(t, f, tab)
-        et = energy.energy_table(t, f, tab, k, mass=m, noise=ev.noise)
+        tab = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=k)
+        tab = ramp_forces(t, f, tab)
+        et = energy_table(t, f, tab, k, mass=m, noise=ev.noise)
         return ev, tab, et
 
     dt, (ev, tab, et) = _best(pipeline)
@@ -139,7 +144,8 @@ def _print_rates(name, rates, target=""):
 def bench_trajectory(frames=400, repeat=7):
     import MDAnalysis as mda
 
-    from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder
+    from filmfriction.analysis.structure.hexatic import HexaticOrder
+    from filmfriction.analysis.structure.layering import DensityProfile, FilmThickness
     from filmfriction.analysis.groundtruth.synthetic import layered_film
 
     with tempfile.TemporaryDirectory() as d:
@@ -188,6 +194,7 @@ if __name__ == "__main__":
     print(f"load average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
           "(wall times inflate when the machine is shared)"
           + ("; LAMMPS is running (pgrep -f lmp)" if _lammps_running() else ""))
-    if "--trajectory-only" not in sys.argv:
-        bench_trace()
-    bench_trajectory()
+    with threadpool_limits(limits=int(os.environ.get("OMP_NUM_THREADS", "1"))):
+        if "--trajectory-only" not in sys.argv:
+            bench_trace()
+        bench_trajectory()

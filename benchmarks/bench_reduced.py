@@ -49,9 +49,7 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from filmfriction.reduced_model import SpringBlock, laws, maps  # noqa: E402
+from filmfriction.reduced_model import SpringBlock, laws, maps
 
 M, K, V, D, T = 1.0, 1.0, 0.1, 0.02, 300.0
 MATCH = 1e-6

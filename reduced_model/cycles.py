@@ -62,7 +62,7 @@ class CycleTable:
         τ_ss = t(next y) − t(y); NaN for the last slip.
     uncertainty : dict, optional
         Column name → (noise error, sampling error), per-slip arrays: what each
-        slip's value may be off by (:func:`filmfriction.analysis.stickslip.refine_extrema`);
+        slip's value may be off by (:func:`filmfriction.analysis.extrema.refine_extrema`);
         None for exact event samples.
     """
 

@@ -21,7 +21,8 @@ import filmfriction
 NEEDS_LAMMPS: dict[str, str] = {}
 
 #: Modules whose every example is marked +SKIP (they read a real run directory).
-SKIPPED_ONLY = {"filmfriction.analysis.structure"}
+SKIPPED_ONLY = {"filmfriction.analysis.structure.layering",
+                "filmfriction.analysis.structure.hexatic"}
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 

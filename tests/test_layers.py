@@ -18,7 +18,8 @@ LAYERS = ("md_inputs", "reduced_model", "analysis", "workflows")
 #: the sub-folders of each layer, lowest first: a sub-folder imports no later one
 FLOORS = {
     "reduced_model": ("laws", "integrators", "sfb"),
-    "analysis": ("files", "ensemble", "observables", "calibration", "groundtruth"),
+    "analysis": ("files", "ensemble", "energy", "structure", "observables", "calibration",
+                 "groundtruth"),
     "workflows": ("md", "sweep", "report", "cost", "cli"),
 }
 

@@ -13,7 +13,8 @@ from pathlib import Path
 from filmfriction.analysis.files.util import read_json_object
 from filmfriction.md_inputs.contract import AGGREGATE_FILE, ANALYSIS_FILE, RUN_FILE, TRACE_FILE
 
-from .md.scene import SceneError, parse_assignment
+from .md.scene import SceneError
+from .md.scenes.parameters import parse_assignment
 
 __all__ = ["UserError", "EXIT_FAILED", "EXIT_BAD_INPUT", "check_writable", "check_run_json",
            "check_run_source", "check_ranks", "parse_overrides", "usable_cpus", "cap_workers",

@@ -91,7 +91,7 @@ its predictions.  The calibrated model is run with the MD's K, M, V and d from
 the MD's first re-stick point (the start-up yield, whose larger threshold reflects the
 contact's age after equilibration, is not part of the steady cycle), and its
 cycles are measured with the same ruler as the MD's
-(:func:`filmfriction.analysis.stickslip.cycle_table` via ``SimulationResult.cycles``).
+(:func:`filmfriction.reduced_model.cycles.cycle_table` via ``SimulationResult.cycles``).
 Errors are (model − MD)/MD of the mean peak force, slip distance and period.
 The peak and re-stick forces are inputs of the model (their errors check the
 replay, they predict nothing); slip distance and period are predictions.

@@ -90,8 +90,8 @@ def ageing(run: RunData) -> Estimate | None:
 
 def shear_stiffness(run: RunData) -> Estimate | None:
     """The stuck film's elastic shear stiffness k_f from the slopes of the stick ramps
-    (:func:`filmfriction.analysis.stickslip.stick_stiffness`); None when not measurable."""
-    from ..stickslip import stick_stiffness
+    (:func:`filmfriction.analysis.stick_ramps.stick_stiffness`); None when not measurable."""
+    from ..stick_ramps import stick_stiffness
 
     tr = run.trace
     k = tr.parameters.spring_constant

@@ -17,7 +17,7 @@ Student's t with k − 1 degrees of freedom.  Hartung-Knapp alone is exact at a 
 slips, but over 1 degree of freedom (two replicas) it is so noisy that a run stopped when it
 dips (:mod:`.stopping`) covers the truth only half of the time.  The larger of the two
 covered at least its nominal 68 % in every case measured, fixed or stopped, and more with
-2-3 replicas (tests/analysis/test_ensemble.py).  With one replica there is no between-run
+2-3 replicas (tests/analysis/ensemble/test_ensemble.py).  With one replica there is no between-run
 part; the error is the within-run one and says so.
 
 Examples

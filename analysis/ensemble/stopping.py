@@ -4,7 +4,7 @@ A run that stops as soon as its error *looks* small enough stops, more often tha
 when its slips happened to agree: the error it reports then is too small (optional
 stopping).  On normal slips with a 10 % scatter, stopping at the first n ≥ 3 whose
 s.e./mean ≤ 3 % covers the truth with ±1 s.e. 56 % of the time, not 68 %
-(``tests/analysis/test_ensemble.py`` measures it).  Two things make the rule honest here:
+(``tests/analysis/ensemble/test_ensemble.py`` measures it).  Two things make the rule honest here:
 
 * a pilot of :attr:`TargetError.min_slips` slips (8 by default) before the first check,
   so that the scatter it judges by is not three numbers;
@@ -15,7 +15,7 @@ s.e./mean ≤ 3 % covers the truth with ±1 s.e. 56 % of the time, not 68 %
 With both, a single run's reported error covered the truth 65-66 % of the time on normal
 slips (10-20 % scatter, targets 3-5 %), against 54-61 % for the naive rule; over 2-4
 replicas with a run-to-run scatter, 74-92 %: conservative, since two or three replica means
-say little about that scatter (:mod:`.replicas`).  ``tests/analysis/test_ensemble.py``
+say little about that scatter (:mod:`.replicas`).  ``tests/analysis/ensemble/test_ensemble.py``
 measures both.  The start-up slip is the caller's to leave out.
 
 Examples

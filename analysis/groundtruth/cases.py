@@ -388,9 +388,9 @@ _QUANTITY = {"static_force": "force", "backward_force": "force", "slip_distance"
 
 def score(case: Case) -> Score:
     """Analyse ``case``'s trace and score every observable against :func:`truth`."""
-    from ..energy import energy_table
+    from ..energy.partition import energy_table
     from ..analyze import context
-    from ..stickslip import stick_stiffness
+    from ..stick_ramps import stick_stiffness
 
     r = simulate(case)
     tr = truth(case, r)

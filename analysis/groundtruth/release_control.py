@@ -38,8 +38,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import savgol_filter
 
+from filmfriction.reduced_model.cycles import cycle_table
+
 from ..slip_law import FilmForceFit, fit_film_force
-from ..stickslip import cycle_table
 
 __all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
 
@@ -104,15 +105,16 @@ def release_profile(run_dir, *, blocks: int = 4) -> dict:
     import json
     from pathlib import Path
 
-    from .. import structure as st
+    from ..structure.layering import DensityProfile
+    from ..structure.trajectory_reader import open_trajectory, select_types
     from ..observables.shear_location_section import locate
 
     run_dir = Path(run_dir)
     tr = np.genfromtxt(run_dir / "trace.csv", delimiter=",", names=True)
     y, s = release_slip(tr["time"], tr["wall_position"])
     t0, t1 = float(tr["time"][y]), float(tr["time"][s])
-    u = st.open_trajectory(run_dir / "topology.data", run_dir / "trajectory.dcd")
-    layers = st.DensityProfile(st.select_types(u, [1])).run().results.layers
+    u = open_trajectory(run_dir / "topology.data", run_dir / "trajectory.dcd")
+    layers = DensityProfile(select_types(u, [1])).run().results.layers
     out = locate(u, layers["edges"], [(t0, t1)], blocks=blocks)
     out["width"], out["width_stderr"] = profile_width(layers["positions"], out["share"],
                                                       out["share_stderr"])

@@ -33,9 +33,10 @@ from functools import lru_cache
 import numpy as np
 
 from filmfriction.reduced_model import SpringBlock, laws
+from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law import VERDICTS, FilmForceFit, fit_film_force
-from ..stickslip import cycle_table, detect_slips
+from ..stickslip import detect_slips
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "SCALE", "CONTROLS", "control_trace", "coulomb_viscous", "replica_fits",

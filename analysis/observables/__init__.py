@@ -15,7 +15,7 @@ file: an :class:`Observable` subclass (``base.py`` has the interface) that
 declares its ``key``, ``title`` and ``needs`` and defines ``compute`` (and, for
 the report, ``rows``, ``notes``, ``figure``); its class statement registers it
 in :data:`REGISTRY`.  The contract test
-(``tests/analysis/test_observable_contract.py``) runs every registered one on a
+(``tests/analysis/observables/test_observable_contract.py``) runs every registered one on a
 synthetic run directory, with each of its needs taken away, and through the
 report.
 

@@ -1,7 +1,7 @@
 """``energy``: where the spring's energy goes, per slip and over the whole run.
 
-The physics is :mod:`filmfriction.analysis.energy` (the per-slip energy table
-and the MD run's ledger); this file writes its summaries into
+The physics is :mod:`filmfriction.analysis.energy` (the per-slip energy table,
+the heat check and the MD run's ledger); this file writes its summaries into
 ``analysis.json["energy"]``, the per-slip energies into ``analysis_cycles.csv``
 (``energy_*``, one value for every slip, the start-up ones included) and the
 whole-run ledger as ``energy.ledger``, and shows in the report the energy
@@ -13,8 +13,10 @@ import math
 
 import numpy as np
 
-from .. import energy as _energy
-from .. import stickslip
+from ..energy.heat_check import compare_heat
+from ..energy.ledger import LEDGER_COLUMNS, ledger
+from ..energy.partition import energy_table
+from ..stick_ramps import stick_stiffness
 from ..files.trace import MissingInput, unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
@@ -69,7 +71,7 @@ class Energy(Observable):
     def compute(self, ctx: Context) -> tuple[dict, dict]:
         trace, table, p = ctx.trace, ctx.all_slips, ctx.trace.parameters
         t, f = trace.time, trace.spring_force
-        ledger_cols = {c: trace.columns[c] for c in _energy.LEDGER_COLUMNS + ("mount_heat",)
+        ledger_cols = {c: trace.columns[c] for c in LEDGER_COLUMNS + ("mount_heat",)
                        if trace.has(c)}
         section: dict = {}
         per_slip: dict = {}
@@ -78,9 +80,9 @@ class Energy(Observable):
                 raise MissingInput("slips", "the energy per slip")
             k = p.require("spring_constant", "the spring energy")
             v_drive, _ = trace.drive_velocity()
-            stiff = (stickslip.stick_stiffness(t, f, table, spring_constant=k,
+            stiff = (stick_stiffness(t, f, table, spring_constant=k,
                                                drive_velocity=v_drive) if v_drive else None)
-            et = _energy.energy_table(
+            et = energy_table(
                 t, f, table, k, mass=p.mass,
                 wall_velocity=trace.columns.get("wall_velocity"),
                 wall_position=trace.wall_position(),
@@ -109,8 +111,8 @@ class Energy(Observable):
                 ctx.skip_part("energy.wall_ke_change", MissingInput("--mass", "ΔKE of the wall"))
         except MissingInput as exc:
             ctx.skip_part("energy", exc)
-        if all(c in ledger_cols for c in _energy.LEDGER_COLUMNS):
-            led = _energy.ledger(ledger_cols)
+        if all(c in ledger_cols for c in LEDGER_COLUMNS):
+            led = ledger(ledger_cols)
             section["ledger"] = {
                 "closure": {"mean": finite_or_none(led["closure"]), "units": "1"},
                 "input_work": {"mean": finite_or_none(led["input"]), "units": ctx.unit("energy")},
@@ -121,7 +123,7 @@ class Energy(Observable):
                 "residual": {"mean": finite_or_none(led["residual"][-1]),
                              "units": ctx.unit("energy")}}
         else:
-            missing = [c for c in _energy.LEDGER_COLUMNS if c not in ledger_cols]
+            missing = [c for c in LEDGER_COLUMNS if c not in ledger_cols]
             ctx.skip_part("energy.ledger", f"missing column(s) {', '.join(missing)}")
         return section, per_slip
 
@@ -188,7 +190,7 @@ class Energy(Observable):
                 "Per cycle (y → next y): the film heat from the mechanics against the "
                 "thermostat's, the mount dashpot's heat and the ledger residual. The film heat "
                 "and the thermostat's are the independent pair that energy.heat_check tests.")]
-        if all(run.trace.has(c) for c in _energy.LEDGER_COLUMNS):
+        if all(run.trace.has(c) for c in LEDGER_COLUMNS):
             out.append(("ledger", fig_ledger(run),
                         "The run's energy ledger over time, each term from the start: the work "
                         "done on the system (drive and load) against the energy stored "
@@ -200,10 +202,10 @@ class Energy(Observable):
 
 def heat_checks(et, skip: int, energy_unit: str) -> dict:
     """``energy.heat_check``: the film heat against the thermostat's, per slip and per cycle
-    (:func:`filmfriction.analysis.energy.compare_heat`), for the windows that have both."""
+    (:func:`filmfriction.analysis.energy.heat_check.compare_heat`), for the windows that have both."""
     out = {}
     for key, film, thermostat, what in HEAT_CHECKS:
-        c = _energy.compare_heat(et._column(film), et._column(thermostat), skip=skip, what=what)
+        c = compare_heat(et._column(film), et._column(thermostat), skip=skip, what=what)
         if c.n == 0:
             continue
         out[key] = {"status": c.status, "message": c.message, "n": c.n,
@@ -281,12 +283,12 @@ def fig_energy(bars, energy_unit: str) -> bytes:
 
 
 def fig_ledger(run) -> bytes:
-    """The ledger's terms against time (:func:`filmfriction.analysis.energy.ledger`)."""
+    """The ledger's terms against time (:func:`filmfriction.analysis.energy.ledger.ledger`)."""
     plt = pyplot()
     tr = run.trace
     lab = lambda q: unit(tr.units, q)  # noqa: E731
-    cols = {c: tr.columns[c] for c in _energy.LEDGER_COLUMNS + ("mount_heat",) if tr.has(c)}
-    led = _energy.ledger(cols)
+    cols = {c: tr.columns[c] for c in LEDGER_COLUMNS + ("mount_heat",) if tr.has(c)}
+    led = ledger(cols)
 
     def since_start(name):
         x = np.asarray(cols[name], float)

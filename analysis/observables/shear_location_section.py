@@ -2,7 +2,7 @@
 
 From the run's trajectory (MDAnalysis, unwrapped positions as the script writes them),
 each film atom is assigned to a layer by z (the layers of
-:class:`~filmfriction.analysis.structure.DensityProfile`, as the ``structure``
+:class:`~filmfriction.analysis.structure.layering.DensityProfile`, as the ``structure``
 section has them) and each layer's mean x-velocity is the mean displacement of its
 atoms between consecutive frames over the frames' interval; the walls' velocities
 likewise.  Only frame pairs inside a slip (yield → re-stick) count.  Each layer's
@@ -72,12 +72,12 @@ def layer_velocities(universe, edges, windows, *, film_types=FILM_TYPES,
         ``slip`` (int per pair: which window), ``layer`` (pairs × layers), ``bottom``,
         ``top`` (per pair), ``time`` (the pair's midpoint).
     """
-    from .. import structure as st
+    from ..structure.trajectory_reader import select_types
 
     edges = np.asarray(edges, float)
-    film = st.select_types(universe, film_types)
-    bottom = st.select_types(universe, bottom_types)
-    top = st.select_types(universe, top_types)
+    film = select_types(universe, film_types)
+    bottom = select_types(universe, bottom_types)
+    top = select_types(universe, top_types)
     if film.n_atoms == 0 or bottom.n_atoms == 0 or top.n_atoms == 0:
         raise ValueError("the trajectory needs film, bottom-wall and top-wall atoms")
     nl = edges.size - 1
@@ -187,7 +187,7 @@ class ShearLocation(Observable):
         return ctx.trajectory_analyses and ctx.trace.run_dir is not None
 
     def compute(self, ctx: Context) -> tuple[dict | None, dict]:
-        from .. import structure as st
+        from ..structure.trajectory_reader import film_layers
         from .structure_section import TOPOLOGY, TRAJECTORY
 
         trace = ctx.trace
@@ -197,7 +197,7 @@ class ShearLocation(Observable):
             ctx.skip_part(self.key, f"no {TRAJECTORY} + {TOPOLOGY} or no slips")
             return None, {}
         try:
-            u, _, profile = st.film_layers(topo, traj, FILM_TYPES)
+            u, _, profile = film_layers(topo, traj, FILM_TYPES)
             layers = profile.results.layers
             if not layers["count"]:
                 raise ValueError("no film layers found")

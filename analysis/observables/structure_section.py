@@ -24,7 +24,7 @@ TRAJECTORY, TOPOLOGY = "trajectory.dcd", "topology.data"
 
 def universe(run_dir: Path):
     """The MDAnalysis Universe of a run directory's trajectory, with times in τ."""
-    from ..structure import open_trajectory
+    from ..structure.trajectory_reader import open_trajectory
 
     return open_trajectory(run_dir / TOPOLOGY, run_dir / TRAJECTORY)
 
@@ -40,24 +40,26 @@ def summarize_run(topology, trajectory, *, trace=None, table=None, units="lj",
     and gap are reported for each.  The film and each wall are the atoms of
     the given types (default: the script's contract, either wall model).
     """
-    from .. import structure as st
+    from ..structure.hexatic import HexaticOrder
+    from ..structure.layering import FilmThickness
+    from ..structure.trajectory_reader import film_layers, frame_steps, select_types
 
-    u, film, prof = st.film_layers(topology, trajectory, film_types, step)
+    u, film, prof = film_layers(topology, trajectory, film_types, step)
     layers = prof.results.layers
     out = {"frames": int(prof.n_frames), "units": units,
            "layers": {"count": layers["count"],
                       "positions": layers["positions"].tolist(),
                       "spacing": {"mean": layers["spacing"], "std": layers["spacing_std"]}}}
-    hex_ = st.HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
-    bottom = st.select_types(u, bottom_types)
-    top = st.select_types(u, top_types)
-    gap = st.FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
+    hex_ = HexaticOrder(film, layers["edges"]).run(step=step) if layers["count"] else None
+    bottom = select_types(u, bottom_types)
+    top = select_types(u, top_types)
+    gap = FilmThickness(bottom, top).run(step=step) if bottom.n_atoms and top.n_atoms else None
     if hex_ is not None:
         out["psi6"] = {"per_layer_mean": np.nanmean(hex_.results.psi6, axis=0).tolist()}
     if gap is not None:
         out["gap"] = {"mean": float(np.mean(gap.results.gap)),
                       "std": float(np.std(gap.results.gap))}
-    steps = st.frame_steps(u)
+    steps = frame_steps(u)
     if (trace is not None and table is not None and len(table) and steps is not None
             and trace.has("step")):
         frames = np.arange(u.trajectory.n_frames)[slice(None, None, step)]
@@ -159,26 +161,28 @@ def slip_windows(run) -> list[tuple[float, float]]:
 
 def film_frames(run) -> dict | None:
     """The trajectory's frames on the trace's time axis, with the film's layers
-    and their ψ6 per frame (:class:`~filmfriction.analysis.structure.DensityProfile`,
-    :class:`~filmfriction.analysis.structure.HexaticOrder`); None without a
+    and their ψ6 per frame (:class:`~filmfriction.analysis.structure.layering.DensityProfile`,
+    :class:`~filmfriction.analysis.structure.hexatic.HexaticOrder`); None without a
     trajectory, a ``step`` column or layers."""
     from filmfriction.md_inputs.contract import FILM_TYPES
 
-    from .. import structure
+    from ..structure.hexatic import HexaticOrder
+    from ..structure.layering import DensityProfile
+    from ..structure.trajectory_reader import frame_steps
 
     tr = run.trace
     if not ((run.run_dir / TRAJECTORY).exists() and (run.run_dir / TOPOLOGY).exists()
             and tr.has("step")):
         return None
     u = universe(run.run_dir)
-    steps = structure.frame_steps(u)
+    steps = frame_steps(u)
     film = u.select_atoms("type " + " ".join(str(int(t)) for t in FILM_TYPES))
     if steps is None or film.n_atoms == 0:
         return None
-    layers = structure.DensityProfile(film).run().results.layers
+    layers = DensityProfile(film).run().results.layers
     if not layers["count"]:
         return None
-    psi6 = structure.HexaticOrder(film, layers["edges"]).run().results.psi6
+    psi6 = HexaticOrder(film, layers["edges"]).run().results.psi6
     time = np.interp(steps, tr.columns["step"], tr.time)
     return {"universe": u, "film": film, "time": time, "psi6": psi6,
             "edges": np.asarray(layers["edges"], float)}
@@ -216,12 +220,12 @@ def fig_structure_time(run, frames: dict) -> bytes:
     else:
         from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, TOP_WALL_TYPES
 
-        from .. import structure
+        from ..structure.layering import FilmThickness
 
         u = frames["universe"]
         pick = lambda types: u.select_atoms(  # noqa: E731
             "type " + " ".join(str(int(x)) for x in types))
-        gap = structure.FilmThickness(pick(BOTTOM_WALL_TYPES), pick(TOP_WALL_TYPES)).run()
+        gap = FilmThickness(pick(BOTTOM_WALL_TYPES), pick(TOP_WALL_TYPES)).run()
         ax.plot(frames["time"], gap.results.gap, ".-", lw=0.7, color="tab:blue",
                 label="gap (trajectory)")
     ax.set_ylabel(f"gap [{lab('length')}]")

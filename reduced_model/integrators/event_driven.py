@@ -1,3 +1,16 @@
+# Two scipy solvers subclassed through _step_impl (_WatchedLSODA, _LocalCapRadau): that
+# method is scipy's documented extension point, not a private internal.  The OdeSolver
+# reference (scipy.integrate.OdeSolver, "In order to implement a new solver ...", the same
+# text from scipy 1.0 to 1.18) says "A solver must implement a private method
+# _step_impl(self) which propagates a solver one step further" returning (success,
+# message), and solve_ivp takes any OdeSolver subclass as ``method``; a subclass that
+# calls super()._step_impl() is that contract used as documented.  The public
+# alternative, driving OdeSolver.step() by hand, would re-implement solve_ivp's event
+# location and dense-output stitching (its helpers are private), and solve_ivp's
+# ``events`` cannot change the step cap.  What the contract does not cover:
+# _LocalCapRadau sets ``max_step`` before each step and Radau reads that attribute at
+# every step (scipy's source, pinned by constraints.txt); tests/reduced_model/
+# test_stiff_hold.py fails if a scipy release stops honouring it (the creeping hold).
 """Event-driven integration for friction laws without a closed form.
 
 Slip phases are integrated by ``solve_ivp`` (DOP853, rtol 1e-10) with the

@@ -8,7 +8,9 @@ def slip_table():
     the analysis' chain on a trace dict (``time``, ``spring_force``, optional
     ``wall_position``): detect the slips, tabulate the cycles and, with ``refine``,
     place each slip's static and backward force on its ramps' fitted lines."""
-    from filmfriction.analysis.stickslip import cycle_table, detect_slips, ramp_forces
+    from filmfriction.analysis.stickslip import detect_slips
+    from filmfriction.analysis.stick_ramps import ramp_forces
+    from filmfriction.reduced_model.cycles import cycle_table
 
     def table(trace, spring_constant, refine=True):
         t, f = trace["time"], trace["spring_force"]

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid
 
-from filmfriction.analysis.energy import compare_heat, energy_table
+from filmfriction.analysis.energy.heat_check import compare_heat
+from filmfriction.analysis.energy.partition import energy_table
 from filmfriction.analysis.groundtruth.synthetic import klein_trace
 
 # Klein's SFB numbers (SI): overdamped viscous slips
@@ -27,7 +28,9 @@ def thermostat_column(tr, noise, seed):
 
 @pytest.fixture(scope="module")
 def klein():
-    from filmfriction.analysis.stickslip import cycle_table, detect_slips, ramp_forces
+    from filmfriction.analysis.stickslip import detect_slips
+    from filmfriction.analysis.stick_ramps import ramp_forces
+    from filmfriction.reduced_model.cycles import cycle_table
     tr = klein_trace(**KLEIN, cycles=CYCLES, noise=0.002 * KLEIN["static_force"], seed=4)
     t, f = tr["time"], tr["spring_force"]
     ev = detect_slips(t, f)

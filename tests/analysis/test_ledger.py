@@ -1,8 +1,8 @@
-"""One MD energy ledger (analysis.energy.ledger): the runner's check uses it."""
+"""One MD energy ledger (analysis/energy/ledger.py): the runner's check uses it."""
 import numpy as np
 import pytest
 
-from filmfriction.analysis import energy
+from filmfriction.analysis.energy import ledger
 from filmfriction.md_inputs import contract
 from filmfriction.workflows.md import sanity
 from filmfriction.workflows.md.scene import load
@@ -30,17 +30,17 @@ def _columns(dat):
 
 
 def test_the_ledger_counts_every_sink():
-    led = energy.ledger(_columns(_dat(0.0)))
+    led = ledger.ledger(_columns(_dat(0.0)))
     assert led["residual"] == pytest.approx(np.zeros(11), abs=1e-12)
     assert led["input"] == pytest.approx(10.0)
     assert led["mount_heat"] == pytest.approx(2.0)
     assert led["thermostat_heat"] == pytest.approx(7.0)
     assert led["turnover"] == pytest.approx(10.0)
-    leaky = energy.ledger(_columns(_dat(1.0)))
+    leaky = ledger.ledger(_columns(_dat(1.0)))
     assert leaky["residual"][-1] == pytest.approx(1.0)
     assert leaky["closure"] == pytest.approx(0.1)
     # the turnover is heat out when more heat leaves than work comes in
-    assert energy.ledger(_columns(_dat(-5.0)))["turnover"] == pytest.approx(14.0)
+    assert ledger.ledger(_columns(_dat(-5.0)))["turnover"] == pytest.approx(14.0)
 
 
 def test_the_runner_fails_a_run_whose_ledger_does_not_close():
@@ -55,13 +55,13 @@ def test_the_runner_fails_a_run_whose_ledger_does_not_close():
 
 def test_the_runner_has_no_ledger_of_its_own(monkeypatch):
     # the runner's verdict is the analysis ledger's numbers: change them, and it follows
-    real = energy.ledger
+    real = ledger.ledger
 
     def inflated(columns):
         out = real(columns)
         return {**out, "residual": out["residual"] * 20.0}
 
     scene = load("stick-slip")
-    monkeypatch.setattr(energy, "ledger", inflated)
+    monkeypatch.setattr(ledger, "ledger", inflated)
     assert sanity.ledger_problem(_dat(0.1), scene).startswith(
         "energy ledger does not close: residual 2 epsilon")

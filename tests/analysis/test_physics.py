@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from filmfriction.analysis.energy import energy_table, ledger, LEDGER_COLUMNS
+from filmfriction.analysis.energy.ledger import ledger, LEDGER_COLUMNS
+from filmfriction.analysis.energy.partition import energy_table
 from filmfriction.analysis.groundtruth.synthetic import klein_trace
 from filmfriction.analysis.viscosity import (power_law_fit, profile_shear, slip_force,
                                 slip_viscosity, steady_viscosity)

@@ -11,7 +11,8 @@ from filmfriction import md_inputs
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import AtomType
 from filmfriction.workflows.md import runner
-from filmfriction.workflows.md.scene import PARAMETERS, Scene, resolve
+from filmfriction.workflows.md.scene import Scene
+from filmfriction.workflows.md.scenes.parameters import PARAMETERS, resolve
 
 SCRIPT = md_inputs.script("film_slide.lmp")
 
@@ -73,7 +74,7 @@ def test_every_printed_variable_is_defined_in_the_script():
 
 
 def test_the_runner_and_the_analysis_take_the_columns_from_the_contract():
-    from filmfriction.analysis import energy
+    from filmfriction.analysis.energy.ledger import LEDGER_COLUMNS
     from filmfriction.analysis.files import trace
 
     assert runner.DAT_COLUMNS == contract.DAT_COLUMNS
@@ -83,7 +84,7 @@ def test_the_runner_and_the_analysis_take_the_columns_from_the_contract():
     assert contract.TRACE_COLUMNS[:2] == ("time", "step")
     assert sorted(contract.TRACE_COLUMNS) == sorted(contract.DAT_COLUMNS)
     assert list(contract.TRACE_UNITS) == list(contract.TRACE_COLUMNS)
-    assert set(energy.LEDGER_COLUMNS + ("mount_heat",)) <= set(contract.DAT_COLUMNS)
+    assert set(LEDGER_COLUMNS + ("mount_heat",)) <= set(contract.DAT_COLUMNS)
     # the analysis labels every column: its quantity has a label in both unit systems,
     # and the LJ label is the contract's unit
     ascii_of = {"τ": "tau", "σ": "sigma", "ε": "epsilon", "1": "-"}
@@ -157,7 +158,7 @@ def test_the_script_defaults_are_the_scene_defaults():
         f"{sorted(set(python) - set(script))}")
     differ = {name: (script[name], value) for name, value in python.items()
               if float(script[name]) != float(value)}
-    assert not differ, f"film_slide.lmp default vs workflows/md/scene.py: {differ}"
+    assert not differ, f"film_slide.lmp default vs workflows/md/scenes/parameters.py: {differ}"
     # each scene parameter's own default, but for the outputs a scene must ask for
     for name, spec in PARAMETERS.items():
         expected = (spec.choices.index(spec.default) if spec.choices

@@ -14,7 +14,8 @@ from filmfriction import md_inputs
 from filmfriction.md_inputs.contract import DATA_FILE, AtomType
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 from filmfriction.workflows.md import engine
-from filmfriction.workflows.md.scene import Scene, derived_quantities, geometry, resolve
+from filmfriction.workflows.md.scene import Scene
+from filmfriction.workflows.md.scenes.parameters import derived_quantities, geometry, resolve
 
 
 def _same_sites(a, b, box, atol=1e-9):

@@ -18,7 +18,8 @@ import pytest
 
 from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.workflows.md import runner
-from filmfriction.workflows.md.scene import SceneError, resolve
+from filmfriction.workflows.md.scene import SceneError
+from filmfriction.workflows.md.scenes.parameters import resolve
 
 pytestmark = pytest.mark.md
 

@@ -14,7 +14,8 @@ import pytest
 from filmfriction import md_inputs
 from filmfriction.md_inputs.contract import DATA_FILE
 from filmfriction.workflows.md import engine
-from filmfriction.workflows.md.scene import Scene, SceneError, load, parse_assignment, resolve
+from filmfriction.workflows.md.scene import Scene, SceneError, load
+from filmfriction.workflows.md.scenes.parameters import parse_assignment, resolve
 
 SMALL_BOX = {"cells_x": 5, "cells_y": 3}
 

@@ -5,7 +5,8 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from filmfriction.workflows.md.scene import SceneError, load, parse_assignment
+from filmfriction.workflows.md.scene import SceneError, load
+from filmfriction.workflows.md.scenes.parameters import parse_assignment
 
 # on the md fixture's 5 x 3 box
 SMALL = {"equilibrate_steps": 2000, "slide_steps": 6000, "trace_every": 20, "wall_mass": 300.0}

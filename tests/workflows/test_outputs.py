@@ -3,7 +3,7 @@ owns and is keyed by the text's content; a copied or moved run keeps its calibra
 a calibration made from other data is said to be out of date; every JSON written
 carries its provenance; a document read back that is not of the project's form is
 refused naming the file and the key.  (The refusals of the command line are cases of
-the bad-input table, tests/workflows/test_bad_inputs.py.)"""
+the bad-input table, tests/workflows/cli/test_bad_paths.py and test_bad_documents.py.)"""
 from __future__ import annotations
 
 import hashlib

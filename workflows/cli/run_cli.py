@@ -113,7 +113,7 @@ def parameter_table(meaning: bool = False) -> str:
     (and, with ``meaning``, what it is)."""
     import textwrap
 
-    from ..md.scene import PARAMETERS
+    from ..md.scenes.parameters import PARAMETERS
 
     rows = [("parameter", "unit", "default", "range")]
     for spec in PARAMETERS.values():

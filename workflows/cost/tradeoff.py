@@ -54,7 +54,7 @@ import numpy as np
 from filmfriction.analysis.files.util import json_safe, write_atomic
 from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 
-from ..md.scene import WCA_CUTOFF as WCA
+from ..md.scenes.parameters import WCA_CUTOFF as WCA
 from .tradeoff_figures import plot
 from .tradeoff_reduced import reduced_rows
 from .tradeoff_table import (EXTENSIVE, Measurement, combine, compare, drift, value_and_error,
@@ -108,7 +108,7 @@ FULL_BASE = {"slide_steps": 80000, "restart_every": 0}
 
 def timestep_overrides(base: dict, dt: float) -> dict:
     """Overrides for a timestep: step counts rescaled to keep the simulated times."""
-    from ..md.scene import PARAMETERS
+    from ..md.scenes.parameters import PARAMETERS
 
     dt0 = base.get("timestep", PARAMETERS["timestep"].default)
     ratio = dt0 / dt
@@ -121,7 +121,7 @@ def timestep_overrides(base: dict, dt: float) -> dict:
 
 def box_overrides(base: dict, cells: tuple[int, int]) -> dict:
     """Overrides for a lateral box: K and M scale with the area (same drive per area)."""
-    from ..md.scene import PARAMETERS
+    from ..md.scenes.parameters import PARAMETERS
 
     def get(key):
         return base.get(key, PARAMETERS[key].default)
@@ -267,7 +267,7 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
     trace_stride : int
         Keep every n-th trace row (a coarser ``trace_every``).
     """
-    from filmfriction.analysis import energy
+    from filmfriction.analysis.energy.ledger import LEDGER_COLUMNS, ledger
     from filmfriction.analysis.analyze import analyze
     from filmfriction.analysis.files.trace_reader import read_trace
 
@@ -286,8 +286,8 @@ def measure(run_dir: Path, *, area_ref: float | None = None, prefix: float = 1.0
         "period": value_and_error(slips["period"]),
         "eta_eff": value_and_error(doc["viscosity"].get("from_slip", {}).get("eta_eff")),
     }
-    led = energy.ledger({c: trace.columns[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)
-                         if trace.has(c)})
+    led = ledger({c: trace.columns[c] for c in LEDGER_COLUMNS + ("mount_heat",)
+                  if trace.has(c)})
     slope, slope_se = drift(trace.time, led["residual"])
     duration = float(trace.time[-1] - trace.time[0])
     values["ledger_closure"] = (led["closure"],
@@ -304,7 +304,7 @@ def _seeded(params: dict, k: int) -> dict:
     """The scene's parameters for the k-th seed of a setting (k = 0: as they are)."""
     if k == 0:
         return params
-    from ..md.scene import PARAMETERS
+    from ..md.scenes.parameters import PARAMETERS
 
     return {**params, "seed": int(params.get("seed", PARAMETERS["seed"].default)) + k}
 

@@ -37,7 +37,7 @@ def _reduced_block():
 
 
 def _reduced_measure(t, f, x, yields, sticks) -> dict:
-    from filmfriction.analysis.stickslip import cycle_table
+    from filmfriction.reduced_model.cycles import cycle_table
 
     table = cycle_table(t, f, yields, sticks, spring_constant=REDUCED["stiffness"],
                         wall_position=x)

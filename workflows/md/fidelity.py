@@ -24,7 +24,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .scene import PARAMETERS, SceneError
+from .scene import SceneError
+from .scenes.parameters import PARAMETERS
 
 
 @dataclass(frozen=True)

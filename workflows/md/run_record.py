@@ -68,7 +68,7 @@ def scene_toml(scene: Scene) -> str:
              f"outputs = {json.dumps(list(scene.outputs))}",
              f"expected_cost = {json.dumps(scene.expected_cost)}",
              "", "[parameters]"]
-    from .scene import PARAMETERS
+    from .scenes.parameters import PARAMETERS
 
     if scene.script:        # the copy next to this file (OWN_SCRIPT)
         lines[-2:-2] = [f"script = {json.dumps(OWN_SCRIPT)}",

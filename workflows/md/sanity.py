@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis import energy
+from filmfriction.analysis.energy import ledger
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import DAT_COLUMNS, TRACE_DAT_FILE
 
@@ -65,7 +65,7 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 def lost_atoms_hint(scene: Scene) -> str:
     """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
     likely causes found in the actual parameters, most likely first."""
-    from .scene import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
+    from .scenes.parameters import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
 
     p = scene.parameters
     d = derived_quantities(p)
@@ -155,7 +155,7 @@ def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
             out.append(f"wall speed: {mean_v:.3g} sigma/tau in steady sliding against the drive "
                        f"V = {V:g} (tolerance {100 * WALL_SPEED_TOLERANCE:.0f} %): not yet "
                        f"steady, or the wall slips past the drive")
-    led = energy.ledger({c: col[c] for c in energy.LEDGER_COLUMNS + ("mount_heat",)})
+    led = ledger.ledger({c: col[c] for c in ledger.LEDGER_COLUMNS + ("mount_heat",)})
     residual, turnover = float(led["residual"][-1]), led["turnover"]
     if turnover > 0 and abs(residual) > LEDGER_WARNING * turnover:
         out.append(f"energy ledger: residual {residual:.3g} epsilon is "
@@ -167,8 +167,8 @@ def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
 
 def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
     """The integrator created or destroyed energy beyond LEDGER_LIMIT of the turnover."""
-    led = energy.ledger({n: dat[:, DAT_COLUMNS.index(n)]
-                         for n in energy.LEDGER_COLUMNS + ("mount_heat",)})
+    led = ledger.ledger({n: dat[:, DAT_COLUMNS.index(n)]
+                                for n in ledger.LEDGER_COLUMNS + ("mount_heat",)})
     residual, turnover = float(led["residual"][-1]), led["turnover"]
     if turnover > 0 and abs(residual) > LEDGER_LIMIT * turnover:
         return (f"energy ledger does not close: residual {residual:.3g} epsilon is "

@@ -45,7 +45,7 @@ class GridAxis:
     Attributes
     ----------
     key : str
-        A scene parameter (:data:`filmfriction.workflows.md.scene.PARAMETERS`).
+        A scene parameter (:data:`filmfriction.workflows.md.scenes.parameters.PARAMETERS`).
     values : tuple
         The values, typed as the parameter (int or float), in the order given.
     spec : str
@@ -96,7 +96,8 @@ def parse_grid(text: str) -> GridAxis:
     >>> parse_grid("seed=1,2").values
     (1, 2)
     """
-    from ..md.scene import PARAMETERS, SceneError, split_parameter
+    from ..md.scene import SceneError
+    from ..md.scenes.parameters import PARAMETERS, split_parameter
 
     key, body = split_parameter(text, "--grid", "KEY=START:STOP:N[:log] or KEY=V1,V2,...")
     kind = PARAMETERS[key].kind
@@ -237,7 +238,8 @@ def plan_sweep(scene: str, grid: list[str], sets: list[str] | None = None, np_: 
     """
     import itertools
 
-    from ..md.scene import SceneError, load, parse_assignment
+    from ..md.scene import SceneError, load
+    from ..md.scenes.parameters import parse_assignment
 
     if not grid:
         raise SceneError("give at least one --grid KEY=START:STOP:N[:log]")

@@ -249,7 +249,7 @@ def test_lj_units_and_cross_system_conversion(tmp_path, columns):
 
 
 # ---------------------------------------------------------------------------- LAMMPS files
-LAMMPS = __import__("pathlib").Path(__file__).parent / "data" / "lammps"
+LAMMPS = __import__("pathlib").Path(__file__).resolve().parents[1] / "data" / "lammps"
 
 
 def test_lammps_fix_print_file_reads_as_its_trace_csv():

@@ -5,7 +5,9 @@ import MDAnalysis as mda
 import numpy as np
 import pytest
 
-from filmfriction.analysis.structure import DensityProfile, FilmThickness, HexaticOrder, frame_steps
+from filmfriction.analysis.structure.hexatic import HexaticOrder
+from filmfriction.analysis.structure.layering import DensityProfile, FilmThickness
+from filmfriction.analysis.structure.trajectory_reader import frame_steps
 from filmfriction.analysis.groundtruth.synthetic import layered_film
 
 warnings.filterwarnings("ignore", category=DeprecationWarning)
@@ -52,7 +54,7 @@ def test_film_thickness_and_steps(tmp_path):
 def test_trajectory_time_is_in_tau(tmp_path):
     """MDAnalysis would read the DCD's delta (the LAMMPS timestep) as AKMA time; the
     project's opener gives time = step x timestep."""
-    from filmfriction.analysis.structure import lammps_frame_interval, open_trajectory
+    from filmfriction.analysis.structure.trajectory_reader import lammps_frame_interval, open_trajectory
 
     top, traj = layered_film(tmp_path, layers=2, frames=4, nsavc=500, timestep=0.005)
     plain = mda.Universe(str(top), str(traj), format="DCD", topology_format="DATA",
@@ -74,10 +76,11 @@ def test_a_lammps_trajectory_time_is_the_trace_time(tmp_path):
     import subprocess
 
     from filmfriction import md_inputs
-    from filmfriction.analysis.structure import open_trajectory
+    from filmfriction.analysis.structure.trajectory_reader import open_trajectory
     from filmfriction.md_inputs.contract import DATA_FILE
     from filmfriction.workflows.md import engine
-    from filmfriction.workflows.md.scene import Scene, resolve
+    from filmfriction.workflows.md.scene import Scene
+    from filmfriction.workflows.md.scenes.parameters import resolve
 
     p = resolve({"timestep": 0.004, "equilibrate_steps": 0, "slide_steps": 60,
                  "dump_every": 20, "trace_every": 10, "restart_every": 0})

@@ -1,7 +1,7 @@
 """Replicas and a target error (workflows/md/replica_study.py, target.py): the parts without LAMMPS.
 
 The statistics (combine_replicas, check_target) are tested on ground truth in
-tests/analysis/test_ensemble.py; the command on real LAMMPS in test_replicas_md.py.
+tests/analysis/ensemble/test_ensemble.py; the command on real LAMMPS in test_replicas_md.py.
 """
 from __future__ import annotations
 

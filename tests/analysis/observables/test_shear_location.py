@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from filmfriction.analysis import structure as st
+from filmfriction.analysis.structure.layering import DensityProfile
+from filmfriction.analysis.structure.trajectory_reader import open_trajectory, select_types
 from filmfriction.analysis.groundtruth.synthetic import layered_film
 from filmfriction.analysis.observables.shear_location_section import locate, shear_shares
 
@@ -13,9 +14,9 @@ V = 0.5     # the top wall's slip velocity, σ/τ
 def _located(tmp_path, plane_velocity, windows=None, frames=30, thermal=0.05):
     top, traj = layered_film(tmp_path, layers=LAYERS, frames=frames, nsavc=100,
                              thermal=thermal, plane_velocity=plane_velocity, seed=3)
-    u = st.open_trajectory(top, traj)
-    film = st.select_types(u, [1])
-    edges = st.DensityProfile(film).run().results.layers["edges"]
+    u = open_trajectory(top, traj)
+    film = select_types(u, [1])
+    edges = DensityProfile(film).run().results.layers["edges"]
     t_end = u.trajectory[-1].time
     windows = windows or [(k * t_end / 4, (k + 1) * t_end / 4) for k in range(4)]
     return locate(u, edges, windows)

@@ -1,4 +1,4 @@
-"""ψ6 per layer (analysis/structure.py) against the field's tool, freud's ``order.Hexatic``,
+"""ψ6 per layer (analysis/structure/hexatic.py) against the field's tool, freud's ``order.Hexatic``,
 and the Verlet list it uses against a fresh neighbour search in every frame."""
 import warnings
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from filmfriction.analysis.structure import (DensityProfile, HexaticOrder, LayerNeighbours,
-                                             psi6_per_layer)
+from filmfriction.analysis.structure.hexatic import HexaticOrder, LayerNeighbours, psi6_per_layer
+from filmfriction.analysis.structure.layering import DensityProfile
 from filmfriction.analysis.groundtruth.synthetic import layered_film
 
 freud = pytest.importorskip("freud")

@@ -1,7 +1,7 @@
 """``filmfriction geometry``: the data file film_slide.lmp starts from, for a run by hand."""
 from filmfriction.md_inputs.contract import AtomType
 from filmfriction.workflows.cli.main import main
-from filmfriction.workflows.md.scene import geometry, resolve
+from filmfriction.workflows.md.scenes.parameters import geometry, resolve
 
 
 def test_writes_the_scene_geometry(tmp_path, capsys):

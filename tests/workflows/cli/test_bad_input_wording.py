@@ -1,5 +1,5 @@
 """Bad input that was refused in the wrong words, or wrongly refused (a table as in
-test_bad_inputs.py): each refusal is one line naming the user's input (the file and
+test_bad_options.py and the other test_bad_*.py tables): each refusal is one line naming the user's input (the file and
 its line, the options as given, the set-up's quantities) and its remedy, exit 2, no
 traceback, nothing written; the accepted cases run.
 """
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-DOCS = Path(__file__).resolve().parents[2] / "docs" / "examples"
+DOCS = Path(__file__).resolve().parents[3] / "docs" / "examples"
 
 
 def _two_columns(tmp: Path) -> Path:

@@ -116,7 +116,7 @@ def test_a_parameter_at_its_bound_has_no_error_bar(tmp_path):
 
 
 def _coverage_module():
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "calibration_coverage.py"
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "calibration_coverage.py"
     spec = importlib.util.spec_from_file_location("calibration_coverage", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -141,7 +141,7 @@ def test_the_error_bars_cover_the_truth_on_random_traces():
 
 def test_issue_example_is_recovered_in_both_unit_systems(tmp_path):
     # F_k = 2.0 uN, B = 1.5 kg/s once came back as start-grid points "± 0" in SI
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "calibration_example.py"
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "calibration_example.py"
     spec = importlib.util.spec_from_file_location("calibration_example", path)
     ex = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(ex)

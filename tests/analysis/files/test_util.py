@@ -9,7 +9,7 @@ import pytest
 
 from filmfriction.analysis.files import util
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_finite_or_none():

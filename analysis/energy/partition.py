@@ -62,14 +62,14 @@ Per slip y → s:
     Heat the thermostat removed over the slip window (MD, ``fix langevin``'s
     own tally): an independent measure of ``film_heat``, noisy by the film's
     thermal fluctuations (and short of it when the window ends before the
-    film has cooled).  :func:`compare_heat` tests the two against each other.
+    film has cooled).  :func:`~filmfriction.analysis.energy.heat_check.compare_heat` tests the two against each other.
 ``film_heat_cycle``
     The film's heat from the mechanics over a whole cycle (y → next y, the
     window of ``thermostat_heat_cycle``): ∫F v dt − ΔKE_wall − the mount
     dashpot's work along x, less its heat along z (the engine's
     ``mount_heat`` less its x part) and the dilation work.  The film starts
     and ends the cycle stuck and cool, so no k_f is needed and no heat is
-    still on its way out: :func:`compare_heat` against
+    still on its way out: :func:`~filmfriction.analysis.energy.heat_check.compare_heat` against
     ``thermostat_heat_cycle`` is the check that does not depend on the window.
 ``dashpot_static_bias``
     γM (V − v̄) at the end of each stick: the mount dashpot's force that the
@@ -93,13 +93,9 @@ from scipy.integrate import trapezoid
 
 from filmfriction.reduced_model.cycles import CycleTable, stats as _stats
 
-__all__ = ["EnergyTable", "HeatComparison", "compare_heat", "energy_table", "ledger"]
+from .ledger import LEDGER_COLUMNS, ledger
 
-# trace columns (md_inputs/contract.py) the ledger needs; mount_heat is optional
-# (traces written before the mount dashpot lack it)
-LEDGER_COLUMNS = ("drive_work", "load_work", "potential_energy",
-                  "kinetic_energy", "spring_energy", "thermostat_heat")
-
+__all__ = ["EnergyTable", "energy_table"]
 
 @dataclass(frozen=True, eq=False)
 class EnergyTable:
@@ -219,7 +215,7 @@ def energy_table(time, spring_force, table: CycleTable, spring_constant: float, 
     mount_damping : float
         γM of an MD run's mount dashpot on v − V (force per velocity), 0 for none.
     film_stiffness : float, optional
-        k_f of the stuck film (:func:`.stickslip.stick_stiffness`).
+        k_f of the stuck film (:func:`filmfriction.analysis.stick_ramps.stick_stiffness`).
     ringing : {"auto", "wall-kinetic", "force-amplitude"}
         How the ringing energy is measured (module text); ``auto`` takes the
         wall's kinetic energy when the wall velocity and mass are known.
@@ -374,148 +370,3 @@ def _film_heat_cycle(t, f, v, yi, mass, mount_damping, v_drive, cols):
             heat += lw[b] - lw[a]          # the film's work lifting the wall: −ΔW_load
         out.append(heat)
     return np.asarray(out, float)
-
-
-@dataclass(frozen=True)
-class HeatComparison:
-    """The film's heat from the mechanics against the thermostat's, slip by slip.
-
-    Attributes
-    ----------
-    status : {"agree", "disagree", "undetermined"}
-        ``disagree`` when the mean paired difference exceeds ``threshold``
-        standard errors; ``undetermined`` with fewer than 3 pairs or no
-        scatter to judge by.
-    message : str
-        One line saying so, with the numbers.
-    film_heat, thermostat_heat : float
-        Means over the ``n`` pairs (both finite).
-    difference, stderr : float
-        Mean of film − thermostat heat, pair by pair, and its standard error
-        (the pairs' scatter: the film's thermal noise and the slips' spread).
-    z : float
-        difference / stderr.
-    threshold : float
-        The two-sided 99 % quantile of Student's t with n − 1 degrees of
-        freedom: a correct film heat is flagged in 1 % of runs.
-    resolution : float
-        threshold × stderr / |film_heat|: the relative error of the film heat
-        that the check flags in half of the runs (its power).
-
-    Windows that share their ends (cycles y → next y) share the tally's
-    fluctuation there, which cancels in the mean; the pairs' scatter then
-    overstates its error, the check flags less often than 1 % and the
-    resolution is an upper bound.
-    """
-
-    status: str
-    message: str
-    n: int
-    film_heat: float
-    thermostat_heat: float
-    difference: float
-    stderr: float
-    z: float
-    threshold: float
-    resolution: float
-
-
-def compare_heat(film_heat, thermostat_heat, *, skip: int = 0,
-                 what: str = "per slip") -> HeatComparison:
-    """Test the film's heat from the mechanics against the thermostat's tally.
-
-    The two are independent measures of the same heat: ``film_heat`` from the
-    wall's equation of motion (the trace's force and velocity), the
-    thermostat's from the atoms (LAMMPS's ``fix langevin … tally yes``).
-    They differ by the film's internal energy still to be removed at the end
-    of the window, the engine's ledger residual and the quadrature of the
-    sampled trace.
-
-    Parameters
-    ----------
-    film_heat, thermostat_heat : array_like
-        Per slip (or per cycle), the same windows; pairs with a NaN are dropped.
-    skip : int
-        Leading pairs left out (start-up slips).
-    what : str
-        Names the windows in the message.
-
-    Returns
-    -------
-    HeatComparison
-
-    Examples
-    --------
-    >>> c = compare_heat([10.2, 9.7, 10.4, 9.9], [10.0, 10.1, 10.3, 9.8])
-    >>> c.status, abs(c.difference) < 1e-12
-    ('agree', True)
-    >>> compare_heat([13.0, 12.4, 13.2, 12.9], [10.0, 10.1, 10.3, 9.8]).status
-    'disagree'
-    """
-    from scipy.stats import t as student_t
-
-    a = np.asarray(film_heat, float)[skip:]
-    b = np.asarray(thermostat_heat, float)[skip:]
-    ok = np.isfinite(a) & np.isfinite(b)
-    a, b = a[ok], b[ok]
-    n = int(a.size)
-    nan = math.nan
-    if n < 3:
-        return HeatComparison("undetermined", f"film heat vs thermostat heat {what}: {n} pair(s) "
-                              "with both values, at least 3 needed", n,
-                              float(a.mean()) if n else nan, float(b.mean()) if n else nan,
-                              nan, nan, nan, nan, nan)
-    d = a - b
-    diff = float(d.mean())
-    err = float(d.std(ddof=1) / math.sqrt(n))
-    q = float(student_t.ppf(0.995, n - 1))
-    fh, th = float(a.mean()), float(b.mean())
-    if not err > 0:
-        return HeatComparison("undetermined", f"film heat vs thermostat heat {what}: the "
-                              "differences do not scatter, no error to judge by", n, fh, th,
-                              diff, err, nan, q, nan)
-    z = diff / err
-    res = q * err / abs(fh) if fh else nan
-    status = "agree" if abs(z) <= q else "disagree"
-    msg = (f"film heat {fh:.4g} vs thermostat heat {th:.4g} {what} ({n} pairs): difference "
-           f"{diff:.3g} ± {err:.2g} = {z:.2f} standard errors, limit {q:.2f} (99 %): {status}; "
-           f"the check resolves a film-heat error of {100 * res:.0f} %")
-    return HeatComparison(status, msg, n, fh, th, diff, err, z, q, res)
-
-
-def ledger(columns: dict) -> dict:
-    """Energy ledger of an MD run.
-
-    drive_work + load_work = Δ(potential + kinetic + spring) + thermostat_heat
-    + mount_heat + residual  (``mount_heat``, the mount dashpot's heat, when the
-    trace has it).
-
-    The one ledger of an MD run: the analysis reports it, and the runner
-    (``filmfriction.workflows.md.runner.ledger_problem``) fails a run whose
-    residual exceeds a share of ``turnover``.
-
-    Returns
-    -------
-    dict
-        ``residual`` (array, cumulative, zero at the first sample),
-        ``input`` (drive_work + load_work at the end, relative to the start),
-        ``closure`` (|final residual| / |input|; NaN when no work was done),
-        ``thermostat_heat`` and ``mount_heat`` (at the end, relative to the
-        start), ``turnover`` (the energy turned over: the larger of |input|
-        and |thermostat_heat + mount_heat|).
-    """
-    c = {n: np.asarray(columns[n], float) for n in LEDGER_COLUMNS}
-    work = c["drive_work"] + c["load_work"]
-    stored = c["potential_energy"] + c["kinetic_energy"] + c["spring_energy"]
-    heat = c["thermostat_heat"] - c["thermostat_heat"][0]
-    mount = np.zeros_like(heat)
-    if "mount_heat" in columns:
-        mount = np.asarray(columns["mount_heat"], float)
-        mount = mount - mount[0]
-    residual = (work - work[0]) - (stored - stored[0]) - heat - mount
-    total = float(work[-1] - work[0])
-    closure = abs(float(residual[-1])) / abs(total) if total else math.nan
-    turnover = max(abs(total), abs(float(heat[-1] + mount[-1])))
-    return {"residual": residual, "input": total, "closure": closure,
-            "thermostat_heat": float(heat[-1]), "mount_heat": float(mount[-1]),
-            "turnover": turnover}

@@ -1,7 +1,8 @@
 """The release test's scene parameters: drive_velocity 0 only with a release_offset."""
 import pytest
 
-from filmfriction.workflows.md.scene import SceneError, load, resolve
+from filmfriction.workflows.md.scene import SceneError, load
+from filmfriction.workflows.md.scenes.parameters import resolve
 
 
 def test_zero_drive_needs_a_release_offset():

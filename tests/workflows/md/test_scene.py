@@ -5,7 +5,8 @@ import re
 import pytest
 
 from filmfriction.workflows.md import scene
-from filmfriction.workflows.md.scene import PARAMETERS, SceneError, load, parse_assignment, resolve
+from filmfriction.workflows.md.scene import SceneError, load
+from filmfriction.workflows.md.scenes.parameters import PARAMETERS, parse_assignment, resolve
 
 
 def test_every_shipped_scene_loads_and_is_valid():
@@ -170,14 +171,14 @@ def test_version(capsys):
                                          ("film_layers=3", 3), ("seed=+12", 12)])
 def test_set_takes_a_whole_number_written_as_a_float(text, value):
     """--set slide_steps=1e5 was refused as 'not a whole number' (a TOML 3.0 was accepted)."""
-    from filmfriction.workflows.md.scene import parse_assignment
+    from filmfriction.workflows.md.scenes.parameters import parse_assignment
 
     key, got = parse_assignment(text)
     assert got == value and isinstance(got, int)
 
 
 def test_set_refusal_shows_the_parameters_own_range():
-    from filmfriction.workflows.md.scene import parse_assignment
+    from filmfriction.workflows.md.scenes.parameters import parse_assignment
 
     with pytest.raises(SceneError, match=r"not a number in \[0, 5\] sigma/tau"):
         parse_assignment("drive_velocity=fast")

@@ -8,7 +8,8 @@ import pytest
 from filmfriction.analysis.slip_law import (VERDICTS, detectable, film_force, fit_film_force,
                                             sigmas)
 from filmfriction.analysis.groundtruth.synthetic import block_trace, klein_trace, with_wall_noise
-from filmfriction.analysis.stickslip import cycle_table, detect_slips
+from filmfriction.analysis.stickslip import detect_slips
+from filmfriction.reduced_model.cycles import cycle_table
 from filmfriction.reduced_model import SpringBlock, laws
 
 
@@ -198,7 +199,7 @@ def test_a_real_stuck_md_wall_is_no_slip():
     from pathlib import Path
     from scipy.signal import argrelextrema, savgol_filter
     from filmfriction.analysis.groundtruth.release_control import fit_releases
-    path = Path(__file__).parent / "data" / "stuck_wall_trace.csv"
+    path = Path(__file__).resolve().parents[1] / "data" / "stuck_wall_trace.csv"
     tr = np.genfromtxt(path, delimiter=",", names=True, skip_header=2)
     t, f, x, v = tr["time"], tr["spring_force"], tr["wall_position"], tr["wall_velocity"]
     xs = savgol_filter(x, 101, 2)

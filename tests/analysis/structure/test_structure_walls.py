@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.observables.structure_section import summarize_run
-from filmfriction.analysis.structure import FilmThickness, frame_steps
+from filmfriction.analysis.structure.layering import FilmThickness
+from filmfriction.analysis.structure.trajectory_reader import frame_steps
 from filmfriction.analysis.groundtruth.synthetic import layered_film
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, TOP_WALL_TYPES
 from filmfriction.md_inputs.geometry import plane_spacing

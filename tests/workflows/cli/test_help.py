@@ -12,7 +12,7 @@ import re
 import pytest
 
 from filmfriction.workflows.cli.main import build_parser
-from filmfriction.workflows.md.scene import PARAMETERS
+from filmfriction.workflows.md.scenes.parameters import PARAMETERS
 
 COMMANDS = sorted(build_parser()._subparsers._group_actions[0].choices)
 

@@ -2,7 +2,9 @@
 import numpy as np
 import pytest
 
-from filmfriction.analysis import stickslip
+from filmfriction.analysis.extrema import refine_extrema
+from filmfriction.analysis.noise import noise_level
+from filmfriction.reduced_model.cycles import cycle_table
 from filmfriction.analysis.groundtruth import synthetic
 
 from filmfriction.analysis.stickslip import detect_slips
@@ -54,9 +56,9 @@ def test_ringing_and_correlated_noise_do_not_hide_the_slips(dt):
     since = t % 54.0
     ring = 20.0 * np.exp(-since / 10.0) * np.sin(2 * np.pi * since / 14.0) * (t >= 54.0)
     f = d["spring_force"] + ring
-    noise, _ = stickslip.noise_level(f)
+    noise, _ = noise_level(f)
     assert noise < 10.0
-    events = stickslip.detect_slips(t, f)
+    events = detect_slips(t, f)
     assert len(events.yield_index) in (6, 7)
 
 
@@ -75,11 +77,11 @@ def test_the_restick_point_is_where_the_fall_ends_not_halfway_down():
     f = f + 15.0 * np.exp(-since / 10.0) * np.sin(2 * np.pi * since / 14.0) * (t > period)
     drive = 0.02 * t
     wall = drive - f / k
-    events = stickslip.detect_slips(t, f)
-    table = stickslip.cycle_table(t, f, events.yield_index, events.stick_index,
+    events = detect_slips(t, f)
+    table = cycle_table(t, f, events.yield_index, events.stick_index,
                                   spring_constant=k, wall_position=wall)
     events_noise = events.noise
-    table = stickslip.refine_extrema(t, f, table, noise=events_noise, lag=events.lag,
+    table = refine_extrema(t, f, table, noise=events_noise, lag=events.lag,
                                      spring_constant=k, drive_velocity=0.02)
     ends = t[table.stick_index] % period
     assert np.all(np.abs(ends - period) % period < 0.3), ends

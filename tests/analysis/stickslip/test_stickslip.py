@@ -4,7 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.stickslip import classify_regime, cycle_table, detect_slips, noise_level
+from filmfriction.analysis.stickslip import classify_regime, detect_slips
+from filmfriction.analysis.noise import noise_level
+from filmfriction.reduced_model.cycles import cycle_table
 from filmfriction.analysis.groundtruth.synthetic import sawtooth, smooth_trace
 
 FS, FB, PERIOD, K = 3.0, 1.0, 2.0, 2.0
