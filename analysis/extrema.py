@@ -142,7 +142,8 @@ def _extremum(t, g, i, lo, hi, sigma, lag, rho):
     same on every slip, which does not average out: on a noise-free trace the
     sampling's (the range the samples leave open), on a noisy one half the bias the
     bootstrap corrected (:mod:`filmfriction.analysis.noisy_extremum`: the correction
-    rests on the fitted shape, which the true one may differ from)."""
+    rests on the fitted shape, which the true one may differ from) and, for the time,
+    the fit's resolution of one sample spacing (uniform: spacing/√12)."""
     n_lo, n_hi = i - lo, hi - i
     if n_lo < 1 or n_hi < 1:              # at the end of its range: the sample itself
         dt = t[min(i + 1, hi)] - t[max(i - 1, lo)]
@@ -160,8 +161,12 @@ def _extremum(t, g, i, lo, hi, sigma, lag, rho):
     w = 1 if sigma == 0.0 or uneven or bump >= EXTREMUM_WINDOW_SIGMAS * sigma else 2
     if w > 1:      # the noise is comparable to the turn over three samples
         e = noisy_extremum(t, g, i, lo, hi, sigma, lag=lag, correlation=rho)
+        # the fit's time resolution: its knots sit on the samples, and where the true
+        # turn is sharper than the fitted shape its time is off by up to a sample
+        # spacing, the same on every slip (a uniform spread over one spacing)
+        resolution = 0.5 * (t[b_] - t[a_]) / math.sqrt(12.0)
         return (e.time, e.value, e.value_error, e.time_error, 0.5 * abs(e.value_bias),
-                0.5 * abs(e.time_bias))
+                math.hypot(0.5 * abs(e.time_bias), resolution))
     a, b, c = coef
     u_lo, u_hi = t[a_] - t[i], t[b_] - t[i]
     if a < 0 and u_lo <= -b / (2 * a) <= u_hi:
@@ -220,7 +225,7 @@ def refine_extrema(time, spring_force, table: CycleTable, *, noise: float = 0.0,
     least-squares fit of the turn's shape, its bias corrected and its errors of
     value and time from a parametric bootstrap with the trace's own noise
     (:func:`filmfriction.analysis.noisy_extremum.noisy_extremum`; half the corrected
-    bias is kept as a systematic error).  The noise is the smaller of ``noise``
+    bias is kept as a systematic error, with a sample spacing's resolution for a time).  The noise is the smaller of ``noise``
     (the local estimate, which overstates noise correlated over many samples) and
     the cycle-to-cycle one (:func:`filmfriction.analysis.noise.cycle_noise`, which
     overstates it on a trace whose cycles differ), its correlation from sample to

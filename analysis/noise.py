@@ -24,6 +24,9 @@ STRADDLE_RATIO_SMOOTH = 8.0
 # fourth differences below this share of the second differences at lag 1: the trace is
 # smooth at its sampling (a noise-free slip), not noisy
 SMOOTH_RATIO = 0.25
+# second differences of AR(1) noise grow by at most √2 per doubling of the lag (a random
+# walk's); beyond this the trace's curvature has entered s(L)
+CURVATURE_GROWTH = 2.0
 
 
 def _chord_residuals(t, f, lag):
@@ -130,16 +133,73 @@ def noise_level_and_bound(spring_force, *, max_lag=None, plateau=1.15, time=None
     smooth = residuals is _line_residuals
     straddle = STRADDLE_RATIO_SMOOTH if smooth else STRADDLE_RATIO
     lag, prev = 1, s(1, residuals)
+    scales = {1: prev}
+    result = None
     while 2 * lag <= max_lag and 8 * lag < n:
         cur = s(2 * lag, residuals)
+        scales[2 * lag] = cur
         if prev == 0.0 or cur < plateau * prev:
-            return (cur if prev else 0.0), lag, smooth
+            result = (cur if prev else 0.0), lag, smooth
+            break
         if cur > straddle * prev:
-            return prev, lag, smooth
+            result = prev, lag, smooth
+            break
+        if not smooth and cur > CURVATURE_GROWTH * prev:
+            # faster than any AR(1) noise grows (a random walk's √2): the trace's own
+            # curvature (a creeping stick, a slip's turn) has entered, and s(L) is a
+            # lower bound of noise correlated over longer lags
+            result = prev, lag, True
+            break
         lag, prev = 2 * lag, cur
-    # the search ended at its longest lag still growing: the noise is correlated over
-    # longer than the estimate sees (a lower bound, as on a smooth trace)
-    return prev, lag, True
+    if result is None:
+        # the search ended at its longest lag still growing: the noise is correlated over
+        # longer than the estimate sees (a lower bound, as on a smooth trace)
+        result = prev, lag, True
+    if smooth:
+        return result
+    ar1 = _ar1_plateau(scales)
+    if ar1 is not None and ar1[0] < result[0]:
+        return ar1[0], ar1[1], result[2]
+    return result
+
+
+#: the growth of s(L) per doubling of L that AR(1) noise of any coefficient stays
+#: below (√2, a random walk's), with room for the quartiles' own scatter
+AR1_GROWTH_MAX = 1.5
+
+
+def _ar1_scale2(rho_l):
+    """s(L)²/σ² of the second differences for AR(1) noise whose correlation at lag L
+    is ``rho_l`` (see :func:`noise_correlation`)."""
+    return (1.0 - rho_l) * (3.0 - rho_l) / 3.0
+
+
+def _ar1_plateau(scales):
+    """σ and the decorrelation lag of AR(1) noise fitted to s(L) at the lags before the
+    trace's curvature enters (each doubling grows s by less than ``AR1_GROWTH_MAX``),
+    or None when fewer than three lags qualify or the fit does not converge."""
+    lags = sorted(scales)
+    keep = [lags[0]]
+    for a, b in zip(lags, lags[1:]):
+        if not (scales[a] > 0.0 and scales[b] < AR1_GROWTH_MAX * scales[a]):
+            break
+        keep.append(b)
+    if len(keep) < 3:
+        return None
+    L = np.asarray(keep, float)
+    y = np.log([scales[k] for k in keep])
+    best = None
+    for rho in np.linspace(0.0, 0.99, 199):
+        g = 0.5 * np.log(_ar1_scale2(rho ** L))
+        log_sigma = float(np.mean(y - g))
+        rss = float(np.sum((y - g - log_sigma) ** 2))
+        if best is None or rss < best[0]:
+            best = (rss, rho, log_sigma)
+    _, rho, log_sigma = best
+    lag = 1
+    while rho ** lag > 0.2 and lag < keep[-1]:
+        lag *= 2
+    return math.exp(log_sigma), lag
 
 
 def _residual_scale(t, f, lag, residuals):

@@ -18,13 +18,17 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["NoisyExtremum", "noisy_extremum", "NOISY_WINDOW_SIGMAS", "NOISY_WINDOW_MAX",
-           "BOOTSTRAP_REPLICATES"]
+           "NOISY_WINDOW_SMOOTHING_MAX", "BOOTSTRAP_REPLICATES"]
 
 #: the window of a noisy extremum's fit reaches where the (lightly smoothed) force
 #: has fallen this many noise standard deviations below it, at most
 #: ``NOISY_WINDOW_MAX`` samples on each side
 NOISY_WINDOW_SIGMAS = 6.0
 NOISY_WINDOW_MAX = 120
+#: the force that bounds the window is smoothed over the noise's decorrelation lag, at
+#: most this many samples each side: a longer average (AR(1) noise of ρ = 0.9 has a lag
+#: of ~19 samples) blurs the turn it bounds, on a slip of a few tens of samples
+NOISY_WINDOW_SMOOTHING_MAX = 4
 #: replicates of the parametric bootstrap (the bias' own error is 1/√R of the spread)
 BOOTSTRAP_REPLICATES = 64
 
@@ -59,10 +63,11 @@ class NoisyExtremum:
 def _window(t, g, i, lo, hi, sigma, lag):
     """The fit's samples about i: where the force, smoothed over ``lag`` samples, has
     fallen :data:`NOISY_WINDOW_SIGMAS` σ below its top, at most :data:`NOISY_WINDOW_MAX`
-    samples each side, at least 2."""
+    samples each side, at least 2 (the smoothing at most
+    :data:`NOISY_WINDOW_SMOOTHING_MAX` samples each side)."""
     from scipy.ndimage import uniform_filter1d
 
-    m = max(1, int(lag))
+    m = min(max(1, int(lag)), NOISY_WINDOW_SMOOTHING_MAX)
     seg = g[lo:hi + 1]
     sm = uniform_filter1d(seg, size=2 * m + 1, mode="nearest") if m > 1 or seg.size > 4 else seg
     k = i - lo

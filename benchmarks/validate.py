@@ -15,7 +15,7 @@ Usage::
     python benchmarks/validate.py --calibration-cases 20   # cases per calibration set
 
 The calibration's F_k, B and η_eff are scored on the traces of
-``benchmarks/calibration_coverage.py`` (Coulomb + viscous in LJ and SI, with white and
+:mod:`filmfriction.analysis.groundtruth.calibration_sets` (Coulomb + viscous in LJ and SI, with white and
 AR(1) noise, and Klein's slip, F_k = 0), each written as a run directory, analysed and
 fitted as ``filmfriction calibrate`` does.
 
@@ -34,10 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
+from filmfriction.analysis.groundtruth import calibration_sets as cc
 from filmfriction.analysis.groundtruth import cases as gt
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import calibration_coverage as cc  # noqa: E402  (the calibration's ground-truth traces)
 
 NAMES = {"static_force": "F_s", "backward_force": "F_b", "slip_distance": "slip distance",
          "slip_duration": "slip duration", "stick_duration": "stick duration",
@@ -148,11 +146,12 @@ TARGETS = {"static_force": 0.005, "backward_force": 0.005, "slip_distance": 0.02
            "slip_duration": 0.02}
 
 
-#: calibration set -> the wall of :data:`calibration_coverage.WALLS` it is drawn on
+#: calibration set -> the wall of :data:`~filmfriction.analysis.groundtruth.calibration_sets.WALLS`
+#: it is drawn on
 CALIBRATION_WALL = {"lj": "lj", "si": "si", "lj-ar1": "lj", "klein": "si"}
 
 
-def calibration_scores(cases, seed):
+def calibration_scores(cases, seed, klein_cases=None):
     """Per calibration set, per case: {observable: (estimate, stderr, at bound, truth)} for
     F_k, B and η_eff (the calibration's B·D/A, and the per-slip fit of Klein's Eq. 1,
     ``viscosity.from_slip`` of analysis.json), of the cases with >= 3 fitted slips."""
@@ -168,7 +167,7 @@ def calibration_scores(cases, seed):
         rng = np.random.default_rng(seed + 1000 * j)
         rows = []
         with tempfile.TemporaryDirectory() as tmp:
-            for i in range(cases):
+            for i in range(klein_cases if name == "klein" and klein_cases else cases):
                 d = Path(tmp) / f"case{i}"
                 truth = cc.SETS[name](d, rng)
                 try:
@@ -190,7 +189,7 @@ def calibration_scores(cases, seed):
                 if slips.get("mean") is not None and slips.get("stderr") is not None:
                     row["eta_slips"] = (slips["mean"], slips["stderr"], False, eta_true)
                 rows.append(row)
-        out[name] = (cases, rows)
+        out[name] = (klein_cases if name == "klein" and klein_cases else cases, rows)
     return out
 
 
@@ -327,16 +326,20 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=2024)
     ap.add_argument("--calibration-cases", type=int, default=20,
                     help="cases per calibration set (default 20)")
+    ap.add_argument("--klein-cases", type=int, default=60,
+                    help="cases of Klein's set, whose slips' η_eff has a target of its own "
+                         "(default 60)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     exact = run_cases(exact_cases(1 if args.quick else 3, rng))
     noisy = run_cases(noisy_cases(4 if args.quick else 10, rng))
-    calibration = calibration_scores(args.calibration_cases, args.seed)
+    calibration = calibration_scores(args.calibration_cases, args.seed, args.klein_cases)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
                             cwd=Path(__file__).resolve().parent).stdout.strip() or "?"
     cmd = ".venv/bin/python benchmarks/validate.py" + (" --quick" if args.quick else "") + \
         (f" --seed {args.seed}" if args.seed != 2024 else "") + \
-        (f" --calibration-cases {args.calibration_cases}" if args.calibration_cases != 20 else "")
+        (f" --calibration-cases {args.calibration_cases}" if args.calibration_cases != 20 else "") + \
+        (f" --klein-cases {args.klein_cases}" if args.klein_cases != 60 else "")
     lines = ["# Ground-truth validation of the slip analysis", "",
              f"Command: `{cmd}`; commit {commit}; {os.cpu_count()} cores (one used); seed "
              f"{args.seed}. A correctness table: biases and coverages only, no timing (it may "
@@ -353,8 +356,8 @@ def main(argv=None):
     lines += ["", "## Noisy traces", ""]
     lines += noisy_table(noisy)
     lines += ["", "## Calibration: F_k, B and η_eff", "",
-              f"{args.calibration_cases} traces per set, drawn as in "
-              "`benchmarks/calibration_coverage.py`: `lj`, `si` Coulomb + viscous blocks (an "
+              f"{args.calibration_cases} traces per set ({args.klein_cases} of `klein`), drawn as in "
+              "`filmfriction.analysis.groundtruth.calibration_sets`: `lj`, `si` Coulomb + viscous blocks (an "
               "MD-like wall in LJ units, Klein's SFB in SI), white noise 0.5-5 % of the drop; "
               "`lj-ar1` the same with AR(1) noise (ρ 0.5-0.9); `klein` Klein's slip (F_k = 0, "
               "the film freezing at F_b), SI. Each written as a run directory, analysed and "

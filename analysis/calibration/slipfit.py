@@ -18,189 +18,25 @@ T0 = sqrt(M/K), so B in units of sqrt(K M).  The same trace in N, m, s or in
 µN, nm, ms or in LJ units is the same problem to the optimiser, and its
 parameters scale back to the same physical values.
 
-Example
--------
->>> import numpy as np
->>> f = coulomb_slip_force(np.array([-1.0, 0.0, 1.0]), 60.0, 20.0, 80.0, 500.0, 100.0, 0.02)
->>> f[:2].tolist()                              # the stick ramp, then the yield force
-[58.0, 60.0]
+The slip's model is in :mod:`~filmfriction.analysis.calibration.slip_model`, the fit's
+result in :mod:`~filmfriction.analysis.calibration.slip_result` (both named here too).
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from filmfriction.reduced_model.integrators.oscillator import DampedOscillator
-
 from .estimators import Estimate
 from .rundata import RunData
+from .slip_model import coulomb_slip_force
+from .slip_result import SlipLawFit
 from ..files.trace import UNITS
-from ..viscosity import slip_force
 
 __all__ = ["coulomb_slip_force", "SlipLawFit", "fit_slips", "fit_slip_law", "LEAD_SAMPLES"]
 
 #: Samples before each detected yield point that the fit's window starts with.
 LEAD_SAMPLES = 4
-
-
-def coulomb_slip_force(t, static_force: float, kinetic_force: float, damping: float,
-                       mass: float, stiffness: float, drive_velocity: float,
-                       freeze_force: float = -math.inf,
-                       stick_rate: float | None = None) -> np.ndarray:
-    """Spring force of one Coulomb + viscous slip from rest at the yield point.
-
-    Solves ``M x'' + b x' = K(x0 + V t − x) − F_k`` from x = x' = 0 with
-    K x0 = F_s (:func:`filmfriction.analysis.viscosity.slip_force` with F_s − F_k) until
-    the wall velocity returns to zero or the spring force has fallen to
-    ``freeze_force`` (the film re-solidifies while the wall still moves), whichever
-    comes first (exact roots), after which the wall sticks and the force ramps
-    at K V.  A second yield inside ``t`` is not modelled.
-
-    Parameters
-    ----------
-    t : array_like
-        Times since the yield point (≥ 0 where the slip applies; earlier
-        times get the stick ramp F_s + K V t).
-    static_force, kinetic_force : float
-        F_s and F_k.
-    damping : float
-        Total damping b = B (film) + d (mount), force per velocity.
-    mass, stiffness, drive_velocity : float
-        M, K, V.
-    freeze_force : float
-        F_f: the slip ends where the spring force has fallen to it (default: never;
-        the slip ends at rest).
-    stick_rate : float, optional
-        The stick ramps' slope (default K V; K_eff V on an elastic stuck film).
-
-    Returns
-    -------
-    numpy.ndarray
-        Spring force at ``t``.
-    """
-    t = np.asarray(t, dtype=float)
-    k, v = stiffness, drive_velocity
-    rate = k * v if stick_rate is None else stick_rate
-    end = float(np.max(t)) if t.size else 0.0
-    out = static_force + rate * t
-    if end <= 0.0:
-        return out
-    drop = static_force - kinetic_force
-    # about steady sliding the wall is x = x_p + u, M u'' + b u' + K u = 0, u(0) = -drop/K + b V/K,
-    # u'(0) = -V: its velocity V + u' returns to zero where u' = -V (the slip starts there)
-    osc = DampedOscillator(mass=mass, damping=damping, stiffness=k)
-    u0 = -drop / k + damping * v / k
-    t_stick = osc.first_crossing(u0, -v, -v, end, skip_start=True)
-    if freeze_force < static_force:
-        # the spring force is F_k + b V - K u: it falls to F_f where u = level.  u is the
-        # derivative of the solution W = -(M u' + b u)/K, so first_crossing finds it
-        level = (kinetic_force + damping * v - freeze_force) / k
-        t_freeze = osc.first_crossing(-(mass * -v + damping * u0) / k, u0, level,
-                                      end if t_stick is None else t_stick)
-        if t_freeze is not None:
-            t_stick = t_freeze
-    if t_stick is None:
-        t_stick, f_stick = math.inf, math.nan
-    else:
-        f_stick = kinetic_force + float(slip_force(t_stick, drop, damping, mass, k, v))
-    after = t >= 0.0
-    slipping = after & (t < t_stick)
-    out[slipping] = kinetic_force + slip_force(t[slipping], drop, damping, mass, k, v)
-    stuck = after & (t >= t_stick)
-    out[stuck] = f_stick + rate * (t[stuck] - t_stick)
-    return out
-
-
-@dataclass(frozen=True, eq=False)
-class SlipLawFit:
-    """Joint fit of F_k, B and the freeze force F_f over the slips of one run.
-
-    Attributes
-    ----------
-    kinetic_force, film_damping : Estimate
-        Each with ``at_bound`` set (and no standard error) when the fit ended at
-        the bound of its range: F_k = 0 (no rate-independent part), B = 0 (no film
-        drag beyond the mount's dashpot).
-    freeze_force : Estimate or None
-        F_f; None where the slips end with the wall at rest (a freeze does not lower
-        χ² by 25, i.e. 5 σ).
-    freeze_note : str
-        Why there is a freeze force or none.
-    static_force : Estimate
-        Spring force at the fitted yield instants (mean ± standard error).
-    mount_damping : float
-        d, fixed (not fitted).
-    rms_residual : float
-        RMS force residual of the joint fit.
-    reduced_chi2 : float
-        Residual variance per degree of freedom over the noise variance of the
-        stick ramps between the windows (the trace's own noise): about 1 when the
-        law describes the slips to the noise.
-    n_slips : int
-    jackknife : list of (float, float)
-        (F_k, B) with each slip left out (≥ 3 slips), a cross-check of the error.
-    windows : list of (int, int)
-        (yield index, last index) of each slip fitted (its window starts on the
-        ramp before the yield, see :func:`fit_slips`).
-    yield_shifts : tuple of float
-        Fitted yield instant minus the detected one, per slip (time units).
-    scales : dict
-        The force, time and damping units the fit ran in.
-    error_method : str
-        How the standard errors were obtained.
-    success : bool
-    message : str
-        The optimiser's.
-    """
-
-    kinetic_force: Estimate
-    film_damping: Estimate
-    static_force: Estimate
-    freeze_force: Estimate | None
-    freeze_note: str
-    mount_damping: float
-    rms_residual: float
-    reduced_chi2: float
-    n_slips: int
-    jackknife: list = field(default_factory=list)
-    windows: list = field(default_factory=list)
-    yield_shifts: tuple = ()
-    scales: dict = field(default_factory=dict)
-    error_method: str = ""
-    success: bool = True
-    message: str = ""
-
-    @property
-    def damping_at_bound(self) -> bool:
-        """B ended at 0: no film drag beyond the mount's is resolved."""
-        return self.film_damping.at_bound
-
-    @property
-    def jackknife_stderr(self) -> tuple[float, float]:
-        """(F_k, B) standard errors from the leave-one-slip-out refits (NaN with fewer
-        than 3): the slip-to-slip scatter, beside the fit's own errors."""
-        arr = np.asarray(self.jackknife, float)
-        if arr.ndim != 2 or arr.shape[0] < 3:
-            return math.nan, math.nan
-        n = arr.shape[0]
-        err = np.sqrt((n - 1) / n * np.sum((arr - arr.mean(axis=0)) ** 2, axis=0))
-        return float(err[0]), float(err[1])
-
-    def as_dict(self) -> dict:
-        from ..files.util import finite_or_none as num
-        return {"kinetic_force": self.kinetic_force.as_dict(),
-                "film_damping": self.film_damping.as_dict(),
-                "freeze_force": None if self.freeze_force is None else self.freeze_force.as_dict(),
-                "freeze_note": self.freeze_note,
-                "rms_residual": num(self.rms_residual), "reduced_chi2": num(self.reduced_chi2),
-                "n_slips": self.n_slips, "mount_damping": num(self.mount_damping),
-                "error_method": self.error_method,
-                "jackknife": [[num(a), num(b)] for a, b in self.jackknife],
-                "jackknife_stderr": [num(x) for x in self.jackknife_stderr],
-                "scales": {k: num(v) for k, v in self.scales.items()},
-                "success": self.success, "message": self.message}
 
 
 def _windows(n_samples: int, yi, si) -> list[tuple[int, int]]:

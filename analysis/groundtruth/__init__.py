@@ -4,6 +4,8 @@
   traces, layered films and whole run directories whose answers are known;
 * :mod:`~filmfriction.analysis.groundtruth.cases` — random spring-block cases, their exact
   truth read off the model, and the analysis' score on them (``benchmarks/validate.py``);
+* :mod:`~filmfriction.analysis.groundtruth.calibration_sets` — the calibration's traces with
+  known F_k and B, and the slip fit's score on them;
 * :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` — the slip-law verdict's
   positive and negative controls and its power.
 

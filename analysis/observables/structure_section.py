@@ -110,9 +110,12 @@ class Structure(Observable):
                 ("layer spacing", f"{format_value((lay.get('spacing') or {}).get('mean'), 3)} "
                                   f"{length}")]
         if section.get("gap"):
+            gap = section["gap"]
+            # a gap that does not change (a rigid wall's) has no spread to print
             rows.append(("gap between the walls' inner planes",
-                         f"{format_value(section['gap']['mean'], 4)} ± "
-                         f"{format_value(section['gap']['std'], 2)} {length} (mean ± std)"))
+                         f"{format_value(gap['mean'], 4)} ± {format_value(gap['std'], 2)} "
+                         f"{length} (mean ± std)" if gap.get("std") else
+                         f"{format_value(gap['mean'], 4)} {length} (the same in every frame)"))
         per_layer = (section.get("psi6") or {}).get("per_layer_mean")
         if per_layer:
             rows.append(("ψ6 per layer, all frames (bottom → top)", _layers(per_layer)))

@@ -75,12 +75,27 @@ def check_outputs(run_dir: Path) -> None:
     assert "slip_time" in {r["name"] for r in rows}
 
 
+#: "± value" in a text: the value is an error or a spread, never exactly 0
+_PLUS_MINUS = re.compile(r"±\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)")
+
+
+def zero_errors(text: str) -> list[str]:
+    """The "± 0"-style zero errors of ``text`` (± followed by a number equal to 0), each
+    with the 40 characters before it."""
+    return [text[max(m.start() - 40, 0):m.end()] for m in _PLUS_MINUS.finditer(text)
+            if float(m.group(1)) == 0.0]
+
+
 def check_content(run_dir: Path, out: Path | None = None) -> None:
     """The report ``out`` (default ``run_dir/report.html``) and its Markdown twin:
-    sections, figures as images, the numbers of the run's analysis.json."""
+    sections, figures as images, the numbers of the run's analysis.json; one η_eff
+    named the run's; no "± 0" in any text the study wrote."""
     out = out or run_dir / "report.html"
     html = out.read_text()
     md = out.with_suffix(".md").read_text()
+    for path in [out, out.with_suffix(".md"), *run_dir.glob("*.json"), *run_dir.glob("*.txt")]:
+        assert not zero_errors(path.read_text()), (path.name, zero_errors(path.read_text()))
+    assert len(re.findall(r"The run's η_eff: ", md)) == 1, re.findall(r".*The run's η_eff.*", md)
     for title in SECTIONS:
         assert title in html and title in md, title
     # the report opens with its summary, then the consistency of its own numbers
@@ -196,7 +211,7 @@ def check_in_browser(report: Path) -> dict[str, tuple[int, int]]:
 def report_checks():
     """The report checks: ``outputs(run_dir)``, ``content(run_dir, out=None)``,
     ``axes_units(labels)``, ``images(html)``, ``in_browser(report_html)``."""
-    return SimpleNamespace(outputs=check_outputs, content=check_content,
+    return SimpleNamespace(outputs=check_outputs, content=check_content, zero_errors=zero_errors,
                            axes_units=check_axes_units, images=images, sections=SECTIONS, png=PNG,
                            in_browser=check_in_browser)
 

@@ -37,8 +37,8 @@ from .summary import consistency_checks
 from .overview import (appendix_section, consistency_section, summary_section,
                        user_contact_point)
 from .sections import (PARAMETER_QUANTITIES, attempt, calibration_section, cost_section,
-                       observable_section, scene_section, sfb_section, similarity_section,
-                       sweep_section, viscosity_section)
+                       observable_section, scene_section, sweep_section, viscosity_section)
+from .sfb_sections import sfb_section, similarity_section
 
 __all__ = ["build_report", "Section", "Figure", "Table", "PARAMETER_QUANTITIES"]
 

@@ -116,11 +116,8 @@ def test_a_parameter_at_its_bound_has_no_error_bar(tmp_path):
 
 
 def _coverage_module():
-    path = Path(__file__).resolve().parents[3] / "benchmarks" / "calibration_coverage.py"
-    spec = importlib.util.spec_from_file_location("calibration_coverage", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from filmfriction.analysis.groundtruth import calibration_sets
+    return calibration_sets
 
 
 def test_the_error_bars_cover_the_truth_on_random_traces():

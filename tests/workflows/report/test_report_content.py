@@ -29,6 +29,16 @@ def test_synthetic_report_shows_the_analysis(synthetic_study, report_checks):
     doc = json.loads((synthetic_study.path / "analysis.json").read_text())
     assert doc["slips"]["static_force"]["mean"] == pytest.approx(3.0, rel=0.1)
     assert doc["structure"]["layers"]["count"] == 3
+    # Klein's slips (F_k = 0): the calibration's friction law and the slip law agree
+    md = (synthetic_study.path / "report.md").read_text()
+    assert "| friction law: calibration vs slip law | agree |" in md
+
+
+def test_the_zero_error_scan_finds_a_zero_error(report_checks):
+    """The scan of the report checks flags "± 0" in every spelling, not "± 0.02"."""
+    zero_errors = report_checks.zero_errors
+    assert zero_errors("F_k = 3 ± 0 N") and zero_errors("3 ± 0.000 σ") and zero_errors("±0e+00")
+    assert not zero_errors("3 ± 0.02 N") and not zero_errors("3 ± 1e-15")
 
 
 def test_every_figure_has_units_on_its_axes(synthetic_study, report_checks):
