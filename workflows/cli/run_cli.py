@@ -308,13 +308,12 @@ def _study_done(args, study: Path, code: int) -> int:
         print(f"filmfriction run: warning: {record['stop']['reason']}", file=sys.stderr)
     if args.md_only:
         return 0
-    from filmfriction.analysis.analyze import analyse_run
-
     from ..md.replica_study import replica_dir
+    from ..md.target import replica_analysis
 
     for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
         try:
-            analyse_run(replica_dir(study, i))
+            replica_analysis(replica_dir(study, i))     # the one the last check read
         except Exception as exc:  # noqa: BLE001 -- one replica's analysis must not stop the rest
             print(f"analysis of replica {i}: FAILED: {type(exc).__name__}: {exc}",
                   file=sys.stderr)

@@ -36,7 +36,7 @@ import numpy as np
 
 from filmfriction.analysis.ensemble import check_target, combine_replicas
 from filmfriction.analysis.files.util import write_atomic
-from filmfriction.md_inputs.contract import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
+from filmfriction.md_inputs.contract import (ANALYSIS_FILE, ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
                                              REPLICA_LOG, RUN_FILE, SCENE_FILE, STUDY_FILE)
 from .locks import DirectoryLock
 from .run_record import OWN_SCRIPT, new_run_dir, scene_toml
@@ -276,6 +276,15 @@ def _values(study: Path, record: dict, observables) -> list[dict[str, list[float
             for i in range(1, len(record["replicas"]) + 1)]
 
 
+def _analysis_digests(study: Path, record: dict) -> dict[str, str]:
+    """The SHA-256 of each replica's ``analysis.json`` a check read (which analysis of
+    which trace the numbers are)."""
+    from filmfriction.analysis.files.provenance import file_sha256
+
+    return {rep["dir"]: file_sha256(replica_dir(study, i) / ANALYSIS_FILE)
+            for i, rep in enumerate(record["replicas"], start=1)}
+
+
 def _warnings(study: Path, record: dict) -> list[str]:
     out = []
     for i in range(1, len(record["replicas"]) + 1):
@@ -332,6 +341,7 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                 values = _values(study, record, [t.observable for t in targets])
                 checks = [check_target([v[t.observable] for v in values], t) for t in targets]
                 seg["checks"] = [c.as_dict() for c in checks]
+                seg["analyses"] = _analysis_digests(study, record)
                 met = all(c.met for c in checks)
                 spent = sum(s.get("wall_time", 0.0) for s in record["segments"])
                 out_of = (budget.steps is not None and slide >= budget.steps) or \
@@ -394,7 +404,9 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
 # ---------------------------------------------------------------- the combined analysis
 def combine_study(study: Path) -> dict:
     """Every per-slip observable combined over the replicas (start-up slip left out of
-    each), written to ``ensemble.json`` and ``ensemble.md``; returns the document."""
+    each), written to ``ensemble.json`` and ``ensemble.md``; returns the document.  The
+    values are each replica's own analysis (:func:`~.target.slip_values`: the one the last
+    check read, analysed again only when its run changed since)."""
     from filmfriction.analysis.files.provenance import provenance
 
     study = Path(study)
