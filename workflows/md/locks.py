@@ -22,7 +22,7 @@ import os
 from pathlib import Path
 from typing import Callable
 
-__all__ = ["DirectoryLock"]
+__all__ = ["DirectoryLock", "RunLock"]
 
 
 class DirectoryLock:
@@ -64,3 +64,15 @@ class DirectoryLock:
 
     def __exit__(self, *exc):
         self.release()
+
+
+def RunLock(run_dir: Path) -> DirectoryLock:
+    """The lock on ``RUN_DIR/.lock`` for as long as a run or a resume drives the directory:
+    a second run or ``--resume`` of the same directory is refused (:class:`SceneError`,
+    naming the holder's pid)."""
+    from .scene import SceneError
+
+    run_dir = Path(run_dir)
+    return DirectoryLock(run_dir / ".lock", lambda holder: SceneError(
+        f"run directory {run_dir} is in use ({holder}: a run or a resume is driving it); "
+        "wait for it to finish, or stop that process first"))

@@ -9,6 +9,8 @@ creates a study directory::
     replica-<i>.log     what replica i's runs printed
     ensemble.json       the observables combined over the replicas (combine_replicas)
     ensemble.md         the same as a report: between- and within-run parts, per-replica rows
+    segments/           with --profile: each segment's replica jobs and their markers
+    snakemake.log       with --profile: Snakemake's output (workflows/sweep/replica_jobs.py)
 
 Each replica is a ``filmfriction run`` of its own (a child process with its own seed, lock,
 interruption handling, sanity checks and ``run.json``), ``P`` ranks each (1 by default), as
@@ -19,7 +21,9 @@ newest restart file) until every target is met or the budget is spent
 (:mod:`filmfriction.workflows.md.target`).  The study directory is locked while a command
 drives it; Ctrl-C, SIGTERM or SIGHUP interrupt every replica (each records its own
 interruption) and the study, and ``filmfriction run --resume STUDY`` carries on where it
-stopped.
+stopped.  With ``--profile`` a segment's replicas are Snakemake jobs instead of this
+process's children (an ``executor`` the command line gives: one Slurm job per replica with
+the ``slurm`` profile); everything else is the same.
 """
 from __future__ import annotations
 
@@ -36,7 +40,7 @@ import numpy as np
 
 from filmfriction.analysis.ensemble import check_target, combine_replicas
 from filmfriction.analysis.files.util import write_atomic
-from filmfriction.md_inputs.contract import (ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
+from filmfriction.md_inputs.contract import (ANALYSIS_FILE, ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
                                              REPLICA_LOG, RUN_FILE, SCENE_FILE, STUDY_FILE)
 from .locks import DirectoryLock
 from .run_record import OWN_SCRIPT, new_run_dir, scene_toml
@@ -44,7 +48,7 @@ from .scene import Scene, SceneError
 from .target import OBSERVABLES, Budget, next_slide, slip_values
 
 __all__ = ["MAX_REPLICAS", "replica_seeds", "replica_dir", "replica_log", "is_study",
-           "run_study", "resume_study", "combine_study"]
+           "replica_state", "run_study", "resume_study", "combine_study"]
 
 SCHEMA = "filmfriction.replicas/1"
 #: the most replicas one study runs (more is a typo, or a job for the sweep)
@@ -121,11 +125,15 @@ def _cli() -> list[str]:
 # ---------------------------------------------------------------- a new study
 def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
               budget: Budget | None = None, out: Path | None = None,
-              lmp: str | None = None, workers: int = 1) -> tuple[Path, int]:
+              lmp: str | None = None, workers: int = 1, executor=None,
+              profile: str | None = None) -> tuple[Path, int]:
     """Run ``replicas`` replicas of ``scene`` in a new study directory, ``workers`` at
     once; return it and the exit code (0 done, 1 a replica failed).  Inputs are the
     caller's to check (the command line does, before this, and caps ``workers`` to the
-    usable CPUs)."""
+    usable CPUs).  ``executor(study, record, slide, indices, workers) -> {index: exit
+    code}`` runs a segment's replicas instead of this process's own children (the
+    Snakemake jobs of :mod:`filmfriction.workflows.sweep.replica_jobs`, recorded as
+    ``profile``)."""
     restart_every = int(scene.parameters["restart_every"])
     if targets and restart_every <= 0:
         raise SceneError("--target extends the slide from restart files: the scene has "
@@ -142,7 +150,7 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
     write_atomic(study / SCENE_FILE, scene_toml(scene))
     record = {
         "schema": SCHEMA, "status": "running", "scene": scene.name,
-        "command": sys.argv[:], "np": nprocs, "lmp": lmp,
+        "command": sys.argv[:], "np": nprocs, "lmp": lmp, "profile": profile,
         "replicas": [{"dir": replica_dir(study, i + 1).name, "seed": s}
                      for i, s in enumerate(seeds)],
         "rule": None if not targets else {
@@ -157,13 +165,15 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
         "started": _now(),
     }
     write_json(study / STUDY_FILE, record)
-    return study, _drive(study, record, targets, budget, workers)
+    return study, _drive(study, record, targets, budget, workers, executor)
 
 
 def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
-                 workers=None) -> int:
+                 workers=None, executor=None, profile: str | None = None) -> int:
     """Carry on an interrupted (or failed) study from where each replica stopped;
-    ``workers(ranks)`` says how many replicas of ``ranks`` ranks run at once."""
+    ``workers(ranks)`` says how many replicas of ``ranks`` ranks run at once;
+    ``executor(profile, ranks)`` gives the runner of a study recorded with a profile, or
+    given one (``profile``), as for :func:`run_study`."""
     from filmfriction.analysis.ensemble import TargetError
 
     study = Path(study)
@@ -184,14 +194,18 @@ def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
         record["np"] = nprocs
     if lmp:
         record["lmp"] = lmp
+    if profile:
+        record["profile"] = profile
     record.setdefault("resumed", []).append(_now())
     ranks = int(record.get("np") or 1)
-    return _drive(study, record, targets, budget, workers(ranks) if workers else 1)
+    run = executor(record["profile"], ranks) if executor and record.get("profile") else None
+    return _drive(study, record, targets, budget, workers(ranks) if workers else 1, run)
 
 
 # ---------------------------------------------------------------- the segments
-def _replica_state(run_dir: Path, slide: int) -> str:
-    """``done`` (slid ``slide`` steps), ``start`` (no run yet) or ``resume``."""
+def replica_state(run_dir: Path, slide: int) -> str:
+    """``done`` (slid ``slide`` steps), ``start`` (no run yet) or ``resume`` (an empty
+    directory a replica's run left when it stopped before writing anything is removed)."""
     try:
         rec = json.loads((run_dir / RUN_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -212,7 +226,7 @@ def _commands(study: Path, record: dict, slide: int) -> dict[int, list[str]]:
     jobs = {}
     for i, rep in enumerate(record["replicas"], start=1):
         run_dir = replica_dir(study, i)
-        state = _replica_state(run_dir, slide)
+        state = replica_state(run_dir, slide)
         if state == "start":
             jobs[i] = [*_cli(), "run", str(study / SCENE_FILE), "--set", f"seed={rep['seed']}",
                        "--set", f"slide_steps={slide}", "--np", np_, "--out", str(run_dir),
@@ -276,6 +290,15 @@ def _values(study: Path, record: dict, observables) -> list[dict[str, list[float
             for i in range(1, len(record["replicas"]) + 1)]
 
 
+def _analysis_digests(study: Path, record: dict) -> dict[str, str]:
+    """The SHA-256 of each replica's ``analysis.json`` a check read (which analysis of
+    which trace the numbers are)."""
+    from filmfriction.analysis.files.provenance import file_sha256
+
+    return {rep["dir"]: file_sha256(replica_dir(study, i) / ANALYSIS_FILE)
+            for i, rep in enumerate(record["replicas"], start=1)}
+
+
 def _warnings(study: Path, record: dict) -> list[str]:
     out = []
     for i in range(1, len(record["replicas"]) + 1):
@@ -287,7 +310,14 @@ def _warnings(study: Path, record: dict) -> list[str]:
     return out
 
 
-def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: int) -> int:
+def _local(study: Path, record: dict, slide: int, indices, workers: int) -> dict[int, int]:
+    """This process's own children run the replicas' ``filmfriction run`` commands."""
+    jobs = _commands(study, record, slide)
+    return _run_jobs(study, {i: jobs[i] for i in indices}, workers)
+
+
+def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: int,
+           executor=None) -> int:
     from ..progress import note
     from .runner import TerminationAsInterrupt
 
@@ -295,6 +325,13 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
     nprocs = int(record.get("np") or 1)
     workers = max(1, min(int(workers), len(record["replicas"])))
     rule = record.get("rule") or {}
+    # wall seconds the study has been driven (this command's and earlier ones'): each
+    # check records it as "elapsed" (what `filmfriction tradeoff --targets` reads)
+    t_start, before = time.monotonic(), float(record.get("elapsed") or 0.0)
+
+    def elapsed() -> float:
+        return before + time.monotonic() - t_start
+
     with TerminationAsInterrupt():
         lock = _lock(study).acquire()
         try:
@@ -305,12 +342,15 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                 slide = int(seg["slide_steps"])
                 jobs = _commands(study, record, slide)
                 if jobs:
-                    note(f"replicas: {len(jobs)} run(s) to slide step {slide}, {workers} at "
-                         f"once, {nprocs} rank(s) each (logs: {study}/replica-*.log)")
+                    how = (f"{workers} at once" if executor is None else
+                           f"as Snakemake jobs (profile {record.get('profile')})")
+                    note(f"replicas: {len(jobs)} run(s) to slide step {slide}, {how}, "
+                         f"{nprocs} rank(s) each (logs: {study}/replica-*.log)")
                 seg.setdefault("started", _now())
                 seg["at_once"], seg["ranks_each"] = workers, nprocs
                 t0 = time.monotonic()
-                codes = _run_jobs(study, jobs, workers)
+                codes = (executor or _local)(study, record, slide, sorted(jobs), workers) \
+                    if jobs else {}
                 seg["wall_time"] = seg.get("wall_time", 0.0) + time.monotonic() - t0
                 seg["finished"] = _now()
                 failed = {i: c for i, c in codes.items() if c != 0}
@@ -320,7 +360,7 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                            f"at slide {slide}: {_last_line(replica_log(study, i))} (see "
                            f"{replica_log(study, i)})")
                     record.update(status="failed", stop={"reason": why, "met": False},
-                                  finished=_now())
+                                  finished=_now(), elapsed=elapsed())
                     write_json(path, record)
                     note(f"replicas: failed: {why}; continue with "
                          f"filmfriction run --resume {study}")
@@ -332,6 +372,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                 values = _values(study, record, [t.observable for t in targets])
                 checks = [check_target([v[t.observable] for v in values], t) for t in targets]
                 seg["checks"] = [c.as_dict() for c in checks]
+                seg["analyses"] = _analysis_digests(study, record)
+                seg["elapsed"] = record["elapsed"] = elapsed()
                 met = all(c.met for c in checks)
                 spent = sum(s.get("wall_time", 0.0) for s in record["segments"])
                 out_of = (budget.steps is not None and slide >= budget.steps) or \
@@ -362,14 +404,14 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                 record["segments"].append({"slide_steps": nxt})
                 write_json(path, record)
             warnings = _warnings(study, record)
-            record.update(warnings=warnings, finished=_now(),
+            record.update(warnings=warnings, finished=_now(), elapsed=elapsed(),
                           status="completed" if record["stop"]["met"] is not False
                           else "target_not_met")
             write_json(path, record)
             note(f"replicas: stopped: {record['stop']['reason']}")
             return 0
         except KeyboardInterrupt as exc:
-            record.update(status="interrupted", finished=_now(),
+            record.update(status="interrupted", finished=_now(), elapsed=elapsed(),
                           stop={"reason": f"interrupted ({str(exc) or 'SIGINT'}); resume with "
                                           f"filmfriction run --resume {study}", "met": False})
             try:
@@ -394,7 +436,9 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
 # ---------------------------------------------------------------- the combined analysis
 def combine_study(study: Path) -> dict:
     """Every per-slip observable combined over the replicas (start-up slip left out of
-    each), written to ``ensemble.json`` and ``ensemble.md``; returns the document."""
+    each), written to ``ensemble.json`` and ``ensemble.md``; returns the document.  The
+    values are each replica's own analysis (:func:`~.target.slip_values`: the one the last
+    check read, analysed again only when its run changed since)."""
     from filmfriction.analysis.files.provenance import provenance
 
     study = Path(study)

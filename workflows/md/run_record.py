@@ -11,6 +11,8 @@ from filmfriction.analysis.files.util import json_default, write_atomic
 
 from .scene import Scene, SceneError
 
+#: the shipped LAMMPS script (md_inputs/)
+SCRIPT = "film_slide.lmp"
 # a scene's own script, as copied into the run directory
 OWN_SCRIPT = "script.lmp"
 
@@ -76,3 +78,15 @@ def scene_toml(scene: Scene) -> str:
     for name, value in scene.parameters.items():
         lines.append(f"{name} = {value!r}  # {PARAMETERS[name].unit}")
     return "\n".join(lines) + "\n"
+
+
+def shell_line(cmd: list[str]) -> str:
+    """A command line as a shell reads it (each word quoted as needed)."""
+    import shlex
+
+    return " ".join(shlex.quote(c) for c in cmd)
+
+
+def resume_command(run_dir: Path) -> str:
+    """The command that continues the run in ``run_dir``."""
+    return f"filmfriction run --resume {shell_line([str(run_dir)])}"

@@ -177,3 +177,26 @@ def ledger_problem(dat: np.ndarray, scene: Scene) -> str | None:
                 f"is inaccurate (timestep {scene.parameters['timestep']:g} tau too large for "
                 f"the forces?)")
     return None
+
+
+def rows_problem(run_dir: Path, dat, scene: Scene, returncode: int) -> str | None:
+    """Why a trace that LAMMPS ended without an error is short (None: it is whole):
+    fewer rows than ``slide_steps // trace_every + 1``, or a last step short of the
+    slide's end.  An engine that exits 0 having printed nothing, or a script that
+    writes no trace, ends here."""
+    # fix print writes on multiples of trace_every from step 0: the last row is the
+    # last such multiple, which is below slide_steps when trace_every does not divide it
+    steps, every = scene.parameters["slide_steps"], scene.parameters["trace_every"]
+    last_row = steps // every * every
+    expected = last_row // every + 1
+    rows = (f"{len(dat)} trace rows where slide_steps {steps} / trace_every {every} "
+            f"implies {expected}")
+    if len(dat) and dat[-1, 0] < last_row:
+        return (f"LAMMPS stopped at step {int(dat[-1, 0])} of {steps} without an error "
+                f"message ({rows})")
+    if len(dat) < expected:
+        what = ("wrote no trace.dat" if not (run_dir / TRACE_DAT_FILE).exists() else
+                "left rows out of trace.dat" if len(dat) else "wrote no row into trace.dat")
+        return (f"the engine exited with code {returncode} but {what}: {rows} "
+                "(see lammps.screen)")
+    return None

@@ -5,12 +5,14 @@
 The run slides ``slide_steps`` (the first segment), then, while a target is not met and
 the budget allows, continues from its newest restart file to a longer slide (the runner's
 resume, :func:`filmfriction.workflows.md.runner.resume` with ``slide_steps``).  After each
-segment every target is checked on the per-slip values of every replica, the start-up slip
-of each left out (:func:`slip_values`, :func:`~filmfriction.analysis.ensemble.check_target`).
+segment every target is checked on the per-slip values of every replica's own analysis
+(``analysis.json`` and ``analysis_cycles.csv``, made once per segment and read again by the
+combined analysis), the start-up slip of each left out (:func:`slip_values`,
+:func:`~filmfriction.analysis.ensemble.check_target`).
 
 This module holds what the rule needs apart from running LAMMPS: the parsing of
 ``--target`` and ``--budget`` (each refused with one line before any compute), the per-slip
-values of a run directory, the length of the next segment, and the change to a run
+values of a run directory's analysis, the length of the next segment, and the change to a run
 record that lets a run (completed too) slide further (:func:`extend_record`).
 
 Examples
@@ -24,6 +26,7 @@ TargetError(observable='static_force', relative=0.05, min_slips=8)
 """
 from __future__ import annotations
 
+import json
 import math
 import re
 from dataclasses import dataclass, fields
@@ -33,17 +36,21 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.ensemble import TargetError
+from filmfriction.md_inputs.contract import ANALYSIS_FILE
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .scene import SceneError
 
-__all__ = ["OBSERVABLES", "Budget", "parse_target", "parse_budget", "slip_values",
+__all__ = ["OBSERVABLES", "Budget", "parse_target", "parse_budget", "replica_analysis",
+           "slip_values",
            "next_slide", "extend_record"]
 
-#: the per-slip observables a target may name: the cycle table's columns of values
+#: the per-slip observables a target may name: the cycle table's columns of values and
+#: the effective viscosity of each slip, as ``analysis_cycles.csv`` names them
 OBSERVABLES = tuple(f.name for f in fields(CycleTable)
                     if f.name not in ("yield_index", "stick_index", "yield_time",
-                                      "stick_time", "uncertainty", "spring_constant"))
+                                      "stick_time", "uncertainty", "spring_constant")) \
+    + ("eta_eff",)
 
 #: a budget in wall time: a number and its unit
 _DURATION = re.compile(r"^\s*([0-9]+(?:\.[0-9]*)?)\s*(s|m|min|h|d)\s*$")
@@ -115,17 +122,44 @@ def parse_budget(text: str) -> Budget:
                            f"in [1, {2**31 - 1}]) or a wall time (e.g. 45s, 90m, 2h, 1d)")
 
 
-def slip_values(run_dir: Path, observables) -> dict[str, list[float]]:
-    """Each observable's per-slip values in ``run_dir``'s trace, the start-up slip (the
-    first one) left out; empty lists for a trace too short to analyse."""
-    from filmfriction.analysis.analyze import MIN_ROWS, context
-    from filmfriction.analysis.files.trace_reader import read_trace
+def replica_analysis(run_dir: Path) -> Path:
+    """``run_dir``'s own ``analysis.json`` (the project's analysis,
+    :func:`filmfriction.analysis.analyze.analyse_run`), made when it is missing or was made
+    from other inputs than the run's files now (its trace and ``run.json``, compared by
+    SHA-256: a slide extended since is analysed again); returns its path."""
+    from filmfriction.analysis.analyze import analyse_run
 
-    trace = read_trace(Path(run_dir))
-    if len(trace.time) < MIN_ROWS:
-        return {name: [] for name in observables}
-    table = context(trace, structure=False).all_slips
-    return {name: [float(v) for v in np.asarray(getattr(table, name), float)[1:]]
+    path = Path(run_dir) / ANALYSIS_FILE
+    if not _analysis_current(path):
+        analyse_run(run_dir)
+    return path
+
+
+def _analysis_current(path: Path) -> bool:
+    from filmfriction.analysis.files.provenance import file_sha256
+
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        inputs = doc["provenance"]["inputs"]
+        if "trace" not in inputs or not (path.parent / doc["cycles_csv"]).is_file():
+            return False
+        return all(file_sha256(path.parent / Path(e["path"]).name) == e["sha256"]
+                   for e in inputs.values())
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+def slip_values(run_dir: Path, observables) -> dict[str, list[float]]:
+    """Each observable's per-slip values in ``run_dir``'s own analysis
+    (``analysis_cycles.csv`` beside :func:`replica_analysis`'s ``analysis.json``), the
+    start-up slip (the first row) left out; empty lists for a trace too short to
+    analyse."""
+    from filmfriction.analysis.files.cycles_csv import read_cycles_csv
+
+    path = replica_analysis(run_dir)
+    doc = json.loads(path.read_text(encoding="utf-8"))
+    columns = read_cycles_csv(path.parent / doc["cycles_csv"])
+    return {name: [float(v) for v in np.asarray(columns.get(name, []), float)[1:]]
             for name in observables}
 
 

@@ -1,4 +1,4 @@
-"""The Snakefile's jobs: ``python -m filmfriction.workflows.sweep point|analyse|aggregate ...``."""
+"""The Snakefiles' jobs: ``python -m filmfriction.workflows.sweep point|analyse|aggregate|replica ...``."""
 from __future__ import annotations
 
 import argparse
@@ -23,11 +23,23 @@ def _job_main(argv: list[str]) -> int:
     a.add_argument("run_dir", type=Path)
     g = sub.add_parser("aggregate")
     g.add_argument("sweep_dir", type=Path)
+    r = sub.add_parser("replica")
+    r.add_argument("study", type=Path)
+    r.add_argument("index", type=int)
+    r.add_argument("--slide-steps", type=int, required=True)
+    r.add_argument("--np", type=int, required=True)
+    r.add_argument("--launcher", default="mpiexec")
+    r.add_argument("--lmp", default=None)
+    r.add_argument("--done", type=Path, required=True)
     args = parser.parse_args(argv)
     # Snakemake stops jobs with SIGTERM or SIGINT: both become an interrupt, so the runner
     # stops its LAMMPS child (which runs in its own session) instead of leaving it behind
     signal.signal(signal.SIGTERM, interrupt)
     signal.signal(signal.SIGINT, interrupt)
+    if args.job == "replica":
+        from .replica_jobs import replica_main
+
+        return replica_main(args)
     if args.job == "point":
         from ..md.runner import RunFailed
 

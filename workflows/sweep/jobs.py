@@ -52,17 +52,20 @@ def profile_path(profile: str) -> Path:
 
 
 def snakemake_command(out: Path, cores: int, *, dry_run: bool = False,
-                      profile: Path | None = None, extra: list[str] | None = None) -> list[str]:
+                      profile: Path | None = None, extra: list[str] | None = None,
+                      snakefile: Path = SNAKEFILE, config: dict | None = None) -> list[str]:
     """The ``python -m snakemake`` command line for a sweep directory (through
-    :mod:`.slurm`, which corrects the Slurm executor's reading of job states)."""
+    :mod:`.slurm`, which corrects the Slurm executor's reading of job states); a study's
+    replicas give their own ``snakefile`` and ``config``."""
     cmd = [sys.executable, "-m", "filmfriction.workflows.sweep.slurm",
-           "--snakefile", str(SNAKEFILE),
+           "--snakefile", str(snakefile),
            "--directory", str(Path(out).resolve()), "--cores", str(cores),
            # resume: a job that was running when the sweep was killed is redone
            "--rerun-incomplete",
            # one failed point does not stop the others
            "--keep-going", "--show-failed-logs",
-           "--config", f"python={sys.executable}"]
+           "--config", f"python={sys.executable}",
+           *(f"{k}={v}" for k, v in (config or {}).items())]
     if profile is not None:
         cmd += ["--profile", str(profile)]
     if dry_run:

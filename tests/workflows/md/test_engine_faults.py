@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from filmfriction.workflows.md import engine, lammps_build, reap, runner
+from filmfriction.workflows.md import engine, finish, lammps_build, reap, runner
 from filmfriction.workflows.md.scene import SceneError, load
 
 SMALL = {"equilibrate_steps": 100, "slide_steps": 400, "trace_every": 20,
@@ -249,7 +249,7 @@ def test_an_unexpected_error_leaves_run_json_failed(tmp_path, silent_lmp, monkey
     def broken(*args, **kwargs):
         raise RuntimeError("something nobody foresaw")
 
-    monkeypatch.setattr(runner, "run_engine", broken)
+    monkeypatch.setattr(finish, "run_engine", broken)
     out = tmp_path / "run"
     with pytest.raises(RuntimeError):
         runner.execute(load("stick-slip", SMALL), out=out, nprocs=1, progress=False,
@@ -281,7 +281,7 @@ def test_resume_never_runs_the_recorded_path(planted, monkeypatch, capsys):
         seen["cmd"] = cmd
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(runner, "run_engine", stop_here)
+    monkeypatch.setattr(finish, "run_engine", stop_here)
     monkeypatch.delenv(lammps_build.ENV, raising=False)
     with pytest.raises(KeyboardInterrupt):
         runner.resume(run_dir, progress=False)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from filmfriction.md_inputs.contract import RESUME_OFFSETS
-from filmfriction.workflows.md import runner
+from filmfriction.workflows.md import finish, runner
 from filmfriction.workflows.md.scene import SceneError
 
 pytestmark = pytest.mark.md
@@ -114,7 +114,7 @@ def test_ledger_carried_across_a_cut_off_resume(tmp_path, md, monkeypatch):
     out = tmp_path / "run"
     scene = md.scene("stick-slip", **{**SMALL, "slide_steps": 4000})
     # a run killed right after its restart at 2000 (rows up to 2400 on disk)
-    real_engine = runner.run_engine
+    real_engine = finish.run_engine
 
     def killed_after_restart(cmd, cwd, *args, **kwargs):
         proc = subprocess.Popen(cmd, cwd=cwd, env=runner.engine.engine_env(),
@@ -126,7 +126,7 @@ def test_ledger_carried_across_a_cut_off_resume(tmp_path, md, monkeypatch):
         proc.wait()
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(runner, "run_engine", killed_after_restart)
+    monkeypatch.setattr(finish, "run_engine", killed_after_restart)
     with pytest.raises(KeyboardInterrupt):
         runner.execute(scene, out=out, nprocs=1, progress=False)
     col = runner.DAT_COLUMNS.index
@@ -137,12 +137,12 @@ def test_ledger_carried_across_a_cut_off_resume(tmp_path, md, monkeypatch):
     def cut_off(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(runner, "run_engine", cut_off)
+    monkeypatch.setattr(finish, "run_engine", cut_off)
     with pytest.raises(KeyboardInterrupt):
         runner.resume(out, nprocs=1, progress=False)
     assert runner.read_trace_dat(out / "trace.dat")[:, 0].max() < 2000
 
-    monkeypatch.setattr(runner, "run_engine", real_engine)
+    monkeypatch.setattr(finish, "run_engine", real_engine)
     runner.resume(out, nprocs=1, progress=False)
     after = runner.read_trace_dat(out / "trace.dat")
     again = after[after[:, 0] == 2000][0]

@@ -21,9 +21,8 @@ import pytest
 
 # the child: pause at one step of the set-up, then the real command line
 CHILD = """
-import signal, sys, time, pathlib
+import importlib, signal, sys, time, pathlib
 signal.signal(signal.SIGINT, signal.default_int_handler)   # Ctrl-C even if the parent ignores it
-from filmfriction.workflows.md import runner
 from filmfriction.workflows.cli.main import main
 
 ready, where, *argv = sys.argv[1:]
@@ -33,7 +32,8 @@ def pause(*args, **kwargs):
     time.sleep(120)
     raise SystemExit("the signal never came")
 
-setattr(runner, where, pause)
+module, name = where.split(".")       # a module of workflows/md and its function
+setattr(importlib.import_module(f"filmfriction.workflows.md.{module}"), name, pause)
 sys.exit(main(argv))
 """
 
@@ -62,7 +62,7 @@ SMALL = ["--set", "slide_steps=4000", "--set", "restart_every=2000",
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT],
                          ids=["SIGTERM", "SIGHUP", "SIGINT"])
-@pytest.mark.parametrize("where", ["_record", "run_engine"],
+@pytest.mark.parametrize("where", ["runner._record", "finish.run_engine"],
                          ids=["before run.json", "run.json written, engine not started"])
 def test_signal_during_setup_of_a_run(tmp_path, where, sig, lock_held):
     out = tmp_path / "run"
@@ -80,7 +80,7 @@ def test_signal_during_setup_of_a_run(tmp_path, where, sig, lock_held):
 
 
 
-@pytest.mark.parametrize("where", ["rewrite_trace_dat", "run_engine"],
+@pytest.mark.parametrize("where", ["resume.rewrite_trace_dat", "finish.run_engine"],
                          ids=["run.json set to running", "engine not started"])
 def test_signal_during_setup_of_a_resume(tmp_path, where, interrupted_run):
     run_dir = interrupted_run(tmp_path / "run")

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import copy
 
+import numpy as np
+
 import pytest
 
 from filmfriction.analysis.ensemble import TargetError
@@ -122,3 +124,55 @@ def test_ensemble_markdown_keeps_every_replica():
     assert "| replica-1 | 1 | 10.07 ±" in text and "| replica-2 | 2 | 11.07 ±" in text
     assert f"| static_force | {est['mean']:.4g} | {est['half_width']:.4g} |" in text
     assert "| 100 | static_force: ok |" in text
+
+
+# ---------------------------------------------------------------- the replica's own analysis
+def test_the_check_reads_the_replicas_own_analysis(tmp_path, monkeypatch):
+    """slip_values reads analysis_cycles.csv beside the run's analysis.json (the project's
+    analysis), analyses once, and again only when the run's files changed."""
+    import json
+
+    from filmfriction.analysis import analyze as analyze_mod
+    from filmfriction.analysis.files.cycles_csv import read_cycles_csv
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
+    from filmfriction.workflows.md.target import slip_values
+
+    run_dir = run_directory(tmp_path / "run", trajectory=False)
+    calls = []
+    real = analyze_mod.analyse_run
+    monkeypatch.setattr(analyze_mod, "analyse_run", lambda d: calls.append(d) or real(d))
+
+    first = slip_values(run_dir, ["static_force", "eta_eff"])
+    assert len(calls) == 1 and (run_dir / "analysis.json").is_file()
+    # exactly the analysis's per-slip values, the start-up slip (first row) left out
+    cycles = read_cycles_csv(run_dir / "analysis_cycles.csv")
+    assert first["static_force"] == [float(v) for v in cycles["static_force"][1:]]
+    assert len(first["static_force"]) == len(cycles["static_force"]) - 1 >= 2
+    assert np.allclose(first["static_force"], 3.0, rtol=0.05)     # the trace's Fs
+    assert len(first["eta_eff"]) == len(first["static_force"])
+    # current: read again, not analysed again
+    stamp = (run_dir / "analysis.json").stat().st_mtime_ns
+    assert slip_values(run_dir, ["static_force"]) == {"static_force": first["static_force"]}
+    assert len(calls) == 1 and (run_dir / "analysis.json").stat().st_mtime_ns == stamp
+    # a changed run (a slide extended: a new trace) is analysed again
+    trace = (run_dir / "trace.csv").read_text().splitlines()
+    (run_dir / "trace.csv").write_text("\n".join(trace[:len(trace) * 3 // 4]) + "\n")
+    shorter = slip_values(run_dir, ["static_force"])["static_force"]
+    assert len(calls) == 2 and len(shorter) < len(first["static_force"])
+    # and a changed run.json too (its status is part of what the analysis read)
+    record = json.loads((run_dir / "run.json").read_text())
+    (run_dir / "run.json").write_text(json.dumps({**record, "status": "completed"}))
+    slip_values(run_dir, ["static_force"])
+    assert len(calls) == 3
+
+
+def test_a_trace_too_short_to_analyse_has_no_slips(tmp_path):
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
+    from filmfriction.workflows.md.target import slip_values
+
+    run_dir = run_directory(tmp_path / "run", trajectory=False)
+    lines = (run_dir / "trace.csv").read_text().splitlines()
+    (run_dir / "trace.csv").write_text("\n".join(lines[:5]) + "\n")
+    assert slip_values(run_dir, ["static_force", "period"]) == {"static_force": [],
+                                                                "period": []}
+    assert (run_dir / "analysis.json").is_file()

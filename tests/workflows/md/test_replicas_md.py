@@ -169,3 +169,65 @@ def test_a_run_slid_further_is_the_longer_run(tmp_path, md):
     assert record["extensions"][0]["from"] == 4000 and record["resumed_from"] == "restart.4000"
     assert "slide_steps = 8000" in (out / "scene.toml").read_text()
     assert (out / "trace.csv").read_bytes() == (whole / "trace.csv").read_bytes()
+
+
+# ---------------------------------------------------------------- replicas as Snakemake jobs
+def _same_study(a, b):
+    """Two studies of the same command, one run by this process's children and one by
+    Snakemake's jobs: the same seeds, slides, checks and combined analysis; every
+    replica's trace byte for byte (one rank, the same seed)."""
+    ra, rb = (json.loads((s / "study.json").read_text()) for s in (a, b))
+    assert ra["replicas"] == rb["replicas"]
+    assert [s["slide_steps"] for s in ra["segments"]] == [s["slide_steps"] for s in rb["segments"]]
+    assert [[c["relative_error"] for c in s.get("checks", [])] for s in ra["segments"]] == \
+        [[c["relative_error"] for c in s.get("checks", [])] for s in rb["segments"]]
+    assert (ra["status"], ra["stop"]) == (rb["status"], rb["stop"])
+    for i in range(1, len(ra["replicas"]) + 1):
+        assert (a / f"replica-{i}" / "trace.csv").read_bytes() == \
+            (b / f"replica-{i}" / "trace.csv").read_bytes()
+        run = json.loads((b / f"replica-{i}" / "run.json").read_text())
+        assert run["status"].startswith("completed") and run["np"] == 1
+        assert run["scene"]["parameters"]["seed"] == rb["replicas"][i - 1]["seed"]
+    ea, eb = (json.loads((s / "ensemble.json").read_text())["observables"] for s in (a, b))
+    assert ea == eb
+
+
+def test_replicas_as_snakemake_jobs_are_the_same_study(tmp_path):
+    """``--profile local``: every replica of every segment one Snakemake job
+    (workflows/sweep/replicas.smk); the study directory, its checks and the combined
+    analysis are those of the same study run without a profile."""
+    # two segments: the first has too few slips for the pilot, the second spends the budget
+    args = ["stick-slip", *SMALL, "--set", "slide_steps=10000", "--set", "restart_every=5000",
+            "--replicas", "2", "--target", "static_force=0.5", "--budget", "15000"]
+    plain = _run([*args, "--out", str(tmp_path / "plain")])
+    assert plain.returncode == 0, plain.stderr
+    jobs = _run([*args, "--profile", "local", "--out", str(tmp_path / "jobs")])
+    assert jobs.returncode == 0, jobs.stderr
+    assert "as Snakemake jobs (profile local)" in jobs.stderr
+    study = tmp_path / "jobs"
+    record = json.loads((study / "study.json").read_text())
+    assert record["profile"] == "local", record["stop"]
+    assert [s["slide_steps"] for s in record["segments"]] == [10000, 15000]
+    _same_study(tmp_path / "plain", study)
+    # one job per replica and segment, each with its marker and its lines in the replica's log
+    for seg in record["segments"]:
+        slide = seg["slide_steps"]
+        spec = json.loads((study / "segments" / f"slide-{slide}.json").read_text())
+        assert spec["replicas"] == [1, 2] and spec["np"] == 1
+        for i in (1, 2):
+            assert (study / "segments" / f"slide-{slide}" / f"replica-{i}.done").is_file()
+    for i in (1, 2):
+        log = (study / f"replica-{i}.log").read_text()
+        assert log.count(f"# replica {i}: ") == len(record["segments"])
+        assert f"# replica {i}: start to slide step 10000 (1 rank(s), mpiexec) in job local" in log
+        assert f"# replica {i}: resume to slide step 15000 (1 rank(s), mpiexec) in job local" in log
+    assert "Finished jobid" in (study / "snakemake.log").read_text()
+
+
+def test_a_study_of_snakemake_jobs_is_refused_without_a_profile_it_knows(tmp_path):
+    done = _run(["stick-slip", "--replicas", "2", "--profile", "nowhere",
+                 "--out", str(tmp_path / "s")])
+    assert done.returncode == 2 and "--profile 'nowhere': no such profile" in done.stderr
+    assert not (tmp_path / "s").exists()
+    done = _run(["stick-slip", "--profile", "local", "--out", str(tmp_path / "s")])
+    assert done.returncode == 2 and "give it with --replicas N" in done.stderr

@@ -12,7 +12,7 @@ import os
 
 import pytest
 
-from filmfriction.workflows.md import restarts, runner
+from filmfriction.workflows.md import finish, restarts, runner
 from filmfriction.workflows.md.scene import SceneError
 
 
@@ -33,7 +33,7 @@ def _resume_choice(run_dir, monkeypatch) -> tuple[list, dict]:
         seen.append(cmd)
         return run_dir
 
-    monkeypatch.setattr(runner, "_drive", drive)
+    monkeypatch.setattr(finish, "drive", drive)
     runner.resume(run_dir, progress=False)
     return seen[0], json.loads((run_dir / "run.json").read_text())
 

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from filmfriction.workflows.md import runner
+from filmfriction.workflows.md import finish, runner
 from filmfriction.workflows.md import lammps_output, sanity, trace_dat
 from filmfriction.workflows.md.scene import load
 
@@ -69,7 +69,7 @@ def test_finish_records_completed_with_warnings(tmp_path):
     dat = _dat(s, 400, film_temperature=np.full(400, 1.4))
     trace_dat.rewrite_trace_dat(tmp_path / "trace.dat", dat)
     record = {"segments": [], "trace_parameters": {}}
-    runner._finish(tmp_path, record, replace(s, parameters={**s.parameters,
+    finish.finish(tmp_path, record, replace(s, parameters={**s.parameters,
                                                               "slide_steps": 399 * 50}),
                    lammps_output.EngineOutcome(returncode=0, error=None), None)
     saved = json.loads((tmp_path / "run.json").read_text())
