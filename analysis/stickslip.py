@@ -29,7 +29,7 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CycleTable, stats
 
-from .noise import CYCLE_NOISE_FACTOR, noise_level_and_bound, cycle_noise, noise_level
+from .noise import CYCLE_NOISE_FACTOR, noise_level_and_bound, cycle_noise
 
 __all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "SlipEvents", "detect_slips",
            "classify_regime", "REGIME_CV_MAX"]

@@ -53,7 +53,7 @@ def _run(args: list[str]) -> float:
 
 
 def _slips(run_dir: Path) -> int:
-    from filmfriction.workflows.md.target import slip_values
+    from filmfriction.workflows.md.replicas.target import slip_values
 
     return len(slip_values(run_dir, ["static_force"])["static_force"])
 
@@ -138,9 +138,9 @@ def coverage(args) -> dict:
 
     from filmfriction.analysis.ensemble import combine_replicas
     from filmfriction.analysis.ensemble.replicas import ONE_SIGMA
-    from filmfriction.workflows.md.replica_study import replica_seeds
+    from filmfriction.workflows.md.replicas.replica_study import replica_seeds
     from filmfriction.workflows.md.scene import load
-    from filmfriction.workflows.md.target import slip_values
+    from filmfriction.workflows.md.replicas.target import slip_values
 
     out = Path(args.out)
     base = load(args.scene).parameters["seed"]
@@ -210,7 +210,7 @@ def main(argv=None) -> int:
     Path(args.out).mkdir(parents=True, exist_ok=True)
     result = paired(args) if args.part == "paired" else coverage(args)
 
-    from filmfriction.workflows.md.replica_study import write_json
+    from filmfriction.workflows.md.replicas.replica_study import write_json
 
     write_json(Path(args.out) / f"{args.part}.json", result)
     print(f"-> {Path(args.out) / f'{args.part}.json'}")

@@ -38,7 +38,7 @@ __all__ = ["STUDY_FILE", "ENSEMBLE_FILE", "ENSEMBLE_REPORT_FILE", "REPLICA_DIR",
 #: A study of replicas (``filmfriction run --replicas N``): its record, the combined
 #: analysis and its report in the study directory, one run directory per replica
 #: (REPLICA_DIR) and each replica's output (REPLICA_LOG): the contract's names
-#: (md_inputs/contract.py), shared with the runner's modules (workflows/md/replica_study.py).
+#: (md_inputs/contract.py), shared with the runner's modules (workflows/md/replicas/replica_study.py).
 STUDY_FILES = (STUDY_FILE, ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR, REPLICA_LOG)
 
 

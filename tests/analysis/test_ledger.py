@@ -4,7 +4,7 @@ import pytest
 
 from filmfriction.analysis.energy import ledger
 from filmfriction.md_inputs import contract
-from filmfriction.workflows.md import sanity
+from filmfriction.workflows.md.output import sanity
 from filmfriction.workflows.md.scene import load
 
 

@@ -16,7 +16,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filmfriction.analysis.analyze import analyse_run
 from filmfriction.analysis.groundtruth.synthetic import run_directory
 from filmfriction.analysis.files.trace_reader import read_trace
 from filmfriction.analysis.files.trace_cache import (BINARY_MIN_ROWS, CACHE_DIR, binary_copy_path,
@@ -182,7 +181,7 @@ def test_the_git_commit_is_the_checkouts_and_none_outside_one(tmp_path):
 # -------------------------------------------------------------- documents read back
 def test_slide_origin_not_numbers(tmp_path):
     from filmfriction.workflows.md.scene import SceneError
-    from filmfriction.workflows.md.trace_dat import slide_origin
+    from filmfriction.workflows.md.output.trace_dat import slide_origin
 
     (tmp_path / "slide_origin.txt").write_text("abc def\n")
     with pytest.raises(SceneError, match=r"slide_origin.txt: 'abc def': expected two finite "

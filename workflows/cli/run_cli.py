@@ -163,7 +163,7 @@ def run(args: argparse.Namespace) -> int:
         if args.slide_to is not None and record is not None:
             import copy
 
-            from ..md.target import extend_record
+            from ..md.replicas.target import extend_record
 
             try:
                 extend_record(args.resume, copy.deepcopy(record), args.slide_to)
@@ -206,8 +206,8 @@ def run(args: argparse.Namespace) -> int:
 def _study_inputs(args: argparse.Namespace):
     """``(replicas, targets, budget)`` for a study of replicas or a target (None for a
     plain run); UserError for any of them a study cannot take, before any compute."""
-    from ..md.replica_study import MAX_REPLICAS
-    from ..md.target import TargetInputError, parse_budget, parse_targets
+    from ..md.replicas.replica_study import MAX_REPLICAS
+    from ..md.replicas.target import TargetInputError, parse_budget, parse_targets
 
     if args.slide_to is not None:
         if not args.resume:
@@ -262,13 +262,13 @@ def _executor(profile: str, ranks: int):
 
 
 def _is_study(path) -> bool:
-    from ..md.replica_study import is_study
+    from ..md.replicas.replica_study import is_study
 
     return is_study(path)
 
 
 def _run_study(args, replicas, targets, budget) -> int:
-    from ..md.replica_study import run_study
+    from ..md.replicas.replica_study import run_study
     from ..md.scene import SceneError
 
     if args.out is not None:
@@ -295,7 +295,7 @@ def _run_study(args, replicas, targets, budget) -> int:
 
 
 def _resume_study(args) -> int:
-    from ..md.replica_study import resume_study
+    from ..md.replicas.replica_study import resume_study
     from ..md.scene import SceneError
 
     if args.slide_to is not None:
@@ -324,7 +324,7 @@ def _study_interrupted(exc: KeyboardInterrupt) -> int:
 def _study_done(args, study: Path, code: int) -> int:
     import json
 
-    from ..md.replica_study import combine_study
+    from ..md.replicas.replica_study import combine_study
     from ..rundir import ENSEMBLE_REPORT_FILE, STUDY_FILE
 
     print(f"study directory: {study}")
@@ -337,8 +337,8 @@ def _study_done(args, study: Path, code: int) -> int:
         print(f"filmfriction run: warning: {record['stop']['reason']}", file=sys.stderr)
     if args.md_only:
         return 0
-    from ..md.replica_study import replica_dir
-    from ..md.target import replica_analysis
+    from ..md.replicas.replica_study import replica_dir
+    from ..md.replicas.target import replica_analysis
 
     for i in range(1, len(record["replicas"]) + 1):     # each replica's own analysis.json
         try:

@@ -103,7 +103,7 @@ def targets_main(args: argparse.Namespace) -> int:
     from ..cost.tradeoff_targets import SCENES, run_targets
     from ..inputs import parse_overrides, usable_cpus
     from ..md.scene import SceneError, load
-    from ..md.target import TargetInputError, parse_budget
+    from ..md.replicas.target import TargetInputError, parse_budget
 
     if args.quick or args.json or args.seeds != 1 or args.np != 2:
         raise UserError("--targets times 2 replicas x 1 rank against 1 run x 2 ranks: "

@@ -30,7 +30,7 @@ from pathlib import Path
 from filmfriction import md_inputs
 from filmfriction.md_inputs.contract import LOG_FILE, RUN_FILE
 from ..md import engine
-from ..md.lammps_output import loop_totals
+from ..md.output.lammps_output import loop_totals
 
 
 def bulk_cells(n_atoms: int) -> tuple[int, int, int]:

@@ -19,7 +19,7 @@ the tightest study's, so a looser level is read at those checks: a study asked o
 read the same way.
 
 The two sides run one after the other in each pair, the order alternating between pairs;
-each pair repeats the same seeds (the scene's own first, :func:`~filmfriction.workflows.md.replica_study.replica_seeds`),
+each pair repeats the same seeds (the scene's own first, :func:`~filmfriction.workflows.md.replicas.replica_study.replica_seeds`),
 so the pairs differ in their timing only.  The table gives each time's median and
 min–max over the pairs, and the ratio ranks/replicas per pair (above 1: the replicas
 were faster).  The CPU time other processes used meanwhile is measured: a figure taken
@@ -183,7 +183,7 @@ def preset_errors(run_dir: Path, levels=LEVELS, observables=OBSERVABLES) -> dict
     left out) and the tightest level it meets (None: none)."""
     from filmfriction.analysis.ensemble import TargetError, check_target
 
-    from ..md.target import slip_values
+    from ..md.replicas.target import slip_values
 
     values = slip_values(Path(run_dir), observables)
     out = {}

@@ -18,13 +18,13 @@ from pathlib import Path
 from filmfriction.md_inputs.contract import RUN_FILE, TRACE_DAT_FILE, TRACE_FILE
 
 from . import engine, lammps_build, restarts
-from .lammps_output import ranks_problem, run_engine
+from .output.lammps_output import ranks_problem, run_engine
 from .run_record import resume_command, write_json
-from .sanity import (contract_message, contract_problem, lost_atoms_hint, rows_problem,
+from .output.sanity import (contract_message, contract_problem, lost_atoms_hint, rows_problem,
                      sanity_warnings, trace_problem)
 from .scene import Scene
 from .signals import Terminated
-from .trace_dat import read_trace_dat, write_trace_csv
+from .output.trace_dat import read_trace_dat, write_trace_csv
 
 __all__ = ["RunFailed", "ContractBroken", "abandoned", "interrupted", "watch", "drive",
            "finish"]

@@ -22,7 +22,7 @@ from .locks import RunLock
 from .run_record import OWN_SCRIPT, SCRIPT, resume_command, scene_toml, write_json
 from .scene import SceneError
 from .signals import TerminationAsInterrupt
-from .trace_dat import read_trace_dat, rewrite_trace_dat, slide_origin
+from .output.trace_dat import read_trace_dat, rewrite_trace_dat, slide_origin
 
 __all__ = ["resume"]
 
@@ -42,7 +42,7 @@ def resume(run_dir: Path, nprocs: int | None = None, progress: bool = True,
     stderr says so and ``run.json``'s ``notes`` keep it.
     The directory is locked for the whole resume: a second one is refused.
     ``slide_steps``: continue to a longer slide (a completed run too), from the newest
-    restart file (:func:`filmfriction.workflows.md.target.extend_parameters` says what is
+    restart file (:func:`filmfriction.workflows.md.replicas.target.extend_parameters` says what is
     accepted); ``run.json`` and ``scene.toml`` then hold the longer slide.
     """
     run_dir = Path(run_dir)
@@ -85,7 +85,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
     except ValueError as exc:
         raise SceneError(str(exc)) from None
     if slide_steps is not None:
-        from .target import extend_record
+        from .replicas.target import extend_record
 
         extend_record(run_dir, record, slide_steps)
     elif record.get("status") in ("completed", "completed_with_warnings"):

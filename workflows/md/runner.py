@@ -38,14 +38,14 @@ from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import COMMAND_FILE, LOG_FILE, RUN_FILE, SCENE_FILE
 from . import engine, finish, lammps_build
 from .finish import ContractBroken, RunFailed
-from .lammps_output import ranks_problem
+from .output.lammps_output import ranks_problem
 from .locks import RunLock
 from .resume import resume
 from .run_record import (OWN_SCRIPT, SCRIPT, new_run_dir, resume_command, scene_toml,
                          shell_line, versions, write_json)
 from .scene import Scene
 from .signals import Terminated, TerminationAsInterrupt
-from .trace_dat import read_trace_dat, write_trace_csv
+from .output.trace_dat import read_trace_dat, write_trace_csv
 
 __all__ = ["execute", "resume", "resume_command", "RunFailed", "ContractBroken", "RunLock",
            "Terminated", "TerminationAsInterrupt", "SCRIPT", "OWN_SCRIPT", "DAT_COLUMNS",

@@ -2,7 +2,7 @@
 
 ``filmfriction run SCENE --replicas N --profile PROFILE`` (a shipped profile, ``local`` or
 ``slurm``, or a profile directory) drives the study exactly as without a profile
-(:mod:`filmfriction.workflows.md.replica_study`: seeds, segments, the target's checks on
+(:mod:`filmfriction.workflows.md.replicas.replica_study`: seeds, segments, the target's checks on
 each replica's analysis, ``study.json``, the combined ``ensemble.json``); only who runs the
 replicas of a segment differs.  :func:`snakemake_executor` writes the segment's replicas to
 ``segments/slide-<S>.json`` and runs ``workflows/sweep/replicas.smk`` on the study
@@ -45,7 +45,7 @@ def marker(study: Path, slide: int, index: int) -> Path:
 
 
 def snakemake_executor(profile: Path, cores: int):
-    """A runner of a segment's replicas for :func:`~filmfriction.workflows.md.replica_study.run_study`:
+    """A runner of a segment's replicas for :func:`~filmfriction.workflows.md.replicas.replica_study.run_study`:
     ``(study, record, slide, indices, workers) -> {index: exit code}`` through Snakemake
     with ``profile`` on at most ``cores`` local cores (a cluster's profile sets its own
     job limit)."""
@@ -98,7 +98,7 @@ def run_replica(study: Path, index: int, slide: int, np_: int, launcher: str = "
     directory (the study's scene with the replica's seed) or continue it from its newest
     restart file; nothing when it is there already.  Raises what the runner raises
     (:class:`~filmfriction.workflows.md.runner.RunFailed`, ``KeyboardInterrupt``)."""
-    from ..md.replica_study import replica_dir, replica_state
+    from ..md.replicas.replica_study import replica_dir, replica_state
     from ..md.runner import execute, resume
     from ..md.scene import load
 

@@ -1,7 +1,7 @@
 # Replicas of one study as independent jobs: a Snakemake job per replica and segment.
 #
 # `filmfriction run SCENE --replicas N --profile PROFILE` drives the study as without a
-# profile (workflows/md/replica_study.py: the seeds, the target's checks, the segments,
+# profile (workflows/md/replicas/replica_study.py: the seeds, the target's checks, the segments,
 # the combined analysis); for each segment it writes segments/slide-<S>.json (the replicas
 # still to bring to a slide of S steps) and calls
 #     python -m snakemake --snakefile workflows/sweep/replicas.smk --directory STUDY_DIR \

@@ -54,7 +54,7 @@ CASES = {
                                                           "--out", t / "r"], "899999990", 2),
     "--resume with --set": (lambda t, b: ["run", "--resume", t, "--set", "seed=1"],
                             "not accepted with it", 2),
-    # -- replicas and a target error (workflows/md/replica_study.py, target.py)
+    # -- replicas and a target error (workflows/md/replicas/replica_study.py, target.py)
     "--replicas 0": (lambda t, b: ["run", "--replicas", "0", "--out", t / "r"],
                      "--replicas 0: give between 1 and", 2),
     "--replicas absurd": (lambda t, b: ["run", "--replicas", "100000", "--out", t / "r"],

@@ -94,7 +94,7 @@ def _fake_engine(tmp_path: Path) -> list:
                                           ("QUIET", "nothing")])
 def test_progress_without_a_terminal_is_lines(level, shown, tmp_path, capsys):
     from filmfriction.workflows import progress
-    from filmfriction.workflows.md.lammps_output import run_engine
+    from filmfriction.workflows.md.output.lammps_output import run_engine
 
     progress.set_level(getattr(progress, level))
     try:

@@ -1,4 +1,4 @@
-"""Replicas and a target error (workflows/md/replica_study.py, target.py): the parts without LAMMPS.
+"""Replicas and a target error (workflows/md/replicas/replica_study.py, target.py): the parts without LAMMPS.
 
 The statistics (combine_replicas, check_target) are tested on ground truth in
 tests/analysis/ensemble/test_ensemble.py; the command on real LAMMPS in test_replicas_md.py.
@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.ensemble import TargetError
-from filmfriction.workflows.md.replica_study import MAX_REPLICAS, ensemble_markdown, replica_seeds
+from filmfriction.workflows.md.replicas.replica_study import MAX_REPLICAS, ensemble_markdown, replica_seeds
 from filmfriction.workflows.md.scene import SceneError
-from filmfriction.workflows.md.target import (OBSERVABLES, Budget, TargetInputError,
+from filmfriction.workflows.md.replicas.target import (OBSERVABLES, Budget, TargetInputError,
                                               extend_record, next_slide, parse_budget,
                                               parse_target, parse_targets)
 
@@ -135,7 +135,7 @@ def test_the_check_reads_the_replicas_own_analysis(tmp_path, monkeypatch):
     from filmfriction.analysis import analyze as analyze_mod
     from filmfriction.analysis.files.cycles_csv import read_cycles_csv
     from filmfriction.analysis.groundtruth.synthetic import run_directory
-    from filmfriction.workflows.md.target import slip_values
+    from filmfriction.workflows.md.replicas.target import slip_values
 
     run_dir = run_directory(tmp_path / "run", trajectory=False)
     calls = []
@@ -168,7 +168,7 @@ def test_the_check_reads_the_replicas_own_analysis(tmp_path, monkeypatch):
 
 def test_a_trace_too_short_to_analyse_has_no_slips(tmp_path):
     from filmfriction.analysis.groundtruth.synthetic import run_directory
-    from filmfriction.workflows.md.target import slip_values
+    from filmfriction.workflows.md.replicas.target import slip_values
 
     run_dir = run_directory(tmp_path / "run", trajectory=False)
     lines = (run_dir / "trace.csv").read_text().splitlines()

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from filmfriction.analysis.ensemble import check_target, combine_replicas
-from filmfriction.workflows.md.target import slip_values
+from filmfriction.workflows.md.replicas.target import slip_values
 
 pytestmark = pytest.mark.md
 
@@ -132,7 +132,7 @@ def test_study_interrupted_locked_and_resumed(tmp_path):
         run = json.loads((study / f"replica-{i}" / "run.json").read_text())
         assert run["status"] in ("interrupted", "completed"), run["status"]
     # the lock went with the process that held it
-    from filmfriction.workflows.md.replica_study import _lock
+    from filmfriction.workflows.md.replicas.replica_study import _lock
 
     _lock(study).acquire().release()
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from filmfriction.workflows.md import finish, runner
-from filmfriction.workflows.md import lammps_output, sanity, trace_dat
+from filmfriction.workflows.md.output import lammps_output, sanity, trace_dat
 from filmfriction.workflows.md.scene import load
 
 

@@ -11,7 +11,7 @@ import numpy as np
 from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs.contract import DAT_COLUMNS, SLIDE_ORIGIN_FILE, TRACE_COLUMNS
 
-from .scene import SceneError
+from ..scene import SceneError
 
 
 def read_trace_dat(path: Path, raw: bool = False) -> np.ndarray:

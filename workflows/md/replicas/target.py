@@ -39,7 +39,7 @@ from filmfriction.analysis.ensemble import TargetError
 from filmfriction.md_inputs.contract import ANALYSIS_FILE
 from filmfriction.reduced_model.cycles import CycleTable
 
-from .scene import SceneError
+from ..scene import SceneError
 
 __all__ = ["OBSERVABLES", "Budget", "parse_target", "parse_budget", "replica_analysis",
            "slip_values",

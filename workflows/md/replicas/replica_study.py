@@ -42,9 +42,9 @@ from filmfriction.analysis.ensemble import check_target, combine_replicas
 from filmfriction.analysis.files.util import write_atomic
 from filmfriction.md_inputs.contract import (ANALYSIS_FILE, ENSEMBLE_FILE, ENSEMBLE_REPORT_FILE, REPLICA_DIR,
                                              REPLICA_LOG, RUN_FILE, SCENE_FILE, STUDY_FILE)
-from .locks import DirectoryLock
-from .run_record import OWN_SCRIPT, new_run_dir, scene_toml
-from .scene import Scene, SceneError
+from ..locks import DirectoryLock
+from ..run_record import OWN_SCRIPT, new_run_dir, scene_toml
+from ..scene import Scene, SceneError
 from .target import OBSERVABLES, Budget, next_slide, slip_values
 
 __all__ = ["MAX_REPLICAS", "replica_seeds", "replica_dir", "replica_log", "is_study",
@@ -241,7 +241,7 @@ def _run_jobs(study: Path, jobs: dict[int, list[str]], workers: int) -> dict[int
     """Run the replicas' commands, ``workers`` at once; their exit codes.  An interruption
     of this process interrupts every replica (SIGINT: each records its own) and waits for
     them, then goes on up."""
-    from ..progress import note
+    from ...progress import note
 
     pending, running, codes = sorted(jobs), {}, {}
     try:
@@ -318,8 +318,8 @@ def _local(study: Path, record: dict, slide: int, indices, workers: int) -> dict
 
 def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: int,
            executor=None) -> int:
-    from ..progress import note
-    from .runner import TerminationAsInterrupt
+    from ...progress import note
+    from ..runner import TerminationAsInterrupt
 
     path = study / STUDY_FILE
     nprocs = int(record.get("np") or 1)

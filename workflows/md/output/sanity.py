@@ -10,7 +10,7 @@ from filmfriction.analysis.energy import ledger
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import DAT_COLUMNS, TRACE_DAT_FILE
 
-from .scene import Scene
+from ..scene import Scene
 
 
 # Largest energy-ledger residual accepted, as a fraction of the energy turned
@@ -65,7 +65,7 @@ def trace_problem(dat: np.ndarray, scene: Scene) -> str | None:
 def lost_atoms_hint(scene: Scene) -> str:
     """Why atoms leave the box, for the engine's bare "Lost atoms" message: the
     likely causes found in the actual parameters, most likely first."""
-    from .scenes.parameters import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
+    from ..scenes.parameters import FLEXIBLE_WALL_MAX_TEMPERATURE, WCA_CUTOFF, derived_quantities
 
     p = scene.parameters
     d = derived_quantities(p)

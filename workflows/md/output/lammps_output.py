@@ -8,7 +8,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import engine, reap
+from .. import engine, reap
 
 
 # ---------------------------------------------------------------- the engine
@@ -94,7 +94,7 @@ def run_engine(cmd: list[str], cwd: Path, total_steps: int, progress: bool = Tru
     slide (or of a resumed slide); an exception it raises stops LAMMPS.
     ``env``: the engine's environment (default :func:`engine.engine_env`).
     """
-    from ..progress import detail, progress_bar
+    from ...progress import detail, progress_bar
 
     t0 = time.perf_counter()
     stage_offset = 0
