@@ -89,33 +89,21 @@ import math
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import stats as sps
 from scipy.integrate import cumulative_trapezoid
-from scipy.optimize import brentq
 from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
+
+from .slip_law_branches import BranchFit, Segment, fit_branch
+from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
+from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, VERDICTS
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION"]
 
-#: The verdicts, in the order the rules are tried.
-VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
 #: The branches of a slip; the verdict is the first one's.
 BRANCHES = ("decelerating", "accelerating")
-#: A fitted term is resolved when it exceeds this many standard errors (at a normal's coverage).
-RESOLVED_SIGMAS = 2.0
-#: The power at which a term the run did not resolve is ruled out.
-POWER = 0.95
-#: A term not resolved is ruled out as dominant when the run would have resolved it (at
-#: :data:`POWER`) carrying this share of the mean film force.
-DOMINANT_SHARE = 0.5
-#: A term is resolved only when it also carries at least this share of the film force
-#: (|F_k| + |B·v̄|): the numerical floor of the sampled equation of motion (its
-#: trapezoid impulse and the sampling leave terms of 1e-4–1e-3 of the force on exact
-#: model traces at the controls' sampling, with standard errors far smaller).
-NUMERICAL_FLOOR = 0.01
 #: A window is a slip only when the spring force falls over it by at least this share of
 #: its value at the yield (K·(Δx − VΔt) of F_s): a window in which the wall did not move
 #: (a film holding the wall, the wall rattling in its well) is refused, not fitted.
@@ -123,73 +111,6 @@ MIN_RELAXATION = 0.05
 #: Default window of the velocity that picks the fitted samples, as a share of the median
 #: slip duration.
 SMOOTHING = 0.1
-#: With this many slips or more, the errors are the scatter of the per-slip fits.
-MIN_SLIPS_FOR_SCATTER = 3
-
-
-@dataclass(frozen=True)
-class BranchFit:
-    """F_film = F_k + B·v [+ m_c·a] fitted on one branch of the slips (see the module text).
-
-    Attributes
-    ----------
-    branch : str
-        ``decelerating``, ``accelerating`` or ``whole``.
-    kinetic_force, kinetic_force_stderr : float
-        F_k and its standard error (force units).
-    damping, damping_stderr : float
-        B and its standard error (force per velocity).
-    comoving_mass, comoving_mass_stderr : float
-        m_c and its standard error (NaN when the term was not fitted).
-    mean_velocity, mean_force : float
-        v̄ and F̄, the means of the fitted samples.
-    viscous_share : float
-        B·v̄ / F̄.
-    exponent, exponent_stderr : float
-        n = d ln F/d ln v of the fitted law at each slip's mean velocity, mean and
-        standard error over the slips.
-    kinetic_sigmas, damping_sigmas : float
-        F_k and B in normal-equivalent standard errors (signed).
-    detectable_damping, detectable_kinetic_force : float
-        The smallest B and F_k the run resolves at 2 σ with 95 % power.
-    dof : int
-        Degrees of freedom of the errors.
-    verdict, reason : str
-        One of :data:`VERDICTS`, and the numbers it rests on.
-    per_slip_kinetic_force, per_slip_damping, per_slip_exponent : ndarray
-        Per-slip fits (NaN where a slip had too few samples on this branch).
-    samples, slips : int
-        Samples and slips fitted.
-    velocity_residual : float
-        Root-mean-square residual of the pooled integral fit over M: how far the
-        wall's velocity strays from the law's (velocity units).
-    """
-
-    branch: str
-    kinetic_force: float
-    kinetic_force_stderr: float
-    damping: float
-    damping_stderr: float
-    comoving_mass: float
-    comoving_mass_stderr: float
-    mean_velocity: float
-    mean_force: float
-    viscous_share: float
-    exponent: float
-    exponent_stderr: float
-    kinetic_sigmas: float
-    damping_sigmas: float
-    detectable_damping: float
-    detectable_kinetic_force: float
-    dof: int
-    verdict: str
-    reason: str
-    per_slip_kinetic_force: np.ndarray
-    per_slip_damping: np.ndarray
-    per_slip_exponent: np.ndarray
-    samples: int
-    slips: int
-    velocity_residual: float
 
 
 @dataclass(frozen=True)
@@ -312,206 +233,6 @@ def _checked(time, spring_force, wall_velocity, mass):
     return t, f, v
 
 
-# ---------------------------------------------------------------------------
-# significance and power
-# ---------------------------------------------------------------------------
-def sigmas(estimate: float, stderr: float, dof: int) -> float:
-    """``estimate/stderr`` as normal-equivalent standard errors (signed): the t of ``dof``
-    degrees of freedom mapped to the normal quantile of the same tail probability.
-
-    >>> round(sigmas(2.0, 1.0, 10**6), 3), round(sigmas(2.0, 1.0, 4), 2)
-    (2.0, 1.57)
-    """
-    if not (math.isfinite(estimate) and math.isfinite(stderr) and stderr >= 0 and dof >= 1):
-        return math.nan
-    if stderr == 0:
-        return math.copysign(38.0, estimate) if estimate else 0.0
-    t = estimate / stderr
-    z = float(sps.norm.isf(sps.t.sf(abs(t), dof)))
-    return math.copysign(min(z, 38.0), t)
-
-
-def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
-               power: float = POWER) -> float:
-    """The smallest true value resolved at ``resolved`` σ (normal-equivalent) in a share
-    ``power`` of repeats, for an estimate with standard error ``stderr`` whose own
-    error has ``dof`` degrees of freedom: δ·stderr with δ the noncentrality at
-    which a noncentral t exceeds the critical t with probability ``power``.
-
-    >>> round(detectable(1.0, 10**6), 2), round(detectable(1.0, 6), 2)   # 2 + 1.645; 6 dof
-    (3.64, 4.45)
-    """
-    if not (math.isfinite(stderr) and stderr >= 0 and dof >= 1):
-        return math.nan
-    crit = sps.t.isf(sps.norm.sf(resolved), dof)
-    if dof > 1000:
-        return float((crit + sps.norm.ppf(power)) * stderr)
-    delta = brentq(lambda d: sps.nct.sf(crit, dof, d) - power, 0.0, 10 * crit + 50)
-    return float(delta * stderr)
-
-
-# ---------------------------------------------------------------------------
-# fitting
-# ---------------------------------------------------------------------------
-def _ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
-    """Least squares y = X·c: (coef, stderr, residuals); the errors widened by the
-    residuals' integrated autocorrelation time (NaN with ``errors=False``)."""
-    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
-    resid = y - X @ coef
-    dof = y.size - X.shape[1]
-    if dof <= 0 or not errors:
-        return coef, np.full(X.shape[1], math.nan), resid
-    s2 = float(resid @ resid) / dof
-    try:
-        se = np.sqrt(np.diag(s2 * np.linalg.inv(X.T @ X)) * _correlation_time(resid))
-    except np.linalg.LinAlgError:
-        se = np.full(X.shape[1], math.nan)
-    return coef, se, resid
-
-
-def _correlation_time(r: np.ndarray) -> float:
-    """Integrated autocorrelation time of ``r`` in samples, 1 + 2 Σ ρ_k summed up to
-    the first lag where ρ_k ≤ 0 (1 for uncorrelated samples)."""
-    r = r - r.mean()
-    den = float(r @ r)
-    if r.size < 3 or den <= 0:
-        return 1.0
-    tau = 1.0
-    for k in range(1, r.size // 2):
-        rho = float(r[k:] @ r[:-k]) / den
-        if rho <= 0:
-            break
-        tau += 2 * rho
-    return tau
-
-
-@dataclass(frozen=True)
-class _Segment:
-    """One branch of one slip in integral form (module text): the response y, the
-    regressors Δt, Δx and v − v0, and the branch's mean velocity."""
-
-    y: np.ndarray           # ∫F_spring dt − γM(Δx − VΔt) − M v
-    dt: np.ndarray
-    dx: np.ndarray
-    dv: np.ndarray          # v − v0 of the smoothed velocity (the m_c term)
-    mass: float
-
-    @property
-    def mean_velocity(self) -> float:
-        return float(self.dx[-1] / self.dt[-1]) if self.dt[-1] > 0 else math.nan
-
-    def design(self, comoving: bool, intercepts: int = 1, which: int = 0):
-        """Columns [intercepts…, Δt, Δx (, v − v0)] and the response (with m_c, the
-        response without the −M·v it would otherwise hold: M·v joins m_c·v)."""
-        cols = [np.full(self.y.size, float(k == which)) for k in range(intercepts)]
-        cols += [self.dt, self.dx]
-        return cols + ([self.dv] if comoving else [])
-
-
-def _fit_branch(branch: str, segments: list[_Segment | None], comoving: bool) -> BranchFit:
-    """Per-slip fits on one branch, their mean, errors, power and verdict."""
-    nterms = 4 if comoving else 3
-    per = []                       # (fk, b, mc, vbar) per slip
-    used, resids = [], []
-    for seg in segments:
-        if seg is None or seg.y.size < nterms + 3:
-            per.append((math.nan,) * 4)
-            continue
-        coef, _, res = _ols(np.column_stack(seg.design(comoving)), seg.y, errors=False)
-        resids.append(res)
-        # with m_c, the coefficient of v − v0 is M + m_c
-        per.append((float(coef[1]), float(coef[2]),
-                    float(coef[3]) - seg.mass if comoving else math.nan, seg.mean_velocity))
-        used.append(seg)
-    per = np.array(per, float).reshape(-1, 4)
-    nan = math.nan
-    if not used:
-        return BranchFit(branch, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan,
-                         nan, nan, nan, 0, "inconclusive",
-                         f"no slip with {nterms + 3} or more samples on the {branch} branch "
-                         "above the velocity floor", per[:, 0], per[:, 1], per[:, 0] * nan,
-                         0, 0, nan)
-    m = len(used)
-    ok = np.isfinite(per[:, 0]) & np.isfinite(per[:, 1])
-    n = int(ok.sum())
-    with np.errstate(invalid="ignore", divide="ignore"):
-        expo = per[:, 1] * per[:, 3] / (per[:, 0] + per[:, 1] * per[:, 3])
-    if n >= MIN_SLIPS_FOR_SCATTER:
-        # the slips are the replicas: the standard error of their mean
-        est = per[ok, :3].mean(axis=0)
-        se = per[ok, :3].std(axis=0, ddof=1) / math.sqrt(n)
-        dof = n - 1
-    else:
-        # too few slips for a scatter: the pooled fit (one intercept per slip, common
-        # F_k, B (, m_c)), its errors widened for the residuals' correlation, with the
-        # degrees of freedom of its independent samples
-        X = np.vstack([np.column_stack(s.design(comoving, m, k)) for k, s in enumerate(used)])
-        y = np.concatenate([s.y for s in used])
-        coef, pse, resid = _ols(X, y)
-        est = np.array([coef[m], coef[m + 1], coef[m + 2] - used[0].mass if comoving else nan])
-        se = np.array([pse[m], pse[m + 1], pse[m + 2] if comoving else nan])
-        dof = max(int(y.size / _correlation_time(resid)) - (m + nterms - 1), 1)
-    fk, b, mc = (float(x) for x in est)
-    se_fk, se_b, se_mc = (float(x) for x in se)
-    ex = expo[ok][np.isfinite(expo[ok])]
-    n_mean = float(ex.mean()) if ex.size else nan
-    n_se = float(ex.std(ddof=1) / math.sqrt(ex.size)) if ex.size >= 2 else nan
-    vbar = float(np.nanmean(per[ok, 3])) if n else nan
-    fbar = fk + b * vbar
-    share = b * vbar / fbar if fbar > 0 else nan
-    # the residual as the error of the law's wall velocity: (response residual) / M
-    allres = np.concatenate(resids)
-    vres = float(np.sqrt(np.mean(allres ** 2))) / used[0].mass
-    z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
-    det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
-    verdict, reason = _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n)
-    return BranchFit(branch, fk, se_fk, b, se_b, mc, se_mc, vbar,
-                     fbar, share, n_mean, n_se, z_fk, z_b, det_b, det_fk, dof, verdict, reason,
-                     per[:, 0], per[:, 1], expo, int(allres.size), n, vres)
-
-
-def _verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
-    """The verdict of one branch and the numbers it rests on (module text)."""
-    r = RESOLVED_SIGMAS
-    nums = (f"F_k = {fk:.4g} ± {se_fk:.2g} ({z_fk:+.1f} σ), B = {b:.4g} ± {se_b:.2g} "
-            f"({z_b:+.1f} σ) over {n} slip(s); F̄ = {fbar:.4g} at v̄ = {vbar:.4g}; "
-            f"95 % power at 2 σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
-    if not all(math.isfinite(x) for x in (z_fk, z_b, fbar, vbar)):
-        return "inconclusive", f"errors not defined: {nums}"
-    # a term counts only above the numerical floor too: on an exact trace its error is
-    # ~0 and the quadrature's own error would otherwise read as a resolved term
-    floor = NUMERICAL_FLOOR * (abs(fk) + abs(b * vbar))
-    b_big, fk_big = abs(b * vbar) >= floor, abs(fk) >= floor
-    small = [f"{name} carries {abs(val) / (abs(fk) + abs(b * vbar)):.1e} of the force, "
-             f"under the numerical floor {NUMERICAL_FLOOR:g}"
-             for name, val, big, z in (("F_k", fk, fk_big, z_fk), ("B·v̄", b * vbar, b_big, z_b))
-             if abs(z) >= r and not big]
-    if small:
-        nums = f"{nums}; {'; '.join(small)}"
-    if z_b <= -r and b_big:
-        return "velocity-weakening", f"B resolved negative: {nums}"
-    b_res, fk_res = z_b >= r and b_big, z_fk >= r and fk_big
-    if b_res and fk_res:
-        return "mixed", f"both terms resolved (viscous share {b * vbar / fbar:.2f}): {nums}"
-    if fbar <= 0:
-        return "inconclusive", f"mean film force not positive: {nums}"
-    hidden_visc = det_b * vbar / fbar       # share a viscous term could carry unseen
-    hidden_kin = det_fk / fbar
-    if b_res:
-        if hidden_kin < DOMINANT_SHARE:
-            return "viscous", (f"B resolved, F_k not; a kinetic force of {hidden_kin:.2f} F̄ "
-                               f"would have been resolved: {nums}")
-        return "inconclusive", (f"B resolved, F_k not, but a kinetic force up to "
-                                f"{hidden_kin:.2f} F̄ could go unresolved: {nums}")
-    if fk_res:
-        if hidden_visc < DOMINANT_SHARE:
-            return "kinetic", (f"F_k resolved, B not; a viscous force of {hidden_visc:.2f} F̄ "
-                               f"would have been resolved: {nums}")
-        return "inconclusive", (f"F_k resolved, B not, but a viscous force up to "
-                                f"{hidden_visc:.2f} F̄ could go unresolved: {nums}")
-    return "inconclusive", f"neither term resolved: {nums}"
-
-
 def _window(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
     """Savitzky–Golay window (odd, ≥ 5 samples) for ``smoothing`` × median slip duration;
     0 when the sampling is not uniform or the window would be under 5 samples."""
@@ -609,9 +330,9 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             dt_, dx = t[i] - t[i[0]], x[i] - x[i[0]]
             resp = (impulse[i] - impulse[i[0]] - mount_damping * (dx - drive_velocity * dt_)
                     - (0.0 if comoving_mass else mass) * v[i])
-            segs[name].append(_Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
+            segs[name].append(Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
         ranges.append((min_velocity_fraction * peak, peak))
-    fits = {name: _fit_branch(name, segs[name], comoving_mass) for name in segs}
+    fits = {name: fit_branch(name, segs[name], comoving_mass) for name in segs}
     if still:
         fits = _refuse_still(fits, still, len(table))
     acc, dec = fits["accelerating"], fits["decelerating"]
@@ -622,7 +343,7 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     area = gap_fk * (hi - lo) + gap_b * (hi ** 2 - lo ** 2) / 2
     with np.errstate(invalid="ignore", divide="ignore"):
         gap = area / (hi - lo)
-    la, lf = _mean_se(area), _mean_se(gap)
+    la, lf = mean_se(area), mean_se(gap)
     return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
                         lf[1], area, w, comoving_mass, len(still))
 
@@ -641,10 +362,3 @@ def _refuse_still(fits: dict, still: list, total: int) -> dict:
         return {k: replace(b, verdict="inconclusive", reason=f"no slip: {note}")
                 for k, b in fits.items()}
     return {k: replace(b, reason=f"{b.reason}; {note}") for k, b in fits.items()}
-
-
-def _mean_se(x: np.ndarray) -> tuple[float, float]:
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        return math.nan, math.nan
-    return float(x.mean()), (float(x.std(ddof=1) / math.sqrt(x.size)) if x.size > 1 else math.nan)
