@@ -96,11 +96,11 @@ from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law_branches import BranchFit, Segment, fit_branch
 from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
-from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, VERDICTS
+from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
-           "NUMERICAL_FLOOR", "MIN_RELAXATION"]
+           "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
 
 #: The branches of a slip; the verdict is the first one's.
 BRANCHES = ("decelerating", "accelerating")
@@ -115,7 +115,7 @@ SMOOTHING = 0.1
 
 @dataclass(frozen=True)
 class FilmForceFit:
-    """The slip law on both branches, the loop, and the verdict (the decelerating branch's).
+    """The slip law on both branches, the one law over the whole slip, the loop, and the verdict.
 
     Attributes
     ----------
@@ -124,8 +124,18 @@ class FilmForceFit:
     whole : BranchFit
         The whole slip in one fit (both branches: a loop makes it a compromise; with
         the co-moving mass, the term where the acceleration takes both signs).
+    one_law : BranchFit
+        The whole slip with the co-moving mass, F_k + B·v + m_c·a (whatever
+        ``comoving_mass`` says): the law when the slip is one (module text).
+    loop_step, loop_step_stderr, loop_step_sigmas, detectable_loop_step : float
+        The step of the film force at the peak velocity beyond the one law,
+        F_acc − F_dec (positive when the accelerating branch lies above), its
+        standard error, its normal-equivalent sigmas and the smallest step the run
+        resolves at 2 σ with 95 % power.
+    verdict_from : str
+        The fit the verdict is: ``one law`` (:data:`ONE_LAW`) or ``decelerating``.
     verdict, reason : str
-        The decelerating branch's.
+        That fit's verdict, and why it is that fit's.
     loop_area, loop_area_stderr : float
         The area between the two branches' fitted lines over the velocities both
         cover (the floor to the peak), ∫(F_acc − F_dec) dv (force × velocity;
@@ -137,7 +147,7 @@ class FilmForceFit:
     smoothing_window : int
         Window of the guiding velocity in samples (0: not smoothed).
     comoving_mass : bool
-        Whether the m_c·a term was fitted.
+        Whether the m_c·a term was fitted on the branches.
     still_windows : int
         Windows of the table left out because the wall did not slip in them (the
         spring relaxed by less than :data:`MIN_RELAXATION` of its force); the
@@ -147,6 +157,12 @@ class FilmForceFit:
     decelerating: BranchFit
     accelerating: BranchFit
     whole: BranchFit
+    one_law: BranchFit
+    loop_step: float
+    loop_step_stderr: float
+    loop_step_sigmas: float
+    detectable_loop_step: float
+    verdict_from: str
     verdict: str
     reason: str
     loop_area: float
@@ -158,38 +174,42 @@ class FilmForceFit:
     comoving_mass: bool
     still_windows: int = 0
 
-    # the verdict's branch, as the single law the callers quote
+    @property
+    def law(self) -> BranchFit:
+        """The fit the verdict is (:attr:`verdict_from`): the law the callers quote."""
+        return self.one_law if self.verdict_from == ONE_LAW else self.decelerating
+
     @property
     def kinetic_force(self) -> float:
-        return self.decelerating.kinetic_force
+        return self.law.kinetic_force
 
     @property
     def kinetic_force_stderr(self) -> float:
-        return self.decelerating.kinetic_force_stderr
+        return self.law.kinetic_force_stderr
 
     @property
     def damping(self) -> float:
-        return self.decelerating.damping
+        return self.law.damping
 
     @property
     def damping_stderr(self) -> float:
-        return self.decelerating.damping_stderr
+        return self.law.damping_stderr
 
     @property
     def detectable_damping(self) -> float:
-        return self.decelerating.detectable_damping
+        return self.law.detectable_damping
 
     @property
     def mean_slip_velocity(self) -> float:
-        return self.decelerating.mean_velocity
+        return self.law.mean_velocity
 
     @property
     def viscous_share(self) -> float:
-        return self.decelerating.viscous_share
+        return self.law.viscous_share
 
     @property
     def samples(self) -> int:
-        return self.decelerating.samples
+        return self.law.samples
 
 
 def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity: float = 0.0,
@@ -328,11 +348,14 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
                 continue
             i = np.arange(k[0], k[-1] + 1) + y          # contiguous: the integral needs it
             dt_, dx = t[i] - t[i[0]], x[i] - x[i[0]]
-            resp = (impulse[i] - impulse[i[0]] - mount_damping * (dx - drive_velocity * dt_)
-                    - (0.0 if comoving_mass else mass) * v[i])
-            segs[name].append(Segment(resp, dt_, dx, guide[i] - guide[i[0]], mass))
+            imp = impulse[i] - impulse[i[0]] - mount_damping * (dx - drive_velocity * dt_)
+            segs[name].append(Segment(imp, v[i], dt_, dx, guide[i] - guide[i[0]], mass,
+                                      np.maximum(dt_ - (t[y + p] - t[i[0]]), 0.0)))
         ranges.append((min_velocity_fraction * peak, peak))
     fits = {name: fit_branch(name, segs[name], comoving_mass) for name in segs}
+    # one law F_k + B·v + m_c·a over the whole slip, and the step at the peak beyond it
+    fits["one_law"] = fit_branch(ONE_LAW, segs["whole"], True)
+    fits["loop_step"] = fit_branch(ONE_LAW, segs["whole"], True, loop_step=True)
     if still:
         fits = _refuse_still(fits, still, len(table))
     acc, dec = fits["accelerating"], fits["decelerating"]
@@ -344,8 +367,12 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     with np.errstate(invalid="ignore", divide="ignore"):
         gap = area / (hi - lo)
     la, lf = mean_se(area), mean_se(gap)
-    return FilmForceFit(dec, acc, fits["whole"], dec.verdict, dec.reason, la[0], la[1], lf[0],
-                        lf[1], area, w, comoving_mass, len(still))
+    one, st = fits["one_law"], fits["loop_step"]
+    frm, verdict, reason = choose_law(dec, one, st, mass)
+    return FilmForceFit(dec, acc, fits["whole"], one, st.loop_step, st.loop_step_stderr,
+                        sigmas(st.loop_step, st.loop_step_stderr, st.dof),
+                        detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
+                        la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still))
 
 
 def _refuse_still(fits: dict, still: list, total: int) -> dict:

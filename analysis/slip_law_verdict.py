@@ -13,9 +13,13 @@ from __future__ import annotations
 
 import math
 
-from .slip_law_stats import RESOLVED_SIGMAS
+from .slip_law_stats import RESOLVED_SIGMAS, detectable, sigmas
 
-__all__ = ["branch_verdict", "VERDICTS", "DOMINANT_SHARE", "NUMERICAL_FLOOR"]
+__all__ = ["branch_verdict", "choose_law", "VERDICTS", "DOMINANT_SHARE", "NUMERICAL_FLOOR",
+           "ONE_LAW"]
+
+#: The name of the fit of the whole slip with a co-moving mass, the slip's one law.
+ONE_LAW = "one law"
 
 #: The verdicts, in the order the rules are tried.
 VERDICTS = ("velocity-weakening", "mixed", "viscous", "kinetic", "inconclusive")
@@ -72,3 +76,41 @@ def branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
         return "inconclusive", (f"F_k resolved, B not, but a viscous force up to "
                                 f"{hidden_visc:.2f} F̄ could go unresolved: {nums}")
     return "inconclusive", f"neither term resolved: {nums}"
+
+
+def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str, str]:
+    """Which fit the verdict is — :data:`ONE_LAW` or ``decelerating`` — its verdict and why.
+
+    The whole slip is one law F_k + B·v + m_c·a (the ``one_law`` fit) when no loop is
+    left beyond the co-moving mass: the step of the force at the peak velocity
+    (``loop_step``: the whole slip fitted with it too) is not resolved and the run
+    had 95 % power to resolve it at :data:`DOMINANT_SHARE` of the one law's mean film
+    force, and m_c is not resolved negative (no mass moves against the wall); as in
+    :func:`branch_verdict`, a step under :data:`NUMERICAL_FLOOR` of F̄ and an m_c under
+    that share of the wall's ``mass`` count as not resolved.  A
+    liquid's slip (no yield) is such a slip; a film that yields on the accelerating
+    branch is not, and its verdict is the decelerating branch's.
+    """
+    r = RESOLVED_SIGMAS
+    step, se, dof = loop_step.loop_step, loop_step.loop_step_stderr, loop_step.dof
+    z = sigmas(step, se, dof)
+    det = detectable(se, dof)
+    fbar = one_law.mean_force
+    z_mc = sigmas(one_law.comoving_mass, one_law.comoving_mass_stderr, one_law.dof)
+    nums = (f"loop step F_acc − F_dec = {step:.3g} ± {se:.2g} ({z:+.1f} σ), 95 % power at "
+            f"2 σ for {det:.3g} against F̄/2 = {DOMINANT_SHARE * fbar:.3g}; m_c = "
+            f"{one_law.comoving_mass:.3g} ± {one_law.comoving_mass_stderr:.2g} ({z_mc:+.1f} σ)")
+    if not all(math.isfinite(q) for q in (z, det, fbar, z_mc)):
+        why = "the one law's errors not defined"
+    elif abs(z) >= r and abs(step) >= NUMERICAL_FLOOR * abs(fbar):
+        why = "a loop resolved beyond the co-moving mass"
+    elif not (fbar > 0 and det < DOMINANT_SHARE * fbar):
+        why = "a loop of half the film force could go unresolved"
+    elif z_mc <= -r and -one_law.comoving_mass >= NUMERICAL_FLOOR * mass:
+        why = "the co-moving mass resolved negative"
+    else:
+        return ONE_LAW, one_law.verdict, (f"the whole slip is one law with a co-moving "
+                                          f"mass ({nums}): {one_law.reason}")
+    return "decelerating", decelerating.verdict, (
+        f"{decelerating.reason}; the decelerating branch's, the whole slip not one law "
+        f"({why}: {nums})")

@@ -41,7 +41,8 @@ from scipy.signal import savgol_filter
 from ..slip_law import FilmForceFit, fit_film_force
 from ..stickslip import cycle_table
 
-__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
+__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile",
+           "couette_comoving_mass"]
 
 
 def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, int]:
@@ -95,6 +96,27 @@ def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
     coef, cov = np.polyfit(z, f, 1, w=w, cov="unscaled" if w is not None else True)
     slope, se = float(coef[0]), float(np.sqrt(cov[0, 0]))
     return 1.0 / slope, se / slope ** 2
+
+
+def couette_comoving_mass(film_mass: float, thickness: float, width: float) -> float:
+    """The mass a Couette film adds to the wall's inertia: the first correction in the
+    frequency to its force on a wall moving slowly, F = η·A/W·v + m_c·a.
+
+    For a film of mass ``film_mass`` and thickness D between a still wall and the
+    moving one, with a Navier slip length b at each wall (``width`` W = D + 2b),
+    ρ u_t = η u_zz solved to first order in ∂/∂t gives
+    m_c = (m_f/D)·(s³ − b³)/(3 W²), s = D + b: m_f/3 without slip (b = 0), more
+    of the film moving with the wall as b grows.
+
+    >>> round(couette_comoving_mass(270.0, 5.9, 5.9), 6)   # no slip: a third of the film
+    90.0
+    """
+    if not (film_mass > 0 and thickness > 0 and width >= thickness):
+        raise ValueError(f"film_mass {film_mass!r}, thickness {thickness!r}, width {width!r}: "
+                         "need positive mass and thickness and width >= thickness")
+    b = (width - thickness) / 2
+    s = thickness + b
+    return film_mass / thickness * (s ** 3 - b ** 3) / (3 * width ** 2)
 
 
 def release_profile(run_dir, *, blocks: int = 4) -> dict:
