@@ -21,12 +21,24 @@ atoms carried along).
 Branches.  A slip is a loop in the (v, F_film) plane, not a line: the force on
 the *accelerating* branch (yield → peak velocity) is the breaking of the pinned
 film, the force on the *decelerating* branch (peak velocity → re-stick) is that
-of the film while it slides and re-solidifies.  The two are fitted separately;
-the verdict is the decelerating branch's (the sliding law), the accelerating
-one is reported beside it, and the loop's area between the two branches'
-lines (and the mean force gap, area over the velocity range) says how far from
-one law F(v) the slip is.  (∮F_film dv over the samples themselves is no
-measure: the noise of M·a is correlated with that of dv.)
+of the film while it slides and re-solidifies.  The two are fitted separately,
+and the loop's area between the two branches' lines (and the mean force gap,
+area over the velocity range) says how far from one law F(v) the slip is.
+(∮F_film dv over the samples themselves is no measure: the noise of M·a is
+correlated with that of dv.)
+
+One law.  A film carried along with the wall also makes a loop: its m_c·a is
+positive while the wall accelerates and negative while it slows.  A liquid's
+force is F_k + B·v + m_c·a to first order in the frequency (a Couette film adds
+a third of its mass without slip), with no yield: its whole slip is one law, and
+fitting both branches with m_c (``one_law``) uses every sample.  A film that
+breaks on the accelerating branch is not: m_c·a would take up its yield loop as
+a mass.  So the whole slip is fitted once more with a step of the force at the
+peak velocity (``loop_step``, F_acc − F_dec at a common law), and the verdict is
+the one law's when that step is not resolved, the run had 95 % power to resolve
+a step of half the one law's film force, and m_c is not resolved negative; else
+it is the decelerating branch's (the sliding law), the accelerating one reported
+beside it (:func:`~filmfriction.analysis.slip_law_verdict.choose_law`).
 
 Smoothing.  The sampled wall velocity of an MD run carries the wall's thermal
 vibration; differentiated for M·a it swamps the film force.  A Savitzky–Golay
@@ -102,7 +114,7 @@ __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detecta
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
 
-#: The branches of a slip; the verdict is the first one's.
+#: The branches of a slip; without one law, the verdict is the first one's.
 BRANCHES = ("decelerating", "accelerating")
 #: A window is a slip only when the spring force falls over it by at least this share of
 #: its value at the yield (K·(Δx − VΔt) of F_s): a window in which the wall did not move
@@ -325,7 +337,9 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     for j, (y, s) in enumerate(zip(table.yield_index, table.stick_index)):
         y, s = int(y), int(s)
         g = guide[y:s + 1]
-        relaxed = (f[y] - f[s]) / abs(f[y]) if f[y] else math.nan
+        # the spring's relaxation as the slips' table has it (F_s − F_b of F_s)
+        f_s, f_b = float(table.static_force[j]), float(table.backward_force[j])
+        relaxed = (f_s - f_b) / abs(f_s) if f_s else math.nan
         if not relaxed >= MIN_RELAXATION:
             still.append((j, float(x[s] - x[y]), float((x[s] - x[y]) / (t[s] - t[y]))
                           if t[s] > t[y] else math.nan, float(relaxed)))

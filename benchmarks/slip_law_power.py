@@ -96,13 +96,15 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--measure", metavar="RUN", help="print the MD noise of a run directory")
     ap.add_argument("--power-only", action="store_true", help="only the power scan")
+    ap.add_argument("--rates-only", action="store_true", help="only the verdict rates")
     a = ap.parse_args(argv)
     if a.measure:
         print(json.dumps(measure(Path(a.measure)), indent=1))
         return 0
     if not a.power_only:
         rates()
-    power()
+    if not a.rates_only:
+        power()
     return 0
 
 

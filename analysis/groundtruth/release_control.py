@@ -42,7 +42,7 @@ from ..slip_law import FilmForceFit, fit_film_force
 from ..stickslip import cycle_table
 
 __all__ = ["release_slip", "fit_releases", "profile_width", "release_profile",
-           "couette_comoving_mass"]
+           "couette_comoving_mass", "model_release"]
 
 
 def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, int]:
@@ -117,6 +117,28 @@ def couette_comoving_mass(film_mass: float, thickness: float, width: float) -> f
     b = (width - thickness) / 2
     s = thickness + b
     return film_mass / thickness * (s ** 3 - b ** 3) / (3 * width ** 2)
+
+
+def model_release(*, damping: float, comoving_mass: float = 0.0, kinetic_force: float = 0.0,
+                  mass: float = 500.0, stiffness: float = 1.0, offset: float = 20.0,
+                  dt: float = 0.05, duration: float = 120.0) -> dict:
+    """A wall of ``mass`` let go from a spring stretched by ``offset`` and resisted by
+    F_k + B·v + m_c·a while it moves forward: (M + m_c)·x'' = K(x0 − x) − B·x' − F_k,
+    sampled every ``dt`` (the ``liquid-release`` scene's scale by default).  Columns
+    ``time, spring_force, wall_position, wall_velocity`` (the trace a release run
+    writes); only the first swing is the law's (the slip :func:`release_slip` finds)."""
+    from scipy.integrate import solve_ivp
+
+    t = np.arange(0.0, duration, dt)
+    inertia = mass + comoving_mass
+
+    def rhs(_, y):
+        return [y[1], (stiffness * (offset - y[0]) - damping * y[1] - kinetic_force) / inertia]
+
+    sol = solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0], t_eval=t, rtol=1e-10, atol=1e-10)
+    x, v = sol.y
+    return {"time": t, "spring_force": stiffness * (offset - x), "wall_position": x,
+            "wall_velocity": v}
 
 
 def release_profile(run_dir, *, blocks: int = 4) -> dict:
