@@ -56,6 +56,8 @@ quadrature's own error would read as a term), and *ruled out as dominant* when t
 run's own errors: :func:`detectable`):
 
 * ``velocity-weakening`` — B resolved negative;
+* ``inconclusive`` — F_k resolved negative (no friction force pushes: the line is
+  not the branch's law);
 * ``mixed`` — B and F_k both resolved positive;
 * ``viscous`` — B resolved, F_k not, and a kinetic force of F̄/2 would have been
   resolved (Klein's reading);

@@ -57,6 +57,10 @@ def branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
     if z_b <= -r and b_big:
         return "velocity-weakening", f"B resolved negative: {nums}"
     b_res, fk_res = z_b >= r and b_big, z_fk >= r and fk_big
+    if z_fk <= -r and fk_big:
+        # no friction force pushes: the line misses the law (on the decelerating branch,
+        # a mass carried with the wall, m_c·a < 0, reads as a negative intercept)
+        return "inconclusive", f"F_k resolved negative, F_k + B·v does not hold: {nums}"
     if b_res and fk_res:
         return "mixed", f"both terms resolved (viscous share {b * vbar / fbar:.2f}): {nums}"
     if fbar <= 0:
