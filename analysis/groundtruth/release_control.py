@@ -63,10 +63,12 @@ def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, i
 
 
 def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
-                 comoving_mass: bool = False) -> FilmForceFit:
+                 comoving_mass: bool = False, **fit) -> FilmForceFit:
     """The slip law fitted to the release slips of ``traces`` (dicts of trace columns
     ``time``, ``spring_force``, ``wall_position``, ``wall_velocity``, one per release,
-    uniformly sampled at one interval), each slip from :func:`release_slip`."""
+    uniformly sampled at one interval), each slip from :func:`release_slip`; ``fit``
+    goes to :func:`~filmfriction.analysis.slip_law.fit_film_force` (e.g.
+    ``min_velocity_fraction``)."""
     parts, yi, si, offset, t0 = [], [], [], 0, 0.0
     for tr in traces:
         t = np.asarray(tr["time"], float)
@@ -84,7 +86,8 @@ def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
     table = cycle_table(cols["time"], cols["spring_force"], np.array(yi), np.array(si))
     return fit_film_force(cols["time"], cols["spring_force"], cols["wall_velocity"], table,
                           mass=mass, mount_damping=mount_damping,
-                          wall_position=cols["wall_position"], comoving_mass=comoving_mass)
+                          wall_position=cols["wall_position"], comoving_mass=comoving_mass,
+                          **fit)
 
 
 def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
