@@ -4,11 +4,12 @@
     python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR RUN_1 RUN_2 ...
 
 Prints the slip law fitted to the runs' release slips together
-(:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict,
-each branch and the whole slip, the whole slip again with a co-moving mass), how
-many releases the rule would need at the releases' own scatter (the kinetic force
-ruled out at half the film force: :func:`~filmfriction.analysis.slip_law.detectable`
-< F̄/2 with the per-release standard deviation of F_k), each run's layer velocity
+(:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict
+and the law it is, each branch and the whole slip, the whole slip with a co-moving
+mass — the one law — and the loop step beyond it), how many releases the rule would
+need at the releases' own scatter (the kinetic force, or the loop step, ruled out at
+half the film force: :func:`~filmfriction.analysis.slip_law.slip_law.detectable` < F̄/2 with
+the per-release standard deviation), each run's layer velocity
 shares, where the shear sits and the width W = D + 2b of its profile, and
 B = η·A/W with η the liquid's viscosity at the film's state point
 (``filmfriction viscosity``).
@@ -22,21 +23,30 @@ import sys
 
 import numpy as np
 
-from filmfriction.analysis.groundtruth.release_control import fit_releases, release_profile
-from filmfriction.analysis.slip_law import DOMINANT_SHARE, detectable
+from filmfriction.analysis.groundtruth.release_control import (couette_comoving_mass,
+                                                               fit_releases, release_profile)
+from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, detectable
 
 
-def releases_needed(branch, most: int = 1000) -> int | None:
-    """Releases at which a kinetic force of DOMINANT_SHARE·F̄ would be resolved at 95 %
-    power, with the branch's per-release scatter of F_k (None: not within ``most``)."""
-    fk = branch.per_slip_kinetic_force[np.isfinite(branch.per_slip_kinetic_force)]
-    if fk.size < 2 or not branch.mean_force > 0:
+def releases_needed(per_release_sd: float, target: float, most: int = 1000) -> int | None:
+    """Releases at which a term of size ``target`` would be resolved at 95 % power (2 σ),
+    with ``per_release_sd`` the standard deviation of its per-release fits (None: not
+    within ``most``)."""
+    if not (per_release_sd > 0 and target > 0):
         return None
-    sd = float(fk.std(ddof=1))
     for n in range(2, most + 1):
-        if detectable(sd / math.sqrt(n), n - 1) < DOMINANT_SHARE * branch.mean_force:
+        if detectable(per_release_sd / math.sqrt(n), n - 1) < target:
             return n
     return None
+
+
+def kinetic_needed(branch) -> int | None:
+    """Releases at which a kinetic force of DOMINANT_SHARE·F̄ would be resolved, with the
+    branch's per-release scatter of F_k."""
+    fk = branch.per_slip_kinetic_force[np.isfinite(branch.per_slip_kinetic_force)]
+    if fk.size < 2:
+        return None
+    return releases_needed(float(fk.std(ddof=1)), DOMINANT_SHARE * branch.mean_force)
 
 
 def main(argv=None) -> int:
@@ -44,26 +54,35 @@ def main(argv=None) -> int:
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--viscosity", nargs=2, type=float, metavar=("ETA", "ERR"), required=True)
     a = ap.parse_args(argv)
-    traces, mass = [], None
+    traces, mass, film_mass, gaps = [], None, None, []
     for run in a.runs:
         tr = np.genfromtxt(f"{run}/trace.csv", delimiter=",", names=True)
         traces.append({k: tr[k] for k in tr.dtype.names})
         p = json.load(open(f"{run}/run.json"))["trace_parameters"]
         mass = p["mass"]
+        film_mass = json.load(open(f"{run}/run.json"))["derived"]["film_atoms"]   # m each
     fit = fit_releases(traces, mass=mass)
-    with_mass = fit_releases(traces, mass=mass, comoving_mass=True).whole
-    print(f"{len(traces)} releases, M = {mass:g}: verdict {fit.verdict} ({fit.reason})")
+    with_mass = fit.one_law
+    print(f"{len(traces)} releases, M = {mass:g}: verdict {fit.verdict}, the {fit.verdict_from}'s "
+          f"({fit.reason})")
     for br in (fit.decelerating, fit.accelerating, fit.whole, with_mass):
-        name = br.branch + (" + m_c" if br is with_mass else "")
+        name = "whole + m_c" if br is with_mass else br.branch
         mc = (f", m_c = {br.comoving_mass:.0f} ± {br.comoving_mass_stderr:.0f}"
               if br is with_mass else "")
         print(f"  {name:14s} F_k = {br.kinetic_force:.2f} ± {br.kinetic_force_stderr:.2f} "
               f"({br.kinetic_sigmas:+.1f} σ), B = {br.damping:.2f} ± {br.damping_stderr:.2f} "
               f"({br.damping_sigmas:+.1f} σ){mc}; F̄ = {br.mean_force:.2f}, "
               f"n = {br.exponent:.2f} ± {br.exponent_stderr:.2f}; verdict {br.verdict}; "
-              f"releases the rule needs: {releases_needed(br)}")
+              f"releases the rule needs: {kinetic_needed(br)}")
         print(f"      per release: F_k {np.round(br.per_slip_kinetic_force, 2).tolist()}, "
               f"B {np.round(br.per_slip_damping, 2).tolist()}")
+    # the one law's condition: the loop step ruled out at half the one law's film force
+    step_sd = fit.loop_step_stderr * math.sqrt(len(traces))
+    print(f"  loop step beyond m_c, F_acc − F_dec = {fit.loop_step:.2f} ± "
+          f"{fit.loop_step_stderr:.2f} ({fit.loop_step_sigmas:+.1f} σ); 95 % power at 2 σ for "
+          f"{fit.detectable_loop_step:.2f} against F̄/2 = "
+          f"{DOMINANT_SHARE * with_mass.mean_force:.2f}; releases that rules it out: "
+          f"{releases_needed(step_sd, DOMINANT_SHARE * with_mass.mean_force)}")
     widths = []
     for run in a.runs:
         prof = release_profile(run)
@@ -78,6 +97,14 @@ def main(argv=None) -> int:
     b = eta * prof["area"] / wm
     b_se = b * math.hypot(eta_se / eta, wse / wm)
     print(f"W = {wm:.2f} ± {wse:.2f}, A = {prof['area']:.2f}: eta*A/W = {b:.2f} ± {b_se:.2f}")
+    for prof_run, tr in zip(a.runs, traces):
+        gaps.append(float(np.mean(tr["gap"])))
+    gap = float(np.mean(gaps))
+    print(f"  co-moving mass of a quasi-static Couette film (film {film_mass} m, W = {wm:.2f}): "
+          + ", ".join(f"D = {d:.2f} σ: {couette_comoving_mass(film_mass, d, max(wm, d)):.0f} m"
+                      for d in (gap, gap - 1.0))
+          + f" (mean gap {gap:.2f} σ; the fit: {with_mass.comoving_mass:.0f} ± "
+          f"{with_mass.comoving_mass_stderr:.0f} m)")
     for name, br in (("decelerating", fit.decelerating), ("whole", fit.whole),
                      ("whole + m_c", with_mass)):
         r = br.damping / b

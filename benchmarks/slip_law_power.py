@@ -18,14 +18,15 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from filmfriction.analysis.slip_law import sigmas
-from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, coulomb_viscous,
-                                                    replica_fits, verdict_rates)
+from filmfriction.analysis.slip_law.slip_law import ONE_LAW, VERDICTS, sigmas
+from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, control_fits,
+                                                                 coulomb_viscous, replica_fits)
 
 REPLICAS = 40
 QUIET = {k: (v if k == "velocity_correlation" else v / 10) for k, v in MD_NOISE.items()}
@@ -69,9 +70,12 @@ def rates() -> None:
         print(f"\n## verdicts of {REPLICAS} replicas, {noise_name}: {noise}")
         for law, what in CONTROLS.items():
             for slips in (4, 8, 30):
-                r = verdict_rates(law, REPLICAS, slips, noise=noise)
-                shown = ", ".join(f"{k} {v}" for k, v in r.items() if v)
-                print(f"{law:10s} {slips:3d} slips: {shown}   ({what})")
+                fits = control_fits(law, REPLICAS, slips, noise=noise)
+                r = Counter(f.verdict for f in fits)
+                shown = ", ".join(f"{k} {r[k]}" for k in VERDICTS if r[k])
+                one = sum(f.verdict_from == ONE_LAW for f in fits)
+                print(f"{law:10s} {slips:3d} slips: {shown}; the one law's in {one}   ({what})",
+                      flush=True)
 
 
 def power() -> None:
@@ -79,25 +83,28 @@ def power() -> None:
     for slips in (8, 30):
         for share in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0):
             fits = replica_fits(coulomb_viscous(share, slips=slips), REPLICAS, slips=slips)
-            hit = sum(sigmas(f.damping, f.damping_stderr, f.decelerating.dof) >= 2 for f in fits)
+            hit = sum(sigmas(f.damping, f.damping_stderr, f.law.dof) >= 2 for f in fits)
             verdicts = {}
             for f in fits:
                 verdicts[f.verdict] = verdicts.get(f.verdict, 0) + 1
+            one = sum(f.verdict_from == ONE_LAW for f in fits)
             print(f"{slips:3d} slips, viscous share {share:.1f}: B resolved in {hit}/{REPLICAS}; "
-                  f"verdicts {verdicts}")
+                  f"verdicts {verdicts}; the one law's in {one}", flush=True)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--measure", metavar="RUN", help="print the MD noise of a run directory")
     ap.add_argument("--power-only", action="store_true", help="only the power scan")
+    ap.add_argument("--rates-only", action="store_true", help="only the verdict rates")
     a = ap.parse_args(argv)
     if a.measure:
         print(json.dumps(measure(Path(a.measure)), indent=1))
         return 0
     if not a.power_only:
         rates()
-    power()
+    if not a.rates_only:
+        power()
     return 0
 
 

@@ -18,7 +18,7 @@ LAYERS = ("md_inputs", "reduced_model", "analysis", "workflows")
 #: the sub-folders of each layer, lowest first: a sub-folder imports no later one
 FLOORS = {
     "reduced_model": ("laws", "integrators", "sfb"),
-    "analysis": ("files", "ensemble", "energy", "structure", "observables", "calibration",
+    "analysis": ("files", "ensemble", "energy", "structure", "slip_law", "observables", "calibration",
                  "groundtruth"),
     "workflows": ("md", "sweep", "report", "cost", "cli"),
 }

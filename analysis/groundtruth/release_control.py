@@ -14,7 +14,7 @@ the layers' velocity shares (:mod:`~filmfriction.analysis.observables.shear_loca
 
 :func:`release_slip` finds the release's slip in a trace (the first swing: from the
 release to the first stop of the wall); :func:`fit_releases` fits the slip law
-(:func:`~filmfriction.analysis.slip_law.fit_film_force`) to the slips of several
+(:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`) to the slips of several
 releases (independent seeds) together, so that the errors are the slips' scatter.
 
 Example
@@ -40,9 +40,10 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import cycle_table
 
-from ..slip_law import FilmForceFit, fit_film_force
+from ..slip_law.slip_law import FilmForceFit, fit_film_force
 
-__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile"]
+__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile",
+           "couette_comoving_mass", "model_release"]
 
 
 def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, int]:
@@ -63,10 +64,12 @@ def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, i
 
 
 def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
-                 comoving_mass: bool = False) -> FilmForceFit:
+                 comoving_mass: bool = False, **fit) -> FilmForceFit:
     """The slip law fitted to the release slips of ``traces`` (dicts of trace columns
     ``time``, ``spring_force``, ``wall_position``, ``wall_velocity``, one per release,
-    uniformly sampled at one interval), each slip from :func:`release_slip`."""
+    uniformly sampled at one interval), each slip from :func:`release_slip`; ``fit``
+    goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force` (e.g.
+    ``min_velocity_fraction``)."""
     parts, yi, si, offset, t0 = [], [], [], 0, 0.0
     for tr in traces:
         t = np.asarray(tr["time"], float)
@@ -84,7 +87,8 @@ def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
     table = cycle_table(cols["time"], cols["spring_force"], np.array(yi), np.array(si))
     return fit_film_force(cols["time"], cols["spring_force"], cols["wall_velocity"], table,
                           mass=mass, mount_damping=mount_damping,
-                          wall_position=cols["wall_position"], comoving_mass=comoving_mass)
+                          wall_position=cols["wall_position"], comoving_mass=comoving_mass,
+                          **fit)
 
 
 def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
@@ -96,6 +100,49 @@ def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:
     coef, cov = np.polyfit(z, f, 1, w=w, cov="unscaled" if w is not None else True)
     slope, se = float(coef[0]), float(np.sqrt(cov[0, 0]))
     return 1.0 / slope, se / slope ** 2
+
+
+def couette_comoving_mass(film_mass: float, thickness: float, width: float) -> float:
+    """The mass a Couette film adds to the wall's inertia: the first correction in the
+    frequency to its force on a wall moving slowly, F = η·A/W·v + m_c·a.
+
+    For a film of mass ``film_mass`` and thickness D between a still wall and the
+    moving one, with a Navier slip length b at each wall (``width`` W = D + 2b),
+    ρ u_t = η u_zz solved to first order in ∂/∂t gives
+    m_c = (m_f/D)·(s³ − b³)/(3 W²), s = D + b: m_f/3 without slip (b = 0), more
+    of the film moving with the wall as b grows.
+
+    >>> round(couette_comoving_mass(270.0, 5.9, 5.9), 6)   # no slip: a third of the film
+    90.0
+    """
+    if not (film_mass > 0 and thickness > 0 and width >= thickness):
+        raise ValueError(f"film_mass {film_mass!r}, thickness {thickness!r}, width {width!r}: "
+                         "need positive mass and thickness and width >= thickness")
+    b = (width - thickness) / 2
+    s = thickness + b
+    return film_mass / thickness * (s ** 3 - b ** 3) / (3 * width ** 2)
+
+
+def model_release(*, damping: float, comoving_mass: float = 0.0, kinetic_force: float = 0.0,
+                  mass: float = 500.0, stiffness: float = 1.0, offset: float = 20.0,
+                  dt: float = 0.05, duration: float = 120.0) -> dict:
+    """A wall of ``mass`` let go from a spring stretched by ``offset`` and resisted by
+    F_k + B·v + m_c·a while it moves forward: (M + m_c)·x'' = K(x0 − x) − B·x' − F_k,
+    sampled every ``dt`` (the ``liquid-release`` scene's scale by default).  Columns
+    ``time, spring_force, wall_position, wall_velocity`` (the trace a release run
+    writes); only the first swing is the law's (the slip :func:`release_slip` finds)."""
+    from scipy.integrate import solve_ivp
+
+    t = np.arange(0.0, duration, dt)
+    inertia = mass + comoving_mass
+
+    def rhs(_, y):
+        return [y[1], (stiffness * (offset - y[0]) - damping * y[1] - kinetic_force) / inertia]
+
+    sol = solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0], t_eval=t, rtol=1e-10, atol=1e-10)
+    x, v = sol.y
+    return {"time": t, "spring_force": stiffness * (offset - x), "wall_position": x,
+            "wall_velocity": v}
 
 
 def release_profile(run_dir, *, blocks: int = 4) -> dict:

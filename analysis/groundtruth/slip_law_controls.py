@@ -1,13 +1,17 @@
 """Controls of the slip-law test: known laws at the MD's noise, and how often each verdict comes out.
 
 A verdict is trusted once the method returns it for laws whose answer is known, at
-the noise of the runs it is used on (:mod:`filmfriction.analysis.slip_law`).  The
+the noise of the runs it is used on (:mod:`filmfriction.analysis.slip_law.slip_law`).  The
 laws here are slid in the reduced model at the Klein-similar MD scene's scale
 (``sfb-similar``: K = 2 ε/σ², M = 30 m, F_s = 48 ε/σ, sampled every 0.25 τ); the
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
-Each replica adds the MD wall's noise (:func:`~filmfriction.analysis.groundtruth.synthetic.with_wall_noise`)
-with :data:`MD_NOISE` to the measured velocity:
+Each replica adds the MD's noise as the film's random force ξ whose impulse over M is the
+velocity noise u of :data:`MD_NOISE` (:func:`~filmfriction.analysis.groundtruth.synthetic.with_wall_noise`):
+the measured spring force carries M·du/dt, the velocity and the position are the law's.
+That is how the MD's noise was measured — the residual of the integrated equation of
+motion over M, ∫ξ dt/M — and it enters every fit alike, the one law with a co-moving mass
+(whose response has no M·v) too:
 
 ``coulomb``      Coulomb, F_s = 48, F_k = 36 ε/σ (B = 0)
 ``rate-state``   Dieterich–Ruina aging law, μ0 = 36, a = 1, b = 4 ε/σ, d_c = 1 σ, v0 = 0.1 σ/τ
@@ -35,12 +39,12 @@ import numpy as np
 from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.cycles import cycle_table
 
-from ..slip_law import VERDICTS, FilmForceFit, fit_film_force
+from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..stickslip import detect_slips
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "SCALE", "CONTROLS", "control_trace", "coulomb_viscous", "replica_fits",
-           "verdict_rates"]
+           "control_fits", "verdict_rates"]
 
 #: The Klein-similar scene's slider and sampling (LJ units).
 SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
@@ -126,10 +130,11 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
 
     The slips are found on the noise-free spring force (the detector is not under
     test here); the start-up slip is left out and the next ``slips`` (all: None)
-    are fitted; ``fit`` goes to :func:`~filmfriction.analysis.slip_law.fit_film_force`.
+    are fitted; ``fit`` goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`.
     """
     noise = MD_NOISE if noise is None else noise
     t, f = trace["time"], trace["spring_force"]
+    v = np.asarray(trace["wall_velocity"], float)
     ev = detect_slips(t, f)
     tab = cycle_table(t, f, ev.yield_index, ev.stick_index,
                       spring_constant=SCALE["spring_constant"],
@@ -137,17 +142,25 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
     tab = tab[1:] if slips is None else tab[1:slips + 1]
     out = []
     for k in range(replicas):
-        noisy = with_wall_noise(trace, seed=seed + k, **noise)
-        out.append(fit_film_force(t, noisy["spring_force"], noisy["wall_velocity"], tab,
+        # the noise as a random force of the film whose impulse over M is the velocity
+        # noise: it enters the integrated equation of motion as M·u whatever is fitted
+        u = with_wall_noise(trace, seed=seed + k, **noise)["wall_velocity"] - v
+        force = np.asarray(f, float) + SCALE["mass"] * np.gradient(u, t)
+        out.append(fit_film_force(t, force, v, tab,
                                   mass=SCALE["mass"], drive_velocity=drive_velocity,
                                   wall_position=trace.get("wall_position"), **fit))
     return out
 
 
+def control_fits(name: str, replicas: int = 40, slips: int = 8, **kwargs) -> list[FilmForceFit]:
+    """The fits of ``replicas`` noisy copies of control ``name`` (``slips`` slips fitted);
+    ``kwargs`` go to :func:`replica_fits`."""
+    return replica_fits(control_trace(name, slips), replicas, slips=slips,
+                        drive_velocity=_DRIVE[name], **kwargs)
+
+
 def verdict_rates(name: str, replicas: int = 40, slips: int = 8, **kwargs) -> dict[str, int]:
     """How many of ``replicas`` noisy copies of control ``name`` (``slips`` slips fitted)
     get each verdict."""
-    fits = replica_fits(control_trace(name, slips), replicas, slips=slips,
-                        drive_velocity=_DRIVE[name], **kwargs)
-    counts = Counter(f.verdict for f in fits)
+    counts = Counter(f.verdict for f in control_fits(name, replicas, slips, **kwargs))
     return {v: counts.get(v, 0) for v in VERDICTS}

@@ -1,12 +1,15 @@
 """``slip_law``: Klein's slip equation tested on the slips, F_film = F_k + B·v.
 
-The physics is :mod:`filmfriction.analysis.slip_law`; this file says what the
+The physics is :mod:`filmfriction.analysis.slip_law.slip_law`; this file says what the
 fit needs, what it writes into ``analysis.json["slip_law"]`` and
 ``analysis_cycles.csv`` (``slip_law_kinetic_force``, ``slip_law_damping`` of
 the decelerating branch, ``slip_law_accelerating_kinetic_force``,
 ``slip_law_accelerating_damping``, ``slip_law_loop_area``), and what the report
 shows: the verdict's table and the film force against the wall's velocity with
-the two branches' lines.
+the two branches' lines.  The section's own F_k, B, exponent and power are the
+verdict's law's (``verdict_from``: the one law over the whole slip with a co-moving
+mass when no loop is left beyond it, else the decelerating branch); every fit is
+under ``branches``, the one law as ``one_law``, with the loop step beside it.
 
 Beside B stand the smallest B the run resolves (``detectable_damping``) and, for
 an LJ run, the B of a no-slip film of bulk viscosity, η_bulk·A/D
@@ -22,7 +25,7 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
 
-from ..slip_law import BRANCHES, film_force, fit_film_force
+from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
 from ..files.trace import unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
@@ -67,41 +70,44 @@ class SlipLaw(Observable):
                     wall_position=trace.wall_position())
         t, f, v = trace.time, trace.spring_force, trace.columns["wall_velocity"]
         fit = fit_film_force(t, f, v, ctx.table, **args)
-        with_mass = fit_film_force(t, f, v, ctx.table, comoving_mass=True, **args)
-        dec = fit.decelerating
+        law, one = fit.law, fit.one_law          # the verdict's law; the whole slip with m_c
         force_velocity = f"{ctx.unit('force')}·{ctx.unit('velocity')}"
-        out = {"verdict": fit.verdict, "reason": fit.reason,
-               "kinetic_force": ctx.value(dec.kinetic_force, dec.kinetic_force_stderr, "force"),
-               "damping": ctx.value(dec.damping, dec.damping_stderr, "damping"),
-               "detectable_damping": ctx.value(dec.detectable_damping, None, "damping"),
-               "mean_slip_velocity": ctx.value(dec.mean_velocity, None, "velocity"),
-               "viscous_share": dec.viscous_share,
-               "exponent": ctx.value(dec.exponent, dec.exponent_stderr, "1"),
-               "samples": dec.samples, "slips": dec.slips,
+        out = {"verdict": fit.verdict, "reason": fit.reason, "verdict_from": fit.verdict_from,
+               "kinetic_force": ctx.value(law.kinetic_force, law.kinetic_force_stderr, "force"),
+               "damping": ctx.value(law.damping, law.damping_stderr, "damping"),
+               "detectable_damping": ctx.value(law.detectable_damping, None, "damping"),
+               "mean_slip_velocity": ctx.value(law.mean_velocity, None, "velocity"),
+               "viscous_share": law.viscous_share,
+               "exponent": ctx.value(law.exponent, law.exponent_stderr, "1"),
+               "samples": law.samples, "slips": law.slips,
                "branches": {b.branch: self._branch(ctx, b)
-                            for b in (fit.decelerating, fit.accelerating, fit.whole)},
+                            for b in (fit.decelerating, fit.accelerating, fit.whole)}
+                           | {"one_law": self._branch(ctx, one)},
+               "loop_step": ctx.value(fit.loop_step, fit.loop_step_stderr, "force",
+                                      sigmas=finite_or_none(fit.loop_step_sigmas),
+                                      detectable=finite_or_none(fit.detectable_loop_step)),
                "loop": {"area": {"mean": finite_or_none(fit.loop_area), "stderr": finite_or_none(fit.loop_area_stderr),
                                  "units": force_velocity},
                         "force_gap": ctx.value(fit.loop_force, fit.loop_force_stderr, "force")},
-               "comoving_mass": ctx.value(with_mass.whole.comoving_mass,
-                                          with_mass.whole.comoving_mass_stderr, "mass",
+               "comoving_mass": ctx.value(one.comoving_mass, one.comoving_mass_stderr, "mass",
                                           branch="whole slip",
-                                          damping=finite_or_none(with_mass.whole.damping),
-                                          damping_stderr=finite_or_none(with_mass.whole.damping_stderr),
-                                          kinetic_force=finite_or_none(with_mass.whole.kinetic_force)),
+                                          damping=finite_or_none(one.damping),
+                                          damping_stderr=finite_or_none(one.damping_stderr),
+                                          kinetic_force=finite_or_none(one.kinetic_force)),
                "smoothing_window": fit.smoothing_window,
-               "law": "F_film = kinetic_force + damping * v on each branch, F_film = "
-                      "F_spring - M a - mount_damping (v - V), fitted in the integrated "
-                      "equation of motion"}
+               "law": "F_film = kinetic_force + damping * v on each branch (+ comoving_mass "
+                      "* a over the whole slip: one_law), F_film = F_spring - M a - "
+                      "mount_damping (v - V), fitted in the integrated equation of motion; "
+                      "the verdict's law is verdict_from's"}
         if p.area is not None and (trace.has("gap") or p.thickness is not None):
             d, d_src = trace.film_thickness()
-            if math.isfinite(dec.damping):
-                out["eta_from_damping"] = ctx.value(dec.damping * d / p.area,
-                                                    dec.damping_stderr * d / p.area,
+            if math.isfinite(law.damping):
+                out["eta_from_damping"] = ctx.value(law.damping * d / p.area,
+                                                    law.damping_stderr * d / p.area,
                                                     "viscosity", thickness=d,
                                                     thickness_source=d_src, form="B·D/A")
             if ctx.units == "lj":
-                out.update(self._bulk(ctx, dec.damping, dec.damping_stderr, d, p.area))
+                out.update(self._bulk(ctx, law.damping, law.damping_stderr, d, p.area))
             else:
                 ctx.skip_part("slip_law.bulk_film_damping",
                               "no bulk viscosity for a measured (SI) trace")
@@ -150,7 +156,8 @@ class SlipLaw(Observable):
 
     def rows(self, section: dict) -> list[tuple[str, str]]:
         br = section.get("branches") or {}
-        rows = [("verdict (decelerating branch)", f"**{section.get('verdict', '?')}**")]
+        frm = section.get("verdict_from", "decelerating")
+        rows = [(f"verdict ({frm})", f"**{section.get('verdict', '?')}**")]
         for name in BRANCHES:
             b = br.get(name) or {}
             rows += [(f"{name}: kinetic force F_k", format_estimate(b.get("kinetic_force"))),
@@ -163,6 +170,13 @@ class SlipLaw(Observable):
         loop = section.get("loop") or {}
         rows.append(("loop: mean force gap, accelerating − decelerating",
                      format_estimate(loop.get("force_gap"))))
+        one = br.get("one_law") or {}
+        if one:
+            rows += [("one law (whole slip + m_c·a): F_k", format_estimate(one.get("kinetic_force"))),
+                     ("one law: B", format_estimate(one.get("damping"))),
+                     ("one law: verdict", one.get("verdict", "?")),
+                     ("loop step beyond the co-moving mass, F_acc − F_dec",
+                      format_estimate(section.get("loop_step")))]
         if section.get("bulk_film_damping"):
             rows.append(("B of a no-slip film of bulk viscosity, η_bulk·A/D",
                          format_estimate(section["bulk_film_damping"])))

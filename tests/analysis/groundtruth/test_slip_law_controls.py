@@ -40,8 +40,12 @@ def test_few_viscous_slips_are_inconclusive_not_kinetic():
 
 
 def test_coulomb_slips_are_kinetic_where_the_noise_allows():
+    # B is truly 0: a 2 σ test resolves it, either sign, in 4.6 % nominally, so `kinetic`
+    # can come out at 95.4 % at best (38 of 40 on average): at most 4 of 40 otherwise,
+    # and never `viscous`
     rates = verdict_rates("coulomb", REPLICAS, 8, noise=QUIET)
-    assert rates["kinetic"] >= REPLICAS - AT_MOST, rates
+    assert rates["kinetic"] >= REPLICAS - 2 * AT_MOST, rates
+    assert rates["viscous"] == 0, rates
 
 
 def test_weakening_slips_are_velocity_weakening_where_the_noise_allows():

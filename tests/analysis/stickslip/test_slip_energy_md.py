@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.slip_law import VERDICTS
+from filmfriction.analysis.slip_law.slip_law import VERDICTS
 
 pytestmark = pytest.mark.md
 

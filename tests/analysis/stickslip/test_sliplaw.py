@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.slip_law import (VERDICTS, detectable, film_force, fit_film_force,
-                                            sigmas)
+from filmfriction.analysis.slip_law.slip_law import (ONE_LAW, VERDICTS, detectable, film_force,
+                                            fit_film_force, sigmas)
 from filmfriction.analysis.groundtruth.synthetic import block_trace, klein_trace, with_wall_noise
 from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.reduced_model.cycles import cycle_table
@@ -100,6 +100,13 @@ def test_a_loop_is_measured_between_the_branches():
     assert fit.decelerating.kinetic_force == pytest.approx(0.4, abs=0.02)
     assert fit.loop_force == pytest.approx(0.1, abs=0.02)
     assert fit.loop_area > 0
+    # a co-moving mass alone would take the loop up (m_c ≈ 0.18, a mass that is not
+    # there); the step at the peak finds it, so the slip is not one law and the verdict
+    # is the decelerating branch's
+    assert fit.loop_step == pytest.approx(0.1, abs=0.005)
+    assert fit.loop_step_sigmas >= 2
+    assert fit.verdict_from == "decelerating", fit.reason
+    assert fit.damping == fit.decelerating.damping
 
 
 def test_comoving_mass_is_found():
@@ -107,10 +114,19 @@ def test_comoving_mass_is_found():
     r, tab = _run(0.4, 0.5, mass=1.5)
     plain = _fit(r, tab[1:], mass=1.0)
     with_mass = _fit(r, tab[1:], mass=1.0, comoving_mass=True)
-    assert abs(plain.damping - 0.5) > 0.02            # the missing inertia biases the law
-    assert with_mass.decelerating.comoving_mass == pytest.approx(0.5, abs=0.02)
-    assert with_mass.damping == pytest.approx(0.5, rel=2e-2)
+    # the missing inertia biases the branches' law fitted without m_c
+    assert abs(plain.decelerating.damping - 0.5) > 0.02
     assert math.isnan(plain.decelerating.comoving_mass)
+    assert with_mass.decelerating.comoving_mass == pytest.approx(0.5, abs=0.02)
+    assert with_mass.decelerating.damping == pytest.approx(0.5, rel=2e-2)
+    # the one law over the whole slip fits m_c whatever was asked, finds no loop beyond
+    # it (the slip is F_k + B·v throughout) and is the verdict's law: unbiased
+    for fit in (plain, with_mass):
+        assert fit.one_law.comoving_mass == pytest.approx(0.5, abs=0.02)
+        assert fit.verdict_from == ONE_LAW, fit.reason
+        assert fit.damping == pytest.approx(0.5, rel=2e-2)
+        assert fit.kinetic_force == pytest.approx(0.4, rel=2e-2)
+        assert fit.verdict == "mixed", fit.reason
 
 
 def test_noise_gives_errors_that_cover_the_truth_at_the_nominal_rate():

@@ -1,0 +1,192 @@
+"""One branch of the slips fitted: F_film = F_k + B·v [+ m_c·a], integrated equation of motion.
+
+:class:`Segment` holds one branch of one slip in integral form; :func:`fit_branch`
+fits each slip, takes the mean over the slips (the errors their scatter, or with
+fewer than :data:`MIN_SLIPS_FOR_SCATTER` slips the pooled fit's), the exponent, the
+power and the verdict (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.branch_verdict`).
+The physics is :mod:`filmfriction.analysis.slip_law.slip_law`'s.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .slip_law_stats import correlation_time, detectable, ols, sigmas
+from .slip_law_verdict import branch_verdict
+
+__all__ = ["BranchFit", "Segment", "fit_branch", "MIN_SLIPS_FOR_SCATTER"]
+
+#: With this many slips or more, the errors are the scatter of the per-slip fits.
+MIN_SLIPS_FOR_SCATTER = 3
+
+
+@dataclass(frozen=True)
+class BranchFit:
+    """F_film = F_k + B·v [+ m_c·a] fitted on one branch of the slips (see the module text).
+
+    Attributes
+    ----------
+    branch : str
+        ``decelerating``, ``accelerating`` or ``whole``.
+    kinetic_force, kinetic_force_stderr : float
+        F_k and its standard error (force units).
+    damping, damping_stderr : float
+        B and its standard error (force per velocity).
+    comoving_mass, comoving_mass_stderr : float
+        m_c and its standard error (NaN when the term was not fitted).
+    mean_velocity, mean_force : float
+        v̄ and F̄, the means of the fitted samples.
+    viscous_share : float
+        B·v̄ / F̄.
+    exponent, exponent_stderr : float
+        n = d ln F/d ln v of the fitted law at each slip's mean velocity, mean and
+        standard error over the slips.
+    kinetic_sigmas, damping_sigmas : float
+        F_k and B in normal-equivalent standard errors (signed).
+    detectable_damping, detectable_kinetic_force : float
+        The smallest B and F_k the run resolves at 2 σ with 95 % power.
+    dof : int
+        Degrees of freedom of the errors.
+    verdict, reason : str
+        One of :data:`VERDICTS`, and the numbers it rests on.
+    per_slip_kinetic_force, per_slip_damping, per_slip_exponent : ndarray
+        Per-slip fits (NaN where a slip had too few samples on this branch).
+    samples, slips : int
+        Samples and slips fitted.
+    velocity_residual : float
+        Root-mean-square residual of the pooled integral fit over M: how far the
+        wall's velocity strays from the law's (velocity units).
+    loop_step, loop_step_stderr : float
+        With the loop step fitted: the force's step at the peak velocity,
+        F_acc − F_dec (positive when the accelerating branch lies above), else NaN.
+    """
+
+    branch: str
+    kinetic_force: float
+    kinetic_force_stderr: float
+    damping: float
+    damping_stderr: float
+    comoving_mass: float
+    comoving_mass_stderr: float
+    mean_velocity: float
+    mean_force: float
+    viscous_share: float
+    exponent: float
+    exponent_stderr: float
+    kinetic_sigmas: float
+    damping_sigmas: float
+    detectable_damping: float
+    detectable_kinetic_force: float
+    dof: int
+    verdict: str
+    reason: str
+    per_slip_kinetic_force: np.ndarray
+    per_slip_damping: np.ndarray
+    per_slip_exponent: np.ndarray
+    samples: int
+    slips: int
+    velocity_residual: float
+    loop_step: float = math.nan
+    loop_step_stderr: float = math.nan
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One branch of one slip in integral form (module text): the impulse y, the
+    sampled velocity v, the regressors Δt, Δx and v − v0, and the time past the slip's
+    peak velocity (the loop step's regressor)."""
+
+    y: np.ndarray           # ∫F_spring dt − γM(Δx − VΔt)
+    v: np.ndarray           # the sampled wall velocity (the wall's own M·v)
+    dt: np.ndarray
+    dx: np.ndarray
+    dv: np.ndarray          # v − v0 of the smoothed velocity (the m_c term)
+    mass: float
+    after_peak: np.ndarray  # max(Δt − Δt_peak, 0)
+
+    @property
+    def mean_velocity(self) -> float:
+        return float(self.dx[-1] / self.dt[-1]) if self.dt[-1] > 0 else math.nan
+
+    def response(self, comoving: bool) -> np.ndarray:
+        """The response: y − M·v, or y alone with m_c (M·v joins m_c·v)."""
+        return self.y if comoving else self.y - self.mass * self.v
+
+    def design(self, comoving: bool, intercepts: int = 1, which: int = 0, step: bool = False):
+        """Columns [intercepts…, Δt, Δx (, v − v0) (, time past the peak)]."""
+        cols = [np.full(self.y.size, float(k == which)) for k in range(intercepts)]
+        cols += [self.dt, self.dx]
+        return cols + ([self.dv] if comoving else []) + ([self.after_peak] if step else [])
+
+
+def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
+               loop_step: bool = False) -> BranchFit:
+    """Per-slip fits on one branch, their mean, errors, power and verdict; with
+    ``loop_step`` (on the whole slip) a step of the force at the peak velocity is
+    fitted too, F_acc − F_dec at a common B (and m_c)."""
+    nterms = 3 + comoving + loop_step
+    per = []                       # (fk, b, mc, vbar, step) per slip
+    used, resids = [], []
+    for seg in segments:
+        if seg is None or seg.y.size < nterms + 3:
+            per.append((math.nan,) * 5)
+            continue
+        coef, _, res = ols(np.column_stack(seg.design(comoving, step=loop_step)),
+                           seg.response(comoving), errors=False)
+        resids.append(res)
+        # with m_c, the coefficient of v − v0 is M + m_c; the step's is F_dec − F_acc
+        per.append((float(coef[1]), float(coef[2]),
+                    float(coef[3]) - seg.mass if comoving else math.nan, seg.mean_velocity,
+                    -float(coef[-1]) if loop_step else math.nan))
+        used.append(seg)
+    per = np.array(per, float).reshape(-1, 5)
+    nan = math.nan
+    if not used:
+        return BranchFit(branch, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan, nan,
+                         nan, nan, nan, 0, "inconclusive",
+                         f"no slip with {nterms + 3} or more samples on the {branch} branch "
+                         "above the velocity floor", per[:, 0], per[:, 1], per[:, 0] * nan,
+                         0, 0, nan)
+    m = len(used)
+    ok = np.isfinite(per[:, 0]) & np.isfinite(per[:, 1])
+    n = int(ok.sum())
+    with np.errstate(invalid="ignore", divide="ignore"):
+        expo = per[:, 1] * per[:, 3] / (per[:, 0] + per[:, 1] * per[:, 3])
+    if n >= MIN_SLIPS_FOR_SCATTER:
+        # the slips are the replicas: the standard error of their mean
+        cols = [0, 1, 2, 4]
+        est = per[np.ix_(ok, cols)].mean(axis=0)
+        se = per[np.ix_(ok, cols)].std(axis=0, ddof=1) / math.sqrt(n)
+        dof = n - 1
+    else:
+        # too few slips for a scatter: the pooled fit (one intercept per slip, common
+        # F_k, B (, m_c)), its errors widened for the residuals' correlation, with the
+        # degrees of freedom of its independent samples
+        X = np.vstack([np.column_stack(s.design(comoving, m, k, loop_step))
+                       for k, s in enumerate(used)])
+        y = np.concatenate([s.response(comoving) for s in used])
+        coef, pse, resid = ols(X, y)
+        est = np.array([coef[m], coef[m + 1], coef[m + 2] - used[0].mass if comoving else nan,
+                        -coef[-1] if loop_step else nan])
+        se = np.array([pse[m], pse[m + 1], pse[m + 2] if comoving else nan,
+                       pse[-1] if loop_step else nan])
+        dof = max(int(y.size / correlation_time(resid)) - (m + nterms - 1), 1)
+    fk, b, mc, step = (float(x) for x in est)
+    se_fk, se_b, se_mc, se_step = (float(x) for x in se)
+    ex = expo[ok][np.isfinite(expo[ok])]
+    n_mean = float(ex.mean()) if ex.size else nan
+    n_se = float(ex.std(ddof=1) / math.sqrt(ex.size)) if ex.size >= 2 else nan
+    vbar = float(np.nanmean(per[ok, 3])) if n else nan
+    fbar = fk + b * vbar
+    share = b * vbar / fbar if fbar > 0 else nan
+    # the residual as the error of the law's wall velocity: (response residual) / M
+    allres = np.concatenate(resids)
+    vres = float(np.sqrt(np.mean(allres ** 2))) / used[0].mass
+    z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
+    det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
+    verdict, reason = branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n)
+    return BranchFit(branch, fk, se_fk, b, se_b, mc, se_mc, vbar,
+                     fbar, share, n_mean, n_se, z_fk, z_b, det_b, det_fk, dof, verdict, reason,
+                     per[:, 0], per[:, 1], expo, int(allres.size), n, vres, step, se_step)

@@ -1,0 +1,98 @@
+"""The slip-law fit's statistics: significance, power, least squares with correlated residuals.
+
+:func:`sigmas` and :func:`detectable` are the verdict's significance and power
+(:mod:`filmfriction.analysis.slip_law.slip_law`); :func:`ols` is the least squares of the
+integrated equation of motion, its errors widened by the residuals' integrated
+autocorrelation time (:func:`correlation_time`).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats as sps
+from scipy.optimize import brentq
+
+__all__ = ["sigmas", "detectable", "ols", "correlation_time", "mean_se", "RESOLVED_SIGMAS",
+           "POWER"]
+
+#: A fitted term is resolved when it exceeds this many standard errors (at a normal's coverage).
+RESOLVED_SIGMAS = 2.0
+#: The power at which a term the run did not resolve is ruled out.
+POWER = 0.95
+
+
+def sigmas(estimate: float, stderr: float, dof: int) -> float:
+    """``estimate/stderr`` as normal-equivalent standard errors (signed): the t of ``dof``
+    degrees of freedom mapped to the normal quantile of the same tail probability.
+
+    >>> round(sigmas(2.0, 1.0, 10**6), 3), round(sigmas(2.0, 1.0, 4), 2)
+    (2.0, 1.57)
+    """
+    if not (math.isfinite(estimate) and math.isfinite(stderr) and stderr >= 0 and dof >= 1):
+        return math.nan
+    if stderr == 0:
+        return math.copysign(38.0, estimate) if estimate else 0.0
+    t = estimate / stderr
+    z = float(sps.norm.isf(sps.t.sf(abs(t), dof)))
+    return math.copysign(min(z, 38.0), t)
+
+
+def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
+               power: float = POWER) -> float:
+    """The smallest true value resolved at ``resolved`` σ (normal-equivalent) in a share
+    ``power`` of repeats, for an estimate with standard error ``stderr`` whose own
+    error has ``dof`` degrees of freedom: δ·stderr with δ the noncentrality at
+    which a noncentral t exceeds the critical t with probability ``power``.
+
+    >>> round(detectable(1.0, 10**6), 2), round(detectable(1.0, 6), 2)   # 2 + 1.645; 6 dof
+    (3.64, 4.45)
+    """
+    if not (math.isfinite(stderr) and stderr >= 0 and dof >= 1):
+        return math.nan
+    crit = sps.t.isf(sps.norm.sf(resolved), dof)
+    if dof > 1000:
+        return float((crit + sps.norm.ppf(power)) * stderr)
+    delta = brentq(lambda d: sps.nct.sf(crit, dof, d) - power, 0.0, 10 * crit + 50)
+    return float(delta * stderr)
+
+
+def ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
+    """Least squares y = X·c: (coef, stderr, residuals); the errors widened by the
+    residuals' integrated autocorrelation time (NaN with ``errors=False``)."""
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    resid = y - X @ coef
+    dof = y.size - X.shape[1]
+    if dof <= 0 or not errors:
+        return coef, np.full(X.shape[1], math.nan), resid
+    s2 = float(resid @ resid) / dof
+    try:
+        se = np.sqrt(np.diag(s2 * np.linalg.inv(X.T @ X)) * correlation_time(resid))
+    except np.linalg.LinAlgError:
+        se = np.full(X.shape[1], math.nan)
+    return coef, se, resid
+
+
+def correlation_time(r: np.ndarray) -> float:
+    """Integrated autocorrelation time of ``r`` in samples, 1 + 2 Σ ρ_k summed up to
+    the first lag where ρ_k ≤ 0 (1 for uncorrelated samples)."""
+    r = r - r.mean()
+    den = float(r @ r)
+    if r.size < 3 or den <= 0:
+        return 1.0
+    tau = 1.0
+    for k in range(1, r.size // 2):
+        rho = float(r[k:] @ r[:-k]) / den
+        if rho <= 0:
+            break
+        tau += 2 * rho
+    return tau
+
+
+def mean_se(x: np.ndarray) -> tuple[float, float]:
+    """Mean and standard error of the finite values of ``x`` (NaN for none; the error NaN
+    for one)."""
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return math.nan, math.nan
+    return float(x.mean()), (float(x.std(ddof=1) / math.sqrt(x.size)) if x.size > 1 else math.nan)
