@@ -89,7 +89,7 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                                   spring_constant=trace.parameters.spring_constant,
                                   wall_position=wall)
     v_drive, _ = trace.drive_velocity()
-    table = refine_extrema(t, f, table, noise=events.threshold_noise, lag=events.lag,
+    table = refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
                                      spring_constant=trace.parameters.spring_constant,
                                      drive_velocity=v_drive, wall_position=wall)
     regime = stickslip.classify_regime(table)

@@ -108,15 +108,6 @@ class SlipEvents:
     def count(self) -> int:
         return int(self.yield_index.size)
 
-    @property
-    def threshold_noise(self) -> float:
-        """The noise the threshold is set from: the cycle-to-cycle noise where it raised
-        the threshold (it exceeds ``noise`` more than :data:`CYCLE_NOISE_FACTOR` times),
-        else ``noise``."""
-        if self.noise > 0.0 and self.cycle_noise > CYCLE_NOISE_FACTOR * self.noise:
-            return float(self.cycle_noise)
-        return float(self.noise)
-
 
 
 def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,

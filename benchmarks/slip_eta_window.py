@@ -52,7 +52,7 @@ def main(argv=None) -> int:
         f0 = klein_trace(noise=0.0, **kw)["spring_force"]
         ev, ev0 = stickslip.detect_slips(t, f), stickslip.detect_slips(t, f0)
         table = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=K)
-        table = refine_extrema(t, f, table, noise=ev.threshold_noise, lag=ev.lag,
+        table = refine_extrema(t, f, table, noise=ev.noise, lag=ev.lag,
                                          spring_constant=K, drive_velocity=v)
         ry, rs = np.asarray(table.yield_index), np.asarray(table.stick_index)
         if ry.size != ev0.yield_index.size:
