@@ -149,15 +149,37 @@ def _sigmas(a: Estimate, b: Estimate) -> float:
 
 
 def _reading(kinetic: Estimate | None, damping: Estimate | None,
-             damping_scatter: float = math.nan) -> str:
+             damping_scatter: float = math.nan, *,
+             significance: tuple[float | None, float | None] = (None, None)) -> str:
     """Which terms of F_k + B·v a fit resolves (more than 2 standard errors, off a bound):
-    ``mixed``, ``viscous`` (B only), ``kinetic`` (F_k only) or ``neither``."""
-    k_ok = kinetic is not None and not kinetic.at_bound and math.isfinite(kinetic.stderr) \
-        and kinetic.value > RESOLVED_SIGMAS * kinetic.stderr
-    b_ok = _resolved(damping) and not (math.isfinite(damping_scatter) and damping is not None
-                                       and damping.value <= RESOLVED_SIGMAS * damping_scatter)
+    ``mixed``, ``viscous`` (B only), ``kinetic`` (F_k only) or ``neither``.
+    ``significance`` gives a fit's own signed significance of F_k and B in standard
+    errors where it has one (the slip law's, which allows for the few slips' t
+    distribution): it then decides, so that the reading is the one the fit states."""
+    k_sig, b_sig = significance
+    if k_sig is not None:
+        k_ok = kinetic is not None and k_sig > RESOLVED_SIGMAS
+    else:
+        k_ok = kinetic is not None and not kinetic.at_bound and math.isfinite(kinetic.stderr) \
+            and kinetic.value > RESOLVED_SIGMAS * kinetic.stderr
+    if b_sig is not None:
+        b_ok = damping is not None and b_sig > RESOLVED_SIGMAS
+    else:
+        b_ok = _resolved(damping) and not (math.isfinite(damping_scatter) and damping is not None
+                                           and damping.value <= RESOLVED_SIGMAS * damping_scatter)
     return {(True, True): "mixed", (False, True): "viscous", (True, False): "kinetic",
             (False, False): "neither"}[(k_ok, b_ok)]
+
+
+def _law_significance(law: dict) -> tuple[float | None, float | None]:
+    """The slip law's own significance of F_k and B (``sigmas`` of the branch its verdict
+    is from), None where analysis.json does not carry it."""
+    branch = (law.get("branches") or {}).get(law.get("verdict_from") or "") or {}
+
+    def sig(key):
+        value = (branch.get(key) or {}).get("sigmas")
+        return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else None
+    return sig("kinetic_force"), sig("damping")
 
 
 def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
@@ -299,7 +321,8 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
     verdict = law.get("verdict")
     if film_damping is not None and verdict:
         mine = _reading(kinetic_force, film_damping, damping_scatter)
-        theirs = _reading(_entry(law.get("kinetic_force"), ""), _entry(law.get("damping"), ""))
+        theirs = _reading(_entry(law.get("kinetic_force"), ""), _entry(law.get("damping"), ""),
+                          significance=_law_significance(law))
 
         def show(e):
             if e is None:

@@ -119,3 +119,22 @@ def test_the_analysis_flags_slips_with_negative_viscosity(tmp_path):
     assert slip["eta_eff"]["mean"] < 0
     assert slip["unphysical"]["slips"] == list(range(2, n + 2)), slip["unphysical"]
     assert f"{n} of {n} slips give η_eff < 0" in slip["unphysical"]["note"]
+
+
+def test_the_slip_law_is_read_by_its_own_significance():
+    # 7 slips: F_k = 60.8 ± 24.4 is 2.5 standard errors by value/stderr but 1.99 by the
+    # slip law's own test (the few slips' t distribution): the law says "neither term
+    # resolved", and the friction-law row must read it so, not as a kinetic part
+    doc = analysis(slips=(8.4, 3.3), slip_law=((60.8, 24.4), (-34.7, 122.7), "inconclusive"))
+    doc["slip_law"]["verdict_from"] = "decelerating"
+    doc["slip_law"]["branches"] = {"decelerating": {
+        "kinetic_force": {"mean": 60.8, "stderr": 24.4, "units": "ε/σ", "sigmas": 1.99},
+        "damping": {"mean": -34.7, "stderr": 122.7, "units": "m/τ", "sigmas": -0.27}}}
+    c = choose(doc, **fit((32.6, 24.0), None))
+    assert c.friction_law["slip_law"] == "neither" and c.friction_law["agree"]
+    # where the law's own test resolves F_k, the row says so
+    doc["slip_law"]["branches"]["decelerating"]["kinetic_force"]["sigmas"] = 2.6
+    assert choose(doc, **fit((32.6, 24.0), None)).friction_law["slip_law"] == "kinetic"
+    # without the law's significance (an older analysis.json) value/stderr decides
+    del doc["slip_law"]["branches"]
+    assert choose(doc, **fit((32.6, 24.0), None)).friction_law["slip_law"] == "kinetic"
