@@ -25,6 +25,7 @@ import numpy as np
 from filmfriction.analysis import stickslip, viscosity
 from filmfriction.analysis.extrema import refine_extrema
 from filmfriction.reduced_model.cycles import cycle_table
+from filmfriction.analysis.groundtruth.calibration_sets import klein_slip
 from filmfriction.analysis.groundtruth.synthetic import klein_trace
 
 K, M, FS = 97.0, 1.47e-3, 9.7e-6
@@ -41,13 +42,9 @@ def main(argv=None) -> int:
     err = {w: [] for w in ways}
     shift_y, shift_s = [], []
     for _ in range(args.cases):
-        b = 2.0 * math.sqrt(K * M) * rng.uniform(0.3, 3.0)
-        fb = FS * rng.uniform(0.2, 0.5)
-        slip = max(math.pi * math.sqrt(M / K), b / K)
-        v = (FS - fb) / (K * rng.uniform(4.0, 10.0) * slip)
-        kw = dict(spring_constant=K, mass=M, damping=b, drive_velocity=v, static_force=FS,
-                  backward_force=fb, cycles=6, dt=slip / rng.uniform(20, 80),
-                  seed=int(rng.integers(2 ** 31)))
+        kw = klein_slip(rng, K, M, FS)
+        b, fb, v = kw["damping"], kw["backward_force"], kw["drive_velocity"]
+        kw["seed"] = int(rng.integers(2 ** 31))
         t, f = (klein_trace(noise=(FS - fb) * args.noise, **kw)[c] for c in ("time", "spring_force"))
         f0 = klein_trace(noise=0.0, **kw)["spring_force"]
         ev, ev0 = stickslip.detect_slips(t, f), stickslip.detect_slips(t, f0)

@@ -38,7 +38,7 @@ from filmfriction.reduced_model import SpringBlock, laws
 
 from .synthetic import klein_trace, write_csv
 
-__all__ = ["WALLS", "SETS", "noise", "write_run", "coulomb_case", "klein_case", "run_set",
+__all__ = ["WALLS", "SETS", "noise", "write_run", "coulomb_case", "klein_slip", "klein_case", "run_set",
            "summary"]
 
 WALLS = {
@@ -90,19 +90,27 @@ def coulomb_case(directory, rng, wall_name, rho_range=None):
     return {"kinetic_force": fk, "film_damping": b}
 
 
-def klein_case(directory, rng):
-    """Klein's slip with a freeze at F_b (F_k = 0), SI; returns its truth."""
-    w = WALLS["si"]
-    k, m, fs = w["k"], w["m"], w["fs"]
+def klein_slip(rng, spring_constant, mass, static_force):
+    """A random Klein slip's parameters (damping ratio 0.3-3, F_b 0.2-0.5 F_s, a stick 4-10
+    slips long, 20-80 samples a slip): :func:`klein_trace`'s keywords but noise and seed."""
+    k, m, fs = spring_constant, mass, static_force
     b = 2.0 * math.sqrt(k * m) * rng.uniform(0.3, 3.0)
     fb = fs * rng.uniform(0.2, 0.5)
     slip = max(math.pi * math.sqrt(m / k), b / k)
     v = (fs - fb) / (k * rng.uniform(4.0, 10.0) * slip)
-    tr = klein_trace(spring_constant=k, mass=m, damping=b, drive_velocity=v, static_force=fs,
-                     backward_force=fb, cycles=6, dt=slip / rng.uniform(20, 80),
-                     noise=(fs - fb) * rng.uniform(0.005, 0.03), seed=int(rng.integers(2 ** 31)))
-    write_run(directory, w, tr["time"], tr["spring_force"], tr["drive_position"], v)
-    return {"kinetic_force": 0.0, "film_damping": b}
+    return dict(spring_constant=k, mass=m, damping=b, drive_velocity=v, static_force=fs,
+                backward_force=fb, cycles=6, dt=slip / rng.uniform(20, 80))
+
+
+def klein_case(directory, rng):
+    """Klein's slip with a freeze at F_b (F_k = 0), SI; returns its truth."""
+    w = WALLS["si"]
+    kw = klein_slip(rng, w["k"], w["m"], w["fs"])
+    drop = kw["static_force"] - kw["backward_force"]
+    tr = klein_trace(noise=drop * rng.uniform(0.005, 0.03), seed=int(rng.integers(2 ** 31)), **kw)
+    write_run(directory, w, tr["time"], tr["spring_force"], tr["drive_position"],
+              kw["drive_velocity"])
+    return {"kinetic_force": 0.0, "film_damping": kw["damping"]}
 
 
 SETS = {"lj": lambda d, rng: coulomb_case(d, rng, "lj"),
