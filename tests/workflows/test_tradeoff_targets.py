@@ -114,3 +114,82 @@ def test_a_preset_whose_key_is_set_is_not_run():
     assert tt.preset_clash("stick-slip", "preview", ("slide_steps=20000",)) == ["slide_steps"]
     assert tt.preset_clash("stick-slip", "reference", ("cells_x=5", "seed=3")) == ["cells_x"]
     assert tt.preset_clash("stick-slip", "standard", ("slide_steps=20000",)) == []
+
+
+def _study(d, rows, status="target_not_met", finished=True):
+    """A side's study directory: study.json with one segment per row."""
+    d.mkdir(parents=True)
+    record = {**_record(rows, tt.OBSERVABLES), "status": status,
+              "elapsed": rows[-1][1] if rows else None}
+    if finished:
+        record["finished"] = "2026-01-01T00:00:00+00:00"
+    (d / "study.json").write_text(tt.json.dumps(record))
+
+
+_ROWS = [(100, 30.0, [(0.08, 12), (0.2, 12), (0.4, 12)]),
+         (200, 61.0, [(0.045, 20), (0.09, 20), (0.3, 20)])]
+
+
+def test_an_interrupted_study_keeps_what_it_measured(tmp_path, monkeypatch):
+    calls = []
+
+    def fake_run(args):
+        out = tt.Path(args[args.index("--out") + 1])
+        calls.append(out)
+        if len(calls) == 3:                       # pair 2's first side: interrupted
+            raise KeyboardInterrupt
+        _study(out, _ROWS)
+        return 40.0 + len(calls), 1.5
+
+    monkeypatch.setattr(tt, "_run", fake_run)
+    monkeypatch.setattr(tt, "_cpu_now", lambda: (None, 0.0))
+    with pytest.raises(KeyboardInterrupt):
+        tt.run_targets(tmp_path / "t", scenes=("stick-slip",), pairs=2, presets=(),
+                       log=lambda m: None)
+    doc = tt.json.loads((tmp_path / "t" / "targets.json").read_text())
+    assert doc["complete"] is False and "pair 2 of 2" in doc["missing"]
+    pair = doc["scenes"]["stick-slip"]["pairs"][0]
+    assert (pair["replicas"]["wall"], pair["ranks"]["wall"]) == (41.0, 42.0)
+    assert pair["replicas"]["other_cpu_seconds"] == 1.5
+    fs = doc["scenes"]["stick-slip"]["summary"]["static_force"]
+    assert fs["0.1"]["replicas"]["seconds"]["median"] == 30.0
+    assert fs["0.05"]["ranks"]["seconds"]["median"] == 61.0 and fs["0.03"]["ranks"]["reached"] == 0
+    assert (tmp_path / "t" / "targets.md").read_text().startswith(
+        "# Wall time to a target error")
+    assert "INCOMPLETE: the study stopped before stick-slip: pair 2 of 2" in \
+        (tmp_path / "t" / "targets.md").read_text()
+
+
+def test_collect_rebuilds_the_tables_from_the_finished_runs(tmp_path):
+    out = tmp_path / "t"
+    for k, side in [(1, "replicas"), (1, "ranks"), (2, "replicas")]:
+        _study(out / "sfb-similar" / f"pair-{k}" / side, _ROWS)
+    _study(out / "sfb-similar" / "pair-2" / "ranks", _ROWS[:1], finished=False)
+    (out / "sfb-similar" / "preset-reference").mkdir()
+    (out / "sfb-similar" / "preset-reference" / "run.json").write_text('{"status": "running"}')
+    doc = tt.collect_targets(out, presets=("standard", "reference"))
+    entry = doc["scenes"]["sfb-similar"]
+    assert len(entry["pairs"]) == 1 and entry["pairs"][0]["ranks"]["wall"] == 61.0
+    assert doc["complete"] is False
+    assert "pair-2 1 replica × 2 ranks" in doc["missing"]
+    assert "preset reference (running)" in doc["missing"]
+    std = entry["presets"]["standard"]
+    assert std["seconds"] == 30.0 and std["errors"]["static_force"]["meets"] == 0.1
+    text = tt.markdown(doc)
+    assert "not known" in text and "INCOMPLETE" in text
+
+
+def test_measurements_beside_other_work_are_named():
+    side = {"wall": 100.0, "other_cpu_seconds": 10.0, "to_target": {}}
+    idle = {"wall": 100.0, "other_cpu_seconds": 1.0, "to_target": {}}
+    doc = {"cpus": 2, "scenes": {"s": {"pairs": [{"replicas": side, "ranks": idle}],
+                                       "presets": {"preview": {"seconds": 50.0,
+                                                               "other_cpu_seconds": 20.0}}}}}
+    assert tt._busy_measurements(doc) == ["s pair 1 2 replicas × 1 rank 5 %", "s preset preview 20 %"]
+
+
+def test_presets_and_collect_refuse_bad_input(tmp_path, run_cli):
+    r = run_cli("tradeoff", "--targets", "--presets", "preview,best", "--out", tmp_path / "t")
+    assert r.code == 2 and "best is no preset" in r.err, r.err
+    r = run_cli("tradeoff", "--targets", "--collect", tmp_path)
+    assert r.code == 2 and "not a tradeoff --targets directory" in r.err, r.err

@@ -47,8 +47,16 @@ def register(subparsers) -> None:
     t.add_argument("--budget", default=None, metavar="STEPS|DURATION",
                    help="with --targets: each study's budget, as for run --budget (default "
                         "10 times the scene's slide_steps)")
-    t.add_argument("--no-presets", dest="presets", action="store_false",
-                   help="with --targets: leave out the presets' runs")
+    t.add_argument("--presets", default="preview,standard,reference", metavar="NAME,...",
+                   help="with --targets: the fidelity presets to run as targets (default "
+                        "preview,standard,reference; 'reference' is 8 times a standard "
+                        "run's atom-steps)")
+    t.add_argument("--no-presets", dest="presets", action="store_const", const="",
+                   help="with --targets: leave out the presets' runs (--presets '')")
+    t.add_argument("--collect", type=Path, default=None, metavar="DIR",
+                   help="with --targets: no runs; rebuild DIR's targets.json and targets.md "
+                        "from the finished studies and preset runs in it (an interrupted "
+                        "study; the existing files are kept as *.before)")
     t.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help="with --targets: a scene parameter for every run (e.g. a short "
                         "check of the command); a preset that sets the same key is not run")
@@ -105,9 +113,18 @@ def targets_main(args: argparse.Namespace) -> int:
     from ..md.scene import SceneError, load
     from ..md.replicas.target import TargetInputError, parse_budget
 
+    from ..cost.tradeoff_targets import PRESETS
+
     if args.quick or args.json or args.seeds != 1 or args.np != 2:
         raise UserError("--targets times 2 replicas x 1 rank against 1 run x 2 ranks: "
                         "--quick, --json, --seeds and --np are not accepted with it")
+    presets = tuple(x.strip() for x in args.presets.split(",") if x.strip())
+    unknown = [x for x in presets if x not in PRESETS]
+    if unknown:
+        raise UserError(f"--presets {args.presets!r}: {', '.join(unknown)} is no preset; "
+                        f"accepted: {', '.join(PRESETS)} (comma-separated) or ''")
+    if args.collect is not None:
+        return _collect(args.collect, _levels(args.levels), presets)
     if not 1 <= args.pairs <= 50:
         raise UserError(f"--pairs {args.pairs}: allowed 1 to 50 pairs per scene")
     levels = _levels(args.levels)
@@ -140,11 +157,29 @@ def targets_main(args: argparse.Namespace) -> int:
             print(msg, flush=True)
     try:
         run_targets(out, scenes=scenes, pairs=args.pairs, levels=levels, budget=args.budget,
-                    sets=tuple(args.sets), presets=args.presets and
-                    ("preview", "standard", "reference"), log=log)
+                    sets=tuple(args.sets), presets=presets, log=log)
     except RuntimeError as exc:
         print(f"filmfriction tradeoff: {exc}", file=sys.stderr)
         return 1
+    print((out / "targets.md").read_text(), end="")
+    print(f"tables: {out / 'targets.md'}; every figure: {out / 'targets.json'}")
+    return 0
+
+
+def _collect(out: Path, levels, presets) -> int:
+    """``--collect DIR``: the tables of an interrupted study from what its runs left."""
+    from ..cost.tradeoff_targets import collect_targets, write_targets
+
+    if not out.is_dir() or not any(out.glob("*/pair-*")) and not any(out.glob("*/preset-*")):
+        raise UserError(f"--collect {out}: not a tradeoff --targets directory (no "
+                        "<scene>/pair-<k>/ or <scene>/preset-<name>/ in it)")
+    check_writable(out, "--collect", directory=True)
+    doc = collect_targets(out, levels, presets=presets)
+    stamp = f"{datetime.now():%Y%m%d-%H%M%S}"
+    for name in ("targets.json", "targets.md"):      # kept, never overwritten
+        if (out / name).exists():
+            (out / name).rename(out / f"{name}.before-{stamp}")
+    write_targets(out, doc)
     print((out / "targets.md").read_text(), end="")
     print(f"tables: {out / 'targets.md'}; every figure: {out / 'targets.json'}")
     return 0

@@ -47,7 +47,7 @@ from filmfriction.md_inputs.contract import STUDY_FILE
 
 __all__ = ["LEVELS", "OBSERVABLES", "SIDES", "PRESETS", "Side", "side_command",
            "check_met", "times_to_target", "summarize", "preset_errors", "preset_clash",
-           "run_targets", "markdown"]
+           "run_targets", "collect_targets", "write_targets", "markdown"]
 
 #: the relative errors asked (68 % half-width over |mean|)
 LEVELS = (0.10, 0.05, 0.03)
@@ -196,15 +196,25 @@ def preset_errors(run_dir: Path, levels=LEVELS, observables=OBSERVABLES) -> dict
     return out
 
 
-def _run(args: list[str]) -> float:
-    """``filmfriction ARGS``; its wall time (RuntimeError with its last lines on failure)."""
-    t0 = time.perf_counter()
+def _run(args: list[str]) -> tuple[float, float | None]:
+    """``filmfriction ARGS``; its wall time and the CPU seconds other processes used
+    meanwhile (None off Linux; RuntimeError with its last lines on failure)."""
+    before, t0 = _cpu_now(), time.perf_counter()
     done = subprocess.run([*CLI, *args], capture_output=True, text=True)
     wall = time.perf_counter() - t0
     if done.returncode != 0:
         raise RuntimeError(f"filmfriction {' '.join(args)} failed ({done.returncode}): "
                            f"{done.stderr.strip()[-1500:]}")
-    return wall
+    return wall, _other_cpu(before, _cpu_now())
+
+
+def _other_cpu(before: tuple, after: tuple) -> float | None:
+    """CPU seconds the machine spent busy between two :func:`_cpu_now` beyond this
+    process and its finished children."""
+    (busy0, own0), (busy1, own1) = before, after
+    if busy0 is None or busy1 is None:
+        return None
+    return max(0.0, (busy1 - busy0) - (own1 - own0))
 
 
 def _cpu_now() -> tuple:
@@ -225,38 +235,114 @@ def run_targets(out: Path, *, scenes=SCENES, pairs: int = 3, levels=LEVELS,
     out.mkdir(parents=True)
     doc = {"schema": "filmfriction.tradeoff-targets/1", "levels": list(levels),
            "observables": list(observables), "budget": budget, "set": list(sets),
-           "cpus": usable_cpus(), "scenes": {}}
+           "cpus": usable_cpus(), "complete": False, "scenes": {}}
     before, t0 = _cpu_now(), time.perf_counter()
+
+    def write(missing: str | None) -> None:
+        # after every measurement: an interrupted study keeps what it measured
+        doc["elapsed"] = time.perf_counter() - t0
+        doc["other_cpu_seconds"] = _other_cpu(before, _cpu_now())
+        doc["complete"], doc["missing"] = missing is None, missing
+        write_targets(out, doc)
+
     for scene in scenes:
         rows = []
+        entry = doc["scenes"][scene] = {"pairs": rows,
+                                        "summary": summarize(rows, levels, observables)}
         for k in range(pairs):
             order = SIDES if k % 2 == 0 else SIDES[::-1]
             pair = {"order": [s.name for s in order]}
             for side in order:
                 d = out / scene / f"pair-{k + 1}" / side.name
-                wall = _run(side_command(scene, side, d, levels=levels,
-                                         observables=observables, budget=budget, sets=sets))
-                record = _read_record(d)
-                pair[side.name] = {"study": str(d), "wall": wall, "status": record["status"],
-                                   "slide_steps": record["segments"][-1]["slide_steps"],
-                                   "segments": len(record["segments"]),
-                                   "to_target": times_to_target(record, levels, observables)}
-                log(f"{scene} pair {k + 1} {side.label}: {record['status']} after "
-                    f"{wall:.0f} s ({len(record['segments'])} segment(s))")
+                write(f"{scene}: pair {k + 1} of {pairs}, {side.label}, and what follows it")
+                wall, other = _run(side_command(scene, side, d, levels=levels,
+                                                observables=observables, budget=budget,
+                                                sets=sets))
+                pair[side.name] = _side_entry(d, wall, other, levels, observables)
+                log(f"{scene} pair {k + 1} {side.label}: {pair[side.name]['status']} after "
+                    f"{wall:.0f} s ({pair[side.name]['segments']} segment(s))")
             rows.append(pair)
-        entry = {"pairs": rows, "summary": summarize(rows, levels, observables)}
+            entry["summary"] = summarize(rows, levels, observables)
         if presets:
-            entry["presets"] = _presets(out, scene, presets, rows, levels, observables,
-                                        sets, log)
-        doc["scenes"][scene] = entry
-    doc["elapsed"] = time.perf_counter() - t0
-    busy0, own0 = before
-    busy1, own1 = _cpu_now()
-    doc["other_cpu_seconds"] = (None if busy0 is None or busy1 is None
-                                else max(0.0, (busy1 - busy0) - (own1 - own0)))
+            entry["presets"] = {}
+            _presets(out, scene, presets, rows, levels, observables, sets, log,
+                     entry["presets"], lambda name: write(f"{scene}: preset {name} and what "
+                                                          "follows it"))
+    write(None)
+    return doc
+
+
+def _side_entry(study: Path, wall: float | None, other: float | None, levels,
+                observables) -> dict:
+    record = _read_record(study)
+    return {"study": str(study), "wall": wall, "other_cpu_seconds": other,
+            "status": record["status"], "slide_steps": record["segments"][-1]["slide_steps"],
+            "segments": len(record["segments"]),
+            "to_target": times_to_target(record, levels, observables)}
+
+
+def write_targets(out: Path, doc: dict) -> None:
+    """``targets.json`` and ``targets.md`` of ``doc`` (atomically)."""
     write_atomic(out / "targets.json", json.dumps(json_safe(doc), indent=1,
                                                   allow_nan=False) + "\n")
     write_atomic(out / "targets.md", markdown(doc))
+
+
+def collect_targets(out: Path, levels=LEVELS, observables=OBSERVABLES,
+                    presets=PRESETS) -> dict:
+    """The document of a study directory ``out`` rebuilt from what its runs left: every
+    side whose ``study.json`` is finished and every finished preset run (an interrupted
+    study's, or one whose ``targets.json`` was lost).  Wall times are the records' own
+    (a side: its study's ``elapsed``; a preset: its run's ``wall_time``); the CPU other
+    processes used is not known afterwards (None)."""
+    out = Path(out)
+    doc = {"schema": "filmfriction.tradeoff-targets/1", "levels": list(levels),
+           "observables": list(observables), "budget": None, "set": [],
+           "cpus": None, "complete": True, "missing": None, "collected": True,
+           "elapsed": None, "other_cpu_seconds": None, "scenes": {}}
+    missing = []
+    for scene_dir in sorted(p for p in out.iterdir() if p.is_dir()):
+        rows = []
+        for pair_dir in sorted(scene_dir.glob("pair-*"), key=lambda p: int(p.name[5:])):
+            pair = {"order": []}
+            for side in SIDES:
+                d = pair_dir / side.name
+                try:
+                    record = _read_record(d)
+                except (OSError, ValueError):
+                    record = {}
+                if not record.get("finished"):
+                    missing.append(f"{scene_dir.name} {pair_dir.name} {side.label}")
+                    continue
+                pair["order"].append(side.name)
+                pair[side.name] = _side_entry(d, record.get("elapsed"), None, levels,
+                                              observables)
+            if all(s.name in pair for s in SIDES):
+                rows.append(pair)
+        entry = {"pairs": rows, "summary": summarize(rows, levels, observables)}
+        found = {}
+        for name in presets:
+            d = scene_dir / f"preset-{name}"
+            if name == "standard" and rows:
+                found[name] = _standard(rows, levels, observables)
+                continue
+            try:
+                run = json.loads((d / "run.json").read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                run = {}
+            if run.get("status") not in ("completed", "completed_with_warnings"):
+                if d.exists():
+                    missing.append(f"{scene_dir.name} preset {name} ({run.get('status') or 'no run.json'})")
+                continue
+            found[name] = {"run": str(d), "seconds": run.get("wall_time"),
+                           "other_cpu_seconds": None,
+                           "slide_steps": run["scene"]["parameters"]["slide_steps"],
+                           "errors": preset_errors(d, levels, observables), "from": "its own run"}
+        if found:
+            entry["presets"] = found
+        doc["scenes"][scene_dir.name] = entry
+    if missing:
+        doc["complete"], doc["missing"] = False, "; ".join(missing)
     return doc
 
 
@@ -271,11 +357,32 @@ def preset_clash(scene: str, name: str, sets=()) -> list[str]:
     return sorted(set(preset(name, load(scene, user).parameters)) & set(user))
 
 
-def _presets(out, scene, presets, rows, levels, observables, sets, log) -> dict:
-    """Each preset's run on 2 ranks and its errors; ``standard`` (the scene as it is) is
-    the ranks side's first segment of the first pair: no run of its own.  A preset whose
-    keys a ``--set`` gives is not run (the reason recorded)."""
-    result = {}
+def _standard(rows, levels, observables) -> dict:
+    """The ``standard`` preset: the ranks side's first segment of the first pair."""
+    record = _read_record(Path(rows[0]["ranks"]["study"]))
+    run_dir = Path(rows[0]["ranks"]["study"]) / "replica-1"
+    first = record["segments"][0]
+    checks = dict(zip([t["observable"] for t in record["rule"]["targets"]],
+                      first.get("checks") or []))
+    errs = {}
+    for obs in observables:
+        c = checks.get(obs)
+        met = [lv for lv in sorted(levels) if c and check_met(c, lv)]
+        errs[obs] = {"relative_error": c["relative_error"] if c else None,
+                     "n_slips": c["n_slips"] if c else 0,
+                     "meets": met[0] if met else None}
+    return {"run": str(run_dir), "seconds": first.get("elapsed"),
+            "other_cpu_seconds": rows[0]["ranks"].get("other_cpu_seconds"),
+            "slide_steps": first["slide_steps"], "errors": errs,
+            "from": "the ranks side's first segment (pair 1)"}
+
+
+def _presets(out, scene, presets, rows, levels, observables, sets, log, result,
+             starting) -> None:
+    """Each preset's run on 2 ranks and its errors into ``result`` (``starting(name)``
+    before each run); ``standard`` (the scene as it is) is the ranks side's first
+    segment of the first pair: no run of its own.  A preset whose keys a ``--set``
+    gives is not run (the reason recorded)."""
     for name in presets:
         clash = preset_clash(scene, name, sets)
         if clash and name != "standard":
@@ -283,34 +390,45 @@ def _presets(out, scene, presets, rows, levels, observables, sets, log) -> dict:
             log(f"{scene} preset {name}: not run ({result[name]['skipped']})")
             continue
         if name == "standard" and rows:
-            record = _read_record(Path(rows[0]["ranks"]["study"]))
-            run_dir = Path(rows[0]["ranks"]["study"]) / "replica-1"
-            first = record["segments"][0]
-            checks = dict(zip([t["observable"] for t in record["rule"]["targets"]],
-                              first.get("checks") or []))
-            errs = {}
-            for obs in observables:
-                c = checks.get(obs)
-                met = [lv for lv in sorted(levels) if c and check_met(c, lv)]
-                errs[obs] = {"relative_error": c["relative_error"] if c else None,
-                             "n_slips": c["n_slips"] if c else 0,
-                             "meets": met[0] if met else None}
-            result[name] = {"run": str(run_dir), "seconds": first.get("elapsed"),
-                            "slide_steps": first["slide_steps"], "errors": errs,
-                            "from": "the ranks side's first segment (pair 1)"}
+            result[name] = _standard(rows, levels, observables)
             continue
         d = out / scene / f"preset-{name}"
         args = ["run", scene, "--fidelity", name, "--np", "2", "--md-only", "--quiet",
                 "--out", str(d)]
         for s in sets:
             args += ["--set", s]
-        wall = _run(args)
+        starting(name)
+        wall, other = _run(args)
         run = json.loads((d / "run.json").read_text(encoding="utf-8"))
-        result[name] = {"run": str(d), "seconds": wall,
+        result[name] = {"run": str(d), "seconds": wall, "other_cpu_seconds": other,
                         "slide_steps": run["scene"]["parameters"]["slide_steps"],
                         "errors": preset_errors(d, levels, observables), "from": "its own run"}
         log(f"{scene} preset {name}: {wall:.0f} s")
-    return result
+
+
+def _busy_measurements(doc: dict, threshold: float = 0.02) -> list[str]:
+    """Each side's study and preset run during which other processes used more than
+    ``threshold`` of the machine, as text."""
+    cpus = doc.get("cpus") or 2
+    out = []
+
+    def share(item):
+        other, wall = item.get("other_cpu_seconds"), item.get("wall", item.get("seconds"))
+        if other is None or not wall:
+            return None
+        return other / (wall * cpus)
+
+    for scene, entry in doc["scenes"].items():
+        for k, pair in enumerate(entry["pairs"], start=1):
+            for side in SIDES:
+                x = share(pair.get(side.name, {}))
+                if x is not None and x > threshold:
+                    out.append(f"{scene} pair {k} {side.label} {100 * x:.0f} %")
+        for name, p in (entry.get("presets") or {}).items():
+            x = None if p.get("from", "").startswith("the ranks") else share(p)
+            if x is not None and x > threshold:
+                out.append(f"{scene} preset {name} {100 * x:.0f} %")
+    return out
 
 
 def _pct(level) -> str:
@@ -327,6 +445,9 @@ def markdown(doc: dict) -> str:
     """The tables: per scene, each (observable, level) on both sides with the ratio; then
     the presets as targets."""
     lines = ["# Wall time to a target error: 2 replicas × 1 rank against 1 run × 2 ranks", ""]
+    if not doc.get("complete", True):
+        lines += [f"INCOMPLETE: the study stopped before {doc.get('missing')}; the tables "
+                  "hold what it measured.", ""]
     other = doc.get("other_cpu_seconds")
     if other is not None:
         share = other / max(1e-9, doc["elapsed"] * doc["cpus"])
@@ -334,6 +455,13 @@ def markdown(doc: dict) -> str:
                   f"{other:.0f} CPU-s meanwhile ({100 * share:.0f} % of the machine)"
                   + ("; OTHER WORK RAN BESIDE IT: these are not an idle machine's figures."
                      if share > 0.02 else "."), ""]
+    elif doc.get("collected"):
+        lines += ["Collected from the runs' own records: the CPU time other processes used "
+                  "while they ran is not known.", ""]
+    busy = _busy_measurements(doc)
+    if busy:
+        lines += ["Measurements beside other work (other processes' CPU over the "
+                  "measurement's wall time × cores; above 2 %): " + "; ".join(busy) + ".", ""]
     for scene, entry in doc["scenes"].items():
         n = len(entry["pairs"])
         lines += [f"## {scene}", "",
