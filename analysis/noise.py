@@ -283,7 +283,10 @@ def cycle_noise(time, spring_force, yield_index) -> float:
     The trace is compared with itself one period P later (P the median time
     between the yields, adjusted within ±2 sample spacings to the shift that
     aligns the cycles best; the later trace interpolated linearly at t + P):
-    d(t) = f(t + P) − f(t), less its median (a drift of the force levels).  A
+    d(t) = f(t + P) − f(t), less its median within each stretch where neither f(t)
+    nor f(t + P) passes a yield (the force levels a cycle starts from: a drift, or an
+    irregular stick-slip's scattered re-stick forces, whose cycles repeat in shape from
+    different offsets; stretches shorter than 8 samples are left out).  A
     periodic trace of any shape, however smooth or coarsely sampled, repeats
     (d ≈ 0); noise does not, white or correlated over any time shorter than
     P, and neither does a trace that only fluctuates (a stuck wall's thermal
@@ -331,16 +334,20 @@ def cycle_noise(time, spring_force, yield_index) -> float:
         # whatever the last digits of the times (a unit's rounding must not move them)
         k = round(2.0 * period / step) / 2.0
         idx = np.arange(f.size, dtype=float)
-        best = min(_unrepeated(idx, f, k + s) for s in np.linspace(-2.0, 2.0, 9) if k + s > 0)
+        best = min(_unrepeated(idx, f, k + s, yi) for s in np.linspace(-2.0, 2.0, 9)
+                   if k + s > 0)
     else:
         shifts = period + step * np.linspace(-2.0, 2.0, 9)
-        best = min(_unrepeated(t, f, p) for p in shifts if p > 0.0)
+        best = min(_unrepeated(t, f, p, t[yi]) for p in shifts if p > 0.0)
     return best if math.isfinite(best) else 0.0
 
 
-def _unrepeated(t, f, period):
+def _unrepeated(t, f, period, yields=None):
     """The scale of f(t + period) − f(t) (see :func:`cycle_noise`); inf when fewer
-    than 8 samples overlap."""
+    than 8 samples overlap.  With ``yields`` (times on the axis of ``t``), d less its
+    median within each stretch where neither f(t) nor f(t + period) passes a yield:
+    cycles that repeat in shape but start from different force levels (an irregular
+    stick-slip's re-stick forces) are offsets there, not noise."""
     # a sample whose shifted time lands on the last one (a period of whole sample
     # spacings) is in, however the times round in the trace's unit
     ok = t + period <= t[-1] + 1e-6 * (t[-1] - t[0]) / max(t.size - 1, 1)
@@ -349,7 +356,18 @@ def _unrepeated(t, f, period):
     x = t[ok] + period
     j = np.clip(np.searchsorted(t, x), 1, t.size - 1)
     w = (x - t[j - 1]) / (t[j] - t[j - 1])
-    d = (1.0 - w) * f[j - 1] + w * f[j] - f[ok]
-    d = (d - np.median(d)) / np.sqrt(1.0 + w * w + (1.0 - w) ** 2)
+    d = ((1.0 - w) * f[j - 1] + w * f[j] - f[ok]) / np.sqrt(1.0 + w * w + (1.0 - w) ** 2)
+    d = d - np.median(d)
+    if yields is not None and len(yields) >= 2:
+        ty = np.asarray(yields, float)
+        key = np.searchsorted(ty, t[ok]) * (ty.size + 1) + np.searchsorted(ty, x)
+        _, group, size = np.unique(key, return_inverse=True, return_counts=True)
+        # stretches of 8 samples or more (shorter ones: the slips' edges, left out);
+        # each residual scaled for the median it lost, (1 - 1/n) of the variance
+        big = size[group] >= 8
+        if np.count_nonzero(big) >= 8:
+            med = np.array([np.median(d[group == g]) if size[g] >= 8 else 0.0
+                            for g in range(size.size)])
+            d = (d - med[group])[big] / np.sqrt(1.0 - 1.0 / size[group][big])
     return float(np.quantile(np.abs(d), NOISE_QUANTILE)) / _Q_NORMAL
 
