@@ -147,14 +147,9 @@ def partial_dir(run_dir: Path) -> Path:
 
 def _set_aside(path: Path, sweep_dir: Path, kind: str, name: str, stamp: str) -> Path:
     """Move ``path`` to ``sweep_dir/kind/name.stamp`` (a new name: nothing is replaced)."""
-    target = sweep_dir / kind / f"{name}.{stamp}"
-    target.parent.mkdir(exist_ok=True)
-    for i in range(1, 1000):
-        if not target.exists():
-            break
-        target = sweep_dir / kind / f"{name}.{stamp}-{i}"
-    os.replace(path, target)
-    return target
+    from ..md.run_record import set_aside
+
+    return set_aside(path, sweep_dir, kind, name, stamp)
 
 
 def _adopt_leftovers(run_dir: Path, partial: Path, sweep_dir: Path, stamp: str) -> None:
