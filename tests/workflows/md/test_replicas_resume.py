@@ -11,6 +11,7 @@ test_replicas_md.py.
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -227,7 +228,7 @@ def test_a_second_driver_of_a_study_is_refused_and_changes_nothing(study, monkey
     _fake_jobs(monkeypatch, seen := {})
     before = (study / "study.json").read_bytes()
     with _lock(study):
-        with pytest.raises(SceneError, match=f"study directory {study} is in use"):
+        with pytest.raises(SceneError, match=re.escape(f"study directory {study} is in use")):
             resume_study(study)
     assert (study / "study.json").read_bytes() == before and seen == {}
 

@@ -59,9 +59,11 @@ def replica_state(run_dir: Path, slide: int) -> str:
         if run_dir.exists():
             run_dir.rmdir()       # an empty directory a child made before it stopped
         return "start"
-    steps = int(((rec.get("scene") or {}).get("parameters") or {}).get("slide_steps", 0)) \
-        if isinstance(rec, dict) else 0
-    if isinstance(rec, dict) and rec.get("status") in _DONE and steps >= slide:
+    scene = rec.get("scene") if isinstance(rec, dict) else None
+    params = scene.get("parameters") if isinstance(scene, dict) else None
+    steps = params.get("slide_steps", 0) if isinstance(params, dict) else 0
+    if isinstance(rec, dict) and rec.get("status") in _DONE and isinstance(steps, int) \
+            and steps >= slide:
         return "done"
     return "resume" if why_not_resumable(run_dir) is None else "restart"
 

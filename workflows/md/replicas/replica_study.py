@@ -174,7 +174,8 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
 
 def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
                  workers=None, executor=None, profile: str | None = None) -> int:
-    """Carry on an interrupted (or failed) study from where each replica stopped;
+    """Carry on an interrupted (or failed) study from where each replica stopped (one
+    with nothing to resume from its beginning, :mod:`.afresh`);
     ``workers(ranks)`` says how many replicas of ``ranks`` ranks run at once;
     ``executor(profile, ranks)`` gives the runner of a study recorded with a profile, or
     given one (``profile``), as for :func:`run_study`."""
