@@ -9,7 +9,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from filmfriction.analysis.files.util import json_default, write_atomic
-from filmfriction.md_inputs.contract import SCENE_FILE
+from filmfriction.md_inputs.contract import SCENE_FILE, STUDY_FILE
 
 from .scene import Scene, SceneError
 
@@ -82,9 +82,13 @@ def start_again(run_dir: Path, nprocs: int | None = None) -> str:
     """What to do with a run that holds nothing to resume (no usable restart file): run
     it again from its beginning in a new directory, ``run_dir`` kept as it is.  Its
     resolved scene (``scene.toml``: the same parameters and seed) on its ``nprocs``
-    ranks is the same run.  (A study's replica or a sweep's point starts again by
-    itself.)"""
+    ranks is the same run.  A study's replica starts again when its study resumes (a
+    sweep's point when the sweep runs again)."""
     run_dir = Path(run_dir)
+    if (run_dir.parent / STUDY_FILE).is_file():     # a study's replica: the study does it
+        return (f"resume its study instead, filmfriction run --resume "
+                f"{shell_line([str(run_dir.parent)])}: it starts this replica again from its "
+                "beginning with its seed")
     if not (run_dir / SCENE_FILE).is_file():        # stopped before it was written
         return "start the run again with the command that started it"
     ranks = f" --np {int(nprocs)}" if nprocs else ""

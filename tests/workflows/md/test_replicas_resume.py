@@ -285,3 +285,12 @@ def test_a_single_run_with_nothing_to_resume_says_how_to_run_it_again(tmp_path,
     after = {p.name: p.read_bytes() for p in run_dir.iterdir()}
     assert {k: v for k, v in after.items() if k != ".lock"} == \
         {k: v for k, v in before.items() if k != ".lock"}
+
+
+def test_a_replica_with_nothing_to_resume_points_to_its_study(study, interrupted_run):
+    run_dir = _stuck(replica_dir(study, 1), interrupted_run)
+    with pytest.raises(SceneError, match=re.escape(
+            f"resume its study instead, filmfriction run --resume {study}: it starts this "
+            "replica again")):
+        runner.resume(run_dir, progress=False)
+    assert (run_dir / "run.json").is_file() and not (study / "superseded").exists()
