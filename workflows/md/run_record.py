@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import json
+import os
 import platform
 from datetime import datetime, timezone
 from pathlib import Path
 
 from filmfriction.analysis.files.util import json_default, write_atomic
+from filmfriction.md_inputs.contract import SCENE_FILE, STUDY_FILE
 
 from .scene import Scene, SceneError
 
@@ -60,6 +62,39 @@ def new_run_dir(scene_name: str, out: Path | None) -> Path:
             f"run directory {out} already exists: a run never overwrites another; "
             f"choose a new --out, or continue it with --resume {out}") from None
     return out
+
+
+def set_aside(path: Path, parent: Path, kind: str, name: str, stamp: str) -> Path:
+    """Move the directory ``path`` to ``parent/kind/name.stamp`` (``kind``: ``superseded``
+    or ``failed``), intact, under a new name: nothing is replaced or deleted.  The
+    convention of a sweep's points and a study's replicas that cannot be resumed."""
+    target = Path(parent) / kind / f"{name}.{stamp}"
+    target.parent.mkdir(exist_ok=True)
+    for i in range(1, 1000):
+        if not target.exists():
+            break
+        target = Path(parent) / kind / f"{name}.{stamp}-{i}"
+    os.replace(path, target)
+    return target
+
+
+def start_again(run_dir: Path, nprocs: int | None = None) -> str:
+    """What to do with a run that holds nothing to resume (no usable restart file): run
+    it again from its beginning in a new directory, ``run_dir`` kept as it is.  Its
+    resolved scene (``scene.toml``: the same parameters and seed) on its ``nprocs``
+    ranks is the same run.  A study's replica starts again when its study resumes (a
+    sweep's point when the sweep runs again)."""
+    run_dir = Path(run_dir)
+    if (run_dir.parent / STUDY_FILE).is_file():     # a study's replica: the study does it
+        return (f"resume its study instead, filmfriction run --resume "
+                f"{shell_line([str(run_dir.parent)])}: it starts this replica again from its "
+                "beginning with its seed")
+    if not (run_dir / SCENE_FILE).is_file():        # stopped before it was written
+        return "start the run again with the command that started it"
+    ranks = f" --np {int(nprocs)}" if nprocs else ""
+    return (f"start it again from the beginning with filmfriction run "
+            f"{shell_line([str(run_dir / SCENE_FILE)])}{ranks} (the same scene, seed and "
+            f"ranks: the same run, in a new directory; {run_dir} stays as it is)")
 
 
 def scene_toml(scene: Scene) -> str:

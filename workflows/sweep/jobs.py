@@ -147,14 +147,9 @@ def partial_dir(run_dir: Path) -> Path:
 
 def _set_aside(path: Path, sweep_dir: Path, kind: str, name: str, stamp: str) -> Path:
     """Move ``path`` to ``sweep_dir/kind/name.stamp`` (a new name: nothing is replaced)."""
-    target = sweep_dir / kind / f"{name}.{stamp}"
-    target.parent.mkdir(exist_ok=True)
-    for i in range(1, 1000):
-        if not target.exists():
-            break
-        target = sweep_dir / kind / f"{name}.{stamp}-{i}"
-    os.replace(path, target)
-    return target
+    from ..md.run_record import set_aside
+
+    return set_aside(path, sweep_dir, kind, name, stamp)
 
 
 def _adopt_leftovers(run_dir: Path, partial: Path, sweep_dir: Path, stamp: str) -> None:
@@ -193,11 +188,10 @@ def why_not_resumable(partial: Path, parameters: dict) -> str | None:
     return None
 
 
-def _keep_partial(partial: Path) -> None:
+def _keep_partial(partial: Path, sweep_dir: Path, name: str, stamp: str) -> None:
     """After an interrupt: the partial run stays for the next sweep to resume, unless it
-    holds no restart file (stopped before the first one: nothing to resume)."""
-    import shutil
-
+    holds no restart file (stopped before the first one: nothing to resume); then it
+    moves to ``superseded/`` (kept, as a study's replica's) and the point starts afresh."""
     from ..md import restarts
 
     if not partial.is_dir():
@@ -205,9 +199,9 @@ def _keep_partial(partial: Path) -> None:
     if restarts.restart_files(partial):
         print(f"partial run kept in {partial}: the next sweep resumes it", file=sys.stderr)
     else:
-        shutil.rmtree(partial, ignore_errors=True)
-        print("stopped before the first restart file: the next sweep starts this point "
-              "afresh", file=sys.stderr)
+        moved = _set_aside(partial, sweep_dir, "superseded", name, stamp)
+        print(f"stopped before the first restart file: nothing to resume, kept in {moved}; "
+              "the next sweep starts this point afresh", file=sys.stderr)
 
 
 def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") -> Path:
@@ -222,8 +216,8 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
     (the point's parameters changed, no usable restart file) moves to ``superseded/``
     and the point starts afresh; a run that failed in the simulation itself (LAMMPS's
     ERROR, lost atoms, NaN) moves to ``failed/``; a stale ``run_dir`` (an older run
-    whose parameters changed) moves to ``superseded/``.  Nothing is deleted except an
-    interrupted run that holds no restart file (nothing to resume).
+    whose parameters changed) moves to ``superseded/``, and so does an interrupted run
+    that holds no restart file (nothing to resume).  Nothing is deleted.
 
     Parameters
     ----------
@@ -282,12 +276,12 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
             raise
         # an interrupt, or an engine killed from outside: for a sweep neither is a
         # result; the next sweep resumes the run
-        _keep_partial(partial)
+        _keep_partial(partial, sweep_dir, run_dir.name, stamp)
         if _INTERRUPTED:
             raise KeyboardInterrupt from None
         raise
     except KeyboardInterrupt:
-        _keep_partial(partial)
+        _keep_partial(partial, sweep_dir, run_dir.name, stamp)
         raise
     if run_dir.exists():
         if any(run_dir.iterdir()):

@@ -11,7 +11,9 @@ machine (``local``), or as one Slurm job each (``slurm``: spread over the nodes)
 
 :func:`run_replica` does what the replica's ``filmfriction run`` does without a profile
 (start the run directory ``replica-<i>/`` with the replica's seed, or continue it to the
-segment's slide from its newest restart file), under the launcher the profile names
+segment's slide from its newest restart file, or start it again from the beginning when it
+holds nothing to resume, its directory moved to ``superseded/``:
+:mod:`filmfriction.workflows.md.replicas.afresh`), under the launcher the profile names
 (``srun`` on Slurm), and writes the segment's marker only when the replica got there.
 """
 from __future__ import annotations
@@ -96,9 +98,11 @@ def run_replica(study: Path, index: int, slide: int, np_: int, launcher: str = "
                 lmp: str | None = None) -> Path:
     """Bring replica ``index`` of ``study`` to a slide of ``slide`` steps: start its run
     directory (the study's scene with the replica's seed) or continue it from its newest
-    restart file; nothing when it is there already.  Raises what the runner raises
+    restart file (one with nothing to resume moves to ``superseded/`` and the replica
+    starts again); nothing when it is there already.  Raises what the runner raises
     (:class:`~filmfriction.workflows.md.runner.RunFailed`, ``KeyboardInterrupt``)."""
-    from ..md.replicas.replica_study import replica_dir, replica_state
+    from ..md.replicas.afresh import move_aside, replica_state, why_not_resumable
+    from ..md.replicas.replica_study import replica_dir
     from ..md.runner import execute, resume
     from ..md.scene import load
 
@@ -111,6 +115,12 @@ def run_replica(study: Path, index: int, slide: int, np_: int, launcher: str = "
     words = shlex.split(launcher)
     words = None if words in ([], ["mpiexec"]) else words
     state = replica_state(run_dir, slide)
+    if state == "restart":      # nothing to resume (a job lost before its first restart file)
+        why = why_not_resumable(run_dir)
+        moved = move_aside(study, index, why, slide)["dir"]
+        print(f"# replica {index}: cannot be resumed ({why}); moved to {moved}; it starts "
+              "again from the beginning with its seed", flush=True)
+        state = "start"
     print(f"# replica {index}: {state} to slide step {slide} ({np_} rank(s), "
           f"{launcher}) in job {os.environ.get('SLURM_JOB_ID', 'local')}", flush=True)
     if state == "start":

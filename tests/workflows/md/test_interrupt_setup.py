@@ -71,9 +71,15 @@ def test_signal_during_setup_of_a_run(tmp_path, where, sig, lock_held):
     assert code == 130, err
     assert "Traceback" not in err
     assert "nothing to resume" in err and sig.name in err, err
+    # what to do instead: run it again from its beginning (its resolved scene, once written)
+    again = (f"start it again from the beginning with filmfriction run {out}/scene.toml --np 1"
+             if where == "finish.run_engine" else
+             "start the run again with the command that started it")
+    assert again in err, err
     record = json.loads((out / "run.json").read_text())
     assert record["status"] == "interrupted", record
     assert sig.name in record["error"] and "before LAMMPS started" in record["error"]
+    assert again in record["error"]
     assert "resume_command" not in record
     assert record["scene"]["name"] == "stick-slip"
     assert not (out / ".lock").exists() or not lock_held(out)

@@ -147,6 +147,64 @@ def test_study_interrupted_locked_and_resumed(tmp_path):
         assert len(trace) == 40000 // 50 + 1 and np.all(np.diff(trace["step"]) == 50)
 
 
+def test_replicas_stopped_before_their_first_restart_start_again(tmp_path):
+    """Ctrl-C while the replicas run and before any restart file (restart_every = 0: none
+    ever): nothing to resume, yet the study resumes. Each replica starts again from its
+    beginning with its seed, its interrupted directory moved intact to superseded/ and
+    listed in study.json; the replica's run is the run its old directory's scene.toml
+    gives (the same scene and seed on the same rank)."""
+    study = tmp_path / "study"
+    proc = subprocess.Popen([*CLI, "run", "stick-slip", *SMALL, "--set", "slide_steps=20000",
+                             "--set", "restart_every=0", "--replicas", "2", "--md-only",
+                             "--out", str(study)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        assert _wait_for(lambda: all((study / f"replica-{i}" / "trace.dat").is_file()
+                                     for i in (1, 2))), "the replicas never started LAMMPS"
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=300)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    record = json.loads((study / "study.json").read_text())
+    assert record["status"] == "interrupted"
+    assert [r["status"] for r in record["replicas"]] == ["interrupted"] * 2
+    old = {}
+    for i in (1, 2):
+        run_dir = study / f"replica-{i}"
+        run = json.loads((run_dir / "run.json").read_text())
+        assert "nothing to resume" in run["error"] and not list(run_dir.glob("restart.*"))
+        old[i] = {p.name: p.read_bytes() for p in run_dir.iterdir() if p.is_file()}
+
+    done = _run(["--resume", str(study), "--md-only"])
+    assert done.returncode == 0, done.stderr
+    assert "replica 1: cannot be resumed (it holds no usable restart file" in done.stderr
+    record = json.loads((study / "study.json").read_text())
+    assert record["status"] == "completed" and len(record["resumed"]) == 1
+    for i, rep in enumerate(record["replicas"], start=1):
+        (entry,) = rep["superseded"]
+        aside = study / entry["dir"]
+        assert entry["dir"].startswith(f"superseded/replica-{i}.")
+        assert entry["slide_steps"] == 20000
+        kept = {p.name: p.read_bytes() for p in aside.iterdir() if p.is_file()}
+        assert {k: v for k, v in kept.items() if k != ".lock"} == \
+            {k: v for k, v in old[i].items() if k != ".lock"}, "moved intact"
+        run = json.loads((study / f"replica-{i}" / "run.json").read_text())
+        assert run["status"] in ("completed", "completed_with_warnings")
+        assert rep["status"] == run["status"]
+        assert run["scene"]["parameters"]["seed"] == rep["seed"] and "resumed_from" not in run
+        trace = np.genfromtxt(study / f"replica-{i}" / "trace.csv", delimiter=",", names=True)
+        assert len(trace) == 20000 // 50 + 1 and np.all(np.diff(trace["step"]) == 50)
+    # the same run as the one the old directory's scene.toml starts (the drawn seed)
+    aside = study / record["replicas"][1]["superseded"][0]["dir"]
+    again = _run([str(aside / "scene.toml"), "--np", "1", "--md-only", "--out",
+                  str(tmp_path / "again")])
+    assert again.returncode == 0, again.stderr
+    assert (tmp_path / "again" / "trace.csv").read_bytes() == \
+        (study / "replica-2" / "trace.csv").read_bytes()
+
+
 def test_a_run_slid_further_is_the_longer_run(tmp_path, md):
     """A completed run of 4000 steps continued to 8000 (``--slide-to``, what a target's
     segments do) gives the trace of one 8000-step run byte for byte on the same single

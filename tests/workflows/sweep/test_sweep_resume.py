@@ -155,7 +155,9 @@ def test_an_interrupt_before_the_first_restart_file_starts_afresh(sweep_dir, fak
     fail["exc"] = KeyboardInterrupt()
     with pytest.raises(KeyboardInterrupt):
         jobs.run_point(inputs, run_dir, 1)
-    assert not jobs.partial_dir(run_dir).exists(), "nothing to resume: not kept"
+    assert not jobs.partial_dir(run_dir).exists(), "nothing to resume: not resumed"
+    (aside,) = (out / "superseded").iterdir()          # but kept
+    assert aside.name.startswith(f"{run_dir.name}.") and aside.is_dir()
     assert not (out / "failed").exists()
 
 

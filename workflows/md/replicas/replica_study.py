@@ -10,6 +10,7 @@ creates a study directory::
     ensemble.json       the observables combined over the replicas (combine_replicas)
     ensemble.md         the same as a report: between- and within-run parts, per-replica rows
     segments/           with --profile: each segment's replica jobs and their markers
+    superseded/         replica directories that held nothing to resume, kept (afresh.py)
     snakemake.log       with --profile: Snakemake's output (workflows/sweep/replica_jobs.py)
 
 Each replica is a ``filmfriction run`` of its own (a child process with its own seed, lock,
@@ -21,9 +22,12 @@ newest restart file) until every target is met or the budget is spent
 (:mod:`filmfriction.workflows.md.target`).  The study directory is locked while a command
 drives it; Ctrl-C, SIGTERM or SIGHUP interrupt every replica (each records its own
 interruption) and the study, and ``filmfriction run --resume STUDY`` carries on where it
-stopped.  With ``--profile`` a segment's replicas are Snakemake jobs instead of this
-process's children (an ``executor`` the command line gives: one Slurm job per replica with
-the ``slurm`` profile); everything else is the same.
+stopped: each replica from its newest restart file, or, with none (stopped before its
+first), from its beginning with its seed, its old directory moved to ``superseded/``
+(:mod:`.afresh`).  ``study.json`` keeps each replica's run status.  With ``--profile`` a
+segment's replicas are Snakemake jobs instead of this process's children (an ``executor``
+the command line gives: one Slurm job per replica with the ``slurm`` profile); everything
+else is the same.
 """
 from __future__ import annotations
 
@@ -45,6 +49,7 @@ from filmfriction.md_inputs.contract import (ANALYSIS_FILE, ENSEMBLE_FILE, ENSEM
 from ..locks import DirectoryLock
 from ..run_record import OWN_SCRIPT, new_run_dir, scene_toml
 from ..scene import Scene, SceneError
+from .afresh import list_moves, replica_state, start_again, why_not_resumable
 from .target import OBSERVABLES, Budget, next_slide, slip_values
 
 __all__ = ["MAX_REPLICAS", "replica_seeds", "replica_dir", "replica_log", "is_study",
@@ -57,7 +62,6 @@ MAX_REPLICAS = 256
 DEFAULT_BUDGET_SEGMENTS = 10
 #: seconds a replica has to record its interruption before it is killed
 STOP_GRACE = 60.0
-_DONE = ("completed", "completed_with_warnings")
 
 
 #: the largest seed drawn for a replica: LAMMPS's Marsaglia generator (fix langevin, seeded
@@ -170,7 +174,8 @@ def run_study(scene: Scene, *, replicas: int, nprocs: int = 1, targets=(),
 
 def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
                  workers=None, executor=None, profile: str | None = None) -> int:
-    """Carry on an interrupted (or failed) study from where each replica stopped;
+    """Carry on an interrupted (or failed) study from where each replica stopped (one
+    with nothing to resume from its beginning, :mod:`.afresh`);
     ``workers(ranks)`` says how many replicas of ``ranks`` ranks run at once;
     ``executor(profile, ranks)`` gives the runner of a study recorded with a profile, or
     given one (``profile``), as for :func:`run_study`."""
@@ -203,20 +208,14 @@ def resume_study(study: Path, nprocs: int | None = None, lmp: str | None = None,
 
 
 # ---------------------------------------------------------------- the segments
-def replica_state(run_dir: Path, slide: int) -> str:
-    """``done`` (slid ``slide`` steps), ``start`` (no run yet) or ``resume`` (an empty
-    directory a replica's run left when it stopped before writing anything is removed)."""
-    try:
-        rec = json.loads((run_dir / RUN_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        if run_dir.exists() and any(run_dir.iterdir()):
-            raise SceneError(f"{run_dir}: a replica's directory without a readable run.json; "
-                             "move it away to start that replica again") from None
-        if run_dir.exists():
-            run_dir.rmdir()       # an empty directory a child made before it stopped
-        return "start"
-    steps = int(rec.get("scene", {}).get("parameters", {}).get("slide_steps", 0))
-    return "done" if rec.get("status") in _DONE and steps >= slide else "resume"
+def _statuses(study: Path, record: dict) -> None:
+    """Each replica's run status (its ``run.json``; None without one) in ``record``."""
+    for i, rep in enumerate(record["replicas"], start=1):
+        try:
+            rep["status"] = json.loads((replica_dir(study, i) / RUN_FILE).read_text(
+                encoding="utf-8")).get("status")
+        except (OSError, ValueError, AttributeError):
+            rep["status"] = None
 
 
 def _commands(study: Path, record: dict, slide: int) -> dict[int, list[str]]:
@@ -234,6 +233,8 @@ def _commands(study: Path, record: dict, slide: int) -> dict[int, list[str]]:
         elif state == "resume":
             jobs[i] = [*_cli(), "run", "--resume", str(run_dir), "--slide-to", str(slide),
                        "--np", np_, "--md-only", *extra]
+        elif state == "restart":        # start_again moves these aside first
+            raise SceneError(f"{run_dir}: nothing to resume ({why_not_resumable(run_dir)})")
     return jobs
 
 
@@ -340,6 +341,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
             while True:
                 seg = record["segments"][-1]
                 slide = int(seg["slide_steps"])
+                if start_again(study, record, slide):
+                    write_json(path, record)
                 jobs = _commands(study, record, slide)
                 if jobs:
                     how = (f"{workers} at once" if executor is None else
@@ -353,6 +356,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                     if jobs else {}
                 seg["wall_time"] = seg.get("wall_time", 0.0) + time.monotonic() - t0
                 seg["finished"] = _now()
+                list_moves(study, record)
+                _statuses(study, record)
                 failed = {i: c for i, c in codes.items() if c != 0}
                 if failed:
                     i, c = sorted(failed.items())[0]
@@ -360,7 +365,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
                            f"at slide {slide}: {_last_line(replica_log(study, i))} (see "
                            f"{replica_log(study, i)})")
                     record.update(status="failed", stop={"reason": why, "met": False},
-                                  finished=_now(), elapsed=elapsed())
+                                  warnings=_warnings(study, record), finished=_now(),
+                                  elapsed=elapsed())
                     write_json(path, record)
                     note(f"replicas: failed: {why}; continue with "
                          f"filmfriction run --resume {study}")
@@ -411,6 +417,8 @@ def _drive(study: Path, record: dict, targets, budget: Budget | None, workers: i
             note(f"replicas: stopped: {record['stop']['reason']}")
             return 0
         except KeyboardInterrupt as exc:
+            list_moves(study, record)
+            _statuses(study, record)
             record.update(status="interrupted", finished=_now(), elapsed=elapsed(),
                           stop={"reason": f"interrupted ({str(exc) or 'SIGINT'}); resume with "
                                           f"filmfriction run --resume {study}", "met": False})
@@ -481,9 +489,10 @@ def ensemble_markdown(doc: dict, record: dict) -> str:
         lines.append(f"| {name} | {_g(e['mean'])} | {_g(e['half_width'])} | {_g(e['stderr'])} "
                      f"| {_g(e['within'])} | {_g(e['between'])} | {e['n_replicas']} | "
                      f"{e['n_slips']} |")
-    lines += ["", "Per replica (mean ± standard error with the pooled within-run scatter):",
-              "", "| replica | seed | " + " | ".join(doc["observables"]) + " |",
-              "|---|---|" + "---|" * len(doc["observables"])]
+    lines += ["", "Per replica (mean ± standard error with the pooled within-run scatter; "
+              "status: its run's, with its sanity checks):",
+              "", "| replica | seed | " + " | ".join(doc["observables"]) + " | status |",
+              "|---|---|" + "---|" * (len(doc["observables"]) + 1)]
     for i, rep in enumerate(record["replicas"]):
         cells = []
         for e in doc["observables"].values():
@@ -492,7 +501,16 @@ def ensemble_markdown(doc: dict, record: dict) -> str:
             # when every replica has some
             r = rows[i] if len(rows) == len(record["replicas"]) else None
             cells.append("-" if r is None else f"{_g(r['mean'])} ± {_g(r['stderr'])} ({r['n']})")
-        lines.append(f"| {rep['dir']} | {rep['seed']} | " + " | ".join(cells) + " |")
+        lines.append(f"| {rep['dir']} | {rep['seed']} | " + " | ".join(cells)
+                     + f" | {rep.get('status') or '-'} |")
+    if record.get("warnings"):
+        lines += ["", "Sanity checks broken (each replica's run.json 'warnings'):", ""]
+        lines += [f"- {w}" for w in record["warnings"]]
+    moved = [(rep["dir"], e) for rep in record["replicas"] for e in rep.get("superseded", [])]
+    if moved:
+        lines += ["", "Started again from the beginning (nothing to resume; the old "
+                  "directory kept):", ""]
+        lines += [f"- {name}: {e['dir']} ({e['why']})" for name, e in moved]
     checks = [(s["slide_steps"], c) for s in record.get("segments", [])
               for c in s.get("checks", [])]
     if checks:
