@@ -24,7 +24,8 @@ import sys
 import numpy as np
 
 from filmfriction.analysis.groundtruth.release_control import (couette_comoving_mass,
-                                                               fit_releases, release_profile)
+                                                               fit_releases, release_gap,
+                                                               release_profile)
 from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, detectable
 
 
@@ -54,12 +55,14 @@ def main(argv=None) -> int:
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--viscosity", nargs=2, type=float, metavar=("ETA", "ERR"), required=True)
     a = ap.parse_args(argv)
-    traces, mass, film_mass, gaps = [], None, None, []
+    traces, mass, film_mass, gaps, moves = [], None, None, [], []
     for run in a.runs:
         tr = np.genfromtxt(f"{run}/trace.csv", delimiter=",", names=True)
         traces.append({k: tr[k] for k in tr.dtype.names})
         p = json.load(open(f"{run}/run.json"))["trace_parameters"]
         mass = p["mass"]
+        pressure = json.load(open(f"{run}/run.json"))["scene"]["parameters"]["normal_pressure"]
+        moves.append(release_gap(traces[-1], pressure=pressure, area=p["area"]))
         film_mass = json.load(open(f"{run}/run.json"))["derived"]["film_atoms"]   # m each
     fit = fit_releases(traces, mass=mass)
     with_mass = fit.one_law
@@ -83,6 +86,20 @@ def main(argv=None) -> int:
           f"{fit.detectable_loop_step:.2f} against F̄/2 = "
           f"{DOMINANT_SHARE * with_mass.mean_force:.2f}; releases that rules it out: "
           f"{releases_needed(step_sd, DOMINANT_SHARE * with_mass.mean_force)}")
+    # the gap: the film at release against the film sliding, and the load's work on its opening
+    def mean_se(vals):
+        v = np.asarray(vals, float)
+        return v.mean(axis=0), v.std(axis=0, ddof=1) / math.sqrt(len(v))
+    for name, vals in (("gap at release", [m["at_release"] for m in moves]),
+                       ("gap by fifths of the slip", [m["by_part"] for m in moves])):
+        m_, se = mean_se(vals)
+        print(f"  {name}: {np.round(m_, 3).tolist()} ± {np.round(se, 3).tolist()}")
+    dil = np.array([m["dilation_force"] for m in moves])
+    (fa, fd), (sa, sd) = mean_se(dil)
+    ds, dse = mean_se(dil[:, 0] - dil[:, 1])
+    print(f"  load's work on the gap's opening, P·A·ΔD/Δx: accelerating {fa:.2f} ± {sa:.2f}, "
+          f"decelerating {fd:.2f} ± {sd:.2f}, difference {ds:.2f} ± {dse:.2f} ε/σ "
+          f"(the loop step: {fit.loop_step:.2f} ± {fit.loop_step_stderr:.2f})")
     widths = []
     for run in a.runs:
         prof = release_profile(run)

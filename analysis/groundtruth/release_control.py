@@ -42,7 +42,7 @@ from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import FilmForceFit, fit_film_force
 
-__all__ = ["release_slip", "fit_releases", "profile_width", "release_profile",
+__all__ = ["release_slip", "release_gap", "fit_releases", "profile_width", "release_profile",
            "couette_comoving_mass", "model_release"]
 
 
@@ -50,6 +50,12 @@ def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, i
     """(0, stick index) of a release: the slip runs from the first sample to the first
     stop of the wall after its peak velocity (the wall's velocity smoothed over
     ``smoothing`` time units, Savitzky–Golay of order 2, crossing zero)."""
+    _, peak, stop = _release_turns(time, wall_position, smoothing)
+    return 0, stop
+
+
+def _release_turns(time, wall_position, smoothing: float) -> tuple[int, int, int]:
+    """(release, peak velocity, stop) indices of a release, as :func:`release_slip`."""
     t, x = np.asarray(time, float), np.asarray(wall_position, float)
     dt = float(t[1] - t[0])
     w = max(5, int(round(smoothing / dt)) | 1)
@@ -60,7 +66,45 @@ def release_slip(time, wall_position, *, smoothing: float = 5.0) -> tuple[int, i
     stops = np.flatnonzero(v[peak:] <= 0)
     if not v[peak] > 0 or stops.size == 0:
         raise ValueError("the wall does not stop within the trace: run the release longer")
-    return 0, peak + int(stops[0])
+    return 0, peak, peak + int(stops[0])
+
+
+def release_gap(trace, *, pressure: float, area: float, parts: int = 5,
+                smoothing: float = 5.0) -> dict:
+    """How the film's gap moves during a release's slip, and the load's share of the film
+    force it implies.
+
+    ``trace``: dict of trace columns ``time``, ``wall_position``, ``gap``.  Returns
+    ``at_release`` (the gap at the first sample: the film as the equilibration left it),
+    ``by_part`` (the mean gap in each of ``parts`` equal-time parts of the slip) and
+    ``dilation_force``, a pair (accelerating, decelerating branch): P·A·ΔD/Δx, the gap's
+    change from the branch's start to its end (means over ``smoothing`` time units around
+    each: the release's first ``smoothing``, the peak velocity, the stop) over the wall's
+    travel.  A gap opened against the load P by the shear takes P·A·ΔD of work from the
+    wall's travel Δx: a force the film exerts beyond its viscous one, on the branch where
+    the gap opens.
+
+    >>> t = np.arange(0, 120, 0.05)
+    >>> tr = model_release(damping=12.0, dt=0.05) | {"gap": np.full(t.size, 5.9)}
+    >>> g = release_gap(tr, pressure=1.0, area=94.3)
+    >>> g["at_release"], [round(f, 6) for f in g["dilation_force"]]
+    (5.9, [0.0, 0.0])
+    """
+    t, x, gap = (np.asarray(trace[k], float) for k in ("time", "wall_position", "gap"))
+    y, peak, stop = _release_turns(t, x, smoothing)
+    half = max(1, int(round(smoothing / 2 / float(t[1] - t[0]))))
+
+    def around(i, lo=None):
+        sl = slice(max(y, i - half) if lo is None else lo, min(t.size, i + half + 1))
+        return float(gap[sl].mean()), float(x[sl].mean())
+
+    ends = [around(y + half, lo=y), around(peak), around(stop)]
+    force = tuple(pressure * area * (d1 - d0) / (x1 - x0)
+                  for (d0, x0), (d1, x1) in zip(ends[:-1], ends[1:]))
+    bounds = np.linspace(y, stop + 1, parts + 1).round().astype(int)
+    return {"at_release": float(gap[y]),
+            "by_part": [float(gap[a:b].mean()) for a, b in zip(bounds[:-1], bounds[1:])],
+            "dilation_force": force}
 
 
 def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,

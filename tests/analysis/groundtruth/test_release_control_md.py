@@ -1,6 +1,6 @@
 """The slip law's MD positive control on real LAMMPS: a liquid film released from x0 = 20 σ.
 
-One release of the ``liquid-release`` scene (900 atoms, 21k steps on one rank).  A liquid
+One release of the ``liquid-release`` scene (990 atoms, 38k steps on one rank).  A liquid
 has no yield stress: its slip must be resisted by B·v alone, with B the Couette damping
 η·A/W of its own velocity profile (W = D + 2b), and the shear spread through the film.
 """

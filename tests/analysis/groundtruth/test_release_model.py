@@ -38,3 +38,22 @@ def test_a_yield_on_the_accelerating_branch_is_not_one_law():
     assert fit.loop_step == pytest.approx(1.5, abs=0.2)
     assert fit.loop_step_sigmas >= 2
     assert fit.verdict_from == "decelerating", fit.reason
+
+
+def test_the_load_s_work_on_a_gap_opening_with_the_travel():
+    from filmfriction.analysis.groundtruth.release_control import release_gap, release_slip
+    tr = model_release(damping=12.0, comoving_mass=75.0, mass=MASS)
+    x = tr["wall_position"]
+    # a gap opening by 0.02 σ per σ of travel: P·A·0.02 on both branches, exactly
+    g = release_gap(tr | {"gap": 5.6 + 0.02 * x}, pressure=2.0, area=100.0)
+    assert g["dilation_force"] == pytest.approx((4.0, 4.0), rel=1e-9)
+    assert g["at_release"] == pytest.approx(5.6)
+    # opening on the accelerating branch only (by 0.25 σ up to the peak velocity's place)
+    _, stop = release_slip(tr["time"], x)
+    peak = int(np.argmax(tr["wall_velocity"][:stop]))
+    gap = 5.65 + 0.25 * np.minimum(x, x[peak]) / x[peak]
+    g = release_gap(tr | {"gap": gap}, pressure=1.0, area=94.3)
+    assert g["dilation_force"][0] == pytest.approx(94.3 * 0.25 / x[peak], rel=0.05)
+    assert abs(g["dilation_force"][1]) < 0.05 * g["dilation_force"][0]
+    by = g["by_part"]
+    assert len(by) == 5 and by[0] < by[1] < by[2] and by[-1] == pytest.approx(5.9)
