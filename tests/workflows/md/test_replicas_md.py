@@ -106,25 +106,37 @@ def _wait_for(predicate, seconds=300.0):
     return False
 
 
-def test_study_interrupted_locked_and_resumed(tmp_path):
-    study = tmp_path / "study"
-    proc = subprocess.Popen([*CLI, "run", "stick-slip", *SMALL, "--set", "slide_steps=40000",
-                             "--set", "restart_every=2000", "--replicas", "2", "--md-only",
-                             "--out", str(study)], stdout=subprocess.PIPE,
+def _interrupted_study(study, sets, ready, what, meanwhile=lambda: None) -> str:
+    """A 2-replica study of the small film with ``sets``, Ctrl-C once ``ready()`` (after
+    ``meanwhile()``); its stderr (the exit status 130 asserted)."""
+    proc = subprocess.Popen([*CLI, "run", "stick-slip", *SMALL, *sets, "--replicas", "2",
+                             "--md-only", "--out", str(study)], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
-        # both replicas past their first restart file
-        assert _wait_for(lambda: all(any((study / f"replica-{i}").glob("restart.*"))
-                                     for i in (1, 2))), "the replicas never wrote a restart"
-        # the study is locked while a command drives it
-        second = _run(["--resume", str(study)])
-        assert second.returncode == 2 and "in use" in second.stderr, second.stderr
+        assert _wait_for(ready), what
+        meanwhile()
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 130, err
+    return err
+
+
+def test_study_interrupted_locked_and_resumed(tmp_path):
+    study = tmp_path / "study"
+
+    def locked():
+        # the study is locked while a command drives it
+        second = _run(["--resume", str(study)])
+        assert second.returncode == 2 and "in use" in second.stderr, second.stderr
+
+    # both replicas past their first restart file, then Ctrl-C
+    err = _interrupted_study(
+        study, ["--set", "slide_steps=40000", "--set", "restart_every=2000"],
+        lambda: all(any((study / f"replica-{i}").glob("restart.*")) for i in (1, 2)),
+        "the replicas never wrote a restart", meanwhile=locked)
     assert f"filmfriction run --resume {study}" in err
     record = json.loads((study / "study.json").read_text())
     assert record["status"] == "interrupted"
@@ -154,19 +166,10 @@ def test_replicas_stopped_before_their_first_restart_start_again(tmp_path):
     listed in study.json; the replica's run is the run its old directory's scene.toml
     gives (the same scene and seed on the same rank)."""
     study = tmp_path / "study"
-    proc = subprocess.Popen([*CLI, "run", "stick-slip", *SMALL, "--set", "slide_steps=20000",
-                             "--set", "restart_every=0", "--replicas", "2", "--md-only",
-                             "--out", str(study)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
-    try:
-        assert _wait_for(lambda: all((study / f"replica-{i}" / "trace.dat").is_file()
-                                     for i in (1, 2))), "the replicas never started LAMMPS"
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=300)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-    assert proc.returncode == 130, err
+    _interrupted_study(
+        study, ["--set", "slide_steps=20000", "--set", "restart_every=0"],
+        lambda: all((study / f"replica-{i}" / "trace.dat").is_file() for i in (1, 2)),
+        "the replicas never started LAMMPS")
     record = json.loads((study / "study.json").read_text())
     assert record["status"] == "interrupted"
     assert [r["status"] for r in record["replicas"]] == ["interrupted"] * 2
