@@ -19,6 +19,7 @@ from pathlib import Path
 from filmfriction.md_inputs.contract import RUN_FILE
 
 from ..inputs import UserError as _user_error
+from ..md.run_record import set_aside
 from .plan import SweepLock, SweepPlan, write_plan
 
 SNAKEFILE = Path(__file__).with_name("sweep.smk")
@@ -145,13 +146,6 @@ def partial_dir(run_dir: Path) -> Path:
     return run_dir.with_name(f".{run_dir.name}.partial")
 
 
-def _set_aside(path: Path, sweep_dir: Path, kind: str, name: str, stamp: str) -> Path:
-    """Move ``path`` to ``sweep_dir/kind/name.stamp`` (a new name: nothing is replaced)."""
-    from ..md.run_record import set_aside
-
-    return set_aside(path, sweep_dir, kind, name, stamp)
-
-
 def _adopt_leftovers(run_dir: Path, partial: Path, sweep_dir: Path, stamp: str) -> None:
     """Hidden ``.<point>.tmp-<pid>`` run directories of jobs that died (the layout of
     earlier sweeps): the first becomes the partial run, any other goes to ``superseded/``."""
@@ -162,7 +156,7 @@ def _adopt_leftovers(run_dir: Path, partial: Path, sweep_dir: Path, stamp: str) 
         if not partial.exists():
             os.replace(old, partial)
         else:
-            _set_aside(old, sweep_dir, "superseded", run_dir.name, stamp)
+            set_aside(old, sweep_dir, "superseded", run_dir.name, stamp)
 
 
 def why_not_resumable(partial: Path, parameters: dict) -> str | None:
@@ -199,7 +193,7 @@ def _keep_partial(partial: Path, sweep_dir: Path, name: str, stamp: str) -> None
     if restarts.restart_files(partial):
         print(f"partial run kept in {partial}: the next sweep resumes it", file=sys.stderr)
     else:
-        moved = _set_aside(partial, sweep_dir, "superseded", name, stamp)
+        moved = set_aside(partial, sweep_dir, "superseded", name, stamp)
         print(f"stopped before the first restart file: nothing to resume, kept in {moved}; "
               "the next sweep starts this point afresh", file=sys.stderr)
 
@@ -251,7 +245,7 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
         RunLock(partial).acquire().release()
         why = why_not_resumable(partial, doc["parameters"])
         if why:
-            moved = _set_aside(partial, sweep_dir, "superseded", run_dir.name, stamp)
+            moved = set_aside(partial, sweep_dir, "superseded", run_dir.name, stamp)
             print(f"the partial run of this point cannot be resumed: {why}; moved to "
                   f"{moved}, starting afresh", file=sys.stderr)
             resuming = False
@@ -271,7 +265,7 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
             resume(partial, nprocs=np_, progress=False, launcher=words)
     except RunFailed as exc:
         if not (_INTERRUPTED or exc.resumable):
-            failed = _set_aside(partial, sweep_dir, "failed", run_dir.name, stamp)
+            failed = set_aside(partial, sweep_dir, "failed", run_dir.name, stamp)
             print(f"run failed; kept in {failed}", file=sys.stderr)
             raise
         # an interrupt, or an engine killed from outside: for a sweep neither is a
@@ -285,7 +279,7 @@ def run_point(inputs: Path, run_dir: Path, np_: int, launcher: str = "mpiexec") 
         raise
     if run_dir.exists():
         if any(run_dir.iterdir()):
-            _set_aside(run_dir, sweep_dir, "superseded", run_dir.name, stamp)
+            set_aside(run_dir, sweep_dir, "superseded", run_dir.name, stamp)
         else:
             run_dir.rmdir()      # Snakemake made it as the parent of run.json
     os.replace(partial, run_dir)
