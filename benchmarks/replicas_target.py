@@ -37,6 +37,8 @@ import sys
 import time
 from pathlib import Path
 
+from filmfriction.workflows.cost.bench import cpu_snapshot, other_cpu_seconds
+
 CLI = [sys.executable, "-c",
        "import sys; from filmfriction.workflows.cli.main import main; sys.exit(main())"]
 
@@ -58,23 +60,10 @@ def _slips(run_dir: Path) -> int:
     return len(slip_values(run_dir, ["static_force"])["static_force"])
 
 
-def _other_cpu(before: tuple, after: tuple) -> float | None:
-    (busy0, own0), (busy1, own1) = before, after
-    if busy0 is None or busy1 is None:
-        return None
-    return max(0.0, (busy1 - busy0) - (own1 - own0))
-
-
-def _cpu_now() -> tuple:
-    from filmfriction.workflows.cost.bench import busy_cpu_seconds, own_cpu_seconds
-
-    return busy_cpu_seconds(), own_cpu_seconds()
-
-
 def paired(args) -> dict:
     out = Path(args.out)
     rows = []
-    before, t0 = _cpu_now(), time.perf_counter()
+    before, t0 = cpu_snapshot(), time.perf_counter()
     for k in range(args.pairs):
         sides = ["replicas", "ranks"] if k % 2 == 0 else ["ranks", "replicas"]
         row = {}
@@ -96,7 +85,7 @@ def paired(args) -> dict:
               f"{row['replicas']['wall']:.1f} s; 1 run x 2 ranks {row['ranks']['slips']} "
               f"slips in {row['ranks']['wall']:.1f} s; ratio {row['ratio']:.2f}", flush=True)
     elapsed = time.perf_counter() - t0
-    other = _other_cpu(before, _cpu_now())
+    other = other_cpu_seconds(before, cpu_snapshot())
 
     def spread(values):
         return {"median": statistics.median(values), "min": min(values), "max": max(values)}
@@ -146,7 +135,7 @@ def coverage(args) -> dict:
     base = load(args.scene).parameters["seed"]
     seeds = replica_seeds(base + 1, args.seeds)     # study seeds, apart from the scene's own
     studies = []
-    before, t0 = _cpu_now(), time.perf_counter()
+    before, t0 = cpu_snapshot(), time.perf_counter()
     for k, seed in enumerate(seeds, start=1):
         d = out / f"study-{k}"
         if not (d / "study.json").exists():
@@ -179,7 +168,7 @@ def coverage(args) -> dict:
     hi = stats.beta.ppf(1 - (1 - ONE_SIGMA) / 2, c + 1, n - c) if c < n else 1.0
     allmean = combine_replicas([v for s in studies for v in s["values"]])
     elapsed = time.perf_counter() - t0
-    other = _other_cpu(before, _cpu_now())
+    other = other_cpu_seconds(before, cpu_snapshot())
     print(f"{args.observable} over every study: {allmean.mean:.4g} ± {allmean.half_width:.2g} "
           f"(68 %, {allmean.n_replicas} runs, {allmean.n_slips} slips)")
     print(f"coverage of the many-seed mean (leave-one-out) by the final ± 68 %: {c}/{n} = "

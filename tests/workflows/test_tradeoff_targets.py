@@ -142,7 +142,7 @@ def test_an_interrupted_study_keeps_what_it_measured(tmp_path, monkeypatch):
         return 40.0 + len(calls), 1.5
 
     monkeypatch.setattr(tt, "_run", fake_run)
-    monkeypatch.setattr(tt, "_cpu_now", lambda: (None, 0.0))
+    monkeypatch.setattr(tt, "cpu_snapshot", lambda: (None, 0.0))
     with pytest.raises(KeyboardInterrupt):
         tt.run_targets(tmp_path / "t", scenes=("stick-slip",), pairs=2, presets=(),
                        log=lambda m: None)

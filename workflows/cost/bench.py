@@ -107,6 +107,21 @@ def own_cpu_seconds() -> float:
     return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
+def cpu_snapshot() -> tuple:
+    """(machine busy CPU seconds, this process's and its finished children's), for
+    :func:`other_cpu_seconds`."""
+    return busy_cpu_seconds(), own_cpu_seconds()
+
+
+def other_cpu_seconds(before: tuple, after: tuple) -> float | None:
+    """CPU seconds the machine spent busy between two :func:`cpu_snapshot` beyond this
+    process and its finished children: other work beside a measurement (None off Linux)."""
+    (busy0, own0), (busy1, own1) = before, after
+    if busy0 is None or busy1 is None:
+        return None
+    return max(0.0, (busy1 - busy0) - (own1 - own0))
+
+
 def summary(values: list[float]) -> dict:
     """Median, spread and best of a list of throughputs."""
     return {"median": statistics.median(values), "min": min(values), "max": max(values),
@@ -124,7 +139,7 @@ def run_bench(scene, nprocs: int, repeat: int, omp: bool = False, progress=None)
         if omp:
             layouts.append(("film", nprocs, nprocs))
     runs: dict[str, list[dict]] = {}
-    busy0, own0, t0 = busy_cpu_seconds(), own_cpu_seconds(), time.perf_counter()
+    before, t0 = cpu_snapshot(), time.perf_counter()
     total = len(layouts) * repeat
     with tempfile.TemporaryDirectory(prefix="filmfriction-bench-") as tmp:
         tmp = Path(tmp)
@@ -143,8 +158,7 @@ def run_bench(scene, nprocs: int, repeat: int, omp: bool = False, progress=None)
                 else:
                     res = time_bulk(film_atoms, film_steps, cores, cutoff, timestep, where)
                 runs.setdefault(key, []).append(res)
-    busy1, own1, elapsed = busy_cpu_seconds(), own_cpu_seconds(), time.perf_counter() - t0
-    other = None if busy0 is None or busy1 is None else max(0.0, (busy1 - busy0) - (own1 - own0))
+    other, elapsed = other_cpu_seconds(before, cpu_snapshot()), time.perf_counter() - t0
     return _report(scene.name, nprocs, repeat, runs, other, elapsed)
 
 

@@ -45,6 +45,8 @@ from pathlib import Path
 from filmfriction.analysis.files.util import json_safe, write_atomic
 from filmfriction.md_inputs.contract import STUDY_FILE
 
+from .bench import cpu_snapshot, other_cpu_seconds
+
 __all__ = ["LEVELS", "OBSERVABLES", "SIDES", "PRESETS", "Side", "side_command",
            "check_met", "times_to_target", "summarize", "preset_errors", "preset_clash",
            "run_targets", "collect_targets", "write_targets", "markdown"]
@@ -199,28 +201,13 @@ def preset_errors(run_dir: Path, levels=LEVELS, observables=OBSERVABLES) -> dict
 def _run(args: list[str]) -> tuple[float, float | None]:
     """``filmfriction ARGS``; its wall time and the CPU seconds other processes used
     meanwhile (None off Linux; RuntimeError with its last lines on failure)."""
-    before, t0 = _cpu_now(), time.perf_counter()
+    before, t0 = cpu_snapshot(), time.perf_counter()
     done = subprocess.run([*CLI, *args], capture_output=True, text=True)
     wall = time.perf_counter() - t0
     if done.returncode != 0:
         raise RuntimeError(f"filmfriction {' '.join(args)} failed ({done.returncode}): "
                            f"{done.stderr.strip()[-1500:]}")
-    return wall, _other_cpu(before, _cpu_now())
-
-
-def _other_cpu(before: tuple, after: tuple) -> float | None:
-    """CPU seconds the machine spent busy between two :func:`_cpu_now` beyond this
-    process and its finished children."""
-    (busy0, own0), (busy1, own1) = before, after
-    if busy0 is None or busy1 is None:
-        return None
-    return max(0.0, (busy1 - busy0) - (own1 - own0))
-
-
-def _cpu_now() -> tuple:
-    from .bench import busy_cpu_seconds, own_cpu_seconds
-
-    return busy_cpu_seconds(), own_cpu_seconds()
+    return wall, other_cpu_seconds(before, cpu_snapshot())
 
 
 def run_targets(out: Path, *, scenes=SCENES, pairs: int = 3, levels=LEVELS,
@@ -236,12 +223,12 @@ def run_targets(out: Path, *, scenes=SCENES, pairs: int = 3, levels=LEVELS,
     doc = {"schema": "filmfriction.tradeoff-targets/1", "levels": list(levels),
            "observables": list(observables), "budget": budget, "set": list(sets),
            "cpus": usable_cpus(), "complete": False, "scenes": {}}
-    before, t0 = _cpu_now(), time.perf_counter()
+    before, t0 = cpu_snapshot(), time.perf_counter()
 
     def write(missing: str | None) -> None:
         # after every measurement: an interrupted study keeps what it measured
         doc["elapsed"] = time.perf_counter() - t0
-        doc["other_cpu_seconds"] = _other_cpu(before, _cpu_now())
+        doc["other_cpu_seconds"] = other_cpu_seconds(before, cpu_snapshot())
         doc["complete"], doc["missing"] = missing is None, missing
         write_targets(out, doc)
 
