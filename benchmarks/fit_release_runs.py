@@ -59,11 +59,13 @@ def main(argv=None) -> int:
     for run in a.runs:
         tr = np.genfromtxt(f"{run}/trace.csv", delimiter=",", names=True)
         traces.append({k: tr[k] for k in tr.dtype.names})
-        p = json.load(open(f"{run}/run.json"))["trace_parameters"]
+        with open(f"{run}/run.json", encoding="utf-8") as fh:
+            record = json.load(fh)
+        p = record["trace_parameters"]
         mass = p["mass"]
-        pressure = json.load(open(f"{run}/run.json"))["scene"]["parameters"]["normal_pressure"]
+        pressure = record["scene"]["parameters"]["normal_pressure"]
         moves.append(release_gap(traces[-1], pressure=pressure, area=p["area"]))
-        film_mass = json.load(open(f"{run}/run.json"))["derived"]["film_atoms"]   # m each
+        film_mass = record["derived"]["film_atoms"]   # m each
     fit = fit_releases(traces, mass=mass)
     with_mass = fit.one_law
     print(f"{len(traces)} releases, M = {mass:g}: verdict {fit.verdict}, the {fit.verdict_from}'s "
