@@ -193,7 +193,7 @@ def run(args: argparse.Namespace) -> int:
         command = getattr(exc, "resume_command", None)
         print(f"filmfriction run: interrupted ({str(exc) or 'SIGINT'}); "
               + (f"resume with {command}" if command else
-                 f"nothing to resume yet (no restart file): {_start_again(run_dir)}; "
+                 f"nothing to resume yet (no restart file): {_start_again_advice(run_dir)}; "
                  f"{run_dir}/run.json records the interruption"), file=sys.stderr)
         return 130
     print(f"run directory: {run_dir}")
@@ -203,17 +203,17 @@ def run(args: argparse.Namespace) -> int:
     return post_process(run_dir)
 
 
-def _start_again(run_dir: Path) -> str:
+def _start_again_advice(run_dir: Path) -> str:
     """How to run again from its beginning a run that holds nothing to resume."""
     import json
 
-    from ..md.run_record import start_again
+    from ..md.run_record import start_again_advice
 
     try:
         ranks = json.loads((Path(run_dir) / RUN_FILE).read_text(encoding="utf-8")).get("np")
     except (OSError, ValueError, AttributeError):
         ranks = None
-    return start_again(run_dir, ranks)
+    return start_again_advice(run_dir, ranks)
 
 
 def _study_inputs(args: argparse.Namespace):

@@ -19,7 +19,7 @@ from filmfriction.md_inputs.contract import RUN_FILE, TRACE_DAT_FILE, TRACE_FILE
 
 from . import engine, lammps_build, restarts
 from .output.lammps_output import ranks_problem, run_engine
-from .run_record import resume_command, start_again, write_json
+from .run_record import resume_command, start_again_advice, write_json
 from .output.sanity import (contract_message, contract_problem, lost_atoms_hint, rows_problem,
                      sanity_warnings, trace_problem)
 from .scene import Scene
@@ -84,7 +84,7 @@ def interrupted(run_dir: Path, record: dict | None, scene: Scene, exc: KeyboardI
         record.pop("resume_command", None)
         stage = "before LAMMPS started" if not started else "before the first restart file"
         message = (f"interrupted {why} {stage}: nothing to resume (no usable restart file); "
-                   + start_again(run_dir, record.get("np")))
+                   + start_again_advice(run_dir, record.get("np")))
     try:
         if started:
             finish(run_dir, record, scene, None, message, status="interrupted")

@@ -19,7 +19,8 @@ from filmfriction.md_inputs.contract import (DAT_COLUMNS, RESUME_OFFSETS, RUN_FI
 
 from . import engine, finish, lammps_build, restarts
 from .locks import RunLock
-from .run_record import OWN_SCRIPT, SCRIPT, resume_command, scene_toml, start_again, write_json
+from .run_record import (OWN_SCRIPT, SCRIPT, resume_command, scene_toml, start_again_advice,
+                         write_json)
 from .scene import SceneError
 from .signals import TerminationAsInterrupt
 from .output.trace_dat import read_trace_dat, rewrite_trace_dat, slide_origin
@@ -97,7 +98,7 @@ def _resume(run_dir: Path, nprocs: int | None, progress: bool, state: dict, lmp,
         why = "".join(f"; {name}: {reason}" for name, reason in bad.items())
         raise SceneError(f"{run_dir} has no usable restart file to resume from (restart_every = "
                          f"{record['scene']['parameters'].get('restart_every')}{why}); "
-                         + start_again(run_dir, record.get("np")))
+                         + start_again_advice(run_dir, record.get("np")))
     params = record["scene"]["parameters"]
     scene = scene_mod.Scene(
         name=record["scene"]["name"], description=record["scene"]["description"],

@@ -78,7 +78,7 @@ def set_aside(path: Path, parent: Path, kind: str, name: str, stamp: str) -> Pat
     return target
 
 
-def start_again(run_dir: Path, nprocs: int | None = None) -> str:
+def start_again_advice(run_dir: Path, nprocs: int | None = None) -> str:
     """What to do with a run that holds nothing to resume (no usable restart file): run
     it again from its beginning in a new directory, ``run_dir`` kept as it is.  Its
     resolved scene (``scene.toml``: the same parameters and seed) on its ``nprocs``
