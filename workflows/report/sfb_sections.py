@@ -122,7 +122,10 @@ def _bingham_reading(rows) -> str:
                  "give, so a fit of Eq. (1) cannot by itself show a viscous film, and the run "
                  "does not reproduce the regime of Klein's film: a verdict on his film needs "
                  "Bi ≫ 1. What the run's slips do say is the slip law's verdict (its own "
-                 "section), with its power.")
+                 "section), with its power. How Bi moves with the slider's mass at this film, "
+                 "how far 2 cores take it and what Klein's Bi would cost on a cluster are "
+                 "measured by the slider-mass ladder (`filmfriction ladder plan`, `run`, "
+                 "`collect`; its results page is docs/results/mass-ladder.md).")
     else:
         text += ("Bi ≫ 1 here as in Klein's film: the slip law's verdict (its own section) says "
                  "whether the large damping is viscous.")
