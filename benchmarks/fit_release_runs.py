@@ -1,7 +1,7 @@
 """The slip law's MD positive control (docs/results/slip-law.md): liquid-release runs fitted.
 
     filmfriction run liquid-release --np 1 --md-only --set seed=S --out RUN_S   # per seed
-    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR RUN_1 RUN_2 ...
+    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] RUN_1 RUN_2 ...
 
 Prints the slip law fitted to the runs' release slips together
 (:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict
@@ -12,7 +12,8 @@ half the film force: :func:`~filmfriction.analysis.slip_law.slip_law.detectable`
 the per-release standard deviation), each run's layer velocity
 shares, where the shear sits and the width W = D + 2b of its profile, and
 B = η·A/W with η the liquid's viscosity at the film's state point
-(``filmfriction viscosity``).
+(``filmfriction viscosity``).  ``--load-work``: the film force less the load's work on
+the gap (``fit_film_force(load_work=…)``), its dissipative part.
 """
 from __future__ import annotations
 
@@ -54,6 +55,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--viscosity", nargs=2, type=float, metavar=("ETA", "ERR"), required=True)
+    ap.add_argument("--load-work", action="store_true",
+                    help="take the load's work on the gap out of the film force")
     a = ap.parse_args(argv)
     traces, mass, film_mass, gaps, moves = [], None, None, [], []
     for run in a.runs:
@@ -66,9 +69,10 @@ def main(argv=None) -> int:
         pressure = record["scene"]["parameters"]["normal_pressure"]
         moves.append(release_gap(traces[-1], pressure=pressure, area=p["area"]))
         film_mass = record["derived"]["film_atoms"]   # m each
-    fit = fit_releases(traces, mass=mass)
+    fit = fit_releases(traces, mass=mass, load_work=a.load_work)
     with_mass = fit.one_law
-    print(f"{len(traces)} releases, M = {mass:g}: verdict {fit.verdict}, the {fit.verdict_from}'s "
+    print(f"{len(traces)} releases, M = {mass:g}"
+          f"{', the load’s work on the gap taken out' if a.load_work else ''}: verdict {fit.verdict}, the {fit.verdict_from}'s "
           f"({fit.reason})")
     for br in (fit.decelerating, fit.accelerating, fit.whole, with_mass):
         name = "whole + m_c" if br is with_mass else br.branch
