@@ -24,9 +24,11 @@ import sys
 
 import numpy as np
 
+from scipy.signal import savgol_filter
+
 from filmfriction.analysis.groundtruth.release_control import (couette_comoving_mass,
                                                                fit_releases, release_gap,
-                                                               release_profile)
+                                                               release_profile, release_slip)
 from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, detectable
 
 
@@ -49,6 +51,49 @@ def kinetic_needed(branch) -> int | None:
     if fk.size < 2:
         return None
     return releases_needed(float(fk.std(ddof=1)), DOMINANT_SHARE * branch.mean_force)
+
+
+def branch_bins(traces, mass: float, law: tuple, load: float, edges=(0.2, 0.4, 0.6, 0.8, 1.0),
+                smoothing: float = 0.1) -> dict:
+    """Where the loop sits: per branch and bin of v / v_peak, the mean over the releases of the
+    film force (F_spring − M·a, Savitzky–Golay over ``smoothing`` of the slip, as the fit
+    smooths) minus ``law`` (F_k, B, m_c), of the load's term P·A·dD/dx (``load`` = P·A, the
+    same smoothing), and of the film force minus the samples' own law (F_k + B·v + m_c·a
+    fitted to each release's smoothed samples); each a list of (mean, standard error)."""
+    rows = {}
+    samples_law = []
+    for tr in traces:
+        t, x = tr["time"], tr["wall_position"]
+        _, s = release_slip(t, x)
+        dt = float(t[1] - t[0])
+        w = int(round(smoothing * (t[s] - t[0]) / dt)) | 1
+        v, a = (savgol_filter(x, w, 2, deriv=k, delta=dt) for k in (1, 2))
+        force = savgol_filter(tr["spring_force"], w, 2) - mass * a
+        dgap = savgol_filter(tr["gap"], w, 2, deriv=1, delta=dt)
+        sl = slice(w // 2 + 1, s - w // 2 + 1)
+        v, a, force, dgap = v[sl], a[sl], force[sl], dgap[sl]
+        p = int(np.argmax(v))
+        fast = v > edges[0] * v[p]
+        coef = np.linalg.lstsq(np.column_stack([np.ones(fast.sum()), v[fast], a[fast]]),
+                               force[fast], rcond=None)[0]
+        samples_law.append(coef)
+        terms = {"film force − the law": force - (law[0] + law[1] * v + law[2] * a),
+                 "P·A·dD/dx": load * dgap / v,
+                 "film force − the samples' law": force - (coef[0] + coef[1] * v + coef[2] * a)}
+        for branch, idx in (("accelerating", np.arange(p + 1)), ("decelerating", np.arange(p, v.size))):
+            k = np.digitize(v[idx] / v[p], edges) - 1
+            for name, arr in terms.items():
+                rows.setdefault((branch, name), []).append(
+                    [arr[idx][k == j].mean() if np.any(k == j) else np.nan
+                     for j in range(len(edges) - 1)])
+    out = {}
+    for key, vals in rows.items():
+        vals = np.array(vals)
+        n = np.isfinite(vals).sum(axis=0)
+        out[key] = list(zip(np.nanmean(vals, axis=0), np.nanstd(vals, axis=0, ddof=1) / np.sqrt(n)))
+    c = np.array(samples_law)
+    out["samples' law"] = list(zip(c.mean(axis=0), c.std(axis=0, ddof=1) / math.sqrt(len(c))))
+    return out
 
 
 def main(argv=None) -> int:
@@ -106,6 +151,14 @@ def main(argv=None) -> int:
     print(f"  load's work on the gap's opening, P·A·ΔD/Δx: accelerating {fa:.2f} ± {sa:.2f}, "
           f"decelerating {fd:.2f} ± {sd:.2f}, difference {ds:.2f} ± {dse:.2f} ε/σ "
           f"(the loop step: {fit.loop_step:.2f} ± {fit.loop_step_stderr:.2f})")
+    one = (with_mass.kinetic_force, with_mass.damping, with_mass.comoving_mass)
+    bins = branch_bins(traces, mass, one, pressure * p["area"])
+    (fk, sfk), (bb, sbb), (mc, smc) = bins.pop("samples' law")
+    print(f"  where the loop sits (bins of v/v_peak 0.2-0.4-0.6-0.8-1; the law: the one law "
+          f"above; the samples' law F_k = {fk:.2f} ± {sfk:.2f}, B = {bb:.2f} ± {sbb:.2f}, "
+          f"m_c = {mc:.1f} ± {smc:.1f}):")
+    for (branch, name), vals in bins.items():
+        print(f"    {branch:12s} {name:30s} " + "  ".join(f"{m:+.2f} ± {e:.2f}" for m, e in vals))
     widths = []
     for run in a.runs:
         prof = release_profile(run)
