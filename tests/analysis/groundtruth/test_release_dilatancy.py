@@ -95,3 +95,21 @@ def test_bad_load_work_is_refused():
     table = cycle_table(t, f, np.array([0]), np.array([1000]))
     with pytest.raises(ValueError, match="load_work has shape"):
         fit_film_force(t, f, tr["wall_velocity"], table, mass=MASS, load_work=np.zeros(3))
+
+
+def test_the_analysis_reports_the_corrected_fit_beside_the_verdict(tmp_path):
+    # a synthetic MD run directory: its trace has a load_work column (a still gap: zeros),
+    # so analysis.json's slip_law carries load_work_removed, here the same fit as its own
+    import json
+
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
+    from filmfriction.workflows.cli.main import main
+
+    run = run_directory(tmp_path / "run")
+    assert main(["analyze", "-q", "--no-structure", "--no-figure", str(run)]) == 0
+    law = json.loads((run / "analysis.json").read_text())["slip_law"]
+    beside = law["load_work_removed"]
+    assert beside["verdict"] == law["verdict"]
+    assert beside["verdict_from"] == law["verdict_from"]
+    assert beside["one_law"]["damping"] == law["branches"]["one_law"]["damping"]
+    assert beside["loop_step"] == law["loop_step"]
