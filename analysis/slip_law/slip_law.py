@@ -93,11 +93,12 @@ it out, F_diss = F_film + dW_L/dx with dW_L/dx = (dW_L/dt)/v, v the guiding
 (smoothed) velocity; in the integral form the response gains ∫(dW_L/dt)/v dt, the
 rate unsmoothed (the integral takes its noise back to the gap's own: by parts it is
 [W_L/v] + ∫W_L·v'/v² dt).  A gap that opens as v² is a mass
-(P·A·dD/dx = 2κP·A·a) and moves only m_c; one that opens otherwise leaves a loop the
-correction removes (``tests/analysis/groundtruth/test_release_dilatancy.py``).  The
-gap's thermal breathing is exchanged with the film's own energy, not with the wall's
-travel: the correction carries its noise into the fit, P·A·Ḋ/v, which the smoothing and
-the velocity floor bound.
+(P·A·dD/dx = 2κP·A·a) and moves only m_c; one that opens otherwise can leave a loop,
+which the correction removes (``tests/analysis/groundtruth/test_release_dilatancy.py``).
+The gap's thermal breathing is exchanged with the film's own energy, not with the
+wall's travel, yet the correction carries it into the fit as P·A·δD/v (bounded by the
+velocity floor): on the MD liquid released at P = 1 it more than doubles the errors
+(docs/results/slip-law.md), so the correction is an option, off by default.
 
 The local exponent n = d ln F/d ln v is fitted per slip as F = c·(v/v̄)^n on the
 same branch: 1 for a viscous film, 0 for a kinetic force, < 0 for weakening.
