@@ -108,19 +108,23 @@ def release_gap(trace, *, pressure: float, area: float, parts: int = 5,
 
 
 def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
-                 comoving_mass: bool = False, **fit) -> FilmForceFit:
+                 comoving_mass: bool = False, load_work: bool = False, **fit) -> FilmForceFit:
     """The slip law fitted to the release slips of ``traces`` (dicts of trace columns
     ``time``, ``spring_force``, ``wall_position``, ``wall_velocity``, one per release,
     uniformly sampled at one interval), each slip from :func:`release_slip`; ``fit``
     goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force` (e.g.
-    ``min_velocity_fraction``)."""
+    ``min_velocity_fraction``).  ``load_work``: take the load's work on the gap out of
+    the film force (each trace's ``load_work`` column, each release's from its own start)."""
     parts, yi, si, offset, t0 = [], [], [], 0, 0.0
+    names = ("spring_force", "wall_position", "wall_velocity") + (("load_work",) if load_work
+                                                                   else ())
     for tr in traces:
         t = np.asarray(tr["time"], float)
         y, s = release_slip(t, tr["wall_position"])
         dt = float(t[1] - t[0])
-        parts.append({k: np.asarray(tr[k], float)[:s + 1] for k in
-                      ("spring_force", "wall_position", "wall_velocity")}
+        if load_work and "load_work" not in tr:
+            raise ValueError("load_work=True: a trace has no load_work column")
+        parts.append({k: np.asarray(tr[k], float)[:s + 1] for k in names}
                      | {"time": t[:s + 1] - t[0] + t0})
         yi.append(offset + y)
         si.append(offset + s)
@@ -132,7 +136,7 @@ def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
     return fit_film_force(cols["time"], cols["spring_force"], cols["wall_velocity"], table,
                           mass=mass, mount_damping=mount_damping,
                           wall_position=cols["wall_position"], comoving_mass=comoving_mass,
-                          **fit)
+                          load_work=cols.get("load_work"), **fit)
 
 
 def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:

@@ -6,7 +6,13 @@ fit needs, what it writes into ``analysis.json["slip_law"]`` and
 the decelerating branch, ``slip_law_accelerating_kinetic_force``,
 ``slip_law_accelerating_damping``, ``slip_law_loop_area``), and what the report
 shows: the verdict's table and the film force against the wall's velocity with
-the two branches' lines.  The section's own F_k, B, exponent and power are the
+the two branches' lines.  Where the trace has the load's work (an MD trace's
+``load_work`` column), the same fit with that work taken out of the film force
+(``fit_film_force(load_work=…)``: the film's dissipative force, the gap's work
+against the load removed) is reported beside it as ``load_work_removed`` (its
+verdict, the one law, the loop step); the section's verdict stays the film force's
+(docs/results/slip-law.md: on the MD liquid the correction carries the gap's thermal
+breathing into the fit and more than doubles the errors).  The section's own F_k, B, exponent and power are the
 verdict's law's (``verdict_from``: the one law over the whole slip with a co-moving
 mass when no loop is left beyond it, else the decelerating branch); every fit is
 under ``branches``, the one law as ``one_law``, with the loop step beside it.
@@ -99,6 +105,10 @@ class SlipLaw(Observable):
                       "* a over the whole slip: one_law), F_film = F_spring - M a - "
                       "mount_damping (v - V), fitted in the integrated equation of motion; "
                       "the verdict's law is verdict_from's"}
+        if trace.has("load_work"):
+            out["load_work_removed"] = self._load_work_removed(
+                ctx, fit_film_force(t, f, v, ctx.table, **args,
+                                    load_work=trace.columns["load_work"]))
         if p.area is not None and (trace.has("gap") or p.thickness is not None):
             d, d_src = trace.film_thickness()
             if math.isfinite(law.damping):
@@ -118,6 +128,20 @@ class SlipLaw(Observable):
                     "accelerating_damping": fit.accelerating.per_slip_damping.tolist(),
                     "loop_area": fit.per_slip_loop_area.tolist()}
         return out, per_slip
+
+    @classmethod
+    def _load_work_removed(cls, ctx, fit) -> dict:
+        """The fit of the film force less the load's work on the gap, beside the section's."""
+        one = fit.one_law
+        return {"verdict": fit.verdict, "verdict_from": fit.verdict_from, "reason": fit.reason,
+                "one_law": cls._branch(ctx, one),
+                "comoving_mass": ctx.value(one.comoving_mass, one.comoving_mass_stderr, "mass"),
+                "decelerating": cls._branch(ctx, fit.decelerating),
+                "loop_step": ctx.value(fit.loop_step, fit.loop_step_stderr, "force",
+                                       sigmas=finite_or_none(fit.loop_step_sigmas),
+                                       detectable=finite_or_none(fit.detectable_loop_step)),
+                "law": "F_film + dW_load/dx (W_load the load's work on the wall, "
+                       "-P A (D - D0)): the film force less the load's work on the gap"}
 
     @staticmethod
     def _branch(ctx, b) -> dict:
@@ -177,6 +201,12 @@ class SlipLaw(Observable):
                      ("one law: verdict", one.get("verdict", "?")),
                      ("loop step beyond the co-moving mass, F_acc − F_dec",
                       format_estimate(section.get("loop_step")))]
+        lw = section.get("load_work_removed") or {}
+        if lw:
+            rows += [("with the load's work on the gap taken out: verdict "
+                      f"({lw.get('verdict_from', '?')})", lw.get("verdict", "?")),
+                     ("  its loop step beyond the co-moving mass",
+                      format_estimate(lw.get("loop_step")))]
         if section.get("bulk_film_damping"):
             rows.append(("B of a no-slip film of bulk viscosity, η_bulk·A/D",
                          format_estimate(section["bulk_film_damping"])))

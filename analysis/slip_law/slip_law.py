@@ -84,6 +84,22 @@ yet shear-melted), which is not the law; nor are the samples whose derivative or
 smoothing window reaches across the yield or the re-stick (half a window and one
 sample at each end of the slip).
 
+The load's work on the gap.  A wall held at a load P whose film's gap D opens while it
+slides pays P·A·dD of its travel to the load, and gets it back as the gap closes: the
+film's x-force then carries P·A·dD/dx beside its dissipative force (the energy per unit
+slide is F_film·dx = dissipation + P·A·dD + the film's own energy).  Given the trace's
+``load_work`` (W_L = −P·A·(D − D0), the work the load did on the wall), the fit takes
+it out, F_diss = F_film + dW_L/dx with dW_L/dx = (dW_L/dt)/v, v the guiding
+(smoothed) velocity; in the integral form the response gains ∫(dW_L/dt)/v dt, the
+rate unsmoothed (the integral takes its noise back to the gap's own: by parts it is
+[W_L/v] + ∫W_L·v'/v² dt).  A gap that opens as v² is a mass
+(P·A·dD/dx = 2κP·A·a) and moves only m_c; one that opens otherwise can leave a loop,
+which the correction removes (``tests/analysis/groundtruth/test_release_dilatancy.py``).
+The gap's thermal breathing is exchanged with the film's own energy, not with the
+wall's travel, yet the correction carries it into the fit as P·A·δD/v (bounded by the
+velocity floor): on the MD liquid released at P = 1 it more than doubles the errors
+(docs/results/slip-law.md), so the correction is an option, off by default.
+
 The local exponent n = d ln F/d ln v is fitted per slip as F = c·(v/v̄)^n on the
 same branch: 1 for a viscous film, 0 for a kinetic force, < 0 for weakening.
 
@@ -167,6 +183,8 @@ class FilmForceFit:
         Windows of the table left out because the wall did not slip in them (the
         spring relaxed by less than :data:`MIN_RELAXATION` of its force); the
         reasons say by how much it moved.
+    load_work_removed : bool
+        Whether the load's work on the gap was taken out of the film force (module text).
     """
 
     decelerating: BranchFit
@@ -188,6 +206,7 @@ class FilmForceFit:
     smoothing_window: int
     comoving_mass: bool
     still_windows: int = 0
+    load_work_removed: bool = False
 
     @property
     def law(self) -> BranchFit:
@@ -288,7 +307,8 @@ def _window(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
 def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass: float,
                    drive_velocity: float = 0.0, mount_damping: float = 0.0,
                    wall_position=None, min_velocity_fraction: float = 0.2,
-                   smoothing: float = SMOOTHING, comoving_mass: bool = False) -> FilmForceFit:
+                   smoothing: float = SMOOTHING, comoving_mass: bool = False,
+                   load_work=None) -> FilmForceFit:
     """Fit F_film = F_k + B·v [+ m_c·a] on each branch of each slip of ``table``.
 
     Parameters
@@ -309,6 +329,10 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         samples, as a share of the median slip duration (0: the samples' own).
     comoving_mass : bool
         Fit the term m_c·a too.
+    load_work : array_like, shape (n,), optional
+        The work the load did on the wall (an MD trace's ``load_work`` column,
+        −P·A·(D − D0)): taken out of the film force, which is then its dissipative
+        part (module text).  None: the film force as the equation of motion gives it.
 
     Returns
     -------
@@ -333,6 +357,7 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     else:
         guide = savgol_filter(v, w, 2) if w else v
     impulse = cumulative_trapezoid(f, t, initial=0.0)
+    gap_rate = None if load_work is None else _load_work_rate(load_work, t)
     segs = {name: [] for name in BRANCHES + ("whole",)}
     ranges = []
     edge = w // 2 + 1
@@ -366,6 +391,11 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             i = np.arange(k[0], k[-1] + 1) + y          # contiguous: the integral needs it
             dt_, dx = t[i] - t[i[0]], x[i] - x[i[0]]
             imp = impulse[i] - impulse[i[0]] - mount_damping * (dx - drive_velocity * dt_)
+            if gap_rate is not None:
+                # + ∫ (dW_L/dt)/v dt: the film force less the load's work on the gap
+                # (v bounded below by the floor, or 1 % of the peak with no floor)
+                u = np.maximum(guide[i], max(min_velocity_fraction, 0.01) * peak)
+                imp = imp + cumulative_trapezoid(gap_rate[i] / u, t[i], initial=0.0)
             segs[name].append(Segment(imp, v[i], dt_, dx, guide[i] - guide[i[0]], mass,
                                       np.maximum(dt_ - (t[y + p] - t[i[0]]), 0.0)))
         ranges.append((min_velocity_fraction * peak, peak))
@@ -389,7 +419,18 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     return FilmForceFit(dec, acc, fits["whole"], one, st.loop_step, st.loop_step_stderr,
                         sigmas(st.loop_step, st.loop_step_stderr, st.dof),
                         detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
-                        la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still))
+                        la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still),
+                        gap_rate is not None)
+
+
+def _load_work_rate(load_work, t: np.ndarray) -> np.ndarray:
+    """dW_L/dt of the load's work (second-order central differences)."""
+    lw = np.asarray(load_work, float)
+    if lw.shape != t.shape:
+        raise ValueError(f"load_work has shape {lw.shape}, the trace {t.shape}")
+    if not np.all(np.isfinite(lw)):
+        raise ValueError("load_work has non-finite samples")
+    return np.gradient(lw, t)
 
 
 def _refuse_still(fits: dict, still: list, total: int) -> dict:
