@@ -278,7 +278,15 @@ def located(lv: dict, *, blocks: int = 4) -> dict:
     slips, per block: each slip's intervals cut into ``blocks`` consecutive blocks), and
     :func:`shear_shares` of them.  A sample's share is the ratio of its mean velocities,
     (⟨v_k⟩ − ⟨v_bottom⟩)/(⟨v_top⟩ − ⟨v_bottom⟩): a ratio of one interval's velocities
-    would blow up where the wall has nearly stopped.  ``intervals``: how many counted."""
+    would blow up where the wall has nearly stopped.  ``intervals``: how many counted;
+    ``jump_per_sample``: each sample's jumps (None where its wall did not move).
+
+    One interval at a time: ``interval_largest_gap`` counts, per gap (bottom wall →
+    layer 1, …), the intervals whose largest jump is there, and
+    ``interval_largest_jump_median`` is the median of that largest jump, over the
+    intervals in which the wall moves at half its mean slip velocity or more (a slip
+    taken up at one plane at a time, the plane moving from interval to interval, gives
+    large jumps here and ``spread`` over the slips)."""
     slips = np.unique(lv["slip"])
     if slips.size >= MIN_SLIPS_FOR_SCATTER:
         groups, unit = [lv["slip"] == s for s in slips], "slip"
@@ -294,11 +302,24 @@ def located(lv: dict, *, blocks: int = 4) -> dict:
         rows.append((np.nanmean(lv["layer"][g], axis=0) - b) / (w - b) if w != b
                     else np.full(lv["layer"].shape[1], np.nan))
     nl = lv["layer"].shape[1]
-    out = shear_shares(np.asarray(rows, float).reshape(-1, nl))
+    rows = np.asarray(rows, float).reshape(-1, nl)
+    out = shear_shares(rows)
     slip_v = lv["top"] - lv["bottom"]
+    jumps = np.diff(np.column_stack([np.zeros(len(rows)), rows, np.ones(len(rows))]), axis=1)
+    moving = slip_v >= 0.5 * slip_v.mean() if slip_v.size else slip_v.astype(bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f = (lv["layer"][moving] - lv["bottom"][moving, None]) / slip_v[moving, None]
+    each = np.diff(np.column_stack([np.zeros(len(f)), f, np.ones(len(f))]), axis=1)
+    each = each[np.all(np.isfinite(each), axis=1)]
     out.update({"samples": unit, "intervals": int(lv["slip"].size),
                 "slips": int(slips.size),
-                "wall_slip_velocity": float(np.mean(slip_v)) if slip_v.size else None})
+                "wall_slip_velocity": float(np.mean(slip_v)) if slip_v.size else None,
+                "jump_per_sample": [[float(x) if np.isfinite(x) else None for x in r]
+                                    for r in jumps],
+                "interval_largest_gap": np.bincount(each.argmax(axis=1),
+                                                    minlength=nl + 1).tolist(),
+                "interval_largest_jump_median": float(np.median(each.max(axis=1)))
+                if len(each) else None})
     return out
 
 
@@ -388,6 +409,12 @@ class ShearLocation(Observable):
             counted = f"{section.get('frame_pairs')} frame pairs"
         rows.append(("samples", f"{section.get('n')} ({section.get('samples')}s; "
                                 f"{counted} in {section.get('slips')} slips)"))
+        counts = section.get("interval_largest_gap")
+        if counts:
+            rows.append(("one interval at a time (wall at ≥ ½ its mean slip velocity): "
+                         "median largest jump; intervals with the largest jump at each gap",
+                         f"{format_value(section.get('interval_largest_jump_median'), 2)}; "
+                         + ", ".join(f"{name}: {c}" for name, c in zip(names, counts))))
         rows.append(("layer velocities from", "the trajectory" if section.get("source") in
                      (None, "trajectory") else "the velocity and density profiles"))
         return rows

@@ -102,6 +102,11 @@ def test_plug_flow_slips_at_the_top_interface(tmp_path):
     assert out["jump"][-1] == pytest.approx(1.0, abs=4 * out["jump_stderr"][-1] + 0.02)
     assert sum(out["jump"]) == pytest.approx(1.0)
     assert out["wall_slip_velocity"] == pytest.approx(V)
+    # per slip and one window at a time: the whole slip at the top plane
+    assert len(out["jump_per_sample"]) == 4
+    assert np.allclose(np.sum(out["jump_per_sample"], axis=1), 1.0)
+    assert out["interval_largest_gap"] == [0, 0, 0, 0, 48]
+    assert out["interval_largest_jump_median"] == pytest.approx(1.0, abs=0.05)
 
 
 def test_linear_couette_is_spread_with_a_linear_profile(tmp_path):
@@ -112,6 +117,8 @@ def test_linear_couette_is_spread_with_a_linear_profile(tmp_path):
     err = np.asarray(out["share_stderr"])
     assert np.all(np.abs(np.asarray(out["share"]) - truth) < 4 * err + 1e-3), (out["share"], err)
     assert np.allclose(out["jump"], 0.2, atol=0.02)
+    # one window at a time as well: no plane takes much more than its fifth
+    assert out["interval_largest_jump_median"] < 0.3
 
 
 def test_plug_flow_with_the_top_wall_slips_at_the_bottom_interface(tmp_path):
