@@ -36,10 +36,11 @@ def test_the_section_comes_from_the_profiles_without_a_trajectory(both):
 def test_profiles_and_trajectory_agree_on_the_same_intervals(both):
     _, prof, traj = both
     assert traj["source"] == "trajectory"
-    # the same 1 τ intervals in the same slips: the same shares within their errors (the
-    # two assign atoms to layers from their own density profiles, the one by bins)
+    # the same 1 τ intervals in the same slips: the same shares, to far less than their
+    # errors (the two differ only in the layers' edges, each from its own density profile,
+    # and in time-averaged velocities against displacements; 0.01 on this run)
     assert prof["slips"] == traj["slips"] and prof["samples"] == traj["samples"]
     assert abs(prof["profile_windows"] - traj["frame_pairs"]) <= prof["slips"]
-    err = np.hypot(prof["jump_stderr"], traj["jump_stderr"])
-    assert np.all(np.abs(np.subtract(prof["jump"], traj["jump"])) < 3 * err + 0.05), (prof, traj)
+    assert np.all(np.abs(np.subtract(prof["jump"], traj["jump"])) < 0.05), (prof, traj)
+    assert prof["interval_largest_gap"] == traj["interval_largest_gap"]
     assert prof["location"] == traj["location"]
