@@ -306,9 +306,8 @@ def located(lv: dict, *, blocks: int = 4) -> dict:
     out = shear_shares(rows)
     slip_v = lv["top"] - lv["bottom"]
     jumps = np.diff(np.column_stack([np.zeros(len(rows)), rows, np.ones(len(rows))]), axis=1)
-    moving = slip_v >= 0.5 * slip_v.mean() if slip_v.size else slip_v.astype(bool)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f = (lv["layer"][moving] - lv["bottom"][moving, None]) / slip_v[moving, None]
+    moving = (slip_v > 0) & (slip_v >= 0.5 * slip_v.mean()) if slip_v.size else slip_v > 0
+    f = (lv["layer"][moving] - lv["bottom"][moving, None]) / slip_v[moving, None]
     each = np.diff(np.column_stack([np.zeros(len(f)), f, np.ones(len(f))]), axis=1)
     each = each[np.all(np.isfinite(each), axis=1)]
     out.update({"samples": unit, "intervals": int(lv["slip"].size),
