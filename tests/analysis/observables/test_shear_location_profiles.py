@@ -19,11 +19,16 @@ SLIPS = [(s, s + 12 * WINDOW) for s in (4000, 14000, 24000, 34000)]
 END = 44000
 
 
-def _write(path, steps, z, count, values, column):
-    lines = [f"# Chunk-averaged data for fix {column.split('/')[0]} and group film",
-             "# Timestep Number-of-chunks Total-count",
-             f"# Chunk Coord1 Ncount {column}"]
-    for s, c, v in zip(steps, count, values):
+def _write(path, steps, z, count, values, column, resumed_at=None):
+    """A ``fix ave/chunk`` file; with ``resumed_at``, a second part (as a resumed run appends
+    it, after a header of its own) begins after the frame of that step."""
+    header = [f"# Chunk-averaged data for fix {column.split('/')[0]} and group film",
+              "# Timestep Number-of-chunks Total-count",
+              f"# Chunk Coord1 Ncount {column}"]
+    lines = list(header)
+    for i, (s, c, v) in enumerate(zip(steps, count, values)):
+        if resumed_at is not None and i and steps[i - 1] > s:
+            lines += header
         lines.append(f"{s} {z.size} {c.sum()}")
         lines += [f"  {i + 1} {zi:g} {ci:g} {vi:g}" for i, (zi, ci, vi) in enumerate(zip(z, c, v))]
     path.write_text("\n".join(lines) + "\n")
@@ -63,10 +68,11 @@ def _run(tmp_path, layer_velocity, noise=0.01, seed=1, resumed_at=None):
              [v for v, r in zip(vx, redo) if r]
         cnt = cnt + [c for c, r in zip(cnt, redo) if r]
     (tmp_path / "profiles").mkdir()
-    _write(tmp_path / "profiles" / "velocity.profile", steps, z, np.array(cnt), np.array(vx), "vx")
+    _write(tmp_path / "profiles" / "velocity.profile", steps, z, np.array(cnt), np.array(vx), "vx",
+           resumed_at)
     dens = np.array(cnt) / (7.7 * 7.6 * BIN)
     _write(tmp_path / "profiles" / "density.profile", steps, z, np.array(cnt), dens,
-           "density/number")
+           "density/number", resumed_at)
     windows = [(a * DT, b * DT) for a, b in SLIPS]
     return trace, windows
 
@@ -127,8 +133,11 @@ def test_plug_flow_with_the_top_wall_slips_at_the_bottom_interface(tmp_path):
 
 
 def test_a_resumed_run_keeps_the_last_frame_of_each_step(tmp_path):
-    # the stale frames (velocity 99) written before the resume are replaced
+    # the resumed run's part follows a header of its own; the frames the interrupted run
+    # wrote after the restart step (velocity 99) are replaced by the resumed run's
     out = _located(tmp_path, np.zeros(LAYERS), resumed_at=20000)
+    text = (tmp_path / "profiles" / "velocity.profile").read_text()
+    assert text.count("# Chunk-averaged data") == 2
     assert out["profile_windows"] == 48 and out["location"] == "top interface"
     assert max(abs(s) for s in out["share"]) < 0.05
 
