@@ -56,6 +56,8 @@ REFERENCE_SLIP_VELOCITY = 0.65
 TIMESTEP = 0.005
 MARGIN = 1.15
 SEEDS = (1, 2, 3)
+#: The scene's profile window (steps): a few per slip of M = 30 m (its ``profile_every``).
+REFERENCE_PROFILE_EVERY = 500
 #: The heavy rungs' steps over the cost model's: the measured first slip of M = 2.4×10⁵
 #: (34 σ against the model's 14 σ) makes a cycle ≈ 15 000 τ at V = 0.002.
 HEAVY_STEP_FACTOR = 1.4
@@ -117,6 +119,13 @@ class Rung:
         return slide_steps(self.mass, self.drive_velocity, self.slips, self.step_factor)
 
     @property
+    def profile_every(self) -> int:
+        """The profiles' window (steps): the scene's scaled by √(M/30), the slips' time
+        scale, so that a slip holds as many windows at every rung and the profile files
+        grow with the slips, not with the steps."""
+        return REFERENCE_PROFILE_EVERY * round(math.sqrt(self.mass / REFERENCE_MASS))
+
+    @property
     def model_steps(self) -> int:
         """The cost model's steps, before :attr:`step_factor`."""
         return slide_steps(self.mass, self.drive_velocity, self.slips)
@@ -134,7 +143,8 @@ class Rung:
 
     def sets(self) -> list[str]:
         return [f"wall_mass={self.mass:g}", f"drive_velocity={self.drive_velocity:g}",
-                f"mount_damping={self.mount_damping:g}", f"slide_steps={self.slide_steps}"]
+                f"mount_damping={self.mount_damping:g}", f"slide_steps={self.slide_steps}",
+                f"profile_every={self.profile_every}"]
 
 
 #: The rungs, lightest first.  M = 2.4e5 is the Bi ≥ 30 rung (the ``sfb-heavy`` scene is its
