@@ -144,6 +144,10 @@ def load(name_or_path: str, overrides: dict[str, Any] | None = None) -> Scene:
     bad = [o for o in outputs if o not in OUTPUTS]
     if bad:
         raise SceneError(f"{path}: unknown outputs {bad}; known: {sorted(OUTPUTS)}")
+    # a user who sets a recording interval asks for that recording: honoured, not zeroed
+    asked = {"dump_every": "structure", "profile_every": "profiles"}
+    outputs = list(outputs) + [o for k, o in asked.items()
+                               if k in (overrides or {}) and o not in outputs]
     params = data.get("parameters", {})
     if not isinstance(params, dict):
         raise SceneError(f"{path}: [parameters] must be a table")

@@ -182,3 +182,14 @@ def test_set_refusal_shows_the_parameters_own_range():
 
     with pytest.raises(SceneError, match=r"not a number in \[0, 5\] sigma/tau"):
         parse_assignment("drive_velocity=fast")
+
+
+def test_a_recording_interval_set_by_the_user_is_recorded():
+    # stick-slip records neither a trajectory nor profiles; --set of their interval asks for them
+    plain = load("stick-slip")
+    assert not plain.writes_profiles and not plain.writes_trajectory
+    assert plain.lammps_variables()["profile_every"] == "0"
+    asked = load("stick-slip", {"profile_every": 1000, "dump_every": 400})
+    assert asked.writes_profiles and asked.writes_trajectory
+    var = asked.lammps_variables()
+    assert var["profile_every"] == "1000" and var["dump_every"] == "400"
