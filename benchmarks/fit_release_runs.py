@@ -1,6 +1,7 @@
 """The slip law's MD positive control (docs/results/slip-law.md): liquid-release runs fitted.
 
     filmfriction run liquid-release --np 1 --md-only --set seed=S --out RUN_S   # per seed
+    (add --set hold_gap=1 for the held-gap control: the wall free along x only)
     python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] RUN_1 RUN_2 ...
 
 Prints the slip law fitted to the runs' release slips together

@@ -18,3 +18,11 @@ def test_release_offset_range_and_its_lammps_variable():
     scene = load("liquid-release")
     assert scene.lammps_variables()["release_offset"] == "20.0"
     assert scene.lammps_variables()["drive_velocity"] == "0.0"
+
+
+def test_hold_gap_is_0_or_1_and_its_lammps_variable():
+    with pytest.raises(SceneError, match=r"hold_gap = 2: outside the allowed range"):
+        resolve({"hold_gap": 2})
+    assert resolve({})["hold_gap"] == 0
+    scene = load("liquid-release", {"hold_gap": 1})
+    assert scene.lammps_variables()["hold_gap"] == "1"

@@ -99,6 +99,9 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("release_offset", float, "sigma", 0.0, 0.0, 1000.0,
       "release test: the spring's far end starts this far ahead of the wall (x0), "
       "so the wall is let go from a stretched spring; 0 = no offset"),
+    P("hold_gap", int, "-", 0, 0, 1,
+      "1 = the top wall's z frozen for the slide (free along x only, at the gap it reached "
+      "under the load while equilibrating: the load does no work); 0 = free along z"),
     P("spring_constant", float, "epsilon/sigma^2", 100.0, 0.0, 1.0e5,
       "stiffness of the drive spring", low_open=True),
     P("normal_pressure", float, "epsilon/sigma^3", 1.0, 0.0, 100.0,
