@@ -38,8 +38,10 @@ def ledger(columns: dict) -> dict:
         ``input`` (drive_work + load_work at the end, relative to the start),
         ``closure`` (|final residual| / |input|; NaN when no work was done),
         ``thermostat_heat`` and ``mount_heat`` (at the end, relative to the
-        start), ``turnover`` (the energy turned over: the larger of |input|
-        and |thermostat_heat + mount_heat|).
+        start), ``turnover`` (the energy turned over: the largest of |input|,
+        |thermostat_heat + mount_heat| and the spring energy released, the most the
+        spring's energy fell below its start: a wall let go from a stretched spring
+        turns that over before any heat leaves).
     """
     c = {n: np.asarray(columns[n], float) for n in LEDGER_COLUMNS}
     work = c["drive_work"] + c["load_work"]
@@ -52,7 +54,9 @@ def ledger(columns: dict) -> dict:
     residual = (work - work[0]) - (stored - stored[0]) - heat - mount
     total = float(work[-1] - work[0])
     closure = abs(float(residual[-1])) / abs(total) if total else math.nan
-    turnover = max(abs(total), abs(float(heat[-1] + mount[-1])))
+    spring = c["spring_energy"]
+    released = float(np.max(spring[0] - spring))
+    turnover = max(abs(total), abs(float(heat[-1] + mount[-1])), released)
     return {"residual": residual, "input": total, "closure": closure,
             "thermostat_heat": float(heat[-1]), "mount_heat": float(mount[-1]),
             "turnover": turnover}

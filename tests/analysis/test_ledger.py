@@ -65,3 +65,21 @@ def test_the_runner_has_no_ledger_of_its_own(monkeypatch):
     monkeypatch.setattr(ledger, "ledger", inflated)
     assert sanity.ledger_problem(_dat(0.1), scene).startswith(
         "energy ledger does not close: residual 2 epsilon")
+
+
+def test_a_released_spring_counts_as_energy_turned_over():
+    # a wall let go from a stretched spring: 200 epsilon of spring energy become the film's
+    # kinetic and potential energy before the thermostat has taken any heat out; a residual
+    # of 0.2 epsilon is 0.1 % of what was turned over, not 8 % of the heat
+    dat = _dat(0.0)
+    cols = _columns(dat)
+    s = np.linspace(0.0, 1.0, 11)
+    cols["drive_work"] = np.zeros(11)
+    cols["spring_energy"] = 200.0 * (1.0 - s)
+    cols["kinetic_energy"] = 20.0 + 150.0 * s
+    cols["potential_energy"] = -100.0 + 47.3 * s
+    cols["mount_heat"] = np.zeros(11)
+    cols["thermostat_heat"] = 2.5 * s
+    led = ledger.ledger(cols)
+    assert led["residual"][-1] == pytest.approx(0.2)
+    assert led["turnover"] == pytest.approx(200.0)
