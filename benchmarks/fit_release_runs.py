@@ -54,6 +54,15 @@ def kinetic_needed(branch) -> int | None:
     return releases_needed(float(fk.std(ddof=1)), DOMINANT_SHARE * branch.mean_force)
 
 
+def _slip_window(tr, smoothing: float):
+    """A release's time, wall position, stick index, sample interval and the odd
+    Savitzky–Golay window of ``smoothing`` × the slip's duration."""
+    t, x = tr["time"], tr["wall_position"]
+    _, s = release_slip(t, x)
+    dt = float(t[1] - t[0])
+    return t, x, s, dt, int(round(smoothing * (t[s] - t[0]) / dt)) | 1
+
+
 def branch_bins(traces, mass: float, law: tuple, load: float, edges=(0.2, 0.4, 0.6, 0.8, 1.0),
                 smoothing: float = 0.1, corrected: bool = False) -> dict:
     """Where the loop sits: per branch and bin of v / v_peak, the mean over the releases of the
@@ -66,10 +75,7 @@ def branch_bins(traces, mass: float, law: tuple, load: float, edges=(0.2, 0.4, 0
     rows = {}
     samples_law = []
     for tr in traces:
-        t, x = tr["time"], tr["wall_position"]
-        _, s = release_slip(t, x)
-        dt = float(t[1] - t[0])
-        w = int(round(smoothing * (t[s] - t[0]) / dt)) | 1
+        t, x, s, dt, w = _slip_window(tr, smoothing)
         v, a = (savgol_filter(x, w, 2, deriv=k, delta=dt) for k in (1, 2))
         force = savgol_filter(tr["spring_force"], w, 2) - mass * a
         dgap = savgol_filter(tr["gap"], w, 2, deriv=1, delta=dt)
@@ -110,10 +116,7 @@ def load_term_coefficient(traces, mass: float, floor: float = 0.2, smoothing: fl
     from scipy.integrate import cumulative_trapezoid
     per = []
     for tr in traces:
-        t, x = tr["time"], tr["wall_position"]
-        _, s = release_slip(t, x)
-        dt = float(t[1] - t[0])
-        w = int(round(smoothing * (t[s] - t[0]) / dt)) | 1
+        t, x, s, dt, w = _slip_window(tr, smoothing)
         g = savgol_filter(x[:s + 1], w, 2, deriv=1, delta=dt)
         p = int(np.argmax(g))
         fast = g > floor * g[p]

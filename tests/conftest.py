@@ -161,6 +161,25 @@ class MD:
             self._shared[key] = MDRun(scene, path)
         return self._shared[key]
 
+    @staticmethod
+    def killed_at(cmd: list[str], out: Path, marker: str = "restart.4000",
+                  timeout: float = 120.0) -> None:
+        """Start ``cmd`` (a ``filmfriction run`` into ``out``) and kill its whole process
+        group hard (SIGKILL, nothing cleaned up) once ``out/marker`` exists or after
+        ``timeout`` seconds: an interrupted run for the resume tests."""
+        import os
+        import signal
+        import subprocess
+        import time
+
+        proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        stop = time.time() + timeout
+        while time.time() < stop and not list(out.glob(marker)):
+            time.sleep(0.2)
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+
     def changed_shared_runs(self) -> list[str]:
         return [str(path) for path, snap in self._snapshots.items() if _snapshot(path) != snap]
 

@@ -5,10 +5,6 @@ and resumed: through both parts the gap keeps the value it had when the wall was
 round-off), the load does no work, and the wall still slides towards the spring's end.
 """
 import json
-import os
-import signal
-import subprocess
-import time
 
 import numpy as np
 import pytest
@@ -28,13 +24,7 @@ def test_held_gap_stays_constant_through_a_resumed_release(tmp_path, md, filmfri
     cmd = [filmfriction_command, "run", "liquid-release", "--md-only", "--quiet",
            "--np", "1", "--out", str(out)]
     cmd += [f"--set={k}={v}" for k, v in {**md.box, **HELD}.items()]
-    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    deadline = time.time() + 120
-    while time.time() < deadline and not list(out.glob("restart.4000")):
-        time.sleep(0.2)
-    os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
+    md.killed_at(cmd, out)
     assert list(out.glob("restart.*")), "no restart file was written before the kill"
     runner.resume(out, progress=False)
     assert json.loads((out / "run.json").read_text())["status"] == "completed"

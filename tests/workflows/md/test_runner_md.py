@@ -4,10 +4,6 @@ Most checks read the session's shared ``film_run`` (conftest.py): film-structure
 on the 5 x 3 box, 2000 + 12000 steps at V = 0.05, with trajectory and profiles.
 """
 import json
-import os
-import signal
-import subprocess
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -133,13 +129,7 @@ def test_interrupted_run_resumes(tmp_path, md, filmfriction_command):
     cmd = [filmfriction_command, "run", "stick-slip", "--md-only", "--quiet", "--out", str(out)]
     cmd += [f"--set={k}={v}" for k, v in
             {**md.box, **SMALL, "slide_steps": 20000, "restart_every": 2000}.items()]
-    proc = subprocess.Popen(cmd, start_new_session=True, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    deadline = time.time() + 120
-    while time.time() < deadline and not list(out.glob("restart.4000")):
-        time.sleep(0.2)
-    os.killpg(proc.pid, signal.SIGKILL)
-    proc.wait()
+    md.killed_at(cmd, out)
     assert list(out.glob("restart.*")), "no restart file was written before the kill"
     record = json.loads((out / "run.json").read_text())
     assert record["status"] == "running"  # killed hard: the record says so
