@@ -50,12 +50,12 @@ slip at the top interface):
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
+from ..files.chunk_file import read_chunk_file
 from .observable import Context, Observable, format_value
 
 __all__ = ["ShearLocation", "layer_velocities", "profile_layer_velocities", "read_profile_frames",
@@ -139,7 +139,7 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
         restart file earlier than its last frame) keeps its last frame; a last frame
         cut short (a run killed while writing it) is left out.
     """
-    prof = _chunk_file(velocity_path)
+    prof = read_chunk_file(velocity_path)
     steps = np.asarray(prof.timesteps, int)
     if steps.size == 0:
         raise ValueError(f"{velocity_path}: no profile frames")
@@ -163,50 +163,13 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
     window = int(gaps.min()) if gaps.size else int(steps[0])
     density = count.mean(axis=0)
     if density_path is not None:
-        dens = _chunk_file(density_path)
+        dens = read_chunk_file(density_path)
         dname = next((k for k in dens.chunks[0] if k.startswith("density")), None)
         if dname is not None and len(dens.chunks) == z.size:
             n = min(len(c[dname]) for c in dens.chunks)
             density = np.array([np.mean(c[dname][:n]) for c in dens.chunks])
     return {"z": z, "steps": steps, "window": window, "vx": vx, "count": count,
             "density": density}
-
-
-def _chunk_file(path):
-    """:class:`lammps.formats.AvgChunkFile` of ``path``; a file a resumed run appended to
-    (each part after a header of its own) is read part by part, its frames in file order."""
-    import tempfile
-
-    from lammps.formats import AvgChunkFile
-
-    text = Path(path).read_text(encoding="utf-8")
-    head = "# Chunk-averaged data for fix"
-    parts = [head + p for p in text.split(head)[1:]] or [text]
-    whole = None
-    for part in parts:
-        with tempfile.NamedTemporaryFile("w", suffix=".profile", encoding="utf-8") as tmp:
-            tmp.write(part)
-            tmp.flush()
-            try:
-                prof = AvgChunkFile(tmp.name)
-            except (AssertionError, IndexError) as exc:  # the reader's own checks of a frame
-                raise ValueError(f"not a complete fix ave/chunk file ({exc!r})") from None
-            except RuntimeError as exc:
-                raise ValueError(str(exc)) from None
-        if whole is None:
-            whole = prof
-            continue
-        if len(prof.chunks) != len(whole.chunks):
-            raise ValueError(f"{path}: its parts have {len(whole.chunks)} and "
-                             f"{len(prof.chunks)} bins")
-        # a part cut short (the run killed while writing a frame) ends at its last whole frame
-        n = min(len(c["ncount"]) for c in whole.chunks)
-        whole.timesteps = whole.timesteps[:n] + prof.timesteps
-        for mine, theirs in zip(whole.chunks, prof.chunks):
-            for key, values in theirs.items():
-                if isinstance(values, list):
-                    mine[key] = mine[key][:n] + values
-    return whole
 
 
 def profile_layer_velocities(frames: dict, edges, windows, *, trace_step, trace_time,

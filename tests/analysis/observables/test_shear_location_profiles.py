@@ -156,3 +156,22 @@ def test_a_frame_cut_short_is_left_out_and_a_broken_line_is_a_value_error(tmp_pa
     path.write_text("".join(lines[:-3]) + "  1 0.05\n")
     with pytest.raises(ValueError, match="not a complete fix ave/chunk file"):
         _from_profiles(trace, path, None, windows)
+
+
+def test_the_viscosity_profile_reads_a_resumed_runs_appended_profile(tmp_path):
+    # the time-averaged profile (viscosity, structure) reads a file a resumed run appended to
+    # with the same reader as the shear location: its parts joined, the mean of all frames'
+    # last half (steps 3000, 4000: vx 3 and 4 in every bin)
+    from filmfriction.analysis.files.chunk_file import read_chunk_file
+    from filmfriction.analysis.observables.viscosity_section import averaged_profile
+
+    z, count = np.array([1.0, 2.0]), np.ones(2)
+    path = tmp_path / "velocity.profile"
+    _write(tmp_path / "first.profile", [1000, 2000], z, [count] * 2,
+           [np.full(2, k) for k in (1.0, 2.0)], "vx")
+    second = tmp_path / "second.profile"
+    _write(second, [3000, 4000], z, [count] * 2, [np.full(2, k) for k in (3.0, 4.0)], "vx")
+    path.write_text((tmp_path / "first.profile").read_text() + second.read_text())
+    assert read_chunk_file(path).timesteps == [1000, 2000, 3000, 4000]
+    zz, vx, name = averaged_profile(path, ("vx",))
+    assert name == "vx" and np.allclose(zz, z) and np.allclose(vx, 3.5)
