@@ -13,9 +13,16 @@ linearly, goes from the bottom wall's velocity to the top wall's, i.e. 1/(d f/dz
 the layers' velocity shares (:mod:`~filmfriction.analysis.observables.shear_location_section`).
 
 :func:`release_slip` finds the release's slip in a trace (the first swing: from the
-release to the first stop of the wall); :func:`fit_releases` fits the slip law
-(:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`) to the slips of several
-releases (independent seeds) together, so that the errors are the slips' scatter.
+release to the first stop of the wall).  :func:`fit_release_ensemble` fits the slip law
+(:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`) to the mean trace of
+several releases (independent seeds: replicas of one initial condition), its errors the
+jackknife's over the releases; :func:`fit_releases` fits each release's slip and takes
+the slips' scatter.  The first is the control's fit: the film's random force moves the
+wall, so each release's regressors (its Δx, Δv) carry the noise of its response and the
+per-release fit is biased (on the fluctuating Newtonian film of
+:mod:`~filmfriction.analysis.groundtruth.film_release`, a loop step of ≈ +1.4 ε/σ where
+there is none, docs/results/slip-law.md); the law is linear in the trace, so the mean
+trace's fit is not.
 
 Example
 -------
@@ -40,9 +47,10 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import cycle_table
 
-from ..slip_law.slip_law import FilmForceFit, fit_film_force
+from ..slip_law.slip_law import FilmForceFit, fit_film_force, jackknife_fit
 
-__all__ = ["release_slip", "release_gap", "fit_releases", "profile_width", "release_profile",
+__all__ = ["release_slip", "release_gap", "fit_releases", "fit_release_ensemble", "mean_release",
+           "profile_width", "release_profile",
            "couette_comoving_mass", "model_release"]
 
 
@@ -137,6 +145,76 @@ def fit_releases(traces, *, mass: float, mount_damping: float = 0.0,
                           mass=mass, mount_damping=mount_damping,
                           wall_position=cols["wall_position"], comoving_mass=comoving_mass,
                           load_work=cols.get("load_work"), **fit)
+
+
+def mean_release(traces, *, columns=("spring_force", "wall_position", "wall_velocity")) -> dict:
+    """The mean trace of releases aligned at the release (each trace's first sample, its
+    time from there), over the samples all of them have; ``load_work`` (each from its
+    own start) is averaged too when every trace has it.
+
+    >>> a = {"time": np.arange(4.0), "spring_force": np.ones(4), "wall_position": np.zeros(4),
+    ...      "wall_velocity": np.zeros(4)}
+    >>> b = a | {"time": np.arange(3.0) + 7, "spring_force": np.full(3, 3.0)}
+    >>> m = mean_release([a, b])
+    >>> m["time"].tolist(), m["spring_force"].tolist()
+    ([0.0, 1.0, 2.0], [2.0, 2.0, 2.0])
+    """
+    traces = list(traces)
+    if not traces:
+        raise ValueError("no release traces to average")
+    n = min(len(tr["time"]) for tr in traces)
+    times = [np.asarray(tr["time"], float)[:n] for tr in traces]
+    rel = times[0] - times[0][0]
+    for j, t in enumerate(times[1:], 1):
+        if not np.allclose(t - t[0], rel, rtol=1e-6, atol=1e-9 * max(1.0, rel[-1])):
+            raise ValueError(f"release trace {j} is sampled at other times than trace 0: "
+                             "the mean needs one sampling interval")
+    names = list(columns) + (["load_work"] if all("load_work" in tr for tr in traces) else [])
+    out = {"time": rel}
+    for k in names:
+        cols = [np.asarray(tr[k], float)[:n] for tr in traces]
+        if k == "load_work":
+            cols = [c - c[0] for c in cols]
+        out[k] = np.mean(cols, axis=0)
+    return out
+
+
+def fit_release_ensemble(traces, *, mass: float, mount_damping: float = 0.0,
+                         comoving_mass: bool = False, load_work: bool = False,
+                         **fit) -> FilmForceFit:
+    """The slip law fitted to the mean release (:func:`mean_release` of ``traces``), its
+    errors from the jackknife over the releases (the fits of the R means that leave one
+    release out: R − 1 degrees of freedom;
+    :func:`~filmfriction.analysis.slip_law.slip_law.jackknife_fit`), the verdict by the
+    same rule on those errors.  Arguments as :func:`fit_releases`; the per-slip arrays
+    of the result hold the jackknife's pseudo-values, one per release.
+
+    The releases must be replicas of one release (one wall, spring and film; the same
+    sampling), which a seed series of one scene is.  ``load_work``: the mean load's
+    work taken out of the mean film force.
+    """
+    traces = list(traces)
+    if len(traces) < 3:
+        raise ValueError(f"{len(traces)} release trace(s): the ensemble fit needs 3 or more")
+    if load_work and not all("load_work" in tr for tr in traces):
+        raise ValueError("load_work=True: a trace has no load_work column")
+    mean = mean_release(traces)
+    n, r = mean["time"].size, len(traces)
+    keys = [k for k in mean if k != "time"]
+    total = {k: mean[k] * r for k in keys}
+
+    def one(tr):
+        return fit_releases([tr], mass=mass, mount_damping=mount_damping,
+                            comoving_mass=comoving_mass, load_work=load_work, **fit)
+
+    loo = []
+    for tr in traces:
+        own = {k: np.asarray(tr[k], float)[:n] for k in keys}
+        if "load_work" in own:
+            own["load_work"] = own["load_work"] - own["load_work"][0]
+        loo.append(one({"time": mean["time"]} | {k: (total[k] - own[k]) / (r - 1)
+                                                  for k in keys}))
+    return jackknife_fit(one(mean), loo, mass=mass)
 
 
 def profile_width(layer_z, share, share_stderr=None) -> tuple[float, float]:

@@ -125,11 +125,12 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
 
-from .slip_law_branches import BranchFit, Segment, fit_branch
+from .slip_law_branches import BranchFit, Segment, fit_branch, jackknife, jackknife_branch
 from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
-__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "detectable",
+__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "jackknife_fit",
+           "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
 
@@ -421,6 +422,45 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
                         detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
                         la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still),
                         gap_rate is not None)
+
+
+def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float) -> FilmForceFit:
+    """The fit of a mean trace with its errors from the jackknife over its replicas.
+
+    ``fit`` is :func:`fit_film_force` on the mean of R replicas of one slip (releases
+    of one initial condition, aligned at the release), ``leave_one_out`` the R fits of
+    the means that leave one replica out.  The law is linear in the trace, so the mean
+    trace's fit has the law's expectation whatever the noise (E[ξ] = 0), while a fit
+    per replica regresses on the replica's own noisy Δx and Δv, which the film's
+    random force has moved (the regressors correlate with the response's noise: a
+    bias that does not shrink with more replicas).  Its errors are not the mean
+    trace's (its residuals are the law's and the smoothing's, not the replicas'
+    scatter) but the jackknife's, R − 1 degrees of freedom
+    (:func:`~filmfriction.analysis.slip_law.slip_law_branches.jackknife_branch`); the
+    significance, the power, the branches' verdicts and the choice of the law
+    (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`) follow from
+    them as on any fit.
+    """
+    loo = list(leave_one_out)
+    if len(loo) < 2:
+        raise ValueError(f"{len(loo)} leave-one-out fit(s): the jackknife needs 2 or more")
+    br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo])
+          for name in ("decelerating", "accelerating", "whole", "one_law")}
+    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo])
+    dof = len(loo) - 1
+    frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass)
+    (la_se, la_ps), (lf_se, _) = (jackknife(getattr(fit, k), [getattr(f, k) for f in loo])
+                                  for k in ("loop_area", "loop_force"))
+    return replace(fit, **br, loop_step_stderr=st.loop_step_stderr,
+                   loop_step_sigmas=sigmas(fit.loop_step, st.loop_step_stderr, dof),
+                   detectable_loop_step=detectable(st.loop_step_stderr, dof),
+                   verdict_from=frm, verdict=verdict, reason=reason, loop_area_stderr=la_se,
+                   loop_force_stderr=lf_se, per_slip_loop_area=la_ps)
+
+
+def _step_branch(fit: FilmForceFit) -> BranchFit:
+    """The one law's fit carrying the loop step (what :func:`choose_law` reads)."""
+    return replace(fit.one_law, loop_step=fit.loop_step, loop_step_stderr=fit.loop_step_stderr)
 
 
 def _load_work_rate(load_work, t: np.ndarray) -> np.ndarray:

@@ -9,14 +9,15 @@ The physics is :mod:`filmfriction.analysis.slip_law.slip_law`'s.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .slip_law_stats import correlation_time, detectable, ols, sigmas
 from .slip_law_verdict import branch_verdict
 
-__all__ = ["BranchFit", "Segment", "fit_branch", "MIN_SLIPS_FOR_SCATTER"]
+__all__ = ["BranchFit", "Segment", "fit_branch", "jackknife_branch", "jackknife",
+           "MIN_SLIPS_FOR_SCATTER"]
 
 #: With this many slips or more, the errors are the scatter of the per-slip fits.
 MIN_SLIPS_FOR_SCATTER = 3
@@ -190,3 +191,48 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
     return BranchFit(branch, fk, se_fk, b, se_b, mc, se_mc, vbar,
                      fbar, share, n_mean, n_se, z_fk, z_b, det_b, det_fk, dof, verdict, reason,
                      per[:, 0], per[:, 1], expo, int(allres.size), n, vres, step, se_step)
+
+
+def jackknife(estimate: float, leave_one_out) -> tuple[float, np.ndarray]:
+    """The jackknife's standard error of ``estimate`` (a smooth function of the mean of R
+    replicas) from its values on the R means that leave one replica out, and the
+    pseudo-values R·θ − (R − 1)·θ₍ᵢ₎ (per-replica values whose standard deviation over
+    √R is that error: they stand for the replicas in the power of more of them).
+
+    >>> x = np.array([1.0, 2.0, 4.0, 7.0])
+    >>> loo = (x.sum() - x) / 3                  # the mean is its own jackknife
+    >>> se, pseudo = jackknife(x.mean(), loo)
+    >>> round(se, 12) == round(x.std(ddof=1) / 2, 12), pseudo.tolist()
+    (True, [1.0, 2.0, 4.0, 7.0])
+    """
+    th = np.asarray(leave_one_out, float)
+    r = th.size
+    if r < 2 or not (math.isfinite(estimate) and np.all(np.isfinite(th))):
+        return math.nan, np.full(r, math.nan)
+    se = math.sqrt((r - 1) / r * float(np.sum((th - th.mean()) ** 2)))
+    return se, r * estimate - (r - 1) * th
+
+
+def jackknife_branch(fit: BranchFit, leave_one_out: list[BranchFit]) -> BranchFit:
+    """``fit`` (of the replicas' mean trace) with its errors from the jackknife over the
+    R replicas (:func:`jackknife`, R − 1 degrees of freedom): F_k, B, m_c, the exponent
+    and the loop step; the significance, the power and the verdict recomputed from them
+    (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.branch_verdict`); the
+    per-slip arrays hold the pseudo-values, one per replica."""
+    r = len(leave_one_out)
+    err = {name: jackknife(getattr(fit, name), [getattr(b, name) for b in leave_one_out])
+           for name in ("kinetic_force", "damping", "comoving_mass", "exponent", "loop_step")}
+    dof = r - 1
+    (se_fk, fk_ps), (se_b, b_ps) = err["kinetic_force"], err["damping"]
+    fk, b, vbar, fbar = fit.kinetic_force, fit.damping, fit.mean_velocity, fit.mean_force
+    z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
+    det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
+    verdict, reason = branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, r)
+    reason = reason.replace(f"over {r} slip(s)", f"mean of {r} releases, jackknife errors")
+    return replace(fit, kinetic_force_stderr=se_fk, damping_stderr=se_b,
+                   comoving_mass_stderr=err["comoving_mass"][0],
+                   exponent_stderr=err["exponent"][0], kinetic_sigmas=z_fk, damping_sigmas=z_b,
+                   detectable_damping=det_b, detectable_kinetic_force=det_fk, dof=dof,
+                   verdict=verdict, reason=reason, per_slip_kinetic_force=fk_ps,
+                   per_slip_damping=b_ps, per_slip_exponent=err["exponent"][1], slips=r,
+                   loop_step_stderr=err["loop_step"][0])

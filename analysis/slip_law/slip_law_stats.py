@@ -8,6 +8,7 @@ autocorrelation time (:func:`correlation_time`).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 from scipy import stats as sps
@@ -50,11 +51,17 @@ def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
     """
     if not (math.isfinite(stderr) and stderr >= 0 and dof >= 1):
         return math.nan
+    return float(_noncentrality(int(dof), float(resolved), float(power)) * stderr)
+
+
+@lru_cache(maxsize=4096)
+def _noncentrality(dof: int, resolved: float, power: float) -> float:
+    """δ of :func:`detectable` for ``dof`` degrees of freedom (a root of the noncentral t's
+    tail: computed once per dof)."""
     crit = sps.t.isf(sps.norm.sf(resolved), dof)
     if dof > 1000:
-        return float((crit + sps.norm.ppf(power)) * stderr)
-    delta = brentq(lambda d: sps.nct.sf(crit, dof, d) - power, 0.0, 10 * crit + 50)
-    return float(delta * stderr)
+        return float(crit + sps.norm.ppf(power))
+    return float(brentq(lambda d: sps.nct.sf(crit, dof, d) - power, 0.0, 10 * crit + 50))
 
 
 def ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
