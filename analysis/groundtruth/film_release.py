@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import expm
 
-__all__ = ["Film", "LIQUID_RELEASE_FILM", "transition", "film_release", "release_traces"]
+__all__ = ["Film", "transition", "film_release", "release_traces", "peak_time", "held_until"]
 
 
 @dataclass(frozen=True)
@@ -205,3 +205,20 @@ def release_traces(q: dict) -> list[dict]:
     :func:`~filmfriction.analysis.groundtruth.release_control.fit_releases`."""
     names = ("wall_position", "wall_velocity", "spring_force")
     return [{"time": q["time"]} | {k: q[k][r] for k in names} for r in range(len(q[names[0]]))]
+
+
+def peak_time(film: Film = Film(), *, kinetic_force: float = 0.0, dt: float = 0.05,
+              duration: float = 120.0) -> float:
+    """The time of the noise-free release's peak wall velocity (kT = 0)."""
+    q = film_release(1, film, kT=0.0, kinetic_force=kinetic_force, dt=dt, duration=duration)
+    return float(q["time"][int(np.argmax(q["wall_velocity"][0]))])
+
+
+def held_until(traces: list[dict], force: float, until: float) -> list[dict]:
+    """``traces`` with a yield on their accelerating branch: the film holds ``force``
+    more up to the time ``until`` (e.g. :func:`peak_time`), carried by the spring — its
+    force reads that much more there, the wall's trajectory unchanged (the film force
+    F_spring − M·a then steps down by ``force`` at ``until``: a loop of that size, as on
+    the model releases of ``tests/analysis/groundtruth/test_release_model.py``)."""
+    return [tr | {"spring_force": tr["spring_force"] + np.where(tr["time"] < until, force, 0.0)}
+            for tr in traces]
