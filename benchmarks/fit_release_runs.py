@@ -2,15 +2,19 @@
 
     filmfriction run liquid-release --np 1 --md-only --set seed=S --out RUN_S   # per seed
     (add --set hold_gap=1 for the held-gap control: the wall free along x only)
-    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] RUN_1 RUN_2 ...
+    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] [--per-release] RUN_1 RUN_2 ...
 
-Prints the slip law fitted to the runs' release slips together
-(:func:`filmfriction.analysis.groundtruth.release_control.fit_releases`: the verdict
+Prints the slip law fitted to the runs' mean release, its errors the jackknife's over
+the releases (:func:`filmfriction.analysis.groundtruth.release_control.fit_release_ensemble`;
+``--per-release``: each release's slip fitted and the slips' scatter taken,
+:func:`~filmfriction.analysis.groundtruth.release_control.fit_releases`, which the film's
+own noise biases: docs/results/slip-law.md): the verdict
 and the law it is, each branch and the whole slip, the whole slip with a co-moving
 mass — the one law — and the loop step beyond it), how many releases the rule would
 need at the releases' own scatter (the kinetic force, or the loop step, ruled out at
 half the film force: :func:`~filmfriction.analysis.slip_law.slip_law.detectable` < F̄/2 with
-the per-release standard deviation), each run's layer velocity
+the per-release standard deviation; with the ensemble fit the standard deviation of the
+jackknife's pseudo-values), each run's layer velocity
 shares, where the shear sits and the width W = D + 2b of its profile, and
 B = η·A/W with η the liquid's viscosity at the film's state point
 (``filmfriction viscosity``).  ``--load-work``: the film force less the load's work on
@@ -28,6 +32,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from filmfriction.analysis.groundtruth.release_control import (couette_comoving_mass,
+                                                               fit_release_ensemble,
                                                                fit_releases, release_gap,
                                                                release_profile, release_slip)
 from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, detectable
@@ -135,7 +140,7 @@ def load_term_coefficient(traces, mass: float, floor: float = 0.2, smoothing: fl
     return list(zip(per.mean(axis=0), per.std(axis=0, ddof=1) / math.sqrt(len(per))))
 
 
-def mean_gap_fit(traces, mass: float, members, points: int = 201):
+def mean_gap_fit(traces, mass: float, members, points: int = 201, fit=fit_release_ensemble):
     """The fit with the load's work of the mean gap taken out: W_L averaged over the
     releases ``members`` (indices) at each share of the slip's duration, and that mean
     curve taken out of every release's film force (the gap's breathing averaged away)."""
@@ -146,8 +151,8 @@ def mean_gap_fit(traces, mass: float, members, points: int = 201):
         curves.append(np.interp(share, u, tr["load_work"] - tr["load_work"][0]))
         shares.append(u)
     mean = np.mean([curves[j] for j in members], axis=0)
-    return fit_releases([tr | {"load_work": np.interp(u, share, mean)}
-                         for tr, u in zip(traces, shares)], mass=mass, load_work=True)
+    return fit([tr | {"load_work": np.interp(u, share, mean)}
+                for tr, u in zip(traces, shares)], mass=mass, load_work=True)
 
 
 def main(argv=None) -> int:
@@ -156,7 +161,11 @@ def main(argv=None) -> int:
     ap.add_argument("--viscosity", nargs=2, type=float, metavar=("ETA", "ERR"), required=True)
     ap.add_argument("--load-work", action="store_true",
                     help="take the load's work on the gap out of the film force")
+    ap.add_argument("--per-release", action="store_true",
+                    help="fit each release's slip and take their scatter (biased by the "
+                         "film's noise) instead of the mean release with jackknife errors")
     a = ap.parse_args(argv)
+    fitter = fit_releases if a.per_release else fit_release_ensemble
     traces, mass, film_mass, gaps, moves = [], None, None, [], []
     for run in a.runs:
         tr = np.genfromtxt(f"{run}/trace.csv", delimiter=",", names=True)
@@ -168,9 +177,10 @@ def main(argv=None) -> int:
         pressure = record["scene"]["parameters"]["normal_pressure"]
         moves.append(release_gap(traces[-1], pressure=pressure, area=p["area"]))
         film_mass = record["derived"]["film_atoms"]   # m each
-    fit = fit_releases(traces, mass=mass, load_work=a.load_work)
+    fit = fitter(traces, mass=mass, load_work=a.load_work)
     with_mass = fit.one_law
-    print(f"{len(traces)} releases, M = {mass:g}"
+    print(f"{len(traces)} releases, M = {mass:g}, "
+          f"{'each release fitted' if a.per_release else 'the mean release fitted, jackknife errors'}"
           f"{', the load’s work on the gap taken out' if a.load_work else ''}: verdict {fit.verdict}, the {fit.verdict_from}'s "
           f"({fit.reason})")
     for br in (fit.decelerating, fit.accelerating, fit.whole, with_mass):
@@ -182,7 +192,8 @@ def main(argv=None) -> int:
               f"({br.damping_sigmas:+.1f} σ){mc}; F̄ = {br.mean_force:.2f}, "
               f"n = {br.exponent:.2f} ± {br.exponent_stderr:.2f}; verdict {br.verdict}; "
               f"releases the rule needs: {kinetic_needed(br)}")
-        print(f"      per release: F_k {np.round(br.per_slip_kinetic_force, 2).tolist()}, "
+        print(f"      per release{'' if a.per_release else ' (jackknife pseudo-values)'}: "
+              f"F_k {np.round(br.per_slip_kinetic_force, 2).tolist()}, "
               f"B {np.round(br.per_slip_damping, 2).tolist()}")
     # the one law's condition: the loop step ruled out at half the one law's film force
     step_sd = fit.loop_step_stderr * math.sqrt(len(traces))
@@ -221,7 +232,7 @@ def main(argv=None) -> int:
         n, half = len(traces), len(traces) // 2
         for name, members in (("all", range(n)), ("first half", range(half)),
                               ("second half", range(half, n))):
-            f = mean_gap_fit(traces, mass, list(members))
+            f = mean_gap_fit(traces, mass, list(members), fit=fitter)
             o = f.one_law
             print(f"  the mean gap of {name} of the releases taken out: step {f.loop_step:.2f} ± "
                   f"{f.loop_step_stderr:.2f} ({f.loop_step_sigmas:+.1f} σ), one law F_k = "
