@@ -4,7 +4,11 @@ Releases of the wall on the film of :mod:`filmfriction.analysis.groundtruth.film
 at the ``liquid-release`` scene's scale (67 per replica, the MD's held-gap series; kT 1.5,
 sampled every 0.05 τ) are viscous with no loop: the mean release's fit, its errors the
 jackknife's over the releases, covers the true loop step (0), F_k (0) and B (η·A/W) at
-about the nominal rate and says ``viscous`` (the one law's).  The negative controls: a
+about the nominal rate and says ``viscous`` (the one law's): 12 replicas here (≈ 1 s of
+fitting each); over 100 (the benchmark) ±2 s.e. covers them in 98, 94 and 95 of 100 and the
+verdict is ``viscous`` in 94 — the rule's own 2 σ tests on F_k (either sign) and on the
+loop step each call a true null resolved in ≈ 4.6 % of repeats, which caps the rate near
+93 %.  The negative controls: a
 yield on the accelerating branch is a resolved loop step and the verdict is not the one
 law's; a kinetic force of about half the film force is not ``viscous``.  The larger study
 is ``benchmarks/release_ensemble_coverage.py`` (docs/results/slip-law.md).
@@ -20,7 +24,7 @@ from filmfriction.analysis.slip_law.slip_law import ONE_LAW
 
 FILM = Film()
 RELEASES = 67
-NULL_REPLICAS = 20
+NULL_REPLICAS = 12
 
 
 def _releases(seed, **kw):
@@ -39,13 +43,14 @@ def test_the_ensemble_fit_covers_the_truth_and_says_viscous(null_fits):
     b = np.array([(f.one_law.damping, f.one_law.damping_stderr) for f in null_fits])
     for (est, se), truth in ((step.T, 0.0), (fk.T, 0.0), (b.T, FILM.damping)):
         covered = np.abs(est - truth) <= 2 * se
-        assert covered.sum() >= NULL_REPLICAS - 3, (est, se)      # nominal 95.4 %
+        assert covered.sum() >= NULL_REPLICAS - 2, (est, se)      # nominal 95.4 %
         # the errors are the estimates' scatter, not far from it either way
         assert 0.6 < se.mean() / est.std(ddof=1) < 1.6
     # no bias of the loop step beyond its scatter over the replicas
     assert abs(step[:, 0].mean()) < 2.5 * step[:, 0].std(ddof=1) / np.sqrt(NULL_REPLICAS)
     verdicts = [(f.verdict, f.verdict_from) for f in null_fits]
-    assert verdicts.count(("viscous", ONE_LAW)) >= 0.95 * NULL_REPLICAS, verdicts
+    # ≈ 93 % by the rule's false alarms (module text); the per-release fit: 19 % (docs)
+    assert verdicts.count(("viscous", ONE_LAW)) >= NULL_REPLICAS - 2, verdicts
     # the errors are the jackknife's over the releases
     assert all(f.one_law.dof == RELEASES - 1 and f.one_law.slips == RELEASES for f in null_fits)
 
@@ -53,13 +58,13 @@ def test_the_ensemble_fit_covers_the_truth_and_says_viscous(null_fits):
 def test_the_per_release_fit_finds_a_loop_the_film_does_not_have():
     # the reason for the ensemble fit: on the same null each release's own noise moves its
     # regressors, and the slips' mean step is biased positive (≈ +1.4 ε/σ, docs)
-    steps = [fit_releases(_releases(1000 + k), mass=FILM.mass).loop_step for k in range(4)]
+    steps = [fit_releases(_releases(1000 + k), mass=FILM.mass).loop_step for k in range(3)]
     assert np.mean(steps) > 0.7, steps
 
 
 def test_a_yield_on_the_accelerating_branch_is_a_loop():
     until = peak_time(FILM)
-    for seed in (2001, 2002, 2003):
+    for seed in (2001, 2002):
         fit = fit_release_ensemble(held_until(_releases(seed), 3.0, until), mass=FILM.mass)
         assert fit.loop_step_sigmas >= 2, fit.reason
         assert fit.loop_step == pytest.approx(3.0, abs=3 * fit.loop_step_stderr)
@@ -67,7 +72,7 @@ def test_a_yield_on_the_accelerating_branch_is_a_loop():
 
 
 def test_a_kinetic_force_is_not_viscous():
-    for seed in (3001, 3002, 3003):
+    for seed in (3001, 3002):
         fit = fit_release_ensemble(_releases(seed, kinetic_force=2.5), mass=FILM.mass)
         assert fit.verdict != "viscous", fit.reason
         assert fit.one_law.kinetic_sigmas >= 2, fit.reason
