@@ -1,6 +1,7 @@
 """The release fits on the fluctuating Newtonian film: coverage, bias and verdicts (docs/results/slip-law.md).
 
     python benchmarks/release_ensemble_coverage.py [--replicas 100] [--releases 67] [--seed 1]
+    python benchmarks/release_ensemble_coverage.py --bins SEED   # one replica, binned as the MD
 
 Replicas of ``--releases`` releases each of the wall on the fluctuating Newtonian film at
 the ``liquid-release`` scene's scale (:mod:`filmfriction.analysis.groundtruth.film_release`:
@@ -12,6 +13,10 @@ law's F_k, B and m_c, how often ±2 standard errors cover the truth (loop step 0
 B = η·A/W and the noise-free film's own fitted B; m_c = ρ·A·W/3), and the verdicts; then the
 two negative controls with the ensemble fit: a yield of ``--yield-force`` on the accelerating
 branch (up to the noise-free peak velocity) and a kinetic force ``--kinetic-force`` on the wall.
+``--bins SEED``: instead, one replica of the null (seed SEED) binned as
+``benchmarks/fit_release_runs.py`` bins the MD releases (``branch_bins``: the film force
+minus the ensemble fit's one law and minus each release's own law fitted to its smoothed
+samples, per branch and bin of v / v_peak).
 """
 from __future__ import annotations
 
@@ -49,6 +54,31 @@ def summary(name: str, rows: list[dict], verdicts: list[str], truths: dict) -> N
     print("  verdicts: " + ", ".join(f"{k} {v}" for k, v in Counter(verdicts).most_common()))
 
 
+def bins(seed: int, releases: int) -> int:
+    """One replica of the null binned as the MD releases are (module text)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location(
+        "fit_release_runs", Path(__file__).with_name("fit_release_runs.py"))
+    runs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(runs)
+    film = Film()
+    trs = [tr | {"gap": np.full(tr["time"].size, film.width)}    # no gap change: no load term
+           for tr in release_traces(film_release(releases, film, seed=seed))]
+    o = fit_release_ensemble(trs, mass=film.mass).one_law
+    out = runs.branch_bins(trs, film.mass, (o.kinetic_force, o.damping, o.comoving_mass), 0.0)
+    (fk, sfk), (b, sb), (mc, smc) = out.pop("samples' law")
+    print(f"{releases} releases on the fluctuating film (seed {seed}); the one law (ensemble fit) "
+          f"F_k {o.kinetic_force:.2f}, B {o.damping:.2f}, m_c {o.comoving_mass:.1f}; the samples' "
+          f"law F_k {fk:.2f} ± {sfk:.2f}, B {b:.2f} ± {sb:.2f}, m_c {mc:.1f} ± {smc:.1f}")
+    print("bins of v/v_peak 0.2-0.4-0.6-0.8-1:")
+    for (branch, name), vals in out.items():
+        if name != "P·A·dD/dx":
+            print(f"  {branch:12s} {name:30s} " + "  ".join(f"{m:+.2f} ± {e:.2f}" for m, e in vals))
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--replicas", type=int, default=100)
@@ -57,7 +87,10 @@ def main(argv=None) -> int:
     ap.add_argument("--negative-replicas", type=int, default=40)
     ap.add_argument("--yield-force", type=float, default=3.0)
     ap.add_argument("--kinetic-force", type=float, default=2.5)
+    ap.add_argument("--bins", type=int, metavar="SEED")
     a = ap.parse_args(argv)
+    if a.bins is not None:
+        return bins(a.bins, a.releases)
     if a.replicas < 2 or a.releases < 3 or a.negative_replicas < 0:
         print(f"error: --replicas {a.replicas} (>= 2), --releases {a.releases} (>= 3), "
               f"--negative-replicas {a.negative_replicas} (>= 0)", file=sys.stderr)
