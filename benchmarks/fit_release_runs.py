@@ -166,6 +166,10 @@ def main(argv=None) -> int:
                          "film's noise) instead of the mean release with jackknife errors")
     a = ap.parse_args(argv)
     fitter = fit_releases if a.per_release else fit_release_ensemble
+    if not a.per_release and len(a.runs) < 3:
+        print(f"error: {len(a.runs)} run(s): the mean release's jackknife needs 3 or more "
+              "(or --per-release)", file=sys.stderr)
+        return 2
     traces, mass, film_mass, gaps, moves = [], None, None, [], []
     for run in a.runs:
         tr = np.genfromtxt(f"{run}/trace.csv", delimiter=",", names=True)

@@ -31,8 +31,8 @@ One law.  A film carried along with the wall also makes a loop: its m_c·a is
 positive while the wall accelerates and negative while it slows.  A liquid's
 force is F_k + B·v + m_c·a to first order in the frequency (a Couette film adds
 a third of its mass without slip), with no yield: its whole slip is one law, and
-fitting both branches with m_c (``one_law``) uses every sample (the MD liquid released
-from rest still leaves a step: docs/results/slip-law.md).  A film that
+fitting both branches with m_c (``one_law``) uses every sample (releases of the MD liquid,
+fitted as their mean trace, are one law: docs/results/slip-law.md).  A film that
 breaks on the accelerating branch is not: m_c·a would take up its yield loop as
 a mass.  So the whole slip is fitted once more with a step of the force at the
 peak velocity (``loop_step``, F_acc − F_dec at a common law), and the verdict is
