@@ -416,8 +416,65 @@ OMCTS_VISCOSITY_MATCHED = viscosity_matched(
     source=f"eta* = {LJ_ETA_FILM} +- {LJ_ETA_FILM_STDERR} at T = 0.71, rho = 0.85, rc = 2.5 "
            "(filmfriction viscosity); " + OMCTS.source)
 
+
+
+@dataclass(frozen=True)
+class BulkViscosity:
+    """The LJ liquid's (rc = 2.5 σ, truncated) shear viscosity measured at one state point.
+
+    Attributes
+    ----------
+    temperature, density : float
+        The state point, ε/k_B and σ⁻³.
+    viscosity, stderr : float
+        η and its standard error over the Green–Kubo blocks, ετ/σ³.
+    command : str
+        The command that measured it (docs/viscosity.md).
+    """
+
+    temperature: float
+    density: float
+    viscosity: float
+    stderr: float
+    command: str
+
+
+#: The bulk viscosities measured at the state points of the project's films: the
+#: Klein-similar film (kT 0.71), the colder films of the mass ladder (kT 0.63, the density
+#: the four-layer film's gap gives) and the liquid of the slip law's positive control
+#: (kT 1.5, film atoms over A·(gap − σ)); docs/results/mass-ladder.md, slip-law.md.
+LJ_BULK_VISCOSITIES = (
+    BulkViscosity(0.71, 0.85, LJ_ETA_FILM, LJ_ETA_FILM_STDERR,
+                  "filmfriction viscosity --temperature 0.71 --density 0.85 --steps 800000 "
+                  "--blocks 20 --seed 4928459"),
+    BulkViscosity(0.63, 0.86, 4.25, 0.18,
+                  "filmfriction viscosity --temperature 0.63 --density 0.86 --steps 400000 "
+                  "--blocks 10 --seed 4928459 --np 1"),
+    BulkViscosity(1.5, 0.585, 0.783, 0.079,
+                  "filmfriction viscosity --temperature 1.5 --density 0.585 --cells 5 "
+                  "--steps 60000 --blocks 6 --equilibrate-steps 5000"),
+)
+
+
+def lj_bulk_viscosity(temperature: float, *, tolerance: float = 0.03) -> BulkViscosity | None:
+    """The measured bulk viscosity (:data:`LJ_BULK_VISCOSITIES`) whose temperature is the
+    nearest to ``temperature`` (ε/k_B) within ``tolerance``, or ``None``: a film at a
+    state point not measured needs ``filmfriction viscosity`` there.
+
+    >>> lj_bulk_viscosity(0.645).viscosity, lj_bulk_viscosity(0.72).viscosity
+    (4.25, 3.55)
+    >>> lj_bulk_viscosity(1.0) is None
+    True
+    """
+    if not math.isfinite(temperature):
+        return None
+    best = min(LJ_BULK_VISCOSITIES, key=lambda b: abs(b.temperature - temperature))
+    return best if abs(best.temperature - temperature) <= tolerance else None
+
+
 __all__ += ["OMCTS_BULK_VISCOSITY", "viscosity_time_unit", "viscosity_matched",
-            "LJ_ETA_FILM", "LJ_ETA_FILM_STDERR", "OMCTS_VISCOSITY_MATCHED"]
+            "LJ_ETA_FILM", "LJ_ETA_FILM_STDERR", "OMCTS_VISCOSITY_MATCHED", "BulkViscosity",
+            "LJ_BULK_VISCOSITIES", "lj_bulk_viscosity"]
 
 
 # ---------------------------------------------------------------------------

@@ -20,7 +20,8 @@ under ``branches``, the one law as ``one_law``, with the loop step beside it.
 Beside B stand the smallest B the run resolves (``detectable_damping``) and, for
 an LJ run, the B of a no-slip film of bulk viscosity, η_bulk·A/D
 (``bulk_film_damping``), with η_bulk the LJ liquid's measured at the film's
-state point (:data:`filmfriction.reduced_model.units.LJ_ETA_FILM`).
+state point (:func:`filmfriction.reduced_model.units.lj_bulk_viscosity`; the Klein-similar
+film's, :data:`~filmfriction.reduced_model.units.LJ_ETA_FILM`, with a note where none was measured).
 """
 from __future__ import annotations
 
@@ -29,7 +30,7 @@ import math
 import numpy as np
 from scipy.signal import savgol_filter
 
-from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR
+from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR, lj_bulk_viscosity
 
 from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
 from ..files.trace import unit
@@ -40,13 +41,15 @@ from .observable import (Context, MissingInput, Observable, column, format_estim
 
 __all__ = ["SlipLaw", "BULK_VISCOSITY_SOURCE"]
 
-#: Where the LJ bulk viscosity of the film's state point comes from.
+#: Where the LJ bulk viscosity of the Klein-similar film's state point comes from (the
+#: value taken for a film at a state point where none was measured).
 BULK_VISCOSITY_SOURCE = {
     "state_point": "T = 0.71 ε/k_B, ρ = 0.85 σ⁻³ (the film's, rc = 2.5 σ)",
     "command": "filmfriction viscosity --temperature 0.71 --density 0.85 --steps 800000 "
                "--blocks 20 --seed 4928459",
 }
-#: Film temperatures (ε/k_B) farther than this from the bulk value's 0.71 get a note.
+#: A film whose mean temperature (ε/k_B) is this close to a measured state point's takes
+#: its bulk viscosity (:func:`~filmfriction.reduced_model.units.lj_bulk_viscosity`).
 _STATE_POINT_TOLERANCE = 0.03
 
 
@@ -161,21 +164,30 @@ class SlipLaw(Observable):
 
     @staticmethod
     def _bulk(ctx, b, b_err, d, area) -> dict:
-        """B of a no-slip film of bulk viscosity beside the fitted B (LJ runs)."""
-        bulk = LJ_ETA_FILM * area / d
-        out = {"bulk_viscosity": ctx.value(LJ_ETA_FILM, LJ_ETA_FILM_STDERR, "viscosity",
-                                           **BULK_VISCOSITY_SOURCE),
-               "bulk_film_damping": ctx.value(bulk, LJ_ETA_FILM_STDERR * area / d, "damping",
+        """B of a no-slip film of bulk viscosity beside the fitted B (LJ runs), η_bulk the
+        one measured at the film's mean temperature (the Klein-similar film's when none
+        was measured there, with a note)."""
+        tr = ctx.trace
+        temp = (float(np.mean(tr.columns["film_temperature"])) if tr.has("film_temperature")
+                else math.nan)
+        at = lj_bulk_viscosity(temp, tolerance=_STATE_POINT_TOLERANCE)
+        if at is not None:
+            eta, eta_err = at.viscosity, at.stderr
+            source = {"state_point": f"T = {at.temperature:g} ε/k_B, ρ = {at.density:g} σ⁻³ "
+                                     "(rc = 2.5 σ)", "command": at.command}
+        else:
+            eta, eta_err, source = LJ_ETA_FILM, LJ_ETA_FILM_STDERR, dict(BULK_VISCOSITY_SOURCE)
+        bulk = eta * area / d
+        out = {"bulk_viscosity": ctx.value(eta, eta_err, "viscosity", **source),
+               "bulk_film_damping": ctx.value(bulk, eta_err * area / d, "damping",
                                               form="eta_bulk·A/D", thickness=d),
                "damping_over_bulk": finite_or_none(b / bulk),
                "damping_over_bulk_stderr": finite_or_none(b_err / bulk)}
-        tr = ctx.trace
-        if tr.has("film_temperature"):
-            temp = float(np.mean(tr.columns["film_temperature"]))
-            if abs(temp - 0.71) > _STATE_POINT_TOLERANCE:
-                out["bulk_viscosity"]["note"] = (
-                    f"the film's mean temperature {temp:.3g} is not the bulk value's 0.71: "
-                    "measure eta_bulk at the film's own state point")
+        if at is None and math.isfinite(temp):
+            out["bulk_viscosity"]["note"] = (
+                f"no bulk viscosity measured at the film's mean temperature {temp:.3g}: the "
+                "Klein-similar film's (0.71) is taken; measure eta_bulk at the film's own "
+                "state point (filmfriction viscosity)")
         return out
 
     def rows(self, section: dict) -> list[tuple[str, str]]:
