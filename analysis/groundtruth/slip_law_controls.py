@@ -41,10 +41,11 @@ from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..stickslip import detect_slips
+from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "SCALE", "CONTROLS", "control_trace", "coulomb_viscous", "replica_fits",
-           "control_fits", "verdict_rates"]
+           "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
 #: The Klein-similar scene's slider and sampling (LJ units).
 SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
@@ -152,11 +153,84 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
     return out
 
 
-def control_fits(name: str, replicas: int = 40, slips: int = 8, **kwargs) -> list[FilmForceFit]:
-    """The fits of ``replicas`` noisy copies of control ``name`` (``slips`` slips fitted);
-    ``kwargs`` go to :func:`replica_fits`."""
-    return replica_fits(control_trace(name, slips), replicas, slips=slips,
-                        drive_velocity=_DRIVE[name], **kwargs)
+#: The controls' laws as the random-force slider integrates them (:func:`_dynamical_law`):
+#: the rate-and-state slider yields from, and re-sticks at, this velocity (σ/τ).
+RATE_STATE_CREEP = 0.01
+
+
+def _dynamical_law(name: str, share: float | None = None) -> dict:
+    """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
+    control ``name`` (or :func:`coulomb_viscous` of ``share``): the law, its yield and
+    re-stick, and the run's length for about 10 slips per 8 asked (scaled by the caller)."""
+    s = SCALE
+    fs = s["static_force"]
+    if share is not None:
+        fk, b = (1 - share) * 28.0, share * 28.0 / 0.55
+        return dict(friction=lambda v, psi: np.where(v >= 0, fk, -fk) + b * v,
+                    static_force=fs, backward_force=20.0, stop_velocity=0.15,
+                    armed_below=34.0, initial_force=20.0, drive_velocity=0.1, period=150.0)
+    if name == "coulomb":
+        return dict(friction=lambda v, psi: np.where(v >= 0, 36.0, -36.0), static_force=fs,
+                    armed_below=36.0, drive_velocity=_DRIVE[name], period=135.0)
+    if name == "weakening":
+        return dict(friction=lambda v, psi: np.sign(v) * (25.0 + 23.0 * np.exp(-np.abs(v))),
+                    static_force=fs, armed_below=27.5, drive_velocity=_DRIVE[name],
+                    period=90.0)
+    if name == "viscous":
+        b = 2 * 4.0 * math.sqrt(s["spring_constant"] * s["mass"])
+        return dict(friction=lambda v, psi: b * v, static_force=fs, backward_force=24.0,
+                    stop_velocity=-math.inf, initial_force=24.0, drive_velocity=_DRIVE[name],
+                    period=150.0)
+    if name == "rate-state":
+        law = laws.RateState(mu0=36.0, a=1.0, b=4.0, dc=1.0, v0=0.1)
+        c = RATE_STATE_CREEP
+        return dict(friction=lambda v, psi: law.coefficient(v, psi),
+                    state_rate=lambda v, psi: (law.v0 * np.exp(-psi) - np.abs(v)) / law.dc,
+                    static_force=lambda psi: law.coefficient(np.full(psi.shape, c), psi),
+                    start_velocity=c, stop_velocity=c, armed_below=30.5, initial_force=36.0,
+                    drive_velocity=_DRIVE[name], period=180.0)
+    raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
+
+
+def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | None = None,
+                   seed: int = 0, share: float | None = None, **fit) -> list[FilmForceFit]:
+    """The slip-law fit of ``replicas`` runs of control ``name`` whose film pushes the wall
+    with the MD's noise as a random force (:mod:`~filmfriction.analysis.groundtruth.random_force`):
+    the wall's position and velocity respond to it, as an MD wall's do.
+
+    With ``share`` the law is :func:`coulomb_viscous`'s of that viscous share (``name``
+    is then ignored).  The slips are the slider's own (its yields and re-sticks: the
+    detector is not under test); the start-up slip is left out and the next ``slips``
+    fitted; ``fit`` goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`.
+    """
+    noise = MD_NOISE if noise is None else noise
+    law = _dynamical_law(name, share)
+    period = law.pop("period")
+    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                 duration=(slips + 3) * period * 1.3, dt=SCALE["dt"], replicas=replicas,
+                 seed=seed, **noise)
+    out = []
+    for tr in runs:
+        t, f = tr["time"], tr["spring_force"]
+        tab = cycle_table(t, f, tr["yield_index"], tr["stick_index"],
+                          spring_constant=SCALE["spring_constant"],
+                          wall_position=tr["wall_position"])[1:slips + 1]
+        out.append(fit_film_force(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
+                                  drive_velocity=law["drive_velocity"],
+                                  wall_position=tr["wall_position"], **fit))
+    return out
+
+
+def control_fits(name: str, replicas: int = 40, slips: int = 8, *, injected: bool = False,
+                 **kwargs) -> list[FilmForceFit]:
+    """The fits of ``replicas`` noisy runs of control ``name`` (``slips`` slips fitted):
+    the noise a random force that moves the wall (:func:`dynamical_fits`), or with
+    ``injected`` added to the noise-free law's trace (:func:`replica_fits`); ``kwargs``
+    go to the one called."""
+    if injected:
+        return replica_fits(control_trace(name, slips), replicas, slips=slips,
+                            drive_velocity=_DRIVE[name], **kwargs)
+    return dynamical_fits(name, replicas, slips, **kwargs)
 
 
 def verdict_rates(name: str, replicas: int = 40, slips: int = 8, **kwargs) -> dict[str, int]:
