@@ -102,7 +102,8 @@ def main(argv=None) -> int:
         for slips in a.slips:
             exact = control_fits(law, 1, slips, noise=NOISE_FREE)
             print(f"\n## {law} ({CONTROLS[law]}), {slips} slips\nnoise-free slider: "
-                  + summary(exact * 2).replace("± 0.00", "").split("\n", 1)[1], flush=True)
+                  + summary(exact * 2).replace(" ± 0.00", "").split("\n", 1)[1].split(", resolved")[0],
+                  flush=True)
             for name, injected in (("random force", False), ("added to the trace", True)):
                 fits = control_fits(law, a.replicas, slips, injected=injected)
                 print(f"{name}, {a.replicas} replicas: {summary(fits)}", flush=True)

@@ -32,7 +32,7 @@ a slip, while the spring still pulls near the yield, is not the slip's end), whe
 its velocity falls to ``stop_velocity`` or the spring force to ``backward_force``.
 
 The equation is integrated by the classical Runge–Kutta method at ``substeps``
-steps per sample, ξ constant within a step (u interpolated linearly: the impulse
+(2) steps per sample, ξ constant within a step (u interpolated linearly: the impulse
 M·Δu per step is exact); events fall on the steps.  Noise-free, the slips are the
 law's to the step's accuracy (``tests/analysis/groundtruth/test_random_force.py``).
 
@@ -64,7 +64,7 @@ def slide(friction: Callable, *, mass: float, stiffness: float, drive_velocity: 
           seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
           backward_force: float = -math.inf, armed_below: float = math.inf,
           start_velocity: float = 0.0, state_rate: Callable | None = None,
-          initial_state: float = 0.0, substeps: int = 4) -> list[dict]:
+          initial_state: float = 0.0, substeps: int = 2) -> list[dict]:
     """``replicas`` runs of the slider (module text), each with its own noise.
 
     Parameters
@@ -177,11 +177,22 @@ def slide(friction: Callable, *, mass: float, stiffness: float, drive_velocity: 
     xd = xd0 + drive_velocity * t
     runs = []
     for r in range(R):
-        y = np.asarray(yields[r], int)
-        s = np.asarray(sticks[r], int)
-        y = y[:s.size]                               # complete slips only
+        y, s = _alternating(yields[r], sticks[r])
         runs.append({"time": t, "spring_force": stiffness * (xd - out_x[:, r]),
                      "drive_position": xd, "wall_position": out_x[:, r].copy(),
                      "wall_velocity": out_v[:, r] + rng.normal(0.0, rattle, samples),
                      "yield_index": y, "stick_index": s})
     return runs
+
+
+def _alternating(yields: list, sticks: list) -> tuple[np.ndarray, np.ndarray]:
+    """The complete slips' (yield, re-stick) samples; a re-stick and a yield within one
+    sample interval (a pause shorter than the sampling) join their two slips into one."""
+    y, s = [], []
+    for a, b in zip(yields, sticks):
+        if s and a < s[-1]:
+            s[-1] = b
+        else:
+            y.append(a)
+            s.append(b)
+    return np.asarray(y, int), np.asarray(s, int)
