@@ -170,7 +170,10 @@ def _dynamical_law(name: str, share: float | None = None) -> dict:
                     static_force=fs, backward_force=20.0, stop_velocity=0.15,
                     armed_below=34.0, initial_force=20.0, drive_velocity=0.1, period=150.0)
     if name == "coulomb":
-        return dict(friction=lambda v, psi: np.where(v >= 0, 36.0, -36.0), static_force=fs,
+        # F_k while slipping, whatever the sign of a recoil the random force gives the wall:
+        # the law is F_k + 0·v on every sample (F_k·sign(v) would make the noise-averaged
+        # force grow with v, a law of its own: docs/results/slip-law.md)
+        return dict(friction=lambda v, psi: np.full(np.shape(v), 36.0), static_force=fs,
                     armed_below=36.0, drive_velocity=_DRIVE[name], period=135.0)
     if name == "weakening":
         return dict(friction=lambda v, psi: np.sign(v) * (25.0 + 23.0 * np.exp(-np.abs(v))),
