@@ -32,7 +32,7 @@ a slip, while the spring still pulls near the yield, is not the slip's end), whe
 its velocity falls to ``stop_velocity`` or the spring force to ``backward_force``.
 
 The equation is integrated by the classical Runge–Kutta method at ``substeps``
-(2) steps per sample, ξ constant within a step (u interpolated linearly: the impulse
+(1) steps per sample, ξ constant within a step (u interpolated linearly: the impulse
 M·Δu per step is exact); events fall on the steps.  Noise-free, the slips are the
 law's to the step's accuracy (``tests/analysis/groundtruth/test_random_force.py``).
 
@@ -64,7 +64,7 @@ def slide(friction: Callable, *, mass: float, stiffness: float, drive_velocity: 
           seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
           backward_force: float = -math.inf, armed_below: float = math.inf,
           start_velocity: float = 0.0, state_rate: Callable | None = None,
-          initial_state: float = 0.0, substeps: int = 2) -> list[dict]:
+          initial_state: float = 0.0, substeps: int = 1) -> list[dict]:
     """``replicas`` runs of the slider (module text), each with its own noise.
 
     Parameters
