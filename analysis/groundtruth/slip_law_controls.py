@@ -169,37 +169,32 @@ RATE_STATE_CREEP = 0.01
 def _dynamical_law(name: str, share: float | None = None) -> dict:
     """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
     control ``name`` (or :func:`coulomb_viscous` of ``share``): the law, its yield and
-    re-stick, and the run's length for about 10 slips per 8 asked (scaled by the caller)."""
+    re-stick, and ``period``, a slip cycle's length or a little more."""
     s = SCALE
     fs = s["static_force"]
     if share is not None:
-        fk, b = (1 - share) * 28.0, share * 28.0 / 0.55
-        return dict(friction=lambda v, psi: np.where(v >= 0, fk, -fk) + b * v,
+        return dict(law="coulomb-viscous", parameters=((1 - share) * 28.0, share * 28.0 / 0.55),
                     static_force=fs, backward_force=20.0, stop_velocity=0.15,
                     armed_below=34.0, initial_force=20.0, drive_velocity=0.1, period=150.0)
     if name == "coulomb":
         # F_k while slipping, whatever the sign of a recoil the random force gives the wall:
         # the law is F_k + 0·v on every sample (F_k·sign(v) would make the noise-averaged
         # force grow with v, a law of its own: docs/results/slip-law.md)
-        return dict(friction=lambda v, psi: np.full(np.shape(v), 36.0), static_force=fs,
+        return dict(law="linear", parameters=(36.0, 0.0), static_force=fs,
                     armed_below=36.0, drive_velocity=_DRIVE[name], period=135.0)
     if name == "weakening":
-        return dict(friction=lambda v, psi: np.sign(v) * (25.0 + 23.0 * np.exp(-np.abs(v))),
-                    static_force=fs, armed_below=27.5, drive_velocity=_DRIVE[name],
-                    period=90.0)
+        return dict(law="weakening", parameters=(25.0, 48.0, 1.0), static_force=fs,
+                    armed_below=27.5, drive_velocity=_DRIVE[name], period=90.0)
     if name == "viscous":
         b = 2 * 4.0 * math.sqrt(s["spring_constant"] * s["mass"])
-        return dict(friction=lambda v, psi: b * v, static_force=fs, backward_force=24.0,
+        return dict(law="linear", parameters=(0.0, b), static_force=fs, backward_force=24.0,
                     stop_velocity=-math.inf, initial_force=24.0, drive_velocity=_DRIVE[name],
                     period=150.0)
     if name == "rate-state":
-        law = laws.RateState(mu0=36.0, a=1.0, b=4.0, dc=1.0, v0=0.1)
-        c = RATE_STATE_CREEP
-        return dict(friction=lambda v, psi: law.coefficient(v, psi),
-                    state_rate=lambda v, psi: (law.v0 * np.exp(-psi) - np.abs(v)) / law.dc,
-                    static_force=lambda psi: law.coefficient(np.full(psi.shape, c), psi),
-                    start_velocity=c, stop_velocity=c, armed_below=30.5, initial_force=36.0,
-                    drive_velocity=_DRIVE[name], period=180.0)
+        return dict(law="rate-state", parameters=(36.0, 1.0, 4.0, 1.0, 0.1),
+                    start_velocity=RATE_STATE_CREEP, stop_velocity=RATE_STATE_CREEP,
+                    armed_below=30.5, initial_force=36.0, drive_velocity=_DRIVE[name],
+                    period=180.0)
     raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
 
 

@@ -11,15 +11,11 @@ from filmfriction.analysis.groundtruth.random_force import slide
 K, M, FS, FK = 2.0, 30.0, 48.0, 36.0
 
 
-def _coulomb(v, psi):
-    return np.where(v >= 0, FK, -FK)
-
-
 def _run(**kw):
     args = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=800.0,
                 dt=0.25, armed_below=FK)
     args.update(kw)
-    return slide(_coulomb, **args)
+    return slide("coulomb-viscous", (FK, 0.0), **args)
 
 
 def test_noise_free_coulomb_slips_are_the_closed_form():
@@ -77,3 +73,11 @@ def test_the_wall_moves_with_the_noise_and_rattle_is_on_the_velocity_only():
 def test_bad_arguments_are_refused(bad):
     with pytest.raises(ValueError):
         _run(**bad)
+
+
+@pytest.mark.parametrize("law, parameters", [("stribeck", (1.0,)), ("linear", (1.0,)),
+                                             ("weakening", (25.0, 48.0, math.nan))])
+def test_a_bad_law_is_refused(law, parameters):
+    with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
+        slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
+              duration=10.0, dt=0.25)
