@@ -14,8 +14,8 @@ measured.  The per-slip fit does not pass every control so: its regressors (Δx,
 branch split at the noisy peak velocity) carry the noise of its response.  With 40
 replicas (``python benchmarks/slip_law_random_force.py``, docs/results/slip-law.md):
 Klein's viscous slips come out ``mixed`` in 40 of 40 at 30 slips (decelerating branch
-B = 28 of 62 m/τ, F_k = 18 of 0 ε/σ), and every law's loop step is resolved, +14 to
-+22 ε/σ where it is 0 to −1.4; no negative control is called ``viscous``.  The noise
+B = 27 of 62 m/τ, F_k = 18.7 of 0 ε/σ), and every law's loop step is resolved, +12 to
++22 ε/σ where it is 0 to −1.3; no negative control is called ``viscous``.  The noise
 added to the noise-free law's trace instead (``injected=True``: the spring force carries
 M·du/dt, the motion is the law's; :func:`replica_fits`) passes them (Klein's slips
 ``viscous`` in 39 of 40) and is kept as the comparison.
