@@ -105,6 +105,79 @@ def cycle_mean_fit(run: dict, slips: int, drive_velocity: float):
                           drive_velocity=drive_velocity, wall_position=xe)
 
 
+def instrumented_fit(run: dict, slips: int, floor: float = 0.2, edge: int = 3) -> np.ndarray:
+    """A prototype of another remedy: each slip fitted with its Δx instrumented by the mean
+    Δx of the other slips at the same lag from the yield (their noise is not this slip's),
+    the branches split at the peak of the others' mean velocity.  Per slip: (F_k, B) of the
+    decelerating and the accelerating branch and the whole slip's step; rows of NaN where
+    a slip has too few samples."""
+    t, f, v, x = run["time"], run["spring_force"], run["wall_velocity"], run["wall_position"]
+    y, s = run["yield_index"][1:slips + 1], run["stick_index"][1:slips + 1]
+    imp = cumulative_trapezoid(f, t, initial=0.0)
+    m, dt = SCALE["mass"], float(t[1] - t[0])
+    out = []
+    for i in range(y.size):
+        n = int(s[i] - y[i]) + 1
+        others = [j for j in range(y.size) if j != i]
+        lag = np.arange(n)
+        xs = np.full((len(others), n), np.nan)
+        vs = np.full((len(others), n), np.nan)
+        for r, j in enumerate(others):
+            k = min(n, int(s[j] - y[j]) + 1)
+            xs[r, :k] = x[y[j]:y[j] + k] - x[y[j]]
+            vs[r, :k] = v[y[j]:y[j] + k]
+        with np.errstate(all="ignore"):
+            zx, zv = np.nanmean(xs, axis=0), np.nanmean(vs, axis=0)
+        ok = np.isfinite(zx)
+        if ok.sum() < 12:
+            out.append([np.nan] * 5)
+            continue
+        n = int(np.flatnonzero(ok)[-1]) + 1
+        p = int(np.nanargmax(zv[:n]))
+        fast = zv[:n] > floor * zv[p]
+        fast[:edge] = False
+        fast[n - edge:] = False
+        idx = y[i] + lag[:n]
+        resp = imp[idx] - imp[idx[0]] - m * v[idx]
+        dts, dxs = lag[:n] * dt, x[idx] - x[idx[0]]
+        after = np.maximum(dts - p * dt, 0.0)
+        row = []
+        for lo, hi, step in ((p, n, False), (0, p + 1, False), (0, n, True)):
+            k = np.flatnonzero(fast[lo:hi]) + lo
+            if k.size < 8:
+                row += [np.nan, np.nan] if not step else [np.nan]
+                continue
+            k = np.arange(k[0], k[-1] + 1)
+            one = np.ones(k.size)
+            X = [one, dts[k], dxs[k]] + ([after[k]] if step else [])
+            Z = [one, dts[k], zx[k]] + ([after[k]] if step else [])
+            X, Z = np.column_stack(X), np.column_stack(Z)
+            try:
+                b = np.linalg.solve(Z.T @ X, Z.T @ resp[k])
+            except np.linalg.LinAlgError:          # e.g. no sample past the peak
+                b = np.full(X.shape[1], np.nan)
+            row += [-b[-1]] if step else [b[1], b[2]]
+        out.append(row)
+    return np.array(out, float)
+
+
+def instrumented(laws, slip_counts, replicas: int) -> None:
+    names = ("decelerating F_k", "decelerating B", "accelerating F_k", "accelerating B",
+             "loop step")
+    for law in laws:
+        args = _dynamical_law(law)
+        period = args.pop("period")
+        for slips in slip_counts:
+            runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                         duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
+                         replicas=replicas, seed=0, **MD_NOISE)
+            per = np.array([np.nanmean(instrumented_fit(r, slips), axis=0) for r in runs])
+            print(f"\n## {law}, {slips} slips instrumented by the other slips, {replicas} "
+                  "replicas (mean over each replica's slips, then over the replicas)\n  "
+                  + ", ".join(f"{nm} {_ms(per[:, c])}" for c, nm in enumerate(names)),
+                  flush=True)
+
+
 def cycle_means(laws, slip_counts, replicas: int) -> None:
     for law in laws:
         args = _dynamical_law(law)
@@ -124,6 +197,8 @@ def main(argv=None) -> int:
     ap.add_argument("--laws", nargs="+", default=list(CONTROLS), choices=list(CONTROLS))
     ap.add_argument("--slips", nargs="+", type=int, default=[8, 30])
     ap.add_argument("--residual", action="store_true", help="only the residual of the replicas")
+    ap.add_argument("--instrumented", action="store_true",
+                    help="the prototype remedy: Δx instrumented by the other slips' mean")
     ap.add_argument("--cycle-mean", action="store_true",
                     help="the prototype remedy: the slips averaged at the yield, then fitted")
     ap.add_argument("--share", type=float, default=None,
@@ -131,6 +206,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     if a.residual:
         residual(a.replicas, a.share)
+        return 0
+    if a.instrumented:
+        instrumented(a.laws, a.slips, a.replicas)
         return 0
     if a.cycle_mean:
         cycle_means(a.laws, a.slips, a.replicas)
