@@ -10,7 +10,8 @@ behind :data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`.
 
 Without it: for each control law (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.CONTROLS`)
 the verdicts of 40 noisy replicas at 4, 8 and 30 slips, at the MD's noise and at a
-tenth of it; then the power: the share of replicas of slips resisted by F_k + B·v
+tenth of it (the noise a random force that moves the wall; with ``--injected`` added to
+the noise-free law's trace); then the power (the noise added to the trace): the share of replicas of slips resisted by F_k + B·v
 (re-sticking as Klein's) whose B is resolved (2 σ), against the viscous share.
 """
 from __future__ import annotations
@@ -65,12 +66,13 @@ def measure(run_dir: Path) -> dict:
             "sample_interval": float(t[1] - t[0])}
 
 
-def rates() -> None:
+def rates(injected: bool = False) -> None:
     for noise_name, noise in (("MD noise", MD_NOISE), ("a tenth of it", QUIET)):
-        print(f"\n## verdicts of {REPLICAS} replicas, {noise_name}: {noise}")
+        how = "added to the law's trace" if injected else "a random force moving the wall"
+        print(f"\n## verdicts of {REPLICAS} replicas, {noise_name} ({how}): {noise}")
         for law, what in CONTROLS.items():
             for slips in (4, 8, 30):
-                fits = control_fits(law, REPLICAS, slips, noise=noise)
+                fits = control_fits(law, REPLICAS, slips, noise=noise, injected=injected)
                 r = Counter(f.verdict for f in fits)
                 shown = ", ".join(f"{k} {r[k]}" for k in VERDICTS if r[k])
                 one = sum(f.verdict_from == ONE_LAW for f in fits)
@@ -97,12 +99,14 @@ def main(argv=None) -> int:
     ap.add_argument("--measure", metavar="RUN", help="print the MD noise of a run directory")
     ap.add_argument("--power-only", action="store_true", help="only the power scan")
     ap.add_argument("--rates-only", action="store_true", help="only the verdict rates")
+    ap.add_argument("--injected", action="store_true",
+                    help="the rates with the noise added to the law's trace (not moving the wall)")
     a = ap.parse_args(argv)
     if a.measure:
         print(json.dumps(measure(Path(a.measure)), indent=1))
         return 0
     if not a.power_only:
-        rates()
+        rates(a.injected)
     if not a.rates_only:
         power()
     return 0

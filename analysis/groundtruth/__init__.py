@@ -7,7 +7,9 @@
 * :mod:`~filmfriction.analysis.groundtruth.calibration_sets` — the calibration's traces with
   known F_k and B, and the slip fit's score on them;
 * :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` — the slip-law verdict's
-  positive and negative controls and its power.
+  positive and negative controls and its power;
+* :mod:`~filmfriction.analysis.groundtruth.random_force` — a driven slider whose film's
+  random force moves the wall (the controls' noise as an MD wall has it).
 
 Nothing in the analysis imports this folder: it stands beside the estimators it checks.
 """

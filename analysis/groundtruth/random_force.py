@@ -1,0 +1,246 @@
+"""A driven slider whose film pushes it with a random force: noise that moves the wall.
+
+The slip-law controls (:mod:`~filmfriction.analysis.groundtruth.slip_law_controls`) need
+the MD's noise as the MD has it: the film's random force ξ acts on the wall, and the
+wall's position and velocity respond to it, so the regressors of the integral-form fit
+(Δx, and the v whose M·v is in the response) carry the noise the response carries.
+This module integrates that slider, many replicas at once:
+
+    M dv/dt = K(x_d − x) − F(v, ψ) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
+
+with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and
+state), and
+
+    ξ = M·du/dt   while the wall slips, 0 while it is stuck,
+
+u an Ornstein–Uhlenbeck velocity: sampled every ``dt`` it is AR(1) of rms
+``velocity_noise`` and lag-one correlation ``velocity_correlation``.  So the
+residual of the integrated equation of motion over M, ∫ξ dt/M over a slip, is
+u(t) − u(t_yield): the noise the MD's was measured as
+(:data:`~filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`), here a
+force that moves the wall.  The wall's thermal rattling (``rattle``, white at the
+sampling) is a vibration faster than the sampling, of bounded amplitude
+(rattle/ω ≪ the sampled Δx): it is added to the sampled velocity only.
+
+Stick and slip.  A stuck wall is at rest (the film holds it and balances its own
+random force); it yields when the spring force reaches ``static_force(ψ)``,
+starting at ``start_velocity`` (0; the small velocity a rate-and-state law is
+integrated from: below it the creep is stiff and moves the wall by nothing the
+fit sees, and is taken as rest with the state aging, dθ/dt = 1).  It re-sticks,
+once the spring force has fallen to ``armed_below`` (a pause of the noise early in
+a slip, while the spring still pulls near the yield, is not the slip's end), when
+its velocity falls to ``stop_velocity`` or the spring force to ``backward_force``.
+
+The equation is integrated by the classical Runge–Kutta method at ``substeps``
+(1) steps per sample, ξ constant within a step (u interpolated linearly: the impulse
+M·Δu per step is exact), compiled (numba); events fall on the steps.  Noise-free, the slips are the
+law's to the step's accuracy (``tests/analysis/groundtruth/test_random_force.py``).
+
+Example
+-------
+A Coulomb slider with and without the random force:
+
+>>> run = slide("coulomb-viscous", (36.0, 0.0), mass=30.0, stiffness=2.0, drive_velocity=0.1, static_force=48.0,
+...             duration=400.0, dt=0.25, replicas=2, velocity_noise=0.75,
+...             velocity_correlation=0.9, seed=1)
+>>> len(run), sorted(run[0])[:3]
+(2, ['drive_position', 'spring_force', 'stick_index'])
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+from scipy.signal import lfilter
+
+__all__ = ["slide", "LAWS"]
+
+#: The friction laws of the slip, F(v, ψ), and their parameters:
+#:
+#: * ``linear`` (F_k, B): F_k + B·v whatever the sign of v (a sliding film's force,
+#:   exactly the fit's law on every sample);
+#: * ``coulomb-viscous`` (F_k, B): F_k·sign(v) + B·v (sign(0) = +1);
+#: * ``weakening`` (F_k, F_s, v_c): sign(v)·(F_k + (F_s − F_k)·exp(−|v|/v_c));
+#: * ``rate-state`` (μ0, a, b, d_c, v0): a·asinh(v/(2v0)·exp((μ0 + bψ)/a)) (the regularized
+#:   Dieterich–Ruina law, :class:`~filmfriction.reduced_model.laws.RateState` at N = 1),
+#:   aging: dψ/dt = (v0·e^{−ψ} − |v|)/d_c.
+LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5}
+_CODE = {name: k for k, name in enumerate(LAWS)}
+
+
+@njit(cache=True)
+def _friction(code, p, v, psi):
+    if code == 0:
+        return p[0] + p[1] * v
+    if code == 1:
+        return (p[0] if v >= 0.0 else -p[0]) + p[1] * v
+    if code == 2:
+        f = p[0] + (p[1] - p[0]) * math.exp(-abs(v) / p[2])
+        return f if v >= 0.0 else -f
+    return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
+
+
+@njit(cache=True)
+def _state_rate(code, p, v, psi):
+    if code == 3:
+        return (p[4] * math.exp(-psi) - abs(v)) / p[3]
+    return 0.0
+
+
+@njit(cache=True)
+def _run(code, p, mass, k, vd, xd0, static, start_v, stop_v, backward, armed_below, psi0,
+         h, n_sub, du, out_x, out_v, yields, sticks, counts):
+    samples, reps = out_x.shape
+    for r in range(reps):
+        x, v, psi = 0.0, 0.0, psi0
+        slipping, armed = False, False
+        ny, ns = 0, 0
+        for i in range(samples):
+            out_x[i, r] = x
+            out_v[i, r] = v
+            for j in range(n_sub):
+                t = (i * n_sub + j) * h
+                if slipping:
+                    xi = mass * du[i * n_sub + j, r] / h
+                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi) + xi) / mass
+                    p1 = _state_rate(code, p, v, psi)
+                    x2, v2, s2 = x + 0.5 * h * v, v + 0.5 * h * a1, psi + 0.5 * h * p1
+                    a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2) - _friction(code, p, v2, s2)
+                          + xi) / mass
+                    p2 = _state_rate(code, p, v2, s2)
+                    x3, v3, s3 = x + 0.5 * h * v2, v + 0.5 * h * a2, psi + 0.5 * h * p2
+                    a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3) - _friction(code, p, v3, s3)
+                          + xi) / mass
+                    p3 = _state_rate(code, p, v3, s3)
+                    x4, v4, s4 = x + h * v3, v + h * a3, psi + h * p3
+                    a4 = (k * (xd0 + vd * (t + h) - x4) - _friction(code, p, v4, s4)
+                          + xi) / mass
+                    p4 = _state_rate(code, p, v4, s4)
+                    x = x + h * (v + 2 * v2 + 2 * v3 + v4) / 6
+                    vn = v + h * (a1 + 2 * a2 + 2 * a3 + a4) / 6
+                    psi = psi + h * (p1 + 2 * p2 + 2 * p3 + p4) / 6
+                    force = k * (xd0 + vd * (t + h) - x)
+                    if force <= armed_below:
+                        armed = True
+                    # the re-stick: the velocity at the step's end or at any of its stages
+                    # fell to the stop (a stage's sign of a Coulomb force flips at v = 0)
+                    low = min(min(v2, v3), min(v4, vn)) <= stop_v
+                    if (armed and low) or force <= backward:
+                        slipping, armed, v = False, False, 0.0
+                        if ns < sticks.shape[1]:
+                            sticks[r, ns] = min(i + 1, samples - 1)
+                        ns += 1
+                    else:
+                        v = vn
+                else:
+                    # stuck: at rest, the state aging
+                    psi = psi + h * _state_rate(code, p, 0.0, psi)
+                    force = k * (xd0 + vd * (t + h) - x)
+                    thr = static if code != 3 else _friction(code, p, start_v, psi)
+                    if force >= thr:
+                        slipping, v = True, start_v
+                        if ny < yields.shape[1]:
+                            yields[r, ny] = i
+                        ny += 1
+        counts[r, 0] = min(ny, yields.shape[1])
+        counts[r, 1] = min(ns, sticks.shape[1])
+
+
+def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity: float,
+          static_force: float = math.inf, duration: float, dt: float, replicas: int = 1,
+          velocity_noise: float = 0.0, velocity_correlation: float = 0.0, rattle: float = 0.0,
+          seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
+          backward_force: float = -math.inf, armed_below: float = math.inf,
+          start_velocity: float = 0.0, initial_state: float = 0.0,
+          substeps: int = 1) -> list[dict]:
+    """``replicas`` runs of the slider (module text), each with its own noise.
+
+    Parameters
+    ----------
+    law : str
+        One of :data:`LAWS`.
+    parameters : sequence of float
+        Its parameters (:data:`LAWS`).
+    mass, stiffness, drive_velocity : float
+        M, K and V (the spring end moves at V from x_d0 = ``initial_force``/K).
+    static_force : float
+        The spring force at which a stuck wall yields (``rate-state``: the law's force at
+        ``start_velocity`` and the aged state).
+    duration, dt : float
+        Length of the run and the sampling step.
+    velocity_noise, velocity_correlation : float
+        rms and lag-one (per ``dt``) correlation of u, the random force's velocity.
+    rattle : float
+        rms of the white noise added to the sampled velocity.
+    stop_velocity, backward_force, armed_below, start_velocity : float
+        The re-stick and the yield (module text).
+    initial_state : float
+        ψ at t = 0 (``rate-state``: ln(θ·v0/d_c)); while stuck ψ ages (dθ/dt = 1).
+    substeps : int
+        Runge–Kutta steps per sample.
+
+    Returns
+    -------
+    list of dict
+        Per replica: ``time, spring_force, drive_position, wall_position, wall_velocity``
+        (the sampled velocity, rattle included) and ``yield_index``, ``stick_index`` (the
+        sample at or just before each yield, at or just after each re-stick; complete
+        slips only).
+    """
+    if law not in LAWS:
+        raise ValueError(f"law = {law!r}: one of {', '.join(LAWS)}")
+    p = np.asarray(parameters, float)
+    if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
+        raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
+    for name, val in (("mass", mass), ("stiffness", stiffness), ("duration", duration),
+                      ("dt", dt)):
+        if not (math.isfinite(val) and val > 0):
+            raise ValueError(f"{name} = {val!r}: must be positive and finite")
+    if int(replicas) < 1 or int(substeps) < 1:
+        raise ValueError(f"replicas = {replicas!r}, substeps = {substeps!r}: must be >= 1")
+    if not (0 <= velocity_correlation < 1) or velocity_noise < 0 or rattle < 0:
+        raise ValueError("velocity_noise, rattle must be >= 0 and velocity_correlation in [0, 1)")
+    reps, n_sub = int(replicas), int(substeps)
+    rng = np.random.default_rng(seed)
+    h = dt / n_sub
+    samples = int(math.floor(duration / dt + 1e-9))
+    # u: Ornstein–Uhlenbeck at the steps, AR(1) of rms σ and correlation ρ per sample
+    rho_h = velocity_correlation ** (1.0 / n_sub)
+    kicks = rng.normal(0.0, velocity_noise * math.sqrt(1.0 - rho_h ** 2),
+                       (samples * n_sub, reps))
+    u0 = rng.normal(0.0, velocity_noise, reps)
+    u = lfilter([1.0], [1.0, -rho_h], kicks, axis=0, zi=(rho_h * u0)[None, :])[0]
+    du = np.diff(np.vstack([u0[None, :], u]), axis=0)
+    out_x, out_v = np.empty((samples, reps)), np.empty((samples, reps))
+    most = samples // 2 + 2
+    yields = np.zeros((reps, most), np.int64)
+    sticks = np.zeros((reps, most), np.int64)
+    counts = np.zeros((reps, 2), np.int64)
+    _run(_CODE[law], p, float(mass), float(stiffness), float(drive_velocity),
+         float(initial_force) / stiffness, float(static_force), float(start_velocity),
+         float(stop_velocity), float(backward_force), float(armed_below), float(initial_state),
+         h, n_sub, du, out_x, out_v, yields, sticks, counts)
+    t = dt * np.arange(samples)
+    xd = initial_force / stiffness + drive_velocity * t
+    runs = []
+    for r in range(reps):
+        y, s = _alternating(yields[r, :counts[r, 0]], sticks[r, :counts[r, 1]])
+        runs.append({"time": t, "spring_force": stiffness * (xd - out_x[:, r]),
+                     "drive_position": xd, "wall_position": out_x[:, r].copy(),
+                     "wall_velocity": out_v[:, r] + rng.normal(0.0, rattle, samples),
+                     "yield_index": y, "stick_index": s})
+    return runs
+
+
+def _alternating(yields, sticks) -> tuple[np.ndarray, np.ndarray]:
+    """The complete slips' (yield, re-stick) samples; a re-stick and a yield within one
+    sample interval (a pause shorter than the sampling) join their two slips into one."""
+    y, s = [], []
+    for a, b in zip(yields, sticks):
+        if s and a < s[-1]:
+            s[-1] = int(b)
+        else:
+            y.append(int(a))
+            s.append(int(b))
+    return np.asarray(y, int), np.asarray(s, int)

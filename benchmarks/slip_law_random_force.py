@@ -1,0 +1,229 @@
+"""The slip-law controls with the MD's noise as a random force that moves the wall, against
+the noise added to the law's trace (docs/results/slip-law.md, "The controls with a random force").
+
+    python benchmarks/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
+                                               [--slips 8 30] [--residual]
+
+For each control law and slip count: the verdicts of the replicas and the estimates' means
+with their standard errors over the replicas (F_k, B and the exponent n on the decelerating
+and the accelerating branch and the one law; the loop step), with the noise as the film's
+random force (:func:`~filmfriction.analysis.groundtruth.slip_law_controls.dynamical_fits`)
+and added to the noise-free law's trace (``replica_fits``), and noise-free.  With
+``--residual``: the integral-form residual of the random-force replicas measured as
+``benchmarks/slip_law_power.py --measure`` measures an MD run's (the whole slip, 2.5 τ off
+its ends, F_k + B·v fitted), to compare with the MD's 0.56–0.75 σ/τ rms and
+autocorrelation 0.82, 0.65, 0.44, 0.08 at 0.25, 1, 2, 4 τ.  With ``--cycle-mean``: a
+prototype of the remedy, the slips of each replica aligned at the yield and averaged
+before the fit (the noise of the regressors averages down as 1/√slips).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections import Counter
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+from filmfriction.analysis.groundtruth.random_force import slide
+from filmfriction.analysis.groundtruth.slip_law_controls import (
+    CONTROLS, MD_NOISE, SCALE, _dynamical_law, control_fits)
+from filmfriction.analysis.slip_law.slip_law import VERDICTS, fit_film_force
+from filmfriction.reduced_model.cycles import cycle_table
+
+NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.9, "rattle": 0.0}
+
+
+def _ms(x) -> str:
+    x = np.asarray(x, float)
+    x = x[np.isfinite(x)]
+    if x.size < 2:
+        return "n/a"
+    return f"{x.mean():.2f} ± {x.std(ddof=1) / math.sqrt(x.size):.2f}"
+
+
+def summary(fits) -> str:
+    c = Counter(f.verdict for f in fits)
+    verdicts = ", ".join(f"{k} {c[k]}" for k in VERDICTS if c[k])
+    rows = [f"verdicts: {verdicts}"]
+    for br in ("decelerating", "accelerating", "one_law"):
+        b = [getattr(f, br) for f in fits]
+        rows.append(f"  {br:12s} F_k {_ms([x.kinetic_force for x in b])}, "
+                    f"B {_ms([x.damping for x in b])}, n {_ms([x.exponent for x in b])}")
+    rows.append(f"  loop step {_ms([f.loop_step for f in fits])}, "
+                f"resolved (2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}")
+    return "\n".join(rows)
+
+
+def residual(replicas: int, share: float | None) -> None:
+    """The integral-form residual of the random-force replicas of the viscous control, or
+    of slips resisted by F_k + B·v of viscous ``share`` (``coulomb_viscous``)."""
+    law = _dynamical_law("viscous", share)
+    law.pop("period")
+    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                 duration=1500.0, dt=SCALE["dt"], replicas=replicas, seed=0,
+                 velocity_noise=0.75, velocity_correlation=0.9, rattle=0.25)
+    m = SCALE["mass"]
+    rms, acf, n = [], np.zeros(17), 0
+    for tr in runs:
+        t, f, v, x = tr["time"], tr["spring_force"], tr["wall_velocity"], tr["wall_position"]
+        imp = cumulative_trapezoid(f, t, initial=0.0)
+        for y, s in zip(tr["yield_index"][1:], tr["stick_index"][1:]):
+            i = np.arange(y + 10, s - 10)
+            if i.size < 24:
+                continue
+            dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
+            resp = imp[i] - imp[i[0]] - m * v[i]
+            X = np.column_stack([np.ones(i.size), dt, dx])
+            r = (resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / m
+            rms.append(float(r.std()))
+            r = r - r.mean()
+            a = np.array([r[:r.size - k] @ r[k:] for k in range(17)])
+            acf += a / a[0]
+            n += 1
+    acf /= max(n, 1)
+    what = "viscous control" if share is None else f"viscous share {share}"
+    print(f"{what}, random force: {n} slips; residual rms {np.mean(rms):.2f} σ/τ "
+          f"(slips {np.min(rms):.2f}–{np.max(rms):.2f}); autocorrelation at 0.25, 1, 2, 4 τ: "
+          + ", ".join(f"{acf[k]:.2f}" for k in (1, 4, 8, 16)))
+
+
+def cycle_mean_fit(run: dict, slips: int, drive_velocity: float):
+    """A prototype of the remedy: the ``slips`` slips after the start-up one aligned at the
+    yield, averaged over the window all of them slip in (the shortest), and the mean slip
+    fitted (one slip: the pooled errors, not the spread over the cycles)."""
+    t, f, v, x = run["time"], run["spring_force"], run["wall_velocity"], run["wall_position"]
+    y, s = run["yield_index"][1:slips + 1], run["stick_index"][1:slips + 1]
+    n = int(np.min(s - y)) + 1
+    idx = y[:, None] + np.arange(n)[None, :]
+    fe, ve = f[idx].mean(axis=0), v[idx].mean(axis=0)
+    xe = (x[idx] - x[y][:, None]).mean(axis=0)
+    tab = cycle_table(t[:n], fe, [0], [n - 1], spring_constant=SCALE["spring_constant"],
+                      wall_position=xe)
+    return fit_film_force(t[:n], fe, ve, tab, mass=SCALE["mass"],
+                          drive_velocity=drive_velocity, wall_position=xe)
+
+
+def instrumented_fit(run: dict, slips: int, floor: float = 0.2, edge: int = 3) -> np.ndarray:
+    """A prototype of another remedy: each slip fitted with its Δx instrumented by the mean
+    Δx of the other slips at the same lag from the yield (their noise is not this slip's),
+    the branches split at the peak of the others' mean velocity.  Per slip: (F_k, B) of the
+    decelerating and the accelerating branch and the whole slip's step; rows of NaN where
+    a slip has too few samples."""
+    t, f, v, x = run["time"], run["spring_force"], run["wall_velocity"], run["wall_position"]
+    y, s = run["yield_index"][1:slips + 1], run["stick_index"][1:slips + 1]
+    imp = cumulative_trapezoid(f, t, initial=0.0)
+    m, dt = SCALE["mass"], float(t[1] - t[0])
+    out = []
+    for i in range(y.size):
+        n = int(s[i] - y[i]) + 1
+        others = [j for j in range(y.size) if j != i]
+        lag = np.arange(n)
+        xs = np.full((len(others), n), np.nan)
+        vs = np.full((len(others), n), np.nan)
+        for r, j in enumerate(others):
+            k = min(n, int(s[j] - y[j]) + 1)
+            xs[r, :k] = x[y[j]:y[j] + k] - x[y[j]]
+            vs[r, :k] = v[y[j]:y[j] + k]
+        with np.errstate(all="ignore"):
+            zx, zv = np.nanmean(xs, axis=0), np.nanmean(vs, axis=0)
+        ok = np.isfinite(zx)
+        if ok.sum() < 12:
+            out.append([np.nan] * 5)
+            continue
+        n = int(np.flatnonzero(ok)[-1]) + 1
+        p = int(np.nanargmax(zv[:n]))
+        fast = zv[:n] > floor * zv[p]
+        fast[:edge] = False
+        fast[n - edge:] = False
+        idx = y[i] + lag[:n]
+        resp = imp[idx] - imp[idx[0]] - m * v[idx]
+        dts, dxs = lag[:n] * dt, x[idx] - x[idx[0]]
+        after = np.maximum(dts - p * dt, 0.0)
+        row = []
+        for lo, hi, step in ((p, n, False), (0, p + 1, False), (0, n, True)):
+            k = np.flatnonzero(fast[lo:hi]) + lo
+            if k.size < 8:
+                row += [np.nan, np.nan] if not step else [np.nan]
+                continue
+            k = np.arange(k[0], k[-1] + 1)
+            one = np.ones(k.size)
+            X = [one, dts[k], dxs[k]] + ([after[k]] if step else [])
+            Z = [one, dts[k], zx[k]] + ([after[k]] if step else [])
+            X, Z = np.column_stack(X), np.column_stack(Z)
+            try:
+                b = np.linalg.solve(Z.T @ X, Z.T @ resp[k])
+            except np.linalg.LinAlgError:          # e.g. no sample past the peak
+                b = np.full(X.shape[1], np.nan)
+            row += [-b[-1]] if step else [b[1], b[2]]
+        out.append(row)
+    return np.array(out, float)
+
+
+def instrumented(laws, slip_counts, replicas: int) -> None:
+    names = ("decelerating F_k", "decelerating B", "accelerating F_k", "accelerating B",
+             "loop step")
+    for law in laws:
+        args = _dynamical_law(law)
+        period = args.pop("period")
+        for slips in slip_counts:
+            runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                         duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
+                         replicas=replicas, seed=0, **MD_NOISE)
+            per = np.array([np.nanmean(instrumented_fit(r, slips), axis=0) for r in runs])
+            print(f"\n## {law}, {slips} slips instrumented by the other slips, {replicas} "
+                  "replicas (mean over each replica's slips, then over the replicas)\n  "
+                  + ", ".join(f"{nm} {_ms(per[:, c])}" for c, nm in enumerate(names)),
+                  flush=True)
+
+
+def cycle_means(laws, slip_counts, replicas: int) -> None:
+    for law in laws:
+        args = _dynamical_law(law)
+        period = args.pop("period")
+        for slips in slip_counts:
+            runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                         duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
+                         replicas=replicas, seed=0, **MD_NOISE)
+            fits = [cycle_mean_fit(r, slips, args["drive_velocity"]) for r in runs]
+            print(f"\n## {law}, {slips} slips averaged at the yield, {replicas} replicas\n"
+                  + summary(fits).split("\n", 1)[1], flush=True)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--replicas", type=int, default=40)
+    ap.add_argument("--laws", nargs="+", default=list(CONTROLS), choices=list(CONTROLS))
+    ap.add_argument("--slips", nargs="+", type=int, default=[8, 30])
+    ap.add_argument("--residual", action="store_true", help="only the residual of the replicas")
+    ap.add_argument("--instrumented", action="store_true",
+                    help="the prototype remedy: Δx instrumented by the other slips' mean")
+    ap.add_argument("--cycle-mean", action="store_true",
+                    help="the prototype remedy: the slips averaged at the yield, then fitted")
+    ap.add_argument("--share", type=float, default=None,
+                    help="with --residual: slips of F_k + B·v of this viscous share")
+    a = ap.parse_args(argv)
+    if a.residual:
+        residual(a.replicas, a.share)
+        return 0
+    if a.instrumented:
+        instrumented(a.laws, a.slips, a.replicas)
+        return 0
+    if a.cycle_mean:
+        cycle_means(a.laws, a.slips, a.replicas)
+        return 0
+    for law in a.laws:
+        for slips in a.slips:
+            exact = control_fits(law, 1, slips, noise=NOISE_FREE)
+            print(f"\n## {law} ({CONTROLS[law]}), {slips} slips\nnoise-free slider: "
+                  + summary(exact * 2).replace(" ± 0.00", "").split("\n", 1)[1].split(", resolved")[0],
+                  flush=True)
+            for name, injected in (("random force", False), ("added to the trace", True)):
+                fits = control_fits(law, a.replicas, slips, injected=injected)
+                print(f"{name}, {a.replicas} replicas: {summary(fits)}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,83 @@
+"""The random-force slider (analysis/groundtruth/random_force.py): the law's slips when
+noise-free, and the noise the integral-form fit sees when not."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import cumulative_trapezoid
+
+from filmfriction.analysis.groundtruth.random_force import slide
+
+K, M, FS, FK = 2.0, 30.0, 48.0, 36.0
+
+
+def _run(**kw):
+    args = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=800.0,
+                dt=0.25, armed_below=FK)
+    args.update(kw)
+    return slide("coulomb-viscous", (FK, 0.0), **args)
+
+
+def test_noise_free_coulomb_slips_are_the_closed_form():
+    # a Coulomb slip from rest at F_s: Δx = 2(F_s − F_k)/K, peak velocity (F_s − F_k)/√(KM)
+    # (plus about the drive's V·τ_s during the slip, τ_s = π√(M/K); the yield and the re-stick
+    # fall on the steps)
+    run = _run()[0]
+    y, s = run["yield_index"], run["stick_index"]
+    assert y.size >= 4
+    x, v, f = run["wall_position"], run["wall_velocity"], run["spring_force"]
+    tau = math.pi * math.sqrt(M / K)
+    for a, b in zip(y[1:], s[1:]):
+        assert x[b] - x[a] == pytest.approx(2 * (FS - FK) / K + 0.1 * tau, abs=0.1)
+        assert v[a:b + 1].max() == pytest.approx((FS - FK) / math.sqrt(K * M) + 0.1, abs=0.02)
+        assert f[b] == pytest.approx(2 * FK - FS, abs=0.1)      # K(Δx − V·τ_s) = 2(F_s − F_k)
+
+
+def test_the_integral_form_residual_is_the_random_force_velocity():
+    # [∫(F_spring − F_k) dt − M(v − v_y)]/M over a slip is −(u − u_y): AR(1) of rms σ and
+    # lag-one correlation ρ, so its lag-one increments have variance 2σ²(1 − ρ)
+    sigma, rho = 0.75, 0.9
+    runs = _run(replicas=16, duration=1200.0, velocity_noise=sigma, velocity_correlation=rho, seed=3)
+    steps, late = [], []
+    for run in runs:
+        t, f, v = run["time"], run["spring_force"], run["wall_velocity"]
+        imp = cumulative_trapezoid(f - FK, t, initial=0.0)
+        for a, b in zip(run["yield_index"], run["stick_index"]):
+            i = np.arange(a + 1, b)          # the wall moving (the Coulomb force is F_k)
+            if i.size < 12:
+                continue
+            r = (imp[i] - imp[i[0]]) / M - (v[i] - v[i[0]])
+            steps.append(np.diff(r))
+            late.append(r[8:])
+    d = np.concatenate(steps)
+    assert d.size > 500
+    # the trapezoid impulse's own error is O(dt²·jerk): a few % of the increments at most
+    assert np.sqrt(np.mean(d ** 2)) == pytest.approx(sigma * math.sqrt(2 * (1 - rho)), rel=0.12)
+    # far from the yield: the variance 2σ²(1 − ρ^k) approaches 2σ²
+    late = np.concatenate(late)
+    assert np.sqrt(np.mean(late ** 2)) == pytest.approx(sigma * math.sqrt(2), rel=0.3)
+
+
+def test_the_wall_moves_with_the_noise_and_rattle_is_on_the_velocity_only():
+    quiet, noisy = _run()[0], _run(velocity_noise=0.75, velocity_correlation=0.9,
+                                   rattle=0.25, seed=1)[0]
+    assert not np.allclose(quiet["wall_position"], noisy["wall_position"])
+    rattled = _run(rattle=0.25, seed=1)[0]
+    assert np.array_equal(rattled["wall_position"], quiet["wall_position"])
+    assert np.std(rattled["wall_velocity"] - quiet["wall_velocity"]) == pytest.approx(0.25,
+                                                                                     rel=0.1)
+
+
+@pytest.mark.parametrize("bad", [{"mass": 0.0}, {"dt": -1.0}, {"replicas": 0},
+                                 {"velocity_correlation": 1.0}, {"rattle": -0.1}])
+def test_bad_arguments_are_refused(bad):
+    with pytest.raises(ValueError):
+        _run(**bad)
+
+
+@pytest.mark.parametrize("law, parameters", [("stribeck", (1.0,)), ("linear", (1.0,)),
+                                             ("weakening", (25.0, 48.0, math.nan))])
+def test_a_bad_law_is_refused(law, parameters):
+    with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
+        slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
+              duration=10.0, dt=0.25)
