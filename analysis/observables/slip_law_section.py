@@ -236,7 +236,13 @@ class SlipLaw(Observable):
                 "27: the friction force against the sliding velocity during the slip). "
                 "`inconclusive` says that the run's slips are too few or too noisy to tell; "
                 "what the test can resolve at the MD's noise is in docs/results/slip-law.md. "
-                "The verdict is this film's: it bears on Klein's film, and on Braun & "
+                "Where the film's random force moves the wall the per-slip fit is biased: on "
+                "driven slips at the MD's noise Klein's viscous controls come out `mixed` (a "
+                "kinetic force and a loop where there are none), so a loop or a `mixed` verdict "
+                "of a driven run is a reading, no evidence of a yield or of a kinetic term; "
+                "releases of one scene, fitted as their mean "
+                "(`release_control.fit_release_ensemble`), pass their controls. A verdict is "
+                "this film's: it bears on Klein's film, and on Braun & "
                 "Tosatti's reading of it, only when the run's Bingham number η_eff/η_bulk "
                 "(sfb.json, `bingham_number`) is ≫ 1, as his is (~10⁴)."]
 

@@ -121,14 +121,19 @@ def _bingham_reading(rows) -> str:
         text += ("Here Eq. (1) asks for less than ten times the damping a bulk film would "
                  "give, so a fit of Eq. (1) cannot by itself show a viscous film, and the run "
                  "does not reproduce the regime of Klein's film: a verdict on his film needs "
-                 "Bi ≫ 1. What the run's slips do say is the slip law's verdict (its own "
-                 "section), with its power. How Bi moves with the slider's mass at this film, "
+                 "Bi ≫ 1. What the run's slips say of the film's own law is the slip law's "
+                 "reading (its own section), with its power; on driven slips at the MD's noise "
+                 "that fit fails its positive control (viscous controls come out `mixed`, with a "
+                 "loop: docs/results/slip-law.md), so a loop or a `mixed` verdict there is no "
+                 "evidence of a yield or of a kinetic term. How Bi moves with the slider's mass at this film, "
                  "how far 2 cores take it and what Klein's Bi would cost on a cluster are "
                  "measured by the slider-mass ladder (`filmfriction ladder plan`, `run`, "
                  "`collect`; its results page is docs/results/mass-ladder.md).")
     else:
-        text += ("Bi ≫ 1 here as in Klein's film: the slip law's verdict (its own section) says "
-                 "whether the large damping is viscous.")
+        text += ("Bi ≫ 1 here as in Klein's film: the slip law's verdict (its own section) would "
+                 "say whether the large damping is viscous, once its fit passes its controls at "
+                 "the run's noise (on driven slips at the MD's noise it does not: "
+                 "docs/results/slip-law.md).")
     return text
 
 

@@ -308,6 +308,10 @@ def _slip_law(a: dict, checks: list, sfb=None) -> Answer:
     if clash:
         text += "; the calibration's friction law disagrees (consistency)"
     text += _reach(sfb)
+    text += ("; the per-slip fit is biased where the film's random force moves the wall: on "
+             "driven slips at the MD's noise Klein's viscous controls come out `mixed`, with a "
+             "loop (docs/results/slip-law.md), so a loop or a `mixed` verdict on a driven run "
+             "is no evidence of a yield or of a kinetic term")
     return Answer(q, text, "inconclusive" if clash or verdict in ("inconclusive", "neither", "?")
                   else "established", rule, SECTIONS["slip_law"])
 
