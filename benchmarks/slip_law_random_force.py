@@ -161,16 +161,23 @@ def instrumented_fit(run: dict, slips: int, floor: float = 0.2, edge: int = 3) -
     return np.array(out, float)
 
 
+def _prototype_runs(law: str, slips: int, replicas: int):
+    """The random-force replicas of control ``law`` long enough for ``slips`` slips (the
+    prototypes' input) and the law's drive velocity."""
+    args = _dynamical_law(law)
+    period = args.pop("period")
+    runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                 duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
+                 replicas=replicas, seed=0, **MD_NOISE)
+    return runs, args["drive_velocity"]
+
+
 def instrumented(laws, slip_counts, replicas: int) -> None:
     names = ("decelerating F_k", "decelerating B", "accelerating F_k", "accelerating B",
              "loop step")
     for law in laws:
-        args = _dynamical_law(law)
-        period = args.pop("period")
         for slips in slip_counts:
-            runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                         duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
-                         replicas=replicas, seed=0, **MD_NOISE)
+            runs, _ = _prototype_runs(law, slips, replicas)
             per = np.array([np.nanmean(instrumented_fit(r, slips), axis=0) for r in runs])
             print(f"\n## {law}, {slips} slips instrumented by the other slips, {replicas} "
                   "replicas (mean over each replica's slips, then over the replicas)\n  "
@@ -180,13 +187,9 @@ def instrumented(laws, slip_counts, replicas: int) -> None:
 
 def cycle_means(laws, slip_counts, replicas: int) -> None:
     for law in laws:
-        args = _dynamical_law(law)
-        period = args.pop("period")
         for slips in slip_counts:
-            runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                         duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
-                         replicas=replicas, seed=0, **MD_NOISE)
-            fits = [cycle_mean_fit(r, slips, args["drive_velocity"]) for r in runs]
+            runs, velocity = _prototype_runs(law, slips, replicas)
+            fits = [cycle_mean_fit(r, slips, velocity) for r in runs]
             print(f"\n## {law}, {slips} slips averaged at the yield, {replicas} replicas\n"
                   + summary(fits).split("\n", 1)[1], flush=True)
 
