@@ -30,7 +30,7 @@ import math
 import numpy as np
 from scipy.signal import savgol_filter
 
-from filmfriction.reduced_model.units import LJ_ETA_FILM, LJ_ETA_FILM_STDERR, lj_bulk_viscosity
+from filmfriction.reduced_model.units import lj_bulk_viscosity
 
 from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
 from ..files.trace import unit
@@ -41,13 +41,19 @@ from .observable import (Context, MissingInput, Observable, column, format_estim
 
 __all__ = ["SlipLaw", "BULK_VISCOSITY_SOURCE"]
 
-#: Where the LJ bulk viscosity of the Klein-similar film's state point comes from (the
-#: value taken for a film at a state point where none was measured).
-BULK_VISCOSITY_SOURCE = {
-    "state_point": "T = 0.71 ε/k_B, ρ = 0.85 σ⁻³ (the film's, rc = 2.5 σ)",
-    "command": "filmfriction viscosity --temperature 0.71 --density 0.85 --steps 800000 "
-               "--blocks 20 --seed 4928459",
-}
+#: The bulk viscosity taken for a film at a state point where none was measured: the
+#: Klein-similar film's (kT 0.71, :data:`~filmfriction.reduced_model.units.LJ_ETA_FILM`).
+_KLEIN_SIMILAR_FILM = lj_bulk_viscosity(0.71)
+
+
+def _source(at) -> dict:
+    """Where a bulk viscosity comes from: its state point and the command that measured it."""
+    return {"state_point": f"T = {at.temperature:g} ε/k_B, ρ = {at.density:g} σ⁻³ (rc = 2.5 σ)",
+            "command": at.command}
+
+
+#: Where the Klein-similar film's bulk viscosity comes from.
+BULK_VISCOSITY_SOURCE = _source(_KLEIN_SIMILAR_FILM)
 #: A film whose mean temperature (ε/k_B) is this close to a measured state point's takes
 #: its bulk viscosity (:func:`~filmfriction.reduced_model.units.lj_bulk_viscosity`).
 _STATE_POINT_TOLERANCE = 0.03
@@ -170,20 +176,16 @@ class SlipLaw(Observable):
         tr = ctx.trace
         temp = (float(np.mean(tr.columns["film_temperature"])) if tr.has("film_temperature")
                 else math.nan)
-        at = lj_bulk_viscosity(temp, tolerance=_STATE_POINT_TOLERANCE)
-        if at is not None:
-            eta, eta_err = at.viscosity, at.stderr
-            source = {"state_point": f"T = {at.temperature:g} ε/k_B, ρ = {at.density:g} σ⁻³ "
-                                     "(rc = 2.5 σ)", "command": at.command}
-        else:
-            eta, eta_err, source = LJ_ETA_FILM, LJ_ETA_FILM_STDERR, dict(BULK_VISCOSITY_SOURCE)
+        measured = lj_bulk_viscosity(temp, tolerance=_STATE_POINT_TOLERANCE)
+        at = measured or _KLEIN_SIMILAR_FILM
+        eta, eta_err = at.viscosity, at.stderr
         bulk = eta * area / d
-        out = {"bulk_viscosity": ctx.value(eta, eta_err, "viscosity", **source),
+        out = {"bulk_viscosity": ctx.value(eta, eta_err, "viscosity", **_source(at)),
                "bulk_film_damping": ctx.value(bulk, eta_err * area / d, "damping",
                                               form="eta_bulk·A/D", thickness=d),
                "damping_over_bulk": finite_or_none(b / bulk),
                "damping_over_bulk_stderr": finite_or_none(b_err / bulk)}
-        if at is None and math.isfinite(temp):
+        if measured is None and math.isfinite(temp):
             out["bulk_viscosity"]["note"] = (
                 f"no bulk viscosity measured at the film's mean temperature {temp:.3g}: the "
                 "Klein-similar film's (0.71) is taken; measure eta_bulk at the film's own "
