@@ -99,6 +99,12 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in [
     P("release_offset", float, "sigma", 0.0, 0.0, 1000.0,
       "release test: the spring's far end starts this far ahead of the wall (x0), "
       "so the wall is let go from a stretched spring; 0 = no offset"),
+    P("preload_force", float, "epsilon/sigma", 0.0, 0.0, 1.0e4,
+      "start-up shortcut: over the first preload_steps the spring's end runs ahead of the "
+      "drive until the spring holds this much more force (a ramp; choose it below the "
+      "static friction force); 0 = none"),
+    P("preload_steps", int, "steps", 0, 0, 2**31 - 1,
+      "length of the preload ramp (longer than the wall's ringing period on the film)"),
     P("hold_gap", int, "-", 0, 0, 1,
       "1 = the top wall's z frozen for the slide (free along x only, at the gap it reached "
       "under the load while equilibrating: the load does no work); 0 = free along z"),
@@ -233,6 +239,14 @@ def check_consistency(p: dict) -> None:
         raise SceneError(
             "drive_velocity = 0.0 sigma/tau: must be > 0, or a release test "
             "(release_offset > 0: the wall let go from a spring stretched by x0, undriven)")
+    if (p["preload_force"] > 0.0) != (p["preload_steps"] > 0):
+        raise SceneError(
+            f"preload_force = {p['preload_force']:g} epsilon/sigma with preload_steps = "
+            f"{p['preload_steps']}: give both (a force > 0 reached over > 0 steps) or neither")
+    if p["preload_steps"] > p["slide_steps"]:
+        raise SceneError(
+            f"preload_steps = {p['preload_steps']} is longer than slide_steps = "
+            f"{p['slide_steps']}: the preload ramp must end within the slide")
     q = derived_quantities(p)
     dt = p["timestep"]
     lj_limit = LJ_TIMESTEP_LIMIT / math.sqrt(max(1.0, p["wall_fluid_epsilon"]))
