@@ -48,6 +48,7 @@ from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
+from ..slip_law.slip_law_cycles import fit_cycle_ensemble
 from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
@@ -199,7 +200,8 @@ def _dynamical_law(name: str, share: float | None = None) -> dict:
 
 
 def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | None = None,
-                   seed: int = 0, share: float | None = None, **fit) -> list[FilmForceFit]:
+                   seed: int = 0, share: float | None = None, ensemble: bool = True,
+                   **fit) -> list[FilmForceFit]:
     """The slip-law fit of ``replicas`` runs of control ``name`` whose film pushes the wall
     with the MD's noise as a random force (:mod:`~filmfriction.analysis.groundtruth.random_force`):
     the wall's position and velocity respond to it, as an MD wall's do.
@@ -207,9 +209,14 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
     With ``share`` the law is :func:`coulomb_viscous`'s of that viscous share (``name``
     is then ignored).  The slips are the slider's own (its yields and re-sticks: the
     detector is not under test); the start-up slip is left out and the next ``slips``
-    fitted; ``fit`` goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`.
+    fitted by the cycle ensemble
+    (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, the
+    driven analysis's fit) or, with ``ensemble=False``, slip by slip
+    (:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`); ``fit`` goes to
+    the one called.
     """
     noise = MD_NOISE if noise is None else noise
+    fitter = fit_cycle_ensemble if ensemble else fit_film_force
     law = _dynamical_law(name, share)
     period = law.pop("period")
     runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
@@ -221,9 +228,9 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
         tab = cycle_table(t, f, tr["yield_index"], tr["stick_index"],
                           spring_constant=SCALE["spring_constant"],
                           wall_position=tr["wall_position"])[1:slips + 1]
-        out.append(fit_film_force(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
-                                  drive_velocity=law["drive_velocity"],
-                                  wall_position=tr["wall_position"], **fit))
+        out.append(fitter(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
+                          drive_velocity=law["drive_velocity"],
+                          wall_position=tr["wall_position"], **fit))
     return out
 
 

@@ -129,7 +129,8 @@ from .slip_law_branches import BranchFit, Segment, fit_branch, jackknife, jackkn
 from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
-__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "jackknife_fit",
+__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
+           "jackknife_fit",
            "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
@@ -400,12 +401,27 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             segs[name].append(Segment(imp, v[i], dt_, dx, guide[i] - guide[i[0]], mass,
                                       np.maximum(dt_ - (t[y + p] - t[i[0]]), 0.0)))
         ranges.append((min_velocity_fraction * peak, peak))
+    return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
+                        smoothing_window=w, still=still, windows=len(table),
+                        load_work_removed=gap_rate is not None)
+
+
+def fit_segments(segs: dict, ranges: list, *, mass: float, comoving_mass: bool,
+                 smoothing_window: int, still=(), windows: int = 0,
+                 load_work_removed: bool = False) -> FilmForceFit:
+    """The branches, the one law, the loop and the verdict from the slips' segments.
+
+    ``segs`` maps ``decelerating``, ``accelerating`` and ``whole`` to one
+    :class:`~filmfriction.analysis.slip_law.slip_law_branches.Segment` (or None) per
+    slip, ``ranges`` holds each slip's fitted velocity range (floor, peak); ``still``
+    the windows refused (:func:`fit_film_force`), of ``windows`` in all."""
+    still = list(still)
     fits = {name: fit_branch(name, segs[name], comoving_mass) for name in segs}
     # one law F_k + B·v + m_c·a over the whole slip, and the step at the peak beyond it
     fits["one_law"] = fit_branch(ONE_LAW, segs["whole"], True)
     fits["loop_step"] = fit_branch(ONE_LAW, segs["whole"], True, loop_step=True)
     if still:
-        fits = _refuse_still(fits, still, len(table))
+        fits = _refuse_still(fits, still, windows)
     acc, dec = fits["accelerating"], fits["decelerating"]
     lo, hi = np.array(ranges, float).reshape(-1, 2).T
     # the loop between the two branches' lines, over the velocities both cover
@@ -420,15 +436,18 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     return FilmForceFit(dec, acc, fits["whole"], one, st.loop_step, st.loop_step_stderr,
                         sigmas(st.loop_step, st.loop_step_stderr, st.dof),
                         detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
-                        la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still),
-                        gap_rate is not None)
+                        la[0], la[1], lf[0], lf[1], area, smoothing_window, comoving_mass,
+                        len(still), load_work_removed)
 
 
-def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float) -> FilmForceFit:
+def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
+                  replicas: str = "releases") -> FilmForceFit:
     """The fit of a mean trace with its errors from the jackknife over its replicas.
 
     ``fit`` is :func:`fit_film_force` on the mean of R replicas of one slip (releases
-    of one initial condition, aligned at the release), ``leave_one_out`` the R fits of
+    of one initial condition, aligned at the release; or the slips of a driven run,
+    :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`),
+    ``leave_one_out`` the R fits of
     the means that leave one replica out.  The law is linear in the trace, so the mean
     trace's fit has the law's expectation whatever the noise (E[ξ] = 0), while a fit
     per replica regresses on the replica's own noisy Δx and Δv, which the film's
@@ -439,14 +458,15 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float) -> FilmForce
     (:func:`~filmfriction.analysis.slip_law.slip_law_branches.jackknife_branch`); the
     significance, the power, the branches' verdicts and the choice of the law
     (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`) follow from
-    them as on any fit.
+    them as on any fit.  ``replicas`` names the replicas in the reasons.
     """
     loo = list(leave_one_out)
     if len(loo) < 2:
         raise ValueError(f"{len(loo)} leave-one-out fit(s): the jackknife needs 2 or more")
-    br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo])
+    br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo],
+                                 replicas=replicas)
           for name in ("decelerating", "accelerating", "whole", "one_law")}
-    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo])
+    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo], replicas=replicas)
     dof = len(loo) - 1
     frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass)
     (la_se, la_ps), (lf_se, _) = (jackknife(getattr(fit, k), [getattr(f, k) for f in loo])
