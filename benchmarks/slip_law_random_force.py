@@ -219,7 +219,7 @@ def _coverage(fits, branch: str, attr: str, truth: float) -> str:
     z = np.array([sigmas(e - truth, s_, d) for e, s_, d in zip(est, se, dof)])
     ok = np.isfinite(est)
     return (f"{np.mean(est[ok]) - truth:+.2f} ± {np.std(est[ok], ddof=1) / math.sqrt(ok.sum()):.2f}"
-            f" (truth {truth:.3g}), covered {int(np.sum(np.abs(z) < 2))}/{len(fits)}")
+            f" (truth {truth:.3g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
 
 
 def ensemble_table(laws, slip_counts, replicas: int, noises) -> None:
@@ -233,10 +233,14 @@ def ensemble_table(laws, slip_counts, replicas: int, noises) -> None:
             name = law if share is None else f"{law} share {share}"
             for slips in slip_counts:
                 exact = dynamical_fits(law, 1, slips, noise=NOISE_FREE, share=share)[0]
-                fits = dynamical_fits(law, replicas, slips, noise=NOISES[noise], share=share)
-                c = Counter(f.verdict for f in fits)
+                fits = dynamical_fits(law, replicas, slips, noise=NOISES[noise], share=share,
+                                      unfitted=True)
+                refused = sum(f is None for f in fits)
+                fits = [f for f in fits if f is not None]
+                c = Counter(f.verdict for f in fits) | Counter({"not fitted (< 3 slips)": refused})
                 print(f"\n## {name}, {slips} slips, noise {noise}, {replicas} replicas: "
-                      + ", ".join(f"{k} {c[k]}" for k in VERDICTS if c[k])
+                      + ", ".join(f"{k} {c[k]}" for k in (*VERDICTS, "not fitted (< 3 slips)")
+                                  if c[k])
                       + f"; verdict from {dict(Counter(f.verdict_from for f in fits))}")
                 for br in ("decelerating", "one_law"):
                     law_ = getattr(exact, br)

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from functools import lru_cache
+from functools import lru_cache, partial
 
 import numpy as np
 
@@ -48,7 +48,7 @@ from filmfriction.reduced_model import SpringBlock, laws
 from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
-from ..slip_law.slip_law_cycles import fit_cycle_ensemble
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
@@ -201,7 +201,7 @@ def _dynamical_law(name: str, share: float | None = None) -> dict:
 
 def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | None = None,
                    seed: int = 0, share: float | None = None, ensemble: bool = True,
-                   **fit) -> list[FilmForceFit]:
+                   unfitted: bool = False, **fit) -> list[FilmForceFit | None]:
     """The slip-law fit of ``replicas`` runs of control ``name`` whose film pushes the wall
     with the MD's noise as a random force (:mod:`~filmfriction.analysis.groundtruth.random_force`):
     the wall's position and velocity respond to it, as an MD wall's do.
@@ -213,10 +213,12 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
     (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, the
     driven analysis's fit) or, with ``ensemble=False``, slip by slip
     (:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`); ``fit`` goes to
-    the one called.
+    the one called.  With ``unfitted`` a replica the fit refuses (too few slips in the
+    run, at a large noise) is None in the list; else its error is raised.
     """
     noise = MD_NOISE if noise is None else noise
-    fitter = fit_cycle_ensemble if ensemble else fit_film_force
+    fitter = (partial(fit_cycle_ensemble, min_window_time=MD_NOISE_TIME) if ensemble
+              else fit_film_force)
     law = _dynamical_law(name, share)
     period = law.pop("period")
     runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
@@ -228,9 +230,14 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
         tab = cycle_table(t, f, tr["yield_index"], tr["stick_index"],
                           spring_constant=SCALE["spring_constant"],
                           wall_position=tr["wall_position"])[1:slips + 1]
-        out.append(fitter(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
-                          drive_velocity=law["drive_velocity"],
-                          wall_position=tr["wall_position"], **fit))
+        try:
+            out.append(fitter(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
+                              drive_velocity=law["drive_velocity"],
+                              wall_position=tr["wall_position"], **fit))
+        except ValueError:
+            if not unfitted:
+                raise
+            out.append(None)
     return out
 
 

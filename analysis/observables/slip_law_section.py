@@ -39,7 +39,7 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.units import lj_bulk_viscosity
 
 from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
-from ..slip_law.slip_law_cycles import fit_cycle_ensemble
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..files.trace import unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
@@ -99,7 +99,9 @@ class SlipLaw(Observable):
         try:
             # the verdict's fit: the slips' mean, unbiased where the film's random force
             # moves the wall (module text)
-            fit, estimator = fit_cycle_ensemble(t, f, v, ctx.table, **args), ESTIMATORS[0]
+            noise_time = MD_NOISE_TIME if ctx.units == "lj" else 0.0
+            fit = fit_cycle_ensemble(t, f, v, ctx.table, **args, min_window_time=noise_time)
+            estimator = ESTIMATORS[0]
         except ValueError as err:
             fit, estimator = per_slip, ESTIMATORS[1]
             ctx.skip_part("slip_law.cycle_ensemble", f"the slips' mean not fitted: {err}; "

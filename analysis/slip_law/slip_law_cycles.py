@@ -68,10 +68,14 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, _checked, _windo
                        fit_segments, jackknife_fit)
 from .slip_law_branches import Segment
 
-__all__ = ["fit_cycle_ensemble", "held_slips", "MIN_CYCLES"]
+__all__ = ["fit_cycle_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
 MIN_CYCLES = 3
+#: The time over which the MD's wall noise stays correlated (LJ τ): its autocorrelation is
+#: 0.44 at 2 τ and 0.08 at 4 τ (docs/results/slip-law.md, "The MD's noise").  The mean
+#: slip's velocity is smoothed over at least this long (``min_window_time``).
+MD_NOISE_TIME = 3.0
 
 
 def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
@@ -151,8 +155,8 @@ def _segments(mean: dict, guide: np.ndarray, p: int, lags: dict, mass: float) ->
 def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, mass: float,
                        drive_velocity: float = 0.0, mount_damping: float = 0.0,
                        wall_position=None, min_velocity_fraction: float = 0.2,
-                       smoothing: float = SMOOTHING, comoving_mass: bool = False
-                       ) -> FilmForceFit:
+                       smoothing: float = SMOOTHING, comoving_mass: bool = False,
+                       min_window_time: float = 0.0) -> FilmForceFit:
     """The slip law of the mean of the slips of ``table`` (module text), errors by the
     jackknife over the slips.
 
@@ -161,7 +165,13 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     relaxed by less than :data:`~filmfriction.analysis.slip_law.slip_law.MIN_RELAXATION`
     of its force) are left out of the ensemble; at least :data:`MIN_CYCLES` slips must
     be left.  The per-slip arrays of the result hold the jackknife's pseudo-values, one
-    per slip; ``smoothing_window`` is the window of the mean's velocity.
+    per slip; ``smoothing_window`` is the window of the mean's velocity: ``smoothing`` of
+    the median slip, and at least ``min_window_time`` (the time over which the film's
+    noise stays correlated, :data:`MD_NOISE_TIME` for an MD run in LJ units; 0: none).
+    The mean's velocity is the m_c term's regressor and sets the branches' split, so its
+    noise biases the loop step (a window much shorter than the noise's correlation leaves
+    the mean's velocity as noisy as its samples: on the Coulomb controls at the MD's
+    noise, 8 slips, a loop step of +7.5 ε/σ with a window of 1.2 τ, +1.4 with 3 τ).
 
     Raises
     ------
@@ -191,8 +201,11 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                          f"{MIN_CYCLES} or more")
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
                       drive_velocity=drive_velocity)
-    window = _window(t, table, smoothing)
+    if not (math.isfinite(min_window_time) and min_window_time >= 0):
+        raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
     dt = float(dts[0])
+    window = max(_window(t, table, smoothing), int(math.ceil(min_window_time / dt)))
+    window += (1 - window % 2) if window else 0
     n = int(keep.sum())
     # the peak and the fitted lags are the whole ensemble's, for its fit and for the
     # jackknife's (the errors are the data's, not a re-selection's)
