@@ -130,7 +130,7 @@ from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
-           "jackknife_fit",
+           "jackknife_fit", "checked_trace", "smoothing_samples",
            "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
@@ -271,11 +271,13 @@ def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity
     >>> film_force(t, np.full(5, 3.0), v, mass=0.5).tolist()   # 3 − 0.5·2
     [2.0, 2.0, 2.0, 2.0, 2.0]
     """
-    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
     return f - mass * np.gradient(v, t) - mount_damping * (v - drive_velocity)
 
 
-def _checked(time, spring_force, wall_velocity, mass):
+def checked_trace(time, spring_force, wall_velocity, mass):
+    """(t, F_spring, v) as float arrays, checked: 1-D, one length, at least 2 samples,
+    a positive ``mass`` (ValueError otherwise)."""
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
     v = np.asarray(wall_velocity, float)
@@ -289,7 +291,7 @@ def _checked(time, spring_force, wall_velocity, mass):
     return t, f, v
 
 
-def _window(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
+def smoothing_samples(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
     """Savitzky–Golay window (odd, ≥ 5 samples) for ``smoothing`` × median slip duration;
     0 when the sampling is not uniform or the window would be under 5 samples."""
     if smoothing <= 0 or t.size < 7:
@@ -344,14 +346,14 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
     if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
         raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
-    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
     if wall_position is None:
         x = cumulative_trapezoid(v, t, initial=0.0)
     else:
         x = np.asarray(wall_position, float)
         if x.shape != t.shape:
             raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
-    w = _window(t, table, smoothing)
+    w = smoothing_samples(t, table, smoothing)
     # the velocity that picks the samples: from the position, whose noise is not the
     # response's (selecting on the response's own noise would bias the fit)
     if w and wall_position is not None:

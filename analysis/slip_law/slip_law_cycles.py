@@ -64,8 +64,8 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
 
-from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, _checked, _window,
-                       fit_segments, jackknife_fit)
+from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_trace, fit_segments,
+                       jackknife_fit, smoothing_samples)
 from .slip_law_branches import Segment
 
 __all__ = ["fit_cycle_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
@@ -182,7 +182,7 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
         raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
     if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
         raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
-    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
     dts = np.diff(t)
     if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
         raise ValueError("the cycle ensemble needs a uniform sampling")
@@ -204,7 +204,7 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     if not (math.isfinite(min_window_time) and min_window_time >= 0):
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
     dt = float(dts[0])
-    window = max(_window(t, table, smoothing), int(math.ceil(min_window_time / dt)))
+    window = max(smoothing_samples(t, table, smoothing), int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
     n = int(keep.sum())
     # the peak and the fitted lags are the whole ensemble's, for its fit and for the
