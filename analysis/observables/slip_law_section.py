@@ -13,10 +13,11 @@ the decelerating branch, ``slip_law_accelerating_kinetic_force``,
 ``slip_law_accelerating_damping``, ``slip_law_loop_area``), and what the report
 shows: the verdict's table and the film force against the wall's velocity with
 the two branches' lines.  Where the trace has the load's work (an MD trace's
-``load_work`` column), the same fit with that work taken out of the film force
+``load_work`` column), each slip's own fit with that work taken out of the film force
 (``fit_film_force(load_work=…)``: the film's dissipative force, the gap's work
-against the load removed) is reported beside it as ``load_work_removed`` (its
-verdict, the one law, the loop step); the section's verdict stays the film force's
+against the load removed; to compare with ``per_slip_fit``) is reported beside it as
+``load_work_removed`` (its verdict, the one law, the loop step); the section's verdict
+stays the film force's
 (docs/results/slip-law.md: on the MD liquid the correction carries the gap's thermal
 breathing into the fit and more than doubles the errors).  The section's own F_k, B, exponent and power are the
 verdict's law's (``verdict_from``: the one law over the whole slip with a co-moving
