@@ -3,6 +3,16 @@ the noise added to the law's trace (docs/results/slip-law.md, "The controls with
 
     python benchmarks/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
                                                [--slips 8 30] [--residual]
+    python benchmarks/slip_law_random_force.py --ensemble [--noises md 1.5x 2tau]
+
+With ``--ensemble``: the driven analysis's fit, the slips' mean
+(:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`), on the
+controls and on Coulomb + viscous slips of viscous share 0.3 and 0.6, at the MD's noise, 1.5
+times its amplitude and twice its correlation time: the verdict counts, and the bias
+(mean − truth ± its standard error over the replicas) and coverage (how many replicas'
+2 σ cover the truth) of F_k and B (decelerating branch, one law) and of the loop step, the
+truth being the same fit of the noise-free slider.  Without it, each slip is fitted on its
+own:
 
 For each control law and slip count: the verdicts of the replicas and the estimates' means
 with their standard errors over the replicas (F_k, B and the exponent n on the decelerating

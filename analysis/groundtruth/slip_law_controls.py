@@ -10,15 +10,19 @@ Each replica's film pushes the wall with the MD's noise as a random force ξ = M
 u the velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`):
 the wall's position and velocity respond to it, as an MD wall's do, and the residual of
 the integrated equation of motion over M, ∫ξ dt/M, is u — how the MD's noise was
-measured.  The per-slip fit does not pass every control so: its regressors (Δx, the
-branch split at the noisy peak velocity) carry the noise of its response.  With 40
-replicas (``python benchmarks/slip_law_random_force.py``, docs/results/slip-law.md):
-Klein's viscous slips come out ``mixed`` in 40 of 40 at 30 slips (decelerating branch
-B = 27 of 62 m/τ, F_k = 18.7 of 0 ε/σ), and every law's loop step is resolved, +12 to
-+22 ε/σ where it is 0 to −1.3; no negative control is called ``viscous``.  The noise
+measured.  The slips are fitted as the driven analysis fits them, as their mean
+(:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, each slip
+held at its end, the jackknife's errors over the slips); ``ensemble=False`` fits each
+slip on its own, which fails the controls so: its regressors (Δx, and the branch split at
+the noisy peak velocity) carry the noise of its response (Klein's viscous slips come out
+``mixed`` in 40 of 40 with 30 slips, every law gets a loop step of +12 to +22 ε/σ).  With
+40 replicas (``python benchmarks/slip_law_random_force.py --ensemble``,
+docs/results/slip-law.md) the mean passes at the MD's noise: Klein's slips ``viscous`` in
+38 of 40 with 30 slips, a Coulomb loop step resolved in 2 of 40, no negative control
+``viscous``; Coulomb + viscous slips keep a bias toward the kinetic reading.  The noise
 added to the noise-free law's trace instead (``injected=True``: the spring force carries
-M·du/dt, the motion is the law's; :func:`replica_fits`) passes them (Klein's slips
-``viscous`` in 39 of 40) and is kept as the comparison.
+M·du/dt, the motion is the law's; :func:`replica_fits`, fitted slip by slip) is kept as
+the comparison.
 
 ``coulomb``      Coulomb, F_s = 48, F_k = 36 ε/σ (B = 0; with the random force F_k while
                  slipping, whatever the sign of a recoil)
