@@ -3,6 +3,16 @@ the noise added to the law's trace (docs/results/slip-law.md, "The controls with
 
     python benchmarks/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
                                                [--slips 8 30] [--residual]
+    python benchmarks/slip_law_random_force.py --ensemble [--noises md 1.5x 2tau]
+
+With ``--ensemble``: the driven analysis's fit, the slips' mean
+(:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`), on the
+controls and on Coulomb + viscous slips of viscous share 0.3 and 0.6, at the MD's noise, 1.5
+times its amplitude and twice its correlation time: the verdict counts, and the bias
+(mean − truth ± its standard error over the replicas) and coverage (how many replicas'
+2 σ cover the truth) of F_k and B (decelerating branch, one law) and of the loop step, the
+truth being the same fit of the noise-free slider.  Without it, each slip is fitted on its
+own:
 
 For each control law and slip count: the verdicts of the replicas and the estimates' means
 with their standard errors over the replicas (F_k, B and the exponent n on the decelerating
@@ -194,6 +204,62 @@ def cycle_means(laws, slip_counts, replicas: int) -> None:
                   + summary(fits).split("\n", 1)[1], flush=True)
 
 
+#: The noises of the ensemble's table: the MD's, 1.5 times its amplitude, twice its
+#: correlation time (ρ per sample to the power 1/2).
+NOISES = {"md": MD_NOISE,
+          "1.5x": {k: (v if k == "velocity_correlation" else 1.5 * v) for k, v in MD_NOISE.items()},
+          "2tau": MD_NOISE | {"velocity_correlation": MD_NOISE["velocity_correlation"] ** 0.5}}
+#: The Coulomb + viscous laws of the table (viscous share of the film force at 0.55 σ/τ).
+SHARES = (0.3, 0.6)
+
+
+def _coverage(fits, branch: str, attr: str, truth: float) -> str:
+    """Mean − truth ± its standard error over the replicas, and how many replicas' 2 σ
+    (normal-equivalent, the fit's own dof) cover the truth."""
+    from filmfriction.analysis.slip_law.slip_law_stats import sigmas
+    if branch == "step":
+        est = np.array([f.loop_step for f in fits])
+        se = np.array([f.loop_step_stderr for f in fits])
+        dof = [f.one_law.dof for f in fits]
+    else:
+        b = [getattr(f, branch) for f in fits]
+        est = np.array([getattr(x, attr) for x in b])
+        se = np.array([getattr(x, f"{attr}_stderr") for x in b])
+        dof = [x.dof for x in b]
+    z = np.array([sigmas(e - truth, s_, d) for e, s_, d in zip(est, se, dof)])
+    ok = np.isfinite(est)
+    return (f"{np.mean(est[ok]) - truth:+.2f} ± {np.std(est[ok], ddof=1) / math.sqrt(ok.sum()):.2f}"
+            f" (truth {truth:.3g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
+
+
+def ensemble_table(laws, slip_counts, replicas: int, noises) -> None:
+    """The cycle ensemble's control table: verdict counts, bias and coverage of F_k and B
+    (the decelerating branch and the one law) and of the loop step, the truth being the
+    same fit of the noise-free slider (the law's own F_k, B for the linear laws)."""
+    from filmfriction.analysis.groundtruth.slip_law_controls import dynamical_fits
+    cases = [(law, None) for law in laws] + [("coulomb-viscous", sh) for sh in SHARES]
+    for noise in noises:
+        for law, share in cases:
+            name = law if share is None else f"{law} share {share}"
+            for slips in slip_counts:
+                exact = dynamical_fits(law, 1, slips, noise=NOISE_FREE, share=share)[0]
+                fits = dynamical_fits(law, replicas, slips, noise=NOISES[noise], share=share,
+                                      unfitted=True)
+                refused = sum(f is None for f in fits)
+                fits = [f for f in fits if f is not None]
+                c = Counter(f.verdict for f in fits) | Counter({"not fitted (< 3 slips)": refused})
+                print(f"\n## {name}, {slips} slips, noise {noise}, {replicas} replicas: "
+                      + ", ".join(f"{k} {c[k]}" for k in (*VERDICTS, "not fitted (< 3 slips)")
+                                  if c[k])
+                      + f"; verdict from {dict(Counter(f.verdict_from for f in fits))}")
+                for br in ("decelerating", "one_law"):
+                    law_ = getattr(exact, br)
+                    print(f"  {br:12s} F_k {_coverage(fits, br, 'kinetic_force', law_.kinetic_force)}"
+                          f"; B {_coverage(fits, br, 'damping', law_.damping)}")
+                print(f"  loop step {_coverage(fits, 'step', '', exact.loop_step)}, resolved "
+                      f"(2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}", flush=True)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--replicas", type=int, default=40)
@@ -204,6 +270,10 @@ def main(argv=None) -> int:
                     help="the prototype remedy: Δx instrumented by the other slips' mean")
     ap.add_argument("--cycle-mean", action="store_true",
                     help="the prototype remedy: the slips averaged at the yield, then fitted")
+    ap.add_argument("--ensemble", action="store_true",
+                    help="the cycle ensemble (the driven analysis's fit): verdicts, bias, coverage")
+    ap.add_argument("--noises", nargs="+", default=["md"], choices=list(NOISES),
+                    help="with --ensemble: the noises (md, 1.5x amplitude, 2tau correlation time)")
     ap.add_argument("--share", type=float, default=None,
                     help="with --residual: slips of F_k + B·v of this viscous share")
     a = ap.parse_args(argv)
@@ -213,17 +283,21 @@ def main(argv=None) -> int:
     if a.instrumented:
         instrumented(a.laws, a.slips, a.replicas)
         return 0
+    if a.ensemble:
+        ensemble_table(a.laws, a.slips, a.replicas, a.noises)
+        return 0
     if a.cycle_mean:
         cycle_means(a.laws, a.slips, a.replicas)
         return 0
     for law in a.laws:
         for slips in a.slips:
-            exact = control_fits(law, 1, slips, noise=NOISE_FREE)
+            exact = control_fits(law, 1, slips, noise=NOISE_FREE, ensemble=False)
             print(f"\n## {law} ({CONTROLS[law]}), {slips} slips\nnoise-free slider: "
                   + summary(exact * 2).replace(" ± 0.00", "").split("\n", 1)[1].split(", resolved")[0],
                   flush=True)
             for name, injected in (("random force", False), ("added to the trace", True)):
-                fits = control_fits(law, a.replicas, slips, injected=injected)
+                fits = control_fits(law, a.replicas, slips, injected=injected,
+                                    **({} if injected else {"ensemble": False}))
                 print(f"{name}, {a.replicas} replicas: {summary(fits)}", flush=True)
     return 0
 

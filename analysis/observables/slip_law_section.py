@@ -1,16 +1,23 @@
 """``slip_law``: Klein's slip equation tested on the slips, F_film = F_k + B·v.
 
-The physics is :mod:`filmfriction.analysis.slip_law.slip_law`; this file says what the
-fit needs, what it writes into ``analysis.json["slip_law"]`` and
+The physics is :mod:`filmfriction.analysis.slip_law.slip_law`.  The verdict's fit is the
+slips' mean, each slip aligned at its yield and held at its end, with the jackknife's
+errors over the slips (:mod:`~filmfriction.analysis.slip_law.slip_law_cycles`,
+``estimator`` ``cycle ensemble``): a fit of each slip is biased where the film's random
+force moves the wall (docs/results/slip-law.md, "The controls with a random force that
+moves the wall"); that per-slip fit stands beside it as ``per_slip_fit``, and is the
+verdict's (``estimator`` ``per slip``) only where the mean cannot be fitted (fewer than
+three slips, a sampling not uniform).  This file says what the fit needs, what it writes into ``analysis.json["slip_law"]`` and
 ``analysis_cycles.csv`` (``slip_law_kinetic_force``, ``slip_law_damping`` of
 the decelerating branch, ``slip_law_accelerating_kinetic_force``,
 ``slip_law_accelerating_damping``, ``slip_law_loop_area``), and what the report
 shows: the verdict's table and the film force against the wall's velocity with
 the two branches' lines.  Where the trace has the load's work (an MD trace's
-``load_work`` column), the same fit with that work taken out of the film force
+``load_work`` column), each slip's own fit with that work taken out of the film force
 (``fit_film_force(load_work=…)``: the film's dissipative force, the gap's work
-against the load removed) is reported beside it as ``load_work_removed`` (its
-verdict, the one law, the loop step); the section's verdict stays the film force's
+against the load removed; to compare with ``per_slip_fit``) is reported beside it as
+``load_work_removed`` (its verdict, the one law, the loop step); the section's verdict
+stays the film force's
 (docs/results/slip-law.md: on the MD liquid the correction carries the gap's thermal
 breathing into the fit and more than doubles the errors).  The section's own F_k, B, exponent and power are the
 verdict's law's (``verdict_from``: the one law over the whole slip with a co-moving
@@ -33,13 +40,18 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.units import lj_bulk_viscosity
 
 from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..files.trace import unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
 from .observable import (Context, MissingInput, Observable, column, format_estimate, format_value,
                          parameter, png_bytes, pyplot)
 
-__all__ = ["SlipLaw", "BULK_VISCOSITY_SOURCE"]
+__all__ = ["SlipLaw", "BULK_VISCOSITY_SOURCE", "ESTIMATORS"]
+
+#: The fits the verdict can be: the slips' mean (three or more slips, uniform sampling),
+#: else each slip's own.
+ESTIMATORS = ("cycle ensemble", "per slip")
 
 #: The bulk viscosity taken for a film at a state point where none was measured: the
 #: Klein-similar film's (kT 0.71, :data:`~filmfriction.reduced_model.units.LJ_ETA_FILM`).
@@ -84,10 +96,21 @@ class SlipLaw(Observable):
                     mount_damping=p.mount_damping or 0.0,
                     wall_position=trace.wall_position())
         t, f, v = trace.time, trace.spring_force, trace.columns["wall_velocity"]
-        fit = fit_film_force(t, f, v, ctx.table, **args)
+        per_slip = fit_film_force(t, f, v, ctx.table, **args)
+        try:
+            # the verdict's fit: the slips' mean, unbiased where the film's random force
+            # moves the wall (module text)
+            noise_time = MD_NOISE_TIME if ctx.units == "lj" else 0.0
+            fit = fit_cycle_ensemble(t, f, v, ctx.table, **args, min_window_time=noise_time)
+            estimator = ESTIMATORS[0]
+        except ValueError as err:
+            fit, estimator = per_slip, ESTIMATORS[1]
+            ctx.skip_part("slip_law.cycle_ensemble", f"the slips' mean not fitted: {err}; "
+                          "the verdict is the per-slip fit's")
         law, one = fit.law, fit.one_law          # the verdict's law; the whole slip with m_c
         force_velocity = f"{ctx.unit('force')}·{ctx.unit('velocity')}"
         out = {"verdict": fit.verdict, "reason": fit.reason, "verdict_from": fit.verdict_from,
+               "estimator": estimator,
                "kinetic_force": ctx.value(law.kinetic_force, law.kinetic_force_stderr, "force"),
                "damping": ctx.value(law.damping, law.damping_stderr, "damping"),
                "detectable_damping": ctx.value(law.detectable_damping, None, "damping"),
@@ -112,8 +135,12 @@ class SlipLaw(Observable):
                "smoothing_window": fit.smoothing_window,
                "law": "F_film = kinetic_force + damping * v on each branch (+ comoving_mass "
                       "* a over the whole slip: one_law), F_film = F_spring - M a - "
-                      "mount_damping (v - V), fitted in the integrated equation of motion; "
-                      "the verdict's law is verdict_from's"}
+                      "mount_damping (v - V), fitted in the integrated equation of motion "
+                      "(estimator: the slips' mean, each slip held at its end, jackknife "
+                      "errors over the slips; or each slip's own); the verdict's law is "
+                      "verdict_from's"}
+        if estimator == ESTIMATORS[0]:
+            out["per_slip_fit"] = self._per_slip_fit(ctx, per_slip)
         if trace.has("load_work"):
             out["load_work_removed"] = self._load_work_removed(
                 ctx, fit_film_force(t, f, v, ctx.table, **args,
@@ -130,13 +157,29 @@ class SlipLaw(Observable):
             else:
                 ctx.skip_part("slip_law.bulk_film_damping",
                               "no bulk viscosity for a measured (SI) trace")
-        per_slip = {"kinetic_force": fit.decelerating.per_slip_kinetic_force.tolist(),
-                    "damping": fit.decelerating.per_slip_damping.tolist(),
-                    "accelerating_kinetic_force":
-                        fit.accelerating.per_slip_kinetic_force.tolist(),
-                    "accelerating_damping": fit.accelerating.per_slip_damping.tolist(),
-                    "loop_area": fit.per_slip_loop_area.tolist()}
-        return out, per_slip
+        # the cycles' table: each slip's own fit (the ensemble's pseudo-values are per slip
+        # kept, not per slip of the table)
+        cycles = {"kinetic_force": per_slip.decelerating.per_slip_kinetic_force.tolist(),
+                  "damping": per_slip.decelerating.per_slip_damping.tolist(),
+                  "accelerating_kinetic_force":
+                      per_slip.accelerating.per_slip_kinetic_force.tolist(),
+                  "accelerating_damping": per_slip.accelerating.per_slip_damping.tolist(),
+                  "loop_area": per_slip.per_slip_loop_area.tolist()}
+        return out, cycles
+
+    @classmethod
+    def _per_slip_fit(cls, ctx, fit) -> dict:
+        """The fit slip by slip, beside the ensemble's: biased where the film's random
+        force moves the wall (kept as the comparison)."""
+        return {"verdict": fit.verdict, "verdict_from": fit.verdict_from, "reason": fit.reason,
+                "one_law": cls._branch(ctx, fit.one_law),
+                "decelerating": cls._branch(ctx, fit.decelerating),
+                "loop_step": ctx.value(fit.loop_step, fit.loop_step_stderr, "force",
+                                       sigmas=finite_or_none(fit.loop_step_sigmas),
+                                       detectable=finite_or_none(fit.detectable_loop_step)),
+                "note": "each slip fitted on its own, the errors the slips' scatter: biased "
+                        "where the film's random force moves the wall (its regressors carry "
+                        "the response's noise); the verdict is the cycle ensemble's"}
 
     @classmethod
     def _load_work_removed(cls, ctx, fit) -> dict:
@@ -195,7 +238,8 @@ class SlipLaw(Observable):
     def rows(self, section: dict) -> list[tuple[str, str]]:
         br = section.get("branches") or {}
         frm = section.get("verdict_from", "decelerating")
-        rows = [(f"verdict ({frm})", f"**{section.get('verdict', '?')}**")]
+        rows = [(f"verdict ({frm})", f"**{section.get('verdict', '?')}**"),
+                ("fitted", section.get("estimator", ESTIMATORS[1]))]
         for name in BRANCHES:
             b = br.get(name) or {}
             rows += [(f"{name}: kinetic force F_k", format_estimate(b.get("kinetic_force"))),
@@ -215,6 +259,11 @@ class SlipLaw(Observable):
                      ("one law: verdict", one.get("verdict", "?")),
                      ("loop step beyond the co-moving mass, F_acc − F_dec",
                       format_estimate(section.get("loop_step")))]
+        ps = section.get("per_slip_fit") or {}
+        if ps:
+            rows += [(f"each slip's own fit (biased by the noise): verdict "
+                      f"({ps.get('verdict_from', '?')})", ps.get("verdict", "?")),
+                     ("  its loop step", format_estimate(ps.get("loop_step")))]
         lw = section.get("load_work_removed") or {}
         if lw:
             rows += [("with the load's work on the gap taken out: verdict "
@@ -238,12 +287,13 @@ class SlipLaw(Observable):
                 "27: the friction force against the sliding velocity during the slip). "
                 "`inconclusive` says that the run's slips are too few or too noisy to tell; "
                 "what the test can resolve at the MD's noise is in docs/results/slip-law.md. "
-                "Where the film's random force moves the wall the per-slip fit is biased: on "
-                "driven slips at the MD's noise Klein's viscous controls come out `mixed` (a "
-                "kinetic force and a loop where there are none), so a loop or a `mixed` verdict "
-                "of a driven run is a reading, no evidence of a yield or of a kinetic term; "
-                "releases of one scene, fitted as their mean "
-                "(`release_control.fit_release_ensemble`), pass their controls. A verdict is "
+                "Where the film's random force moves the wall a fit of each slip is biased "
+                "(on driven slips at the MD's noise Klein's viscous controls come out `mixed`, "
+                "with a kinetic force and a loop where there are none): the verdict is the "
+                "slips' mean's, each slip aligned at its yield and held at its end, its errors "
+                "the jackknife's over the slips (`estimator`), which passes the controls as "
+                "docs/results/slip-law.md states them; the per-slip fit stands beside it "
+                "(`per_slip_fit`) as the comparison. A verdict is "
                 "this film's: it bears on Klein's film, and on Braun & "
                 "Tosatti's reading of it, only when the run's Bingham number η_eff/η_bulk "
                 "(sfb.json, `bingham_number`) is ≫ 1, as his is (~10⁴)."]

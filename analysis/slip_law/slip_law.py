@@ -129,7 +129,8 @@ from .slip_law_branches import BranchFit, Segment, fit_branch, jackknife, jackkn
 from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
-__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "jackknife_fit",
+__all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
+           "jackknife_fit", "checked_trace", "smoothing_samples",
            "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
@@ -270,11 +271,13 @@ def film_force(time, spring_force, wall_velocity, *, mass: float, drive_velocity
     >>> film_force(t, np.full(5, 3.0), v, mass=0.5).tolist()   # 3 − 0.5·2
     [2.0, 2.0, 2.0, 2.0, 2.0]
     """
-    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
     return f - mass * np.gradient(v, t) - mount_damping * (v - drive_velocity)
 
 
-def _checked(time, spring_force, wall_velocity, mass):
+def checked_trace(time, spring_force, wall_velocity, mass):
+    """(t, F_spring, v) as float arrays, checked: 1-D, one length, at least 2 samples,
+    a positive ``mass`` (ValueError otherwise)."""
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
     v = np.asarray(wall_velocity, float)
@@ -288,7 +291,7 @@ def _checked(time, spring_force, wall_velocity, mass):
     return t, f, v
 
 
-def _window(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
+def smoothing_samples(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
     """Savitzky–Golay window (odd, ≥ 5 samples) for ``smoothing`` × median slip duration;
     0 when the sampling is not uniform or the window would be under 5 samples."""
     if smoothing <= 0 or t.size < 7:
@@ -343,14 +346,14 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
     if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
         raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
-    t, f, v = _checked(time, spring_force, wall_velocity, mass)
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
     if wall_position is None:
         x = cumulative_trapezoid(v, t, initial=0.0)
     else:
         x = np.asarray(wall_position, float)
         if x.shape != t.shape:
             raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
-    w = _window(t, table, smoothing)
+    w = smoothing_samples(t, table, smoothing)
     # the velocity that picks the samples: from the position, whose noise is not the
     # response's (selecting on the response's own noise would bias the fit)
     if w and wall_position is not None:
@@ -400,12 +403,27 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
             segs[name].append(Segment(imp, v[i], dt_, dx, guide[i] - guide[i[0]], mass,
                                       np.maximum(dt_ - (t[y + p] - t[i[0]]), 0.0)))
         ranges.append((min_velocity_fraction * peak, peak))
+    return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
+                        smoothing_window=w, still=still, windows=len(table),
+                        load_work_removed=gap_rate is not None)
+
+
+def fit_segments(segs: dict, ranges: list, *, mass: float, comoving_mass: bool,
+                 smoothing_window: int, still=(), windows: int = 0,
+                 load_work_removed: bool = False) -> FilmForceFit:
+    """The branches, the one law, the loop and the verdict from the slips' segments.
+
+    ``segs`` maps ``decelerating``, ``accelerating`` and ``whole`` to one
+    :class:`~filmfriction.analysis.slip_law.slip_law_branches.Segment` (or None) per
+    slip, ``ranges`` holds each slip's fitted velocity range (floor, peak); ``still``
+    the windows refused (:func:`fit_film_force`), of ``windows`` in all."""
+    still = list(still)
     fits = {name: fit_branch(name, segs[name], comoving_mass) for name in segs}
     # one law F_k + B·v + m_c·a over the whole slip, and the step at the peak beyond it
     fits["one_law"] = fit_branch(ONE_LAW, segs["whole"], True)
     fits["loop_step"] = fit_branch(ONE_LAW, segs["whole"], True, loop_step=True)
     if still:
-        fits = _refuse_still(fits, still, len(table))
+        fits = _refuse_still(fits, still, windows)
     acc, dec = fits["accelerating"], fits["decelerating"]
     lo, hi = np.array(ranges, float).reshape(-1, 2).T
     # the loop between the two branches' lines, over the velocities both cover
@@ -420,15 +438,18 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     return FilmForceFit(dec, acc, fits["whole"], one, st.loop_step, st.loop_step_stderr,
                         sigmas(st.loop_step, st.loop_step_stderr, st.dof),
                         detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
-                        la[0], la[1], lf[0], lf[1], area, w, comoving_mass, len(still),
-                        gap_rate is not None)
+                        la[0], la[1], lf[0], lf[1], area, smoothing_window, comoving_mass,
+                        len(still), load_work_removed)
 
 
-def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float) -> FilmForceFit:
+def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
+                  replicas: str = "releases") -> FilmForceFit:
     """The fit of a mean trace with its errors from the jackknife over its replicas.
 
     ``fit`` is :func:`fit_film_force` on the mean of R replicas of one slip (releases
-    of one initial condition, aligned at the release), ``leave_one_out`` the R fits of
+    of one initial condition, aligned at the release; or the slips of a driven run,
+    :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`),
+    ``leave_one_out`` the R fits of
     the means that leave one replica out.  The law is linear in the trace, so the mean
     trace's fit has the law's expectation whatever the noise (E[ξ] = 0), while a fit
     per replica regresses on the replica's own noisy Δx and Δv, which the film's
@@ -439,14 +460,15 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float) -> FilmForce
     (:func:`~filmfriction.analysis.slip_law.slip_law_branches.jackknife_branch`); the
     significance, the power, the branches' verdicts and the choice of the law
     (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`) follow from
-    them as on any fit.
+    them as on any fit.  ``replicas`` names the replicas in the reasons.
     """
     loo = list(leave_one_out)
     if len(loo) < 2:
         raise ValueError(f"{len(loo)} leave-one-out fit(s): the jackknife needs 2 or more")
-    br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo])
+    br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo],
+                                 replicas=replicas)
           for name in ("decelerating", "accelerating", "whole", "one_law")}
-    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo])
+    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo], replicas=replicas)
     dof = len(loo) - 1
     frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass)
     (la_se, la_ps), (lf_se, _) = (jackknife(getattr(fit, k), [getattr(f, k) for f in loo])

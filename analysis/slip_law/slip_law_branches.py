@@ -213,12 +213,14 @@ def jackknife(estimate: float, leave_one_out) -> tuple[float, np.ndarray]:
     return se, r * estimate - (r - 1) * th
 
 
-def jackknife_branch(fit: BranchFit, leave_one_out: list[BranchFit]) -> BranchFit:
+def jackknife_branch(fit: BranchFit, leave_one_out: list[BranchFit], *,
+                     replicas: str = "releases") -> BranchFit:
     """``fit`` (of the replicas' mean trace) with its errors from the jackknife over the
     R replicas (:func:`jackknife`, R − 1 degrees of freedom): F_k, B, m_c, the exponent
     and the loop step; the significance, the power and the verdict recomputed from them
     (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.branch_verdict`); the
-    per-slip arrays hold the pseudo-values, one per replica."""
+    per-slip arrays hold the pseudo-values, one per replica; ``replicas`` names them in
+    the reason."""
     r = len(leave_one_out)
     err = {name: jackknife(getattr(fit, name), [getattr(b, name) for b in leave_one_out])
            for name in ("kinetic_force", "damping", "comoving_mass", "exponent", "loop_step")}
@@ -228,7 +230,7 @@ def jackknife_branch(fit: BranchFit, leave_one_out: list[BranchFit]) -> BranchFi
     z_fk, z_b = sigmas(fk, se_fk, dof), sigmas(b, se_b, dof)
     det_b, det_fk = detectable(se_b, dof), detectable(se_fk, dof)
     verdict, reason = branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, r)
-    reason = reason.replace(f"over {r} slip(s)", f"mean of {r} releases, jackknife errors")
+    reason = reason.replace(f"over {r} slip(s)", f"mean of {r} {replicas}, jackknife errors")
     return replace(fit, kinetic_force_stderr=se_fk, damping_stderr=se_b,
                    comoving_mass_stderr=err["comoving_mass"][0],
                    exponent_stderr=err["exponent"][0], kinetic_sigmas=z_fk, damping_sigmas=z_b,
