@@ -93,7 +93,11 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     :func:`branch_verdict`, a step under :data:`NUMERICAL_FLOOR` of F̄ and an m_c under
     that share of the wall's ``mass`` count as not resolved.  A
     liquid's slip (no yield) is such a slip; a film that yields on the accelerating
-    branch is not, and its verdict is the decelerating branch's.
+    branch is not, and its verdict is the decelerating branch's — except that a
+    ``viscous`` decelerating branch fitted without a co-moving mass, while the one law
+    resolves a positive one, is ``inconclusive``: m_c·a < 0 on that branch reads as a
+    negative intercept and can cancel a kinetic force (the release's kinetic control,
+    docs/results/slip-law.md).
     """
     r = RESOLVED_SIGMAS
     step, se, dof = loop_step.loop_step, loop_step.loop_step_stderr, loop_step.dof
@@ -115,6 +119,16 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     else:
         return ONE_LAW, one_law.verdict, (f"the whole slip is one law with a co-moving "
                                           f"mass ({nums}): {one_law.reason}")
-    return "decelerating", decelerating.verdict, (
-        f"{decelerating.reason}; the decelerating branch's, the whole slip not one law "
-        f"({why}: {nums})")
+    verdict, reason = decelerating.verdict, decelerating.reason
+    if (verdict == "viscous" and not math.isfinite(decelerating.comoving_mass)
+            and z_mc >= r and one_law.comoving_mass >= NUMERICAL_FLOOR * mass):
+        # the branch has no co-moving mass term while the one law resolves one: on the
+        # decelerating branch m_c·a < 0 reads as a negative intercept, so its F_k not
+        # resolved does not rule out a kinetic force (it can cancel one)
+        verdict, reason = "inconclusive", (
+            f"{reason}; but the one law resolves a co-moving mass the branch does not fit, "
+            f"whose m_c·a biases its F_k low: a kinetic force up to m_c·|a| is not ruled out "
+            f"(the one law's F_k = {one_law.kinetic_force:.3g} ± "
+            f"{one_law.kinetic_force_stderr:.2g})")
+    return "decelerating", verdict, (
+        f"{reason}; the decelerating branch's, the whole slip not one law ({why}: {nums})")
