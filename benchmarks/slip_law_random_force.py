@@ -11,8 +11,8 @@ random force (:func:`~filmfriction.analysis.groundtruth.slip_law_controls.dynami
 and added to the noise-free law's trace (``replica_fits``), and noise-free.  With
 ``--residual``: the integral-form residual of the random-force replicas measured as
 ``benchmarks/slip_law_power.py --measure`` measures an MD run's (the whole slip, 2.5 τ off
-its ends, F_k + B·v fitted), to compare with the MD's 0.56–0.75 σ/τ rms and
-autocorrelation 0.82, 0.65, 0.44, 0.08 at 0.25, 1, 2, 4 τ.  With ``--cycle-mean``: a
+its ends, F_k + B·v fitted; :mod:`~filmfriction.analysis.groundtruth.md_noise`), to compare
+with the MD's (``benchmarks/md_noise_calibration.py``).  With ``--cycle-mean``: a
 prototype of the remedy, the slips of each replica aligned at the yield and averaged
 before the fit (the noise of the regressors averages down as 1/√slips).
 """
@@ -26,6 +26,7 @@ from collections import Counter
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residual_statistics
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.slip_law_controls import (
     CONTROLS, MD_NOISE, SCALE, _dynamical_law, control_fits)
@@ -58,35 +59,14 @@ def summary(fits) -> str:
 
 def residual(replicas: int, share: float | None) -> None:
     """The integral-form residual of the random-force replicas of the viscous control, or
-    of slips resisted by F_k + B·v of viscous ``share`` (``coulomb_viscous``)."""
-    law = _dynamical_law("viscous", share)
-    law.pop("period")
-    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                 duration=1500.0, dt=SCALE["dt"], replicas=replicas, seed=0,
-                 velocity_noise=0.75, velocity_correlation=0.9, rattle=0.25)
-    m = SCALE["mass"]
-    rms, acf, n = [], np.zeros(17), 0
-    for tr in runs:
-        t, f, v, x = tr["time"], tr["spring_force"], tr["wall_velocity"], tr["wall_position"]
-        imp = cumulative_trapezoid(f, t, initial=0.0)
-        for y, s in zip(tr["yield_index"][1:], tr["stick_index"][1:]):
-            i = np.arange(y + 10, s - 10)
-            if i.size < 24:
-                continue
-            dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
-            resp = imp[i] - imp[i[0]] - m * v[i]
-            X = np.column_stack([np.ones(i.size), dt, dx])
-            r = (resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / m
-            rms.append(float(r.std()))
-            r = r - r.mean()
-            a = np.array([r[:r.size - k] @ r[k:] for k in range(17)])
-            acf += a / a[0]
-            n += 1
-    acf /= max(n, 1)
+    of slips resisted by F_k + B·v of viscous ``share`` (``coulomb_viscous``), at
+    ``MD_NOISE`` (:mod:`~filmfriction.analysis.groundtruth.md_noise`)."""
+    s = residual_statistics(replica_residuals(MD_NOISE, share=share, replicas=replicas))
     what = "viscous control" if share is None else f"viscous share {share}"
-    print(f"{what}, random force: {n} slips; residual rms {np.mean(rms):.2f} σ/τ "
-          f"(slips {np.min(rms):.2f}–{np.max(rms):.2f}); autocorrelation at 0.25, 1, 2, 4 τ: "
-          + ", ".join(f"{acf[k]:.2f}" for k in (1, 4, 8, 16)))
+    print(f"{what}, random force {MD_NOISE}: {s['slips']} slips; residual rms {s['rms']:.2f} "
+          f"σ/τ (slips {min(s['per_slip_rms']):.2f}–{max(s['per_slip_rms']):.2f}); "
+          "autocorrelation at 0.25, 1, 2, 4 τ: "
+          + ", ".join(f"{x:.2f}" for x in s["autocorrelation"]))
 
 
 def cycle_mean_fit(run: dict, slips: int, drive_velocity: float):
