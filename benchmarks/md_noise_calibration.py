@@ -1,15 +1,15 @@
-"""The controls' noise calibrated to the MD's: the slip residual of MD runs and of random-force
-replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
+"""The controls' noise calibrated to the MD's: slip residuals and the wall's jitter of MD runs and
+of random-force replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
 
     python benchmarks/md_noise_calibration.py RUN [RUN ...] [--replicas 40]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
-control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_residuals`, seed 0) at
-each named process of :mod:`~filmfriction.analysis.groundtruth.slip_law_controls`
-(``RESIDUAL_AS_NOISE``, ``MD_NOISE``, ``MD_NOISE_FAST``): the residual's rms (mean over the
-slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with F_k + B·v fitted
-(``trend 1``) and with Δt², Δt³ fitted besides (``trend 3``: the part faster than the
-slip's own shape).
+control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
+process of :data:`PROCESSES` (the named ones of
+:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` and the u whose plain residual
+has the MD's rms): the rms of the wall velocity's change over 0.25, 1, 2 τ; the residual's
+rms (mean over the slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with
+F_k + B·v fitted (``trend 1``) and with Δt², Δt³ fitted besides (``trend 3``).
 """
 from __future__ import annotations
 
@@ -17,18 +17,26 @@ import argparse
 import sys
 from pathlib import Path
 
-from filmfriction.analysis.groundtruth import slip_law_controls as controls
-from filmfriction.analysis.groundtruth.md_noise import (replica_residuals, residual_statistics,
-                                                        run_residuals)
+from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_slips,
+                                                        residual_statistics, residuals, run_slips,
+                                                        slip_velocities)
+from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE
 
-PROCESSES = ("RESIDUAL_AS_NOISE", "MD_NOISE", "MD_NOISE_FAST")
+PROCESSES = {"MD_NOISE": MD_NOISE, "RESIDUAL_AS_NOISE": RESIDUAL_AS_NOISE,
+             "the plain residual's rms": {"velocity_noise": 1.9, "velocity_correlation": 0.95,
+                                          "rattle": 0.15}}
 
 
-def row(name: str, stats: dict) -> str:
-    acf = ", ".join(f"{a:.2f} ± {e:.2f}" for a, e in zip(stats["autocorrelation"],
-                                                          stats["autocorrelation_stderr"]))
-    return (f"| {name} | {stats['slips']} | {stats['rms']:.3f} ± {stats['rms_stderr']:.3f} | "
-            f"{acf} |")
+def row(name: str, slips: list[dict]) -> str:
+    inc = increment_rms([v for sl in slips for v in slip_velocities(
+        sl["wall_velocity"], sl["yields"], sl["sticks"])])
+    cells = [", ".join(f"{x:.3f}" for x in inc)]
+    for trend in (1, 3):
+        st = residual_statistics([r for sl in slips for r in residuals(sl, trend=trend)])
+        cells.append(f"{st['rms']:.3f} ± {st['rms_stderr']:.3f}; " + ", ".join(
+            f"{a:.2f} ± {e:.2f}" for a, e in zip(st["autocorrelation"],
+                                                  st["autocorrelation_stderr"])))
+    return f"| {name} | {st['slips']} | " + " | ".join(cells) + " |"
 
 
 def main(argv=None) -> int:
@@ -37,21 +45,18 @@ def main(argv=None) -> int:
     ap.add_argument("--replicas", type=int, default=40)
     a = ap.parse_args(argv)
     missing = [r for r in a.runs if not (Path(r) / "trace.csv").is_file()]
-    if missing or a.replicas < 1:
-        print(f"error: {'RUN without trace.csv: ' + ', '.join(missing) if missing else ''}"
-              f"{' --replicas ' + str(a.replicas) + ' (>= 1)' if a.replicas < 1 else ''}",
-              file=sys.stderr)
+    if missing:
+        print(f"error: RUN without trace.csv: {', '.join(missing)}", file=sys.stderr)
         return 2
-    for trend in (1, 3):
-        print(f"\n## trend {trend}: the residual's rms (σ/τ) and autocorrelation at 0.25, 1, 2, "
-              "4 τ\n\n| noise | slips | rms | autocorrelation |\n|---|---|---|---|")
-        md = [r for run in a.runs for r in run_residuals(run, trend=trend)]
-        print(row(f"MD ({len(a.runs)} runs)", residual_statistics(md)), flush=True)
-        for name in PROCESSES:
-            noise = getattr(controls, name)
-            stats = residual_statistics(replica_residuals(noise, replicas=a.replicas,
-                                                          trend=trend))
-            print(row(f"{name} {noise}", stats), flush=True)
+    if a.replicas < 1:
+        print(f"error: --replicas {a.replicas}: must be >= 1", file=sys.stderr)
+        return 2
+    print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
+          "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | residual, + Δt², Δt³ |\n"
+          "|---|---|---|---|---|")
+    print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs]), flush=True)
+    for name, noise in PROCESSES.items():
+        print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas)), flush=True)
     return 0
 
 

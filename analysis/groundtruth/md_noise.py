@@ -12,10 +12,16 @@ root-mean-square per slip and its autocorrelation (each slip's, at lags of whole
 then averaged over the slips) are the numbers a noise model must reproduce when pushed
 through the same fit (:func:`residual_statistics`).
 
-:func:`run_residuals` measures them on a run directory (its analysed slips);
-:func:`replica_residuals` on the random-force replicas of
-:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (one control law, a noise
-process).  Slips shorter than ``min_samples`` after the edges are left out in both.
+:func:`increment_rms` reads the wall's jitter without a fit: the rms of its velocity's
+change over 0.25, 1 and 2 τ within the same windows.  A slip's own smooth change of
+velocity is small at those lags, so it measures the random force's effect on the wall
+whatever the law; the residual of the fit carries, besides the noise, whatever of the
+slip's law F_k + B·v misses (with ``trend`` = 3 the slip-long part of that is fitted out).
+
+:func:`run_slips` reads a run directory's analysed slips, :func:`replica_slips` makes the
+random-force replicas of :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (one
+control law, a noise process); both feed :func:`residuals` and :func:`slip_velocities`.
+Slips shorter than ``min_samples`` after the edges are left out in both.
 
 Example
 -------
@@ -33,7 +39,8 @@ import math
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-__all__ = ["slip_residuals", "residual_statistics", "run_residuals", "replica_residuals",
+__all__ = ["slip_residuals", "residual_statistics", "slip_velocities", "increment_rms",
+           "run_slips", "replica_slips", "residuals", "run_residuals", "replica_residuals",
            "LAGS", "EDGE", "MIN_SAMPLES"]
 
 #: The lags (in samples: 0.25, 1, 2 and 4 τ at the 0.25 τ sampling) the statistics report.
@@ -86,29 +93,49 @@ def residual_statistics(residuals, lags=LAGS) -> dict:
             "autocorrelation_stderr": np.atleast_1d(se(acf)).tolist()}
 
 
-def run_residuals(run_dir, **kwargs) -> list[np.ndarray]:
-    """The residuals of a run directory's analysed slips (those its analysis keeps;
-    ``kwargs`` to :func:`slip_residuals`)."""
+def slip_velocities(wall_velocity, yields, sticks, *, edge: int = EDGE,
+                    min_samples: int = MIN_SAMPLES) -> list[np.ndarray]:
+    """The wall's sampled velocity within each slip, the same windows as
+    :func:`slip_residuals`."""
+    v = np.asarray(wall_velocity, float)
+    return [v[y + edge:s - edge] for y, s in zip(np.asarray(yields, int), np.asarray(sticks, int))
+            if s - y - 2 * edge >= min_samples]
+
+
+def increment_rms(velocities, lags=(1, 4, 8)) -> list[float]:
+    """rms of the velocity's change over each lag (samples), pooled over the slips: how much
+    the wall's motion jitters, read without a fit (a slip's own smooth change of velocity
+    over 2 τ is a few hundredths of σ/τ at the controls' scale)."""
+    out = []
+    for k in lags:
+        d = np.concatenate([v[k:] - v[:-k] for v in velocities if v.size > k])
+        out.append(float(np.sqrt(np.mean(d ** 2))))
+    return out
+
+
+def run_slips(run_dir) -> dict:
+    """A run directory's analysed slips as :func:`slip_residuals` takes them: its columns,
+    ``yields``, ``sticks`` (the slips its analysis keeps), ``mass``, ``mount_damping``,
+    ``drive_velocity``."""
     from ..calibration.rundata import load_run
 
     run = load_run(run_dir)
     tr, p = run.trace, run.trace.parameters
     vd, _ = tr.drive_velocity()
-    return slip_residuals(tr.time, tr.spring_force, tr.columns["wall_velocity"],
-                          tr.wall_position(), np.asarray(run.cycles["yield_index"])[run.skip:],
-                          np.asarray(run.cycles["stick_index"])[run.skip:], mass=p.mass,
-                          mount_damping=p.mount_damping or 0.0, drive_velocity=vd or 0.0,
-                          **kwargs)
+    return {"time": tr.time, "spring_force": tr.spring_force,
+            "wall_velocity": tr.columns["wall_velocity"], "wall_position": tr.wall_position(),
+            "yields": np.asarray(run.cycles["yield_index"])[run.skip:],
+            "sticks": np.asarray(run.cycles["stick_index"])[run.skip:], "mass": p.mass,
+            "mount_damping": p.mount_damping or 0.0, "drive_velocity": vd or 0.0}
 
 
-def replica_residuals(noise: dict, *, law: str = "viscous", share: float | None = None,
-                      replicas: int = 40, duration: float = 1500.0, seed: int = 0,
-                      **kwargs) -> list[np.ndarray]:
-    """The residuals of the random-force replicas of control ``law`` (or of slips of viscous
-    ``share``: :func:`~filmfriction.analysis.groundtruth.slip_law_controls.coulomb_viscous`)
-    with the film's random force of ``noise`` (the keywords of
-    :func:`~filmfriction.analysis.groundtruth.random_force.slide`), the start-up slip left
-    out; ``kwargs`` to :func:`slip_residuals`."""
+def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = None,
+                  replicas: int = 40, duration: float = 1500.0, seed: int = 0) -> list[dict]:
+    """The random-force replicas of control ``law`` (or of slips of viscous ``share``:
+    :func:`~filmfriction.analysis.groundtruth.slip_law_controls.coulomb_viscous`) with the
+    film's random force of ``noise`` (the keywords of
+    :func:`~filmfriction.analysis.groundtruth.random_force.slide`), as :func:`run_slips`
+    gives a run (the start-up slip left out)."""
     from .random_force import slide
     from .slip_law_controls import SCALE, _dynamical_law
 
@@ -116,9 +143,26 @@ def replica_residuals(noise: dict, *, law: str = "viscous", share: float | None 
     args.pop("period")
     runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
                  duration=duration, dt=SCALE["dt"], replicas=replicas, seed=seed, **noise)
-    out = []
-    for tr in runs:
-        out += slip_residuals(tr["time"], tr["spring_force"], tr["wall_velocity"],
-                              tr["wall_position"], tr["yield_index"][1:],
-                              tr["stick_index"][1:], mass=SCALE["mass"], **kwargs)
-    return out
+    return [{k: tr[k] for k in ("time", "spring_force", "wall_velocity", "wall_position")}
+            | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:],
+               "mass": SCALE["mass"]} for tr in runs]
+
+
+def residuals(slips: dict, **kwargs) -> list[np.ndarray]:
+    """:func:`slip_residuals` of a :func:`run_slips` or :func:`replica_slips` item."""
+    keys = ("time", "spring_force", "wall_velocity", "wall_position", "yields", "sticks")
+    opt = {k: slips[k] for k in ("mass", "mount_damping", "drive_velocity") if k in slips}
+    return slip_residuals(*(slips[k] for k in keys), **opt, **kwargs)
+
+
+def run_residuals(run_dir, **kwargs) -> list[np.ndarray]:
+    """The residuals of a run directory's analysed slips (``kwargs`` to
+    :func:`slip_residuals`)."""
+    return residuals(run_slips(run_dir), **kwargs)
+
+
+def replica_residuals(noise: dict, *, law: str = "viscous", share: float | None = None,
+                      replicas: int = 40, seed: int = 0, **kwargs) -> list[np.ndarray]:
+    """The residuals of :func:`replica_slips` (``kwargs`` to :func:`slip_residuals`)."""
+    return [r for sl in replica_slips(noise, law=law, share=share, replicas=replicas, seed=seed)
+            for r in residuals(sl, **kwargs)]

@@ -52,7 +52,7 @@ from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "MD_NOISE_FAST", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "CONTROLS",
+__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -60,30 +60,30 @@ __all__ = ["MD_NOISE", "MD_NOISE_FAST", "RESIDUAL_AS_NOISE", "scaled", "SCALE", 
 SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
 
 #: The film's random force of the controls, calibrated to the MD (LJ units; the keywords of
-#: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of
-#: 1.9 σ/τ rms and correlation 0.95 per 0.25 τ (4.9 τ), the wall's rattling white
-#: √(kT/M) = 0.15 σ/τ.  Pushed through the slip-residual fit
-#: (:mod:`~filmfriction.analysis.groundtruth.md_noise`: each slip, 2.5 τ off its ends,
-#: F_k + B·v fitted in integral form) on 40 random-force replicas of the ``viscous``
-#: control it leaves 0.68 σ/τ rms, the MD's 0.69 ± 0.05 (47 slips of three
-#: ``sfb-similar`` runs of 2.8 M steps at f952bc8).  No process of this family reproduces
-#: the MD's autocorrelation as well (replicas 0.60, 0.20, 0.05 at 0.25, 1, 2 τ; the MD
-#: 0.78, 0.57, 0.38): the fit takes up the part of u that moves the wall, and most of the
-#: MD's residual is a shape as long as the slip (with Δt², Δt³ fitted besides, the MD
-#: keeps 0.23 σ/τ, these replicas 0.53).  So this is the upper reading: the whole
-#: residual taken as noise.  ``python benchmarks/md_noise_calibration.py RUN …``
-#: (docs/results/slip-law.md, "The MD's noise").
-MD_NOISE = {"velocity_noise": 1.9, "velocity_correlation": 0.95, "rattle": 0.15}
+#: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of 0.45 σ/τ
+#: rms and correlation 0.9 per 0.25 τ (2.4 τ), the wall's rattling white at
+#: √(kT/M) = 0.15 σ/τ.  On the 47 slips of three ``sfb-similar`` runs of 2.8 M steps
+#: (f952bc8) and on 40 random-force replicas of the ``viscous`` control, measured alike
+#: (:mod:`~filmfriction.analysis.groundtruth.md_noise`, each slip 2.5 τ off its ends):
+#:
+#: * the wall's velocity changes over 0.25, 1, 2 τ by 0.29, 0.33, 0.36 σ/τ rms in the MD,
+#:   0.28, 0.34, 0.34 in the replicas;
+#: * the residual of F_k + B·v with Δt², Δt³ fitted besides (the part faster than the
+#:   slip): MD 0.229 ± 0.007 σ/τ, autocorrelation 0.19, −0.03, −0.05 at 0.25, 1, 2 τ;
+#:   replicas 0.223, 0.23, −0.07, −0.08;
+#: * the plain residual of F_k + B·v: MD 0.69 ± 0.05 σ/τ, 0.78, 0.57, 0.38; replicas 0.34,
+#:   0.61, 0.27, 0.04.  No process of this family gives the MD's (the fit takes up the
+#:   slow part of a force that moves the wall; a u large enough for the rms, 1.9 σ/τ,
+#:   makes the wall jitter twice as much as the MD's): the rest of the MD's residual is
+#:   a shape as long as the slip, half of it common to all slips, that F_k + B·v misses.
+#:
+#: ``python benchmarks/md_noise_calibration.py RUN …`` (docs/results/slip-law.md, "The
+#: MD's noise").
+MD_NOISE = {"velocity_noise": 0.45, "velocity_correlation": 0.9, "rattle": 0.15}
 
-#: The lower reading: the process whose replicas leave, with Δt² and Δt³ fitted besides,
-#: the MD's residual faster than the slip (0.23 σ/τ rms, autocorrelation 0.19, −0.03 at
-#: 0.25, 1 τ; replicas 0.22, 0.23, −0.07); the plain fit's residual is then 0.34 σ/τ,
-#: half the MD's.  Same command.
-MD_NOISE_FAST = {"velocity_noise": 0.45, "velocity_correlation": 0.9, "rattle": 0.15}
-
-#: The MD's residual itself taken as u (0.75 σ/τ, 0.9 per 0.25 τ, rattling 0.25): its
-#: replicas leave 0.52 σ/τ rms, autocorrelation 0.56, 0.25, 0.09 — the fit takes up part
-#: of a noise that moves the wall.  Kept for comparison.
+#: The MD's plain residual taken as u itself (0.75 σ/τ, 0.9 per 0.25 τ, rattling 0.25):
+#: the wall jitters 1.6 times as much as the MD's (0.46, 0.56, 0.58 σ/τ over 0.25, 1,
+#: 2 τ).  Kept for comparison.
 RESIDUAL_AS_NOISE = {"velocity_noise": 0.75, "velocity_correlation": 0.9, "rattle": 0.25}
 
 

@@ -17,14 +17,14 @@ from functools import lru_cache
 import pytest
 
 from filmfriction.analysis.groundtruth.slip_law_controls import (
-    MD_NOISE, control_fits, coulomb_viscous, dynamical_fits, replica_fits)
+    MD_NOISE, control_fits, coulomb_viscous, dynamical_fits, replica_fits, scaled)
 from filmfriction.analysis.slip_law.slip_law import VERDICTS
 
 REPLICAS = 40
 AT_MOST = 2          # of 40: ≥ 95 % pass
 
 #: A tenth of the MD's noise: where the laws' own small slopes can be resolved.
-QUIET = {k: (v if k == "velocity_correlation" else v / 10) for k, v in MD_NOISE.items()}
+QUIET = scaled(MD_NOISE, 0.1)
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.9, "rattle": 0.0}
 
 @lru_cache(maxsize=None)
