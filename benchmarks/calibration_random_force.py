@@ -9,8 +9,8 @@ sampled every 0.25 τ, V = 0.1 σ/τ; the film re-freezes where the spring force
 to 24 ε/σ, as Klein's and the viscous control's, or the wall stops once it has fallen
 to 34), the film pushing the wall with the controls' random force
 (:mod:`~filmfriction.analysis.groundtruth.random_force`) of each named process of
-:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (none, ``MD_NOISE_FAST``,
-``MD_NOISE``), fitted by :func:`~filmfriction.analysis.calibration.slipfit.fit_slips` as
+:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (none, ``MD_NOISE``,
+``RESIDUAL_AS_NOISE``), fitted by :func:`~filmfriction.analysis.calibration.slipfit.fit_slips` as
 ``filmfriction calibrate`` fits a run (the slips after the start-up one; no jackknife).
 Per noise: the mean estimate with its standard error over the replicas (the bias), the
 spread, the mean standard error, and how often ±2 standard errors cover the truth.  The
@@ -28,7 +28,7 @@ from filmfriction.analysis.calibration.slipfit import fit_slips
 from filmfriction.analysis.groundtruth import slip_law_controls as controls
 from filmfriction.analysis.groundtruth.random_force import slide
 
-NOISES = ("none", "MD_NOISE_FAST", "MD_NOISE")
+NOISES = ("none", "MD_NOISE", "RESIDUAL_AS_NOISE")
 
 
 def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float) -> list:
