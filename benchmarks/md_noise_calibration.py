@@ -9,7 +9,9 @@ process of :data:`PROCESSES` (the named ones of
 :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` and the u whose plain residual
 has the MD's rms): the rms of the wall velocity's change over 0.25, 1, 2 τ; the residual's
 rms (mean over the slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with
-F_k + B·v fitted (``trend 1``) and with Δt², Δt³ fitted besides (``trend 3``).
+F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean shape carries,
+:func:`~filmfriction.analysis.groundtruth.md_noise.common_shape_share`) and with Δt², Δt³
+fitted besides (``trend 3``).
 """
 from __future__ import annotations
 
@@ -17,7 +19,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_slips,
+from filmfriction.analysis.groundtruth.md_noise import (common_shape_share, increment_rms,
+                                                        replica_slips,
                                                         residual_statistics, residuals, run_slips,
                                                         slip_velocities)
 from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE
@@ -32,10 +35,13 @@ def row(name: str, slips: list[dict]) -> str:
         sl["wall_velocity"], sl["yields"], sl["sticks"])])
     cells = [", ".join(f"{x:.3f}" for x in inc)]
     for trend in (1, 3):
-        st = residual_statistics([r for sl in slips for r in residuals(sl, trend=trend)])
+        rs = [r for sl in slips for r in residuals(sl, trend=trend)]
+        st = residual_statistics(rs)
         cells.append(f"{st['rms']:.3f} ± {st['rms_stderr']:.3f}; " + ", ".join(
             f"{a:.2f} ± {e:.2f}" for a, e in zip(st["autocorrelation"],
                                                   st["autocorrelation_stderr"])))
+        if trend == 1:
+            cells.append(f"{common_shape_share(rs):.2f}")
     return f"| {name} | {st['slips']} | " + " | ".join(cells) + " |"
 
 
@@ -52,8 +58,8 @@ def main(argv=None) -> int:
         print(f"error: --replicas {a.replicas}: must be >= 1", file=sys.stderr)
         return 2
     print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
-          "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | residual, + Δt², Δt³ |\n"
-          "|---|---|---|---|---|")
+          "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
+          "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
     print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs]), flush=True)
     for name, noise in PROCESSES.items():
         print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas)), flush=True)

@@ -39,7 +39,7 @@ import math
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-__all__ = ["slip_residuals", "residual_statistics", "slip_velocities", "increment_rms",
+__all__ = ["slip_residuals", "residual_statistics", "common_shape_share", "slip_velocities", "increment_rms",
            "run_slips", "replica_slips", "residuals", "run_residuals", "replica_residuals",
            "LAGS", "EDGE", "MIN_SAMPLES"]
 
@@ -91,6 +91,17 @@ def residual_statistics(residuals, lags=LAGS) -> dict:
             "per_slip_rms": rms.tolist(), "lags": list(lags),
             "autocorrelation": acf.mean(axis=0).tolist(),
             "autocorrelation_stderr": np.atleast_1d(se(acf)).tolist()}
+
+
+def common_shape_share(residuals, points: int = 40) -> float:
+    """The share of the residuals' variance that their mean shape carries: each slip's
+    residual resampled on ``points`` equal parts of its own duration, averaged over the
+    slips; a noise of zero mean leaves a share of order 1/slips, a shape every slip has
+    (a law's misfit) a share of order 1."""
+    grid = np.linspace(0.0, 1.0, points)
+    rs = np.array([np.interp(grid, np.linspace(0.0, 1.0, r.size), r - np.mean(r))
+                   for r in residuals])
+    return float(np.mean(rs.mean(axis=0) ** 2) / np.mean(rs ** 2))
 
 
 def slip_velocities(wall_velocity, yields, sticks, *, edge: int = EDGE,

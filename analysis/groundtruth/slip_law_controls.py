@@ -7,16 +7,17 @@ laws here are slid in the reduced model at the Klein-similar MD scene's scale
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
 Each replica's film pushes the wall with the MD's noise as a random force ξ = M·du/dt,
-u the velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`):
+u the velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
+calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`):
 the wall's position and velocity respond to it, as an MD wall's do, and the residual of
-the integrated equation of motion over M, ∫ξ dt/M, is u — how the MD's noise was
-measured.  The per-slip fit does not pass every control so: its regressors (Δx, the
-branch split at the noisy peak velocity) carry the noise of its response.  With 40
-replicas (``python benchmarks/slip_law_random_force.py``, docs/results/slip-law.md):
-Klein's viscous slips come out ``mixed`` in 40 of 40 at 30 slips (decelerating branch
-B = 27 of 62 m/τ, F_k = 18.7 of 0 ε/σ), and every law's loop step is resolved, +12 to
-+22 ε/σ where it is 0 to −1.3; no negative control is called ``viscous``.  The noise
-added to the noise-free law's trace instead (``injected=True``: the spring force carries
+the integrated equation of motion over M, ∫ξ dt/M, is u.  The per-slip fit does not pass
+every control so: its regressors (Δx, the branch split at the noisy peak velocity) carry
+the noise of its response.  With 40 replicas (``python benchmarks/slip_law_random_force.py``,
+docs/results/slip-law.md): Klein's viscous slips come out ``mixed`` in 40 of 40 at 30
+slips (decelerating branch B = 48 of 62 m/τ, F_k = 7.5 of 0 ε/σ, a loop step of +6.0
+resolved in 32), and every other law's loop step is resolved in 40 of 40, +13 to +14
+ε/σ where it is 0 to −1.3; no negative control is called ``viscous``.  The noise added
+to the noise-free law's trace instead (``injected=True``: the spring force carries
 M·du/dt, the motion is the law's; :func:`replica_fits`) passes them (Klein's slips
 ``viscous`` in 39 of 40) and is kept as the comparison.
 
