@@ -1,7 +1,7 @@
 """The controls' noise calibrated to the MD's: slip residuals and the wall's jitter of MD runs and
 of random-force replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
 
-    python benchmarks/md_noise_calibration.py RUN [RUN ...] [--replicas 40]
+    python benchmarks/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
 control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
@@ -11,7 +11,8 @@ has the MD's rms): the rms of the wall velocity's change over 0.25, 1, 2 τ; the
 rms (mean over the slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with
 F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean shape carries,
 :func:`~filmfriction.analysis.groundtruth.md_noise.common_shape_share`) and with Δt², Δt³
-fitted besides (``trend 3``).
+fitted besides (``trend 3``).  ``--scan``: besides, u of 1 σ/τ at correlations 0.8–0.999 per
+sample (rattling 0.15): how slow a residual this family of noise can leave.
 """
 from __future__ import annotations
 
@@ -49,6 +50,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+", metavar="RUN", help="run directories (analysed slips)")
     ap.add_argument("--replicas", type=int, default=40)
+    ap.add_argument("--scan", action="store_true", help="also u of 1 σ/τ at several correlations")
     a = ap.parse_args(argv)
     missing = [r for r in a.runs if not (Path(r) / "trace.csv").is_file()]
     if missing:
@@ -61,7 +63,11 @@ def main(argv=None) -> int:
           "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
           "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
     print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs]), flush=True)
-    for name, noise in PROCESSES.items():
+    processes = dict(PROCESSES)
+    if a.scan:
+        processes |= {f"scan {rho}": {"velocity_noise": 1.0, "velocity_correlation": rho,
+                                      "rattle": 0.15} for rho in (0.8, 0.9, 0.95, 0.99, 0.999)}
+    for name, noise in processes.items():
         print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas)), flush=True)
     return 0
 
