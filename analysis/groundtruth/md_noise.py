@@ -147,13 +147,10 @@ def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = No
     film's random force of ``noise`` (the keywords of
     :func:`~filmfriction.analysis.groundtruth.random_force.slide`), as :func:`run_slips`
     gives a run (the start-up slip left out)."""
-    from .random_force import slide
-    from .slip_law_controls import SCALE, _dynamical_law
+    from .slip_law_controls import SCALE, random_force_runs
 
-    args = _dynamical_law(law, share)
-    args.pop("period")
-    runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                 duration=duration, dt=SCALE["dt"], replicas=replicas, seed=seed, **noise)
+    runs, _ = random_force_runs(law, replicas, duration=duration, noise=noise, seed=seed,
+                                share=share)
     return [{k: tr[k] for k in ("time", "spring_force", "wall_velocity", "wall_position")}
             | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:],
                "mass": SCALE["mass"]} for tr in runs]

@@ -55,7 +55,7 @@ from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
-           "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
+           "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
 #: The Klein-similar scene's slider and sampling (LJ units).
 SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
@@ -225,6 +225,23 @@ def _dynamical_law(name: str, share: float | None = None) -> dict:
     raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
 
 
+def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: float | None = None,
+                      noise: dict | None = None, seed: int = 0,
+                      share: float | None = None) -> tuple[list[dict], float]:
+    """``replicas`` runs of control ``name`` (or of :func:`coulomb_viscous`'s law of viscous
+    ``share``) whose film pushes the wall with ``noise`` (:data:`MD_NOISE` by default) as a
+    random force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`), long
+    enough for ``slips`` slips after the start-up one (or ``duration`` long), and the
+    law's drive velocity."""
+    noise = MD_NOISE if noise is None else noise
+    law = _dynamical_law(name, share)
+    period = law.pop("period")
+    duration = (slips + 3) * period * 1.3 if duration is None else duration
+    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
+                 duration=duration, dt=SCALE["dt"], replicas=replicas, seed=seed, **noise)
+    return runs, law["drive_velocity"]
+
+
 def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | None = None,
                    seed: int = 0, share: float | None = None, **fit) -> list[FilmForceFit]:
     """The slip-law fit of ``replicas`` runs of control ``name`` whose film pushes the wall
@@ -236,12 +253,8 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
     detector is not under test); the start-up slip is left out and the next ``slips``
     fitted; ``fit`` goes to :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`.
     """
-    noise = MD_NOISE if noise is None else noise
-    law = _dynamical_law(name, share)
-    period = law.pop("period")
-    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                 duration=(slips + 3) * period * 1.3, dt=SCALE["dt"], replicas=replicas,
-                 seed=seed, **noise)
+    runs, velocity = random_force_runs(name, replicas, slips=slips, noise=noise, seed=seed,
+                                       share=share)
     out = []
     for tr in runs:
         t, f = tr["time"], tr["spring_force"]
@@ -249,7 +262,7 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
                           spring_constant=SCALE["spring_constant"],
                           wall_position=tr["wall_position"])[1:slips + 1]
         out.append(fit_film_force(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
-                                  drive_velocity=law["drive_velocity"],
+                                  drive_velocity=velocity,
                                   wall_position=tr["wall_position"], **fit))
     return out
 
