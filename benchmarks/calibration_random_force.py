@@ -3,6 +3,7 @@
 
     python benchmarks/calibration_random_force.py [--replicas 40] [--slips 8]
                                                   [--kinetic-force 19] [--damping 27]
+                                                  [--noises none MD_NOISE RESIDUAL_AS_NOISE]
 
 Slips of F_k·sign(v) + B·v at the Klein-similar scene's scale (K = 2, M = 30, F_s = 48,
 sampled every 0.25 τ, V = 0.1 σ/τ; the film re-freezes where the spring force has fallen
@@ -39,7 +40,7 @@ def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float) ->
                  duration=(slips + 2) * 2 * s["static_force"] / s["spring_constant"] / 0.1 * 1.1,
                  dt=s["dt"], replicas=replicas, seed=0, **noise)
     out = []
-    for tr in runs:
+    for k, tr in enumerate(runs):
         y, st = tr["yield_index"][1:slips + 1], tr["stick_index"][1:slips + 1]
         f = tr["spring_force"]
         try:
@@ -47,7 +48,12 @@ def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float) ->
                                  spring_constant=s["spring_constant"], mass=s["mass"],
                                  drive_velocity=0.1, jackknife=False))
         except ValueError as e:                     # a replica with no slip to fit
-            print(f"  a replica not fitted: {e}", file=sys.stderr)
+            print(f"  replica {k} not fitted: {e}", file=sys.stderr)
+            continue
+        f = out[-1]
+        print(f"  replica {k}: F_k {f.kinetic_force.value:.2f} ± {f.kinetic_force.stderr:.2f}, "
+              f"B {f.film_damping.value:.2f} ± {f.film_damping.stderr:.2f}", file=sys.stderr,
+              flush=True)
     return out
 
 
@@ -68,13 +74,14 @@ def main(argv=None) -> int:
     ap.add_argument("--slips", type=int, default=8)
     ap.add_argument("--kinetic-force", type=float, default=19.0)
     ap.add_argument("--damping", type=float, default=27.0)
+    ap.add_argument("--noises", nargs="+", default=list(NOISES), choices=NOISES)
     a = ap.parse_args(argv)
     if a.replicas < 2 or a.slips < 3 or not 0 <= a.kinetic_force < 48 or a.damping < 0:
         print(f"error: --replicas {a.replicas} (>= 2), --slips {a.slips} (>= 3), "
               f"--kinetic-force {a.kinetic_force} (0 to 48), --damping {a.damping} (>= 0)",
               file=sys.stderr)
         return 2
-    for name in NOISES:
+    for name in a.noises:
         noise = ({"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
                  if name == "none" else getattr(controls, name))
         n = 1 if name == "none" else a.replicas
