@@ -8,7 +8,7 @@
 Slips of F_k·sign(v) + B·v at the Klein-similar scene's scale (K = 2, M = 30, F_s = 48,
 sampled every 0.25 τ, V = 0.1 σ/τ; the film re-freezes where the spring force has fallen
 to 24 ε/σ, as Klein's and the viscous control's, or the wall stops once it has fallen
-to 34), the film pushing the wall with the controls' random force
+to 34; ``--freeze-only``: at the freeze alone), the film pushing the wall with the controls' random force
 (:mod:`~filmfriction.analysis.groundtruth.random_force`) of each named process of
 :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (none, ``MD_NOISE``,
 ``RESIDUAL_AS_NOISE``), fitted by :func:`~filmfriction.analysis.calibration.slipfit.fit_slips` as
@@ -32,11 +32,15 @@ from filmfriction.analysis.groundtruth.random_force import slide
 NOISES = ("none", "MD_NOISE", "RESIDUAL_AS_NOISE")
 
 
-def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float) -> list:
+def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float,
+                 freeze_only: bool = False) -> list:
     s = controls.SCALE
+    # the wall stops where its velocity falls to 0 (the noise can bring it to rest before
+    # the freeze), or with ``freeze_only`` at the freeze alone (Klein's control's re-stick)
+    stop = -math.inf if freeze_only else 0.0
     runs = slide("coulomb-viscous", (fk, b), mass=s["mass"], stiffness=s["spring_constant"],
                  drive_velocity=0.1, static_force=s["static_force"], backward_force=24.0,
-                 armed_below=34.0, initial_force=24.0,
+                 armed_below=34.0, initial_force=24.0, stop_velocity=stop,
                  duration=(slips + 2) * 2 * s["static_force"] / s["spring_constant"] / 0.1 * 1.1,
                  dt=s["dt"], replicas=replicas, seed=0, **noise)
     out = []
@@ -75,6 +79,8 @@ def main(argv=None) -> int:
     ap.add_argument("--kinetic-force", type=float, default=19.0)
     ap.add_argument("--damping", type=float, default=27.0)
     ap.add_argument("--noises", nargs="+", default=list(NOISES), choices=NOISES)
+    ap.add_argument("--freeze-only", action="store_true",
+                    help="the slips end at the freeze force only, never where the wall stops")
     a = ap.parse_args(argv)
     if a.replicas < 2 or a.slips < 3 or not 0 <= a.kinetic_force < 48 or a.damping < 0:
         print(f"error: --replicas {a.replicas} (>= 2), --slips {a.slips} (>= 3), "
@@ -85,7 +91,7 @@ def main(argv=None) -> int:
         noise = ({"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
                  if name == "none" else getattr(controls, name))
         n = 1 if name == "none" else a.replicas
-        fits = replica_fits(noise, n, a.slips, a.kinetic_force, a.damping)
+        fits = replica_fits(noise, n, a.slips, a.kinetic_force, a.damping, a.freeze_only)
         print(f"## {name} {noise}: {len(fits)} replicas of {a.slips} slips", flush=True)
         if n == 1:
             f = fits[0]
