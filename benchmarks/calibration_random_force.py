@@ -4,6 +4,7 @@
     python benchmarks/calibration_random_force.py [--replicas 40] [--slips 8]
                                                   [--kinetic-force 19] [--damping 27]
                                                   [--noises none MD_NOISE RESIDUAL_AS_NOISE]
+                                                  [--freeze-only] [--slip-ends]
 
 Slips of F_k·sign(v) + B·v at the Klein-similar scene's scale (K = 2, M = 30, F_s = 48,
 sampled every 0.25 τ, V = 0.1 σ/τ; the film re-freezes where the spring force has fallen
@@ -32,7 +33,7 @@ from filmfriction.analysis.groundtruth.random_force import slide
 NOISES = ("none", "MD_NOISE", "RESIDUAL_AS_NOISE")
 
 
-def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float,
+def replica_runs(noise: dict, replicas: int, slips: int, fk: float, b: float,
                  freeze_only: bool = False) -> list:
     s = controls.SCALE
     # the wall stops where its velocity falls to 0 (the noise can bring it to rest before
@@ -43,6 +44,20 @@ def replica_fits(noise: dict, replicas: int, slips: int, fk: float, b: float,
                  armed_below=34.0, initial_force=24.0, stop_velocity=stop,
                  duration=(slips + 2) * 2 * s["static_force"] / s["spring_constant"] / 0.1 * 1.1,
                  dt=s["dt"], replicas=replicas, seed=0, **noise)
+    return runs
+
+
+def slip_ends(runs: list, slips: int) -> str:
+    """Where the fitted slips end: the spring force's quantiles (5, 25, 50, 75, 95 %) and the
+    share ending at the freeze (24 ε/σ)."""
+    f = np.concatenate([r["spring_force"][r["stick_index"][1:slips + 1]] for r in runs])
+    q = ", ".join(f"{x:.1f}" for x in np.percentile(f, [5, 25, 50, 75, 95]))
+    return (f"{f.size} slips end at spring force {q} (5–95 %); "
+            f"at the freeze in {np.mean(f <= 24.5):.2f}")
+
+
+def replica_fits(runs: list, slips: int) -> list:
+    s = controls.SCALE
     out = []
     for k, tr in enumerate(runs):
         y, st = tr["yield_index"][1:slips + 1], tr["stick_index"][1:slips + 1]
@@ -79,6 +94,8 @@ def main(argv=None) -> int:
     ap.add_argument("--kinetic-force", type=float, default=19.0)
     ap.add_argument("--damping", type=float, default=27.0)
     ap.add_argument("--noises", nargs="+", default=list(NOISES), choices=NOISES)
+    ap.add_argument("--slip-ends", action="store_true",
+                    help="only where the slips end (no fits)")
     ap.add_argument("--freeze-only", action="store_true",
                     help="the slips end at the freeze force only, never where the wall stops")
     a = ap.parse_args(argv)
@@ -91,7 +108,11 @@ def main(argv=None) -> int:
         noise = ({"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
                  if name == "none" else getattr(controls, name))
         n = 1 if name == "none" else a.replicas
-        fits = replica_fits(noise, n, a.slips, a.kinetic_force, a.damping, a.freeze_only)
+        runs = replica_runs(noise, n, a.slips, a.kinetic_force, a.damping, a.freeze_only)
+        if a.slip_ends:
+            print(f"## {name} {noise}: {slip_ends(runs, a.slips)}", flush=True)
+            continue
+        fits = replica_fits(runs, a.slips)
         print(f"## {name} {noise}: {len(fits)} replicas of {a.slips} slips", flush=True)
         if n == 1:
             f = fits[0]
