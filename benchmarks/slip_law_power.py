@@ -5,14 +5,19 @@
 
 ``--measure`` fits each analysed slip of RUN (its whole slip, F_k + B·v in the
 integrated equation of motion) and prints how far the wall's velocity strays from
-the fitted law's (rms) and the autocorrelation of that residual: the numbers
-behind :data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`.
+the fitted law's (rms) and the autocorrelation of that residual at 0.25, 1, 2, 4 τ
+(:mod:`~filmfriction.analysis.groundtruth.md_noise`; the calibration of
+:data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE` on it and on the
+wall's jitter is ``benchmarks/md_noise_calibration.py``).
 
 Without it: for each control law (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.CONTROLS`)
 the verdicts of 40 noisy replicas at 4, 8 and 30 slips, at the MD's noise and at a
 tenth of it (the noise a random force that moves the wall; with ``--injected`` added to
-the noise-free law's trace); then the power (the noise added to the trace): the share of replicas of slips resisted by F_k + B·v
-(re-sticking as Klein's) whose B is resolved (2 σ), against the viscous share.
+the noise-free law's trace); then the power, with the MD's noise as the random force
+(:func:`~filmfriction.analysis.groundtruth.slip_law_controls.dynamical_fits` of ``share``):
+the share of replicas of slips resisted by F_k + B·v (re-sticking as Klein's) whose B is
+resolved (2 σ), the mean B against the truth and the median ``detectable_damping``,
+against the viscous share.
 """
 from __future__ import annotations
 
@@ -23,47 +28,23 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
+from filmfriction.analysis.groundtruth.md_noise import residual_statistics, run_residuals
 from filmfriction.analysis.slip_law.slip_law import ONE_LAW, VERDICTS, sigmas
 from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, control_fits,
-                                                                 coulomb_viscous, replica_fits)
+                                                                 dynamical_fits, scaled)
 
 REPLICAS = 40
-QUIET = {k: (v if k == "velocity_correlation" else v / 10) for k, v in MD_NOISE.items()}
+QUIET = scaled(MD_NOISE, 0.1)
 
 
 def measure(run_dir: Path) -> dict:
-    """The integral-form residual of the run's analysed slips (whole slips)."""
-    from filmfriction.analysis.calibration.rundata import load_run
-
-    run = load_run(run_dir)
-    tr, p = run.trace, run.trace.parameters
-    t, f, v = tr.time, tr.spring_force, tr.columns["wall_velocity"]
-    x = tr.wall_position()
-    vd, _ = tr.drive_velocity()
-    gm = p.mount_damping or 0.0
-    imp = cumulative_trapezoid(f, t, initial=0.0)
-    yi = np.asarray(run.cycles["yield_index"], int)[run.skip:]
-    si = np.asarray(run.cycles["stick_index"], int)[run.skip:]
-    rms, acf = [], np.zeros(41)
-    for y, s in zip(yi, si):
-        i = np.arange(y + 10, s - 10)       # 2.5 τ off the yield and the re-stick
-        if i.size < 60:
-            continue
-        dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
-        resp = imp[i] - imp[i[0]] - gm * (dx - (vd or 0.0) * dt) - p.mass * v[i]
-        X = np.column_stack([np.ones(i.size), dt, dx])
-        r = (resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / p.mass
-        rms.append(float(r.std()))
-        r = r - r.mean()
-        a = np.array([r[:r.size - k] @ r[k:] for k in range(41)])
-        acf += a / a[0]
-    acf /= max(len(rms), 1)
-    return {"slips": len(rms), "velocity_residual_rms": rms,
-            "mean_rms": float(np.mean(rms)) if rms else None,
-            "acf_at_lags_0_1_4_8_16": [round(float(acf[k]), 2) for k in (0, 1, 4, 8, 16)],
-            "sample_interval": float(t[1] - t[0])}
+    """The integral-form residual of the run's analysed slips (whole slips;
+    :func:`~filmfriction.analysis.groundtruth.md_noise.run_residuals`)."""
+    s = residual_statistics(run_residuals(run_dir))
+    return {"slips": s["slips"], "velocity_residual_rms": s["per_slip_rms"],
+            "mean_rms": s["rms"], "mean_rms_stderr": s["rms_stderr"],
+            "acf_at_lags_1_4_8_16": [round(a, 2) for a in s["autocorrelation"]]}
 
 
 def rates(injected: bool = False) -> None:
@@ -81,17 +62,20 @@ def rates(injected: bool = False) -> None:
 
 
 def power() -> None:
-    print(f"\n## power at the MD noise: share of {REPLICAS} replicas with B resolved (2 σ)")
+    print(f"\n## power at the MD noise (a random force moving the wall, {MD_NOISE}): share of "
+          f"{REPLICAS} replicas with B resolved (2 σ)")
     for slips in (8, 30):
         for share in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0):
-            fits = replica_fits(coulomb_viscous(share, slips=slips), REPLICAS, slips=slips)
+            fits = dynamical_fits("", REPLICAS, slips, share=share)
             hit = sum(sigmas(f.damping, f.damping_stderr, f.law.dof) >= 2 for f in fits)
-            verdicts = {}
-            for f in fits:
-                verdicts[f.verdict] = verdicts.get(f.verdict, 0) + 1
+            r = Counter(f.verdict for f in fits)
             one = sum(f.verdict_from == ONE_LAW for f in fits)
-            print(f"{slips:3d} slips, viscous share {share:.1f}: B resolved in {hit}/{REPLICAS}; "
-                  f"verdicts {verdicts}; the one law's in {one}", flush=True)
+            truth = share * 28.0 / 0.55
+            print(f"{slips:3d} slips, viscous share {share:.1f} (B {truth:.1f}): B resolved in "
+                  f"{hit}/{REPLICAS}, B {np.mean([f.damping for f in fits]):.1f} ± "
+                  f"{np.std([f.damping for f in fits], ddof=1) / np.sqrt(len(fits)):.1f}, "
+                  f"detectable_damping {np.median([f.detectable_damping for f in fits]):.1f} "
+                  f"(median); verdicts {dict(r)}; the one law's in {one}", flush=True)
 
 
 def main(argv=None) -> int:

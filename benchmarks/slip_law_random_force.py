@@ -3,7 +3,7 @@ the noise added to the law's trace (docs/results/slip-law.md, "The controls with
 
     python benchmarks/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
                                                [--slips 8 30] [--residual]
-    python benchmarks/slip_law_random_force.py --ensemble [--noises md 1.5x 2tau]
+    python benchmarks/slip_law_random_force.py --ensemble [--noises md md-1.5x md-2tau residual ...]
 
 With ``--ensemble``: the driven analysis's fit, the slips' mean
 (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`), on the
@@ -21,8 +21,8 @@ random force (:func:`~filmfriction.analysis.groundtruth.slip_law_controls.dynami
 and added to the noise-free law's trace (``replica_fits``), and noise-free.  With
 ``--residual``: the integral-form residual of the random-force replicas measured as
 ``benchmarks/slip_law_power.py --measure`` measures an MD run's (the whole slip, 2.5 τ off
-its ends, F_k + B·v fitted), to compare with the MD's 0.56–0.75 σ/τ rms and
-autocorrelation 0.82, 0.65, 0.44, 0.08 at 0.25, 1, 2, 4 τ.  With ``--cycle-mean``: a
+its ends, F_k + B·v fitted; :mod:`~filmfriction.analysis.groundtruth.md_noise`), to compare
+with the MD's (``benchmarks/md_noise_calibration.py``).  With ``--cycle-mean``: a
 prototype of the remedy, the slips of each replica aligned at the yield and averaged
 before the fit (the noise of the regressors averages down as 1/√slips).
 """
@@ -36,9 +36,10 @@ from collections import Counter
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residual_statistics
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.slip_law_controls import (
-    CONTROLS, MD_NOISE, SCALE, _dynamical_law, control_fits)
+    CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, _dynamical_law, control_fits)
 from filmfriction.analysis.slip_law.slip_law import VERDICTS, fit_film_force
 from filmfriction.reduced_model.cycles import cycle_table
 
@@ -68,35 +69,14 @@ def summary(fits) -> str:
 
 def residual(replicas: int, share: float | None) -> None:
     """The integral-form residual of the random-force replicas of the viscous control, or
-    of slips resisted by F_k + B·v of viscous ``share`` (``coulomb_viscous``)."""
-    law = _dynamical_law("viscous", share)
-    law.pop("period")
-    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                 duration=1500.0, dt=SCALE["dt"], replicas=replicas, seed=0,
-                 velocity_noise=0.75, velocity_correlation=0.9, rattle=0.25)
-    m = SCALE["mass"]
-    rms, acf, n = [], np.zeros(17), 0
-    for tr in runs:
-        t, f, v, x = tr["time"], tr["spring_force"], tr["wall_velocity"], tr["wall_position"]
-        imp = cumulative_trapezoid(f, t, initial=0.0)
-        for y, s in zip(tr["yield_index"][1:], tr["stick_index"][1:]):
-            i = np.arange(y + 10, s - 10)
-            if i.size < 24:
-                continue
-            dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
-            resp = imp[i] - imp[i[0]] - m * v[i]
-            X = np.column_stack([np.ones(i.size), dt, dx])
-            r = (resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / m
-            rms.append(float(r.std()))
-            r = r - r.mean()
-            a = np.array([r[:r.size - k] @ r[k:] for k in range(17)])
-            acf += a / a[0]
-            n += 1
-    acf /= max(n, 1)
+    of slips resisted by F_k + B·v of viscous ``share`` (``coulomb_viscous``), at
+    ``MD_NOISE`` (:mod:`~filmfriction.analysis.groundtruth.md_noise`)."""
+    s = residual_statistics(replica_residuals(MD_NOISE, share=share, replicas=replicas))
     what = "viscous control" if share is None else f"viscous share {share}"
-    print(f"{what}, random force: {n} slips; residual rms {np.mean(rms):.2f} σ/τ "
-          f"(slips {np.min(rms):.2f}–{np.max(rms):.2f}); autocorrelation at 0.25, 1, 2, 4 τ: "
-          + ", ".join(f"{acf[k]:.2f}" for k in (1, 4, 8, 16)))
+    print(f"{what}, random force {MD_NOISE}: {s['slips']} slips; residual rms {s['rms']:.2f} "
+          f"σ/τ (slips {min(s['per_slip_rms']):.2f}–{max(s['per_slip_rms']):.2f}); "
+          "autocorrelation at 0.25, 1, 2, 4 τ: "
+          + ", ".join(f"{x:.2f}" for x in s["autocorrelation"]))
 
 
 def cycle_mean_fit(run: dict, slips: int, drive_velocity: float):
@@ -205,10 +185,16 @@ def cycle_means(laws, slip_counts, replicas: int) -> None:
 
 
 #: The noises of the ensemble's table: the MD's, 1.5 times its amplitude, twice its
-#: correlation time (ρ per sample to the power 1/2).
-NOISES = {"md": MD_NOISE,
-          "1.5x": {k: (v if k == "velocity_correlation" else 1.5 * v) for k, v in MD_NOISE.items()},
-          "2tau": MD_NOISE | {"velocity_correlation": MD_NOISE["velocity_correlation"] ** 0.5}}
+#: correlation time (ρ per sample to the power 1/2), and the MD's plain residual taken as
+#: the noise (``residual``: 1.7 times the MD's jitter) with its 1.5x and 2tau.
+def _variants(noise: dict, name: str) -> dict[str, dict]:
+    return {name: noise,
+            f"{name}-1.5x": {k: (v if k == "velocity_correlation" else 1.5 * v)
+                             for k, v in noise.items()},
+            f"{name}-2tau": noise | {"velocity_correlation": noise["velocity_correlation"] ** 0.5}}
+
+
+NOISES = _variants(MD_NOISE, "md") | _variants(RESIDUAL_AS_NOISE, "residual")
 #: The Coulomb + viscous laws of the table (viscous share of the film force at 0.55 σ/τ).
 SHARES = (0.3, 0.6)
 
@@ -273,7 +259,7 @@ def main(argv=None) -> int:
     ap.add_argument("--ensemble", action="store_true",
                     help="the cycle ensemble (the driven analysis's fit): verdicts, bias, coverage")
     ap.add_argument("--noises", nargs="+", default=["md"], choices=list(NOISES),
-                    help="with --ensemble: the noises (md, 1.5x amplitude, 2tau correlation time)")
+                    help="with --ensemble: the noises (md: MD_NOISE, residual: RESIDUAL_AS_NOISE; -1.5x: 1.5x the amplitude, -2tau: twice the correlation time)")
     ap.add_argument("--share", type=float, default=None,
                     help="with --residual: slips of F_k + B·v of this viscous share")
     a = ap.parse_args(argv)

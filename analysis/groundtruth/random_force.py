@@ -14,7 +14,8 @@ state), and
     ξ = M·du/dt   while the wall slips, 0 while it is stuck,
 
 u an Ornstein–Uhlenbeck velocity: sampled every ``dt`` it is AR(1) of rms
-``velocity_noise`` and lag-one correlation ``velocity_correlation``.  So the
+``velocity_noise`` and lag-one correlation ``velocity_correlation`` (or a sum of
+independent such terms, one per pair of the two sequences).  So the
 residual of the integrated equation of motion over M, ∫ξ dt/M over a slip, is
 u(t) − u(t_yield): the noise the MD's was measured as
 (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`), here a
@@ -149,7 +150,7 @@ def _run(code, p, mass, k, vd, xd0, static, start_v, stop_v, backward, armed_bel
 
 def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity: float,
           static_force: float = math.inf, duration: float, dt: float, replicas: int = 1,
-          velocity_noise: float = 0.0, velocity_correlation: float = 0.0, rattle: float = 0.0,
+          velocity_noise=0.0, velocity_correlation=0.0, rattle: float = 0.0,
           seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
           backward_force: float = -math.inf, armed_below: float = math.inf,
           start_velocity: float = 0.0, initial_state: float = 0.0,
@@ -169,8 +170,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
         ``start_velocity`` and the aged state).
     duration, dt : float
         Length of the run and the sampling step.
-    velocity_noise, velocity_correlation : float
-        rms and lag-one (per ``dt``) correlation of u, the random force's velocity.
+    velocity_noise, velocity_correlation : float or sequence of float
+        rms and lag-one (per ``dt``) correlation of u, the random force's velocity; with
+        sequences (one correlation per rms) u is the sum of independent such terms.
     rattle : float
         rms of the white noise added to the sampled velocity.
     stop_velocity, backward_force, armed_below, start_velocity : float
@@ -199,19 +201,26 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
             raise ValueError(f"{name} = {val!r}: must be positive and finite")
     if int(replicas) < 1 or int(substeps) < 1:
         raise ValueError(f"replicas = {replicas!r}, substeps = {substeps!r}: must be >= 1")
-    if not (0 <= velocity_correlation < 1) or velocity_noise < 0 or rattle < 0:
-        raise ValueError("velocity_noise, rattle must be >= 0 and velocity_correlation in [0, 1)")
+    sig, rho = np.atleast_1d(np.asarray(velocity_noise, float)), np.atleast_1d(
+        np.asarray(velocity_correlation, float))
+    if (sig.ndim != 1 or sig.shape != rho.shape or not np.all((0 <= rho) & (rho < 1))
+            or not np.all(sig >= 0) or not rattle >= 0):
+        raise ValueError(f"velocity_noise = {velocity_noise!r}, velocity_correlation = "
+                         f"{velocity_correlation!r}, rattle = {rattle!r}: rms >= 0 and "
+                         "correlations in [0, 1), one correlation per rms")
     reps, n_sub = int(replicas), int(substeps)
     rng = np.random.default_rng(seed)
     h = dt / n_sub
     samples = int(math.floor(duration / dt + 1e-9))
-    # u: Ornstein–Uhlenbeck at the steps, AR(1) of rms σ and correlation ρ per sample
-    rho_h = velocity_correlation ** (1.0 / n_sub)
-    kicks = rng.normal(0.0, velocity_noise * math.sqrt(1.0 - rho_h ** 2),
-                       (samples * n_sub, reps))
-    u0 = rng.normal(0.0, velocity_noise, reps)
-    u = lfilter([1.0], [1.0, -rho_h], kicks, axis=0, zi=(rho_h * u0)[None, :])[0]
-    du = np.diff(np.vstack([u0[None, :], u]), axis=0)
+    # u: a sum of Ornstein–Uhlenbeck terms at the steps, each AR(1) of rms σ_j and
+    # correlation ρ_j per sample
+    du = np.zeros((samples * n_sub, reps))
+    for s_j, r_j in zip(sig, rho):
+        rho_h = float(r_j) ** (1.0 / n_sub)
+        kicks = rng.normal(0.0, s_j * math.sqrt(1.0 - rho_h ** 2), (samples * n_sub, reps))
+        u0 = rng.normal(0.0, s_j, reps)
+        u = lfilter([1.0], [1.0, -rho_h], kicks, axis=0, zi=(rho_h * u0)[None, :])[0]
+        du += np.diff(np.vstack([u0[None, :], u]), axis=0)
     out_x, out_v = np.empty((samples, reps)), np.empty((samples, reps))
     most = samples // 2 + 2
     yields = np.zeros((reps, most), np.int64)

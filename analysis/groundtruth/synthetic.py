@@ -174,13 +174,14 @@ def block_trace(block, duration: float, dt: float, **simulate) -> dict:
             "wall_position": wall, "wall_velocity": vel}
 
 
-def with_wall_noise(columns: dict, *, velocity_noise: float, velocity_correlation: float = 0.0,
+def with_wall_noise(columns: dict, *, velocity_noise, velocity_correlation=0.0,
                     rattle: float = 0.0, force_noise: float = 0.0,
                     force_correlation: float = 0.0, seed: int = 0) -> dict:
     """``columns`` with an MD wall's noise added to what is measured, not to the motion.
 
     * ``wall_velocity`` + AR(1) noise of rms ``velocity_noise`` and lag-one
-      correlation ``velocity_correlation`` (the wall's bursts and pauses about the
+      correlation ``velocity_correlation`` (or, sequences of both, a sum of such
+      independent terms; the wall's bursts and pauses about the
       law's motion) + white noise of rms ``rattle`` (its thermal rattling);
     * ``spring_force`` + AR(1) noise of rms ``force_noise`` and lag-one correlation
       ``force_correlation`` (a random force of the film, carried as it is by the
@@ -192,8 +193,10 @@ def with_wall_noise(columns: dict, *, velocity_noise: float, velocity_correlatio
     rng = np.random.default_rng(seed)
     out = dict(columns)
     n = len(columns["time"])
-    out["wall_velocity"] = (np.asarray(columns["wall_velocity"], float)
-                            + _ar1(n, velocity_noise, velocity_correlation, rng)
+    # a sum of AR(1) terms when the rms and the correlation are sequences (one each)
+    u = sum(_ar1(n, float(s), float(r), rng) for s, r in
+            zip(np.atleast_1d(velocity_noise), np.atleast_1d(velocity_correlation)))
+    out["wall_velocity"] = (np.asarray(columns["wall_velocity"], float) + u
                             + rng.normal(0.0, rattle, n))
     out["spring_force"] = np.asarray(columns["spring_force"], float) + _ar1(
         n, force_noise, force_correlation, rng)

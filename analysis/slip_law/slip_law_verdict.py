@@ -93,7 +93,11 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     :func:`branch_verdict`, a step under :data:`NUMERICAL_FLOOR` of F̄ and an m_c under
     that share of the wall's ``mass`` count as not resolved.  A
     liquid's slip (no yield) is such a slip; a film that yields on the accelerating
-    branch is not, and its verdict is the decelerating branch's.
+    branch is not, and its verdict is the decelerating branch's — except that a
+    ``viscous`` decelerating branch fitted without a co-moving mass, while the one law
+    resolves a positive one and a positive kinetic force, is ``inconclusive``: m_c·a < 0
+    on that branch reads as a negative intercept and can cancel the kinetic force (the
+    release's kinetic control, docs/results/slip-law.md).
     """
     r = RESOLVED_SIGMAS
     step, se, dof = loop_step.loop_step, loop_step.loop_step_stderr, loop_step.dof
@@ -115,6 +119,17 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     else:
         return ONE_LAW, one_law.verdict, (f"the whole slip is one law with a co-moving "
                                           f"mass ({nums}): {one_law.reason}")
-    return "decelerating", decelerating.verdict, (
-        f"{decelerating.reason}; the decelerating branch's, the whole slip not one law "
-        f"({why}: {nums})")
+    verdict, reason = decelerating.verdict, decelerating.reason
+    z_fk = sigmas(one_law.kinetic_force, one_law.kinetic_force_stderr, one_law.dof)
+    if (verdict == "viscous" and not math.isfinite(decelerating.comoving_mass)
+            and z_mc >= r and one_law.comoving_mass >= NUMERICAL_FLOOR * mass
+            and z_fk >= r and one_law.kinetic_force >= NUMERICAL_FLOOR * abs(fbar)):
+        # the branch has no co-moving mass term while the one law resolves one and a kinetic
+        # force: on the decelerating branch m_c·a < 0 reads as a negative intercept, which
+        # can cancel the kinetic force the one law sees
+        verdict, reason = "inconclusive", (
+            f"{reason}; but the one law resolves a co-moving mass the branch does not fit "
+            f"(its m_c·a < 0 biases the branch's F_k low) and a kinetic force, F_k = "
+            f"{one_law.kinetic_force:.3g} ± {one_law.kinetic_force_stderr:.2g} ({z_fk:+.1f} σ)")
+    return "decelerating", verdict, (
+        f"{reason}; the decelerating branch's, the whole slip not one law ({why}: {nums})")

@@ -1,0 +1,176 @@
+"""The MD's noise as the slip-law fit sees it, measured the same way on MD runs and on model replicas.
+
+Within a slip, fit the integrated equation of motion with F_k + B·v,
+
+    ∫F_spring dt − γ(Δx − V·Δt) − M·v = c + F_k·Δt + B·Δx + M·r,
+
+over the whole slip less ``edge`` samples at each end (2.5 τ at the 0.25 τ sampling: the
+yield and the re-stick are left out), γ the mount's damping.  The residual r (a velocity)
+is what the law does not explain: on a slip whose law is F_k + B·v it is the velocity the
+film's random force gives the wall, ∫ξ dt/M, less the part of it the fit takes up.  Its
+root-mean-square per slip and its autocorrelation (each slip's, at lags of whole samples,
+then averaged over the slips) are the numbers a noise model must reproduce when pushed
+through the same fit (:func:`residual_statistics`).
+
+:func:`increment_rms` reads the wall's jitter without a fit: the rms of its velocity's
+change over 0.25, 1 and 2 τ within the same windows.  A slip's own smooth change of
+velocity is small at those lags, so it measures the random force's effect on the wall
+whatever the law; the residual of the fit carries, besides the noise, whatever of the
+slip's law F_k + B·v misses (with ``trend`` = 3 the slip-long part of that is fitted out).
+
+:func:`run_slips` reads a run directory's analysed slips, :func:`replica_slips` makes the
+random-force replicas of :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (one
+control law, a noise process); both feed :func:`residuals` and :func:`slip_velocities`.
+Slips shorter than ``min_samples`` after the edges are left out in both.
+
+Example
+-------
+A white residual has no autocorrelation beyond lag 0:
+
+>>> rng = np.random.default_rng(0)
+>>> s = residual_statistics([rng.normal(0, 0.5, 400) for _ in range(20)], lags=(1, 4))
+>>> round(s["rms"], 1), [abs(a) < 0.05 for a in s["autocorrelation"]]
+(0.5, [True, True])
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+__all__ = ["slip_residuals", "residual_statistics", "common_shape_share", "slip_velocities", "increment_rms",
+           "run_slips", "replica_slips", "residuals", "run_residuals", "replica_residuals",
+           "LAGS", "EDGE", "MIN_SAMPLES"]
+
+#: The lags (in samples: 0.25, 1, 2 and 4 τ at the 0.25 τ sampling) the statistics report.
+LAGS = (1, 4, 8, 16)
+#: Samples left out at each end of a slip (the yield and the re-stick).
+EDGE = 10
+#: Fewest samples a slip keeps after the edges to be measured.
+MIN_SAMPLES = 60
+
+
+def slip_residuals(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
+                   mass: float, mount_damping: float = 0.0, drive_velocity: float = 0.0,
+                   edge: int = EDGE, min_samples: int = MIN_SAMPLES,
+                   trend: int = 1) -> list[np.ndarray]:
+    """The integral-form residual over M of each slip (module text), one array per slip
+    long enough.  ``trend`` > 1 fits Δt², …, Δt^trend besides: what is left is the part of
+    the residual faster than the slip's own shape (a law's misfit over the slip, or a noise
+    slower than the slip, is taken out with it)."""
+    t, f, v, x = (np.asarray(a, float) for a in (time, spring_force, wall_velocity,
+                                                 wall_position))
+    imp = cumulative_trapezoid(f, t, initial=0.0)
+    out = []
+    for y, s in zip(np.asarray(yields, int), np.asarray(sticks, int)):
+        i = np.arange(y + edge, s - edge)
+        if i.size < min_samples:
+            continue
+        dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
+        resp = imp[i] - imp[i[0]] - mount_damping * (dx - drive_velocity * dt) - mass * v[i]
+        X = np.column_stack([np.ones(i.size), dt, dx] + [dt ** k for k in range(2, trend + 1)])
+        out.append((resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / mass)
+    return out
+
+
+def residual_statistics(residuals, lags=LAGS) -> dict:
+    """rms and autocorrelation of per-slip residuals: ``rms`` (the mean over the slips of
+    each slip's rms) with ``rms_stderr`` (over the slips), ``per_slip_rms``,
+    ``autocorrelation`` at ``lags`` (each slip's, Σ r_i r_{i+k} / Σ r_i², averaged over the
+    slips) with ``autocorrelation_stderr``, and ``slips``."""
+    rs = [np.asarray(r, float) - np.mean(r) for r in residuals]
+    if not rs:
+        raise ValueError("no slip long enough to measure a residual")
+    rms = np.array([r.std() for r in rs])
+    acf = np.array([[(r[:r.size - k] @ r[k:]) / (r @ r) for k in lags] for r in rs])
+    n = len(rs)
+    se = (lambda a: a.std(axis=0, ddof=1) / math.sqrt(n)) if n > 1 else (
+        lambda a: np.full(np.shape(a)[1:], math.nan))
+    return {"slips": n, "rms": float(rms.mean()), "rms_stderr": float(se(rms)),
+            "per_slip_rms": rms.tolist(), "lags": list(lags),
+            "autocorrelation": acf.mean(axis=0).tolist(),
+            "autocorrelation_stderr": np.atleast_1d(se(acf)).tolist()}
+
+
+def common_shape_share(residuals, points: int = 40) -> float:
+    """The share of the residuals' variance that their mean shape carries: each slip's
+    residual resampled on ``points`` equal parts of its own duration, averaged over the
+    slips; a noise of zero mean leaves a share of order 1/slips, a shape every slip has
+    (a law's misfit) a share of order 1."""
+    grid = np.linspace(0.0, 1.0, points)
+    rs = np.array([np.interp(grid, np.linspace(0.0, 1.0, r.size), r - np.mean(r))
+                   for r in residuals])
+    return float(np.mean(rs.mean(axis=0) ** 2) / np.mean(rs ** 2))
+
+
+def slip_velocities(wall_velocity, yields, sticks, *, edge: int = EDGE,
+                    min_samples: int = MIN_SAMPLES) -> list[np.ndarray]:
+    """The wall's sampled velocity within each slip, the same windows as
+    :func:`slip_residuals`."""
+    v = np.asarray(wall_velocity, float)
+    return [v[y + edge:s - edge] for y, s in zip(np.asarray(yields, int), np.asarray(sticks, int))
+            if s - y - 2 * edge >= min_samples]
+
+
+def increment_rms(velocities, lags=(1, 4, 8)) -> list[float]:
+    """rms of the velocity's change over each lag (samples), pooled over the slips: how much
+    the wall's motion jitters, read without a fit (a slip's own smooth change of velocity
+    over 2 τ is a few hundredths of σ/τ at the controls' scale)."""
+    out = []
+    for k in lags:
+        d = np.concatenate([v[k:] - v[:-k] for v in velocities if v.size > k])
+        out.append(float(np.sqrt(np.mean(d ** 2))))
+    return out
+
+
+def run_slips(run_dir) -> dict:
+    """A run directory's analysed slips as :func:`slip_residuals` takes them: its columns,
+    ``yields``, ``sticks`` (the slips its analysis keeps), ``mass``, ``mount_damping``,
+    ``drive_velocity``."""
+    from ..calibration.rundata import load_run
+
+    run = load_run(run_dir)
+    tr, p = run.trace, run.trace.parameters
+    vd, _ = tr.drive_velocity()
+    return {"time": tr.time, "spring_force": tr.spring_force,
+            "wall_velocity": tr.columns["wall_velocity"], "wall_position": tr.wall_position(),
+            "yields": np.asarray(run.cycles["yield_index"])[run.skip:],
+            "sticks": np.asarray(run.cycles["stick_index"])[run.skip:], "mass": p.mass,
+            "mount_damping": p.mount_damping or 0.0, "drive_velocity": vd or 0.0}
+
+
+def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = None,
+                  replicas: int = 40, duration: float = 1500.0, seed: int = 0) -> list[dict]:
+    """The random-force replicas of control ``law`` (or of slips of viscous ``share``:
+    :func:`~filmfriction.analysis.groundtruth.slip_law_controls.coulomb_viscous`) with the
+    film's random force of ``noise`` (the keywords of
+    :func:`~filmfriction.analysis.groundtruth.random_force.slide`), as :func:`run_slips`
+    gives a run (the start-up slip left out)."""
+    from .slip_law_controls import SCALE, random_force_runs
+
+    runs, _ = random_force_runs(law, replicas, duration=duration, noise=noise, seed=seed,
+                                share=share)
+    return [{k: tr[k] for k in ("time", "spring_force", "wall_velocity", "wall_position")}
+            | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:],
+               "mass": SCALE["mass"]} for tr in runs]
+
+
+def residuals(slips: dict, **kwargs) -> list[np.ndarray]:
+    """:func:`slip_residuals` of a :func:`run_slips` or :func:`replica_slips` item."""
+    keys = ("time", "spring_force", "wall_velocity", "wall_position", "yields", "sticks")
+    opt = {k: slips[k] for k in ("mass", "mount_damping", "drive_velocity") if k in slips}
+    return slip_residuals(*(slips[k] for k in keys), **opt, **kwargs)
+
+
+def run_residuals(run_dir, **kwargs) -> list[np.ndarray]:
+    """The residuals of a run directory's analysed slips (``kwargs`` to
+    :func:`slip_residuals`)."""
+    return residuals(run_slips(run_dir), **kwargs)
+
+
+def replica_residuals(noise: dict, *, law: str = "viscous", share: float | None = None,
+                      replicas: int = 40, seed: int = 0, **kwargs) -> list[np.ndarray]:
+    """The residuals of :func:`replica_slips` (``kwargs`` to :func:`slip_residuals`)."""
+    return [r for sl in replica_slips(noise, law=law, share=share, replicas=replicas, seed=seed)
+            for r in residuals(sl, **kwargs)]

@@ -1,0 +1,76 @@
+"""The controls' noise calibrated to the MD's: slip residuals and the wall's jitter of MD runs and
+of random-force replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
+
+    python benchmarks/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
+
+For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
+control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
+process of :data:`PROCESSES` (the named ones of
+:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` and the u whose plain residual
+has the MD's rms): the rms of the wall velocity's change over 0.25, 1, 2 τ; the residual's
+rms (mean over the slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with
+F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean shape carries,
+:func:`~filmfriction.analysis.groundtruth.md_noise.common_shape_share`) and with Δt², Δt³
+fitted besides (``trend 3``).  ``--scan``: besides, u of 1 σ/τ at correlations 0.8–0.999 per
+sample (rattling 0.15): how slow a residual this family of noise can leave.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from filmfriction.analysis.groundtruth.md_noise import (common_shape_share, increment_rms,
+                                                        replica_slips,
+                                                        residual_statistics, residuals, run_slips,
+                                                        slip_velocities)
+from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE
+
+PROCESSES = {"MD_NOISE": MD_NOISE, "RESIDUAL_AS_NOISE": RESIDUAL_AS_NOISE,
+             "the plain residual's rms": {"velocity_noise": 1.9, "velocity_correlation": 0.95,
+                                          "rattle": 0.15}}
+
+
+def row(name: str, slips: list[dict]) -> str:
+    inc = increment_rms([v for sl in slips for v in slip_velocities(
+        sl["wall_velocity"], sl["yields"], sl["sticks"])])
+    cells = [", ".join(f"{x:.3f}" for x in inc)]
+    for trend in (1, 3):
+        rs = [r for sl in slips for r in residuals(sl, trend=trend)]
+        st = residual_statistics(rs)
+        cells.append(f"{st['rms']:.3f} ± {st['rms_stderr']:.3f}; " + ", ".join(
+            f"{a:.2f} ± {e:.2f}" for a, e in zip(st["autocorrelation"],
+                                                  st["autocorrelation_stderr"])))
+        if trend == 1:
+            cells.append(f"{common_shape_share(rs):.2f}")
+    return f"| {name} | {st['slips']} | " + " | ".join(cells) + " |"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs", nargs="+", metavar="RUN", help="run directories (analysed slips)")
+    ap.add_argument("--replicas", type=int, default=40)
+    ap.add_argument("--scan", action="store_true", help="also u of 1 σ/τ at several correlations")
+    a = ap.parse_args(argv)
+    missing = [r for r in a.runs if not (Path(r) / "trace.csv").is_file()]
+    if missing:
+        print(f"error: RUN without trace.csv: {', '.join(missing)}", file=sys.stderr)
+        return 2
+    if a.replicas < 1:
+        print(f"error: --replicas {a.replicas}: must be >= 1", file=sys.stderr)
+        return 2
+    print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
+          "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
+          "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
+    print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs]), flush=True)
+    processes = dict(PROCESSES)
+    if a.scan:
+        processes |= {f"scan {rho}": {"velocity_noise": 1.0, "velocity_correlation": rho,
+                                      "rattle": 0.15} for rho in (0.8, 0.9, 0.95, 0.99, 0.999)}
+    for name, noise in processes.items():
+        print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas)), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
