@@ -123,9 +123,9 @@ def _bingham_reading(rows) -> str:
                  "does not reproduce the regime of Klein's film: a verdict on his film needs "
                  "Bi ≫ 1. What the run's slips say of the film's own law is the slip law's "
                  "reading (its own section), with its power; on driven slips at the MD's noise "
-                 "that fit fails its positive control (viscous controls come out `mixed`, with a "
-                 "loop: docs/results/slip-law.md), so a loop or a `mixed` verdict there is no "
-                 "evidence of a yield or of a kinetic term. How Bi moves with the slider's mass at this film, "
+                 "that fit (the slips' mean) is unbiased but calls viscous controls `mixed` in 4 "
+                 "of 40 (docs/results/slip-law.md), so a `mixed` verdict there is weak evidence "
+                 "of a kinetic term. How Bi moves with the slider's mass at this film, "
                  "how far 2 cores take it and what Klein's Bi would cost on a cluster are "
                  "measured by the slider-mass ladder (`filmfriction ladder plan`, `run`, "
                  "`collect`; its results page is docs/results/mass-ladder.md).")

@@ -115,8 +115,9 @@ def test_a_fitted_effect_larger_than_what_it_modifies_is_listed():
 
 
 def test_the_slip_law_is_a_reading_never_established():
-    # the per-slip fit fails its positive control at the MD's noise (viscous slips read
-    # `mixed`): a resolved verdict, with or without the calibration's agreement, stays a reading
+    # the driven fit does not reach its positive control's 95 % at the MD's noise (viscous
+    # slips `mixed` in 4 of 40): a resolved verdict, with or without the calibration's
+    # agreement, stays a reading
     a = _analysis()
     a["slip_law"] = {"verdict": "mixed", "kinetic_force": {"mean": 30.0, "stderr": 5.0},
                      "damping": {"mean": 100.0, "stderr": 20.0},
