@@ -18,7 +18,7 @@ slip on its own, which fails the controls so: its regressors (Δx, and the branc
 the noisy peak velocity) carry the noise of its response (at :data:`MD_NOISE` Klein's
 viscous slips come out ``mixed`` in 40 of 40 with 30 slips, decelerating B = 48 of
 62 m/τ, F_k = 7.5 of 0 ε/σ; every other law's loop step is resolved, +13 to +14 ε/σ).
-The rates of the mean at :data:`MD_NOISE`: ``python benchmarks/slip_law_random_force.py
+The rates of the mean at :data:`MD_NOISE`: ``python benchmarks/slip_law/slip_law_random_force.py
 --ensemble`` (docs/results/slip-law.md).  The noise added to the noise-free law's trace
 instead (``injected=True``: the spring force carries M·du/dt, the motion is the law's;
 :func:`replica_fits`, fitted slip by slip) is kept as the comparison.
@@ -81,7 +81,7 @@ SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
 #:   makes the wall jitter twice as much as the MD's): the rest of the MD's residual is
 #:   a shape as long as the slip, half of it common to all slips, that F_k + B·v misses.
 #:
-#: ``python benchmarks/md_noise_calibration.py RUN …`` (docs/results/slip-law.md, "The
+#: ``python benchmarks/slip_law/md_noise_calibration.py RUN …`` (docs/results/slip-law.md, "The
 #: MD's noise").
 MD_NOISE = {"velocity_noise": 0.45, "velocity_correlation": 0.9, "rattle": 0.15}
 

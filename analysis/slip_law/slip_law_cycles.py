@@ -36,7 +36,7 @@ What is left of the noise's selection: a slip still running at a late lag had a
 noise that kept it going, and the noise's velocity relaxes (its correlation time,
 ~2.4 τ in the MD), so the slips ending late carry a mean force that slows them: the
 bias is confined to the lags where slips end and is measured on the controls
-(``python benchmarks/slip_law_random_force.py --ensemble``, docs/results/slip-law.md).
+(``python benchmarks/slip_law/slip_law_random_force.py --ensemble``, docs/results/slip-law.md).
 
 Example
 -------

@@ -1,7 +1,7 @@
 """The MD's noise measured on slips (analysis/groundtruth/md_noise.py) and the controls' process
 calibrated to it (slip_law_controls.MD_NOISE).
 
-The MD's numbers are those of ``python benchmarks/md_noise_calibration.py`` on the 47 slips of
+The MD's numbers are those of ``python benchmarks/slip_law/md_noise_calibration.py`` on the 47 slips of
 three ``sfb-similar`` runs of 2.8 M steps (docs/results/slip-law.md, "The MD's noise"); the
 runs are not in the repository, so they are written here as measured data.
 """

@@ -11,7 +11,7 @@ the loop step each call a true null resolved in ≈ 4.6 % of repeats, which keep
 under 95 %.  The negative controls: a
 yield on the accelerating branch is a resolved loop step and the verdict is not the one
 law's; a kinetic force of about half the film force is not ``viscous``.  The larger study
-is ``benchmarks/release_ensemble_coverage.py`` (docs/results/slip-law.md).
+is ``benchmarks/slip_law/release_ensemble_coverage.py`` (docs/results/slip-law.md).
 """
 import numpy as np
 import pytest

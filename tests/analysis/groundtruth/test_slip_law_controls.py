@@ -8,7 +8,7 @@ held at its end, with the jackknife's errors over the slips
 velocity-weakening slips are not called ``viscous``; positive: Klein's viscous slips are
 ``viscous`` with 30 slips and never ``kinetic``; a Coulomb slip has no loop step.  The
 measured rates, bias and coverage: docs/results/slip-law.md, "The controls with a random
-force that moves the wall" (``python benchmarks/slip_law_random_force.py --ensemble``).
+force that moves the wall" (``python benchmarks/slip_law/slip_law_random_force.py --ensemble``).
 40 replicas each; ≥ 95 % means at most 2 of 40 otherwise.  The noise added to the law's
 trace (the position and the velocity the law's) is kept as the comparison, fitted slip
 by slip.

@@ -1,7 +1,7 @@
 """The controls' noise calibrated to the MD's: slip residuals and the wall's jitter of MD runs and
 of random-force replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
 
-    python benchmarks/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
+    python benchmarks/slip_law/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
 control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each

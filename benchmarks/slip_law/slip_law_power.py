@@ -1,14 +1,14 @@
 """The slip-law test's controls and power at the MD's noise (docs/results/slip-law.md).
 
-    python benchmarks/slip_law_power.py                 # verdict rates and the power
-    python benchmarks/slip_law_power.py --measure RUN   # the MD noise of a run directory
+    python benchmarks/slip_law/slip_law_power.py                 # verdict rates and the power
+    python benchmarks/slip_law/slip_law_power.py --measure RUN   # the MD noise of a run directory
 
 ``--measure`` fits each analysed slip of RUN (its whole slip, F_k + B·v in the
 integrated equation of motion) and prints how far the wall's velocity strays from
 the fitted law's (rms) and the autocorrelation of that residual at 0.25, 1, 2, 4 τ
 (:mod:`~filmfriction.analysis.groundtruth.md_noise`; the calibration of
 :data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE` on it and on the
-wall's jitter is ``benchmarks/md_noise_calibration.py``).
+wall's jitter is ``benchmarks/slip_law/md_noise_calibration.py``).
 
 Without it: for each control law (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.CONTROLS`)
 the verdicts of 40 noisy replicas at 4, 8 and 30 slips, at the MD's noise and at a

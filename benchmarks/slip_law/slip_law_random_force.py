@@ -1,9 +1,9 @@
 """The slip-law controls with the MD's noise as a random force that moves the wall, against
 the noise added to the law's trace (docs/results/slip-law.md, "The controls with a random force").
 
-    python benchmarks/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
+    python benchmarks/slip_law/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
                                                [--slips 8 30] [--residual]
-    python benchmarks/slip_law_random_force.py --ensemble [--noises md md-1.5x md-2tau residual ...]
+    python benchmarks/slip_law/slip_law_random_force.py --ensemble [--noises md md-1.5x md-2tau residual ...]
 
 With ``--ensemble``: the driven analysis's fit, the slips' mean
 (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`), on the
@@ -20,9 +20,9 @@ and the accelerating branch and the one law; the loop step), with the noise as t
 random force (:func:`~filmfriction.analysis.groundtruth.slip_law_controls.dynamical_fits`)
 and added to the noise-free law's trace (``replica_fits``), and noise-free.  With
 ``--residual``: the integral-form residual of the random-force replicas measured as
-``benchmarks/slip_law_power.py --measure`` measures an MD run's (the whole slip, 2.5 τ off
+``benchmarks/slip_law/slip_law_power.py --measure`` measures an MD run's (the whole slip, 2.5 τ off
 its ends, F_k + B·v fitted; :mod:`~filmfriction.analysis.groundtruth.md_noise`), to compare
-with the MD's (``benchmarks/md_noise_calibration.py``).  With ``--cycle-mean``: a
+with the MD's (``benchmarks/slip_law/md_noise_calibration.py``).  With ``--cycle-mean``: a
 prototype of the remedy, the slips of each replica aligned at the yield and averaged
 before the fit (the noise of the regressors averages down as 1/√slips).
 """

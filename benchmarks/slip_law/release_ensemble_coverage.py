@@ -1,7 +1,7 @@
 """The release fits on the fluctuating Newtonian film: coverage, bias and verdicts (docs/results/slip-law.md).
 
-    python benchmarks/release_ensemble_coverage.py [--replicas 100] [--releases 67] [--seed 1]
-    python benchmarks/release_ensemble_coverage.py --bins SEED   # one replica, binned as the MD
+    python benchmarks/slip_law/release_ensemble_coverage.py [--replicas 100] [--releases 67] [--seed 1]
+    python benchmarks/slip_law/release_ensemble_coverage.py --bins SEED   # one replica, binned as the MD
 
 Replicas of ``--releases`` releases each of the wall on the fluctuating Newtonian film at
 the ``liquid-release`` scene's scale (:mod:`filmfriction.analysis.groundtruth.film_release`:
@@ -14,7 +14,7 @@ B = η·A/W and the noise-free film's own fitted B; m_c = ρ·A·W/3), and the v
 two negative controls with the ensemble fit: a yield of ``--yield-force`` on the accelerating
 branch (up to the noise-free peak velocity) and a kinetic force ``--kinetic-force`` on the wall.
 ``--bins SEED``: instead, one replica of the null (seed SEED) binned as
-``benchmarks/fit_release_runs.py`` bins the MD releases (``branch_bins``: the film force
+``benchmarks/slip_law/fit_release_runs.py`` bins the MD releases (``branch_bins``: the film force
 minus the ensemble fit's one law and minus each release's own law fitted to its smoothed
 samples, per branch and bin of v / v_peak).
 """

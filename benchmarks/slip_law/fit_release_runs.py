@@ -2,7 +2,7 @@
 
     filmfriction run liquid-release --np 1 --md-only --set seed=S --out RUN_S   # per seed
     (add --set hold_gap=1 for the held-gap control: the wall free along x only)
-    python benchmarks/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] [--per-release] RUN_1 RUN_2 ...
+    python benchmarks/slip_law/fit_release_runs.py --viscosity ETA ETA_ERR [--load-work] [--per-release] RUN_1 RUN_2 ...
 
 Prints the slip law fitted to the runs' mean release, its errors the jackknife's over
 the releases (:func:`filmfriction.analysis.groundtruth.release_control.fit_release_ensemble`;
