@@ -1,4 +1,6 @@
 """Where the shear sits: per-layer velocities from a trajectory, on films of known profile."""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -64,3 +66,19 @@ def test_frames_outside_the_slips_do_not_count(tmp_path):
 
 def test_no_samples_is_inconclusive():
     assert shear_shares(np.empty((0, 3)))["location"] == "inconclusive"
+
+
+def test_a_slip_whose_layer_emptied_is_left_out_quietly():
+    # a film that melted loses a layer: no atom there in one slip's intervals gives NaN
+    # for that layer, and the slip is left out of the shares without a RuntimeWarning
+    from filmfriction.analysis.observables.shear_location_section import located
+    rng = np.random.default_rng(1)
+    slips = np.repeat(np.arange(4), 5)
+    layer = rng.normal(0, 0.01, (slips.size, 3))      # the film moves with the bottom wall
+    layer[slips == 2, 1] = np.nan
+    lv = {"slip": slips, "bottom": np.zeros(slips.size), "top": np.full(slips.size, V),
+          "layer": layer}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        out = located(lv)
+    assert out["n"] == 3 and out["location"] == "top interface"
