@@ -14,12 +14,16 @@ velocity, law plus noise, falls to zero), so a mean over the slips still slippin
 lag, or over the window of the shortest one, selects on the noise.
 
 The ensemble here keeps every slip at every lag.  Slip i, from its yield y_i to its
-re-stick s_i = y_i + d_i, is *held at its end* after it: at lag k its impulse
-I_i(k) = ∫ (F_spring − γM(v − V)) dt, displacement x_i(k) − x_i(0), velocity v_i(k) and
-slipping time are those of lag min(k, d_i).  The wall's integrated equation of motion
-holds for each slip so held (nothing moves after the re-stick; the film's force is the
-law's while the wall slips), and it is linear, so it holds for the mean over the
-slips:
+last slipping sample y_i + d_i (the sample before its re-stick s_i), is *held at its end*
+after it: at lag k its impulse I_i(k) = ∫ (F_spring − γM(v − V)) dt, displacement
+x_i(k) − x_i(0), velocity v_i(k) and slipping time are those of lag min(k, d_i).  The
+re-stick's own sample is left out: it carries the impulse of the static friction that
+stops the wall, which is not the law's (Klein's slips re-stick at F_b still moving at half
+their peak velocity; held at the re-stick, with v = 0, each ended slip left M·v out of the
+equation, a bias that grew with the share of slips ended and so did not shrink with more
+slips).  The wall's integrated equation of motion holds for each slip so held (the
+film's force is the law's while the wall slips), and it is linear, so it holds for the
+mean over the slips:
 
     Ī(k) − M·v̄(k) = c + F_k·S̄(k) + B·x̄(k) [+ m_c·v̄(k)] + M·ū(k)
 
@@ -99,6 +103,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     out = {k: np.empty((y.size, n)) for k in ("impulse", "velocity", "displacement",
                                                "slipping_time")}
     for i, (a, b) in enumerate(zip(y, s)):
+        # held at the last sample on which the wall slipped: the re-stick's sample carries
+        # the impulse of the static friction that stops the wall, which is not the law's
+        b = max(b - 1, a + 1)
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
         force = f[seg] - mount_damping * (v[seg] - drive_velocity)

@@ -218,12 +218,30 @@ def _coverage(fits, branch: str, attr: str, truth: float) -> str:
             f" (truth {truth:.3g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
 
 
-def ensemble_table(laws, slip_counts, replicas: int, noises) -> None:
+def _paths(fits, exact) -> str:
+    """Which fit each verdict came from and why (choose_law's reason), and the one law's
+    co-moving mass: its mean over the replicas, the noise-free fit's, and how often it is
+    resolved negative (one of choose_law's reasons for the decelerating branch)."""
+    why = Counter(f"{f.verdict} from {f.verdict_from}"
+                  + (f" ({f.reason.split('whole slip not one law (')[1].split(':')[0]})"
+                     if f.verdict_from == "decelerating" else "") for f in fits)
+    mc = np.array([f.one_law.comoving_mass for f in fits])
+    from filmfriction.analysis.slip_law.slip_law_stats import sigmas
+    neg = sum(sigmas(f.one_law.comoving_mass, f.one_law.comoving_mass_stderr,
+                     f.one_law.dof) <= -2 for f in fits)
+    return ("  paths: " + "; ".join(f"{k} {n}" for k, n in why.most_common())
+            + f"\n  one law m_c {mc.mean():+.1f} ± {mc.std(ddof=1) / math.sqrt(mc.size):.1f} "
+            f"(noise-free {exact.one_law.comoving_mass:+.2f}; the wall {SCALE['mass']:g}), "
+            f"below −2 s.e. in {neg}")
+
+
+def ensemble_table(laws, slip_counts, replicas: int, noises, shares=SHARES) -> None:
     """The cycle ensemble's control table: verdict counts, bias and coverage of F_k and B
     (the decelerating branch and the one law) and of the loop step, the truth being the
-    same fit of the noise-free slider (the law's own F_k, B for the linear laws)."""
+    same fit of the noise-free slider (the law's own F_k, B for the linear laws); the
+    verdicts' paths and the co-moving mass (:func:`_paths`)."""
     from filmfriction.analysis.groundtruth.slip_law_controls import dynamical_fits
-    cases = [(law, None) for law in laws] + [("coulomb-viscous", sh) for sh in SHARES]
+    cases = [(law, None) for law in laws] + [("coulomb-viscous", sh) for sh in shares]
     for noise in noises:
         for law, share in cases:
             name = law if share is None else f"{law} share {share}"
@@ -243,7 +261,8 @@ def ensemble_table(laws, slip_counts, replicas: int, noises) -> None:
                     print(f"  {br:12s} F_k {_coverage(fits, br, 'kinetic_force', law_.kinetic_force)}"
                           f"; B {_coverage(fits, br, 'damping', law_.damping)}")
                 print(f"  loop step {_coverage(fits, 'step', '', exact.loop_step)}, resolved "
-                      f"(2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}", flush=True)
+                      f"(2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}")
+                print(_paths(fits, exact), flush=True)
 
 
 def main(argv=None) -> int:
@@ -260,6 +279,8 @@ def main(argv=None) -> int:
                     help="the cycle ensemble (the driven analysis's fit): verdicts, bias, coverage")
     ap.add_argument("--noises", nargs="+", default=["md"], choices=list(NOISES),
                     help="with --ensemble: the noises (md: MD_NOISE, residual: RESIDUAL_AS_NOISE; -1.5x: 1.5x the amplitude, -2tau: twice the correlation time)")
+    ap.add_argument("--shares", nargs="*", type=float, default=list(SHARES),
+                    help="with --ensemble: the Coulomb + viscous laws' viscous shares (none: no such rows)")
     ap.add_argument("--share", type=float, default=None,
                     help="with --residual: slips of F_k + B·v of this viscous share")
     a = ap.parse_args(argv)
@@ -270,7 +291,7 @@ def main(argv=None) -> int:
         instrumented(a.laws, a.slips, a.replicas)
         return 0
     if a.ensemble:
-        ensemble_table(a.laws, a.slips, a.replicas, a.noises)
+        ensemble_table(a.laws, a.slips, a.replicas, a.noises, a.shares)
         return 0
     if a.cycle_mean:
         cycle_means(a.laws, a.slips, a.replicas)

@@ -16,6 +16,7 @@ by slip.
 from collections import Counter
 from functools import lru_cache
 
+import numpy as np
 import pytest
 
 from filmfriction.analysis.groundtruth.slip_law_controls import (
@@ -47,21 +48,39 @@ def test_negative_controls_are_not_viscous_at_the_md_noise(law, slips):
     assert rates["viscous"] <= AT_MOST, rates
 
 
-@pytest.mark.xfail(strict=True, reason="36 of 40 `viscous`, 4 `mixed`, at the calibrated MD_NOISE: "
-                                       "the slips' mean is unbiased (F_k +0.25 ± 0.28 ε/σ, B −0.41 ± "
-                                       "0.52 m/τ) and the shortfall is the 2 σ tests' false alarms "
-                                       "(covered 35–37 of 40)")
+#: The positive control's replicas: enough to tell a bias of a quarter of the fit's error.
+POSITIVE_REPLICAS = 200
+#: The most replicas of Klein's slips that the rule's 2 σ tests leave short of `viscous` when the
+#: estimates are unbiased: F_k resolved, either sign, in 4.6 % nominally, so `viscous` in 95.4 %
+#: at best; 17 of 200 is that rate's 99th percentile (binomial).
+FALSE_ALARMS_99 = 17
+
+
+def test_klein_slips_decelerating_branch_is_unbiased_and_covered_at_the_md_noise():
+    # the slips' mean, each held at its last slipping sample, on 30 slips: the decelerating
+    # branch's F_k and B recover the law (mean within 3 s.e. of the noise-free fit's) and
+    # their 2 σ bars cover it at the nominal rate (95 %: 91 % is its 1st percentile at 200).
+    # Held at the re-stick's sample (v = 0: the static friction's impulse in the law) the
+    # branch's F_k was +0.61 ± 0.04 ε/σ over 1000 replicas: this fails there
+    from filmfriction.analysis.slip_law.slip_law_stats import sigmas
+    fits = _fits("viscous", 30, replicas=POSITIVE_REPLICAS)
+    exact = dynamical_fits("viscous", 1, 30, noise=NOISE_FREE)[0].decelerating
+    for attr in ("kinetic_force", "damping"):
+        est = np.array([getattr(f.decelerating, attr) for f in fits])
+        se = np.array([getattr(f.decelerating, f"{attr}_stderr") for f in fits])
+        truth = getattr(exact, attr)
+        bias, se_mean = est.mean() - truth, est.std(ddof=1) / np.sqrt(est.size)
+        assert abs(bias) < 3 * se_mean, (attr, bias, se_mean)
+        z = [sigmas(e - truth, s, f.decelerating.dof) for e, s, f in zip(est, se, fits)]
+        assert np.mean(np.abs(z) < 2) >= 0.90, (attr, np.mean(np.abs(z) < 2))
+
+
 def test_viscous_slips_are_viscous_with_enough_slips_at_the_md_noise():
-    rates = verdict_rates("viscous", REPLICAS, 30)
-    assert rates["viscous"] >= REPLICAS - AT_MOST, rates
-
-
-def test_viscous_slips_are_mostly_viscous_and_never_a_negative_law():
-    # what the positive control does reach at the MD's noise (the stated 95 % above is not):
-    # the verdict is `viscous` or, by a 2 σ false alarm on the kinetic force or the loop,
-    # `mixed`; never `kinetic` or `velocity-weakening`
-    rates = verdict_rates("viscous", REPLICAS, 30)
-    assert rates["viscous"] >= REPLICAS - 3 * AT_MOST, rates
+    # Klein's slips, 30 of them, at the calibrated noise: `viscous` but for the rule's own
+    # 2 σ false alarms (`mixed` or `inconclusive`), never a negative law.  Measured
+    # (docs/results/slip-law.md, 1000 replicas): 94.0 % at 30 slips, 95.5 % at 90
+    rates = verdict_rates("viscous", POSITIVE_REPLICAS, 30)
+    assert rates["viscous"] >= POSITIVE_REPLICAS - FALSE_ALARMS_99, rates
     assert rates["kinetic"] + rates["velocity-weakening"] == 0, rates
 
 
