@@ -130,7 +130,10 @@ def _run(code, p, mass, k, vd, xd0, static, start_v, stop_v, backward, armed_bel
                     if (armed and low) or force <= backward:
                         slipping, armed, v = False, False, 0.0
                         if ns < sticks.shape[1]:
-                            sticks[r, ns] = min(i + 1, samples - 1)
+                            # the last sample on which the wall slid (the detector's
+                            # re-stick): sample i + 1 has the wall stopped, the static
+                            # friction's impulse in the step before it
+                            sticks[r, ns] = i
                         ns += 1
                     else:
                         v = vn
@@ -187,7 +190,7 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     list of dict
         Per replica: ``time, spring_force, drive_position, wall_position, wall_velocity``
         (the sampled velocity, rattle included) and ``yield_index``, ``stick_index`` (the
-        sample at or just before each yield, at or just after each re-stick; complete
+        sample at or just before each yield, the last sample of each slip; complete
         slips only).
     """
     if law not in LAWS:

@@ -14,14 +14,14 @@ velocity, law plus noise, falls to zero), so a mean over the slips still slippin
 lag, or over the window of the shortest one, selects on the noise.
 
 The ensemble here keeps every slip at every lag.  Slip i, from its yield y_i to its
-last slipping sample y_i + d_i (the sample before its re-stick s_i), is *held at its end*
-after it: at lag k its impulse I_i(k) = ∫ (F_spring − γM(v − V)) dt, displacement
-x_i(k) − x_i(0), velocity v_i(k) and slipping time are those of lag min(k, d_i).  The
-re-stick's own sample is left out: it carries the impulse of the static friction that
-stops the wall, which is not the law's (Klein's slips re-stick at F_b still moving at half
-their peak velocity; held at the re-stick, with v = 0, each ended slip left M·v out of the
-equation, a bias that grew with the share of slips ended and so did not shrink with more
-slips).  The wall's integrated equation of motion holds for each slip so held (the
+re-stick s_i = y_i + d_i, is *held at its end* after it: at lag k its impulse
+I_i(k) = ∫ (F_spring − γM(v − V)) dt, displacement x_i(k) − x_i(0), velocity v_i(k) and
+slipping time are those of lag min(k, d_i).  The re-stick is the last sample on which
+the wall slid (the detector's: the spring force's minimum, where the wall still moves at
+the drive's velocity); a sample after the wall stopped carries the impulse of the static
+friction that stopped it, which is not the law's (a control slider that marked its
+re-stick there, with v = 0, biased the ensemble by a bias that grew with the share of
+slips ended: docs/results/slip-law.md, "Holding a slip at its last slipping sample").  The wall's integrated equation of motion holds for each slip so held (the
 film's force is the law's while the wall slips), and it is linear, so it holds for the
 mean over the slips:
 
@@ -106,9 +106,6 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     out = {k: np.empty((y.size, n)) for k in ("impulse", "velocity", "displacement",
                                                "slipping_time")}
     for i, (a, b) in enumerate(zip(y, s)):
-        # held at the last sample on which the wall slipped: the re-stick's sample carries
-        # the impulse of the static friction that stops the wall, which is not the law's
-        b = max(b - 1, a + 1)
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
         force = f[seg] - mount_damping * (v[seg] - drive_velocity)
