@@ -21,9 +21,10 @@ the wall slid (the detector's: the spring force's minimum, where the wall still 
 the drive's velocity); a sample after the wall stopped carries the impulse of the static
 friction that stopped it, which is not the law's (a control slider that marked its
 re-stick there, with v = 0, biased the ensemble by a bias that grew with the share of
-slips ended: docs/results/slip-law.md, "Holding a slip at its last slipping sample").  The wall's integrated equation of motion holds for each slip so held (the
-film's force is the law's while the wall slips), and it is linear, so it holds for the
-mean over the slips:
+slips ended: docs/results/slip-law.md, "Holding a slip at its last slipping sample").
+The wall's integrated equation of motion holds for each slip so held (the film's force
+is the law's while the wall slips), and it is linear, so it holds for the mean over the
+slips:
 
     Ī(k) − M·v̄(k) = c + F_k·S̄(k) + B·x̄(k) [+ m_c·v̄(k)] + M·ū(k)
 

@@ -57,11 +57,12 @@ FALSE_ALARMS_99 = 17
 
 
 def test_klein_slips_decelerating_branch_is_unbiased_and_covered_at_the_md_noise():
-    # the slips' mean, each held at its last slipping sample, on 30 slips: the decelerating
-    # branch's F_k and B recover the law (mean within 3 s.e. of the noise-free fit's) and
-    # their 2 σ bars cover it at the nominal rate (95 %: 91 % is its 1st percentile at 200).
-    # Held at the re-stick's sample (v = 0: the static friction's impulse in the law) the
-    # branch's F_k was +0.61 ± 0.04 ε/σ over 1000 replicas: this fails there
+    # the slips' mean, each held at its re-stick (the last sample on which the wall slid), on
+    # 30 slips: the decelerating branch's F_k and B recover the law (mean within 3 s.e. of the
+    # noise-free fit's) and their 2 σ bars cover it at the nominal rate (95 %: 91 % is its 1st
+    # percentile at 200).  With the slider's re-stick marked after the wall stopped (v = 0:
+    # the static friction's impulse taken for the law's) the branch's F_k was +0.61 ± 0.04 ε/σ
+    # over 1000 replicas: this fails there
     from filmfriction.analysis.slip_law.slip_law_stats import sigmas
     fits = _fits("viscous", 30, replicas=POSITIVE_REPLICAS)
     exact = dynamical_fits("viscous", 1, 30, noise=NOISE_FREE)[0].decelerating
