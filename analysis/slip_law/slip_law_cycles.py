@@ -39,8 +39,8 @@ N − 1 degrees of freedom; :func:`~filmfriction.analysis.slip_law.slip_law.jack
 
 What is left of the noise's selection, measured on the controls
 (``python benchmarks/slip_law/slip_law_random_force.py --ensemble``, docs/results/slip-law.md):
-on Klein's slips at the MD's noise the decelerating branch is unbiased (F_k +0.01 ± 0.05,
-B −0.03 ± 0.08 over 1000 replicas of 30 slips); where a wall re-sticks when its velocity
+on Klein's slips at the MD's noise the decelerating branch is unbiased (F_k +0.04 ± 0.05,
+B −0.07 ± 0.08 over 1000 replicas of 30 slips); where a wall re-sticks when its velocity
 falls (Coulomb), it re-sticks where the noise slowed it, and the decelerating branch's F_k
 is low by ~1.4 ε/σ.  The one law's co-moving mass has as regressor the mean's smoothed
 velocity, which lags a fast start (Klein's overdamped slips: m_c ≈ −18 m of a 30 m wall

@@ -79,7 +79,7 @@ def test_klein_slips_decelerating_branch_is_unbiased_and_covered_at_the_md_noise
 def test_viscous_slips_are_viscous_with_enough_slips_at_the_md_noise():
     # Klein's slips, 30 of them, at the calibrated noise: `viscous` but for the rule's own
     # 2 σ false alarms (`mixed` or `inconclusive`), never a negative law.  Measured
-    # (docs/results/slip-law.md, 1000 replicas): 94.0 % at 30 slips, 95.5 % at 90
+    # (docs/results/slip-law.md, 1000 replicas): 94.3 % at 30 slips, 95.1 % at 90
     rates = verdict_rates("viscous", POSITIVE_REPLICAS, 30)
     assert rates["viscous"] >= POSITIVE_REPLICAS - FALSE_ALARMS_99, rates
     assert rates["kinetic"] + rates["velocity-weakening"] == 0, rates
