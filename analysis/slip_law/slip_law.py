@@ -130,7 +130,7 @@ from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
-           "jackknife_fit", "checked_trace", "smoothing_samples",
+           "jackknife_fit", "checked_trace", "checked_fit_inputs", "smoothing_samples",
            "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
@@ -291,6 +291,25 @@ def checked_trace(time, spring_force, wall_velocity, mass):
     return t, f, v
 
 
+def checked_fit_inputs(time, spring_force, wall_velocity, wall_position, mass, *,
+                       min_velocity_fraction: float, smoothing: float):
+    """The slip-law fits' inputs checked (ValueError otherwise): ``min_velocity_fraction``
+    and ``smoothing`` in [0, 1), the trace (:func:`checked_trace`), and the wall's
+    position of the trace's shape (the integral of its velocity when None).  Returns
+    (t, F_spring, v, x) as float arrays."""
+    if not 0 <= min_velocity_fraction < 1:
+        raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
+    if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
+        raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
+    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
+    if wall_position is None:
+        return t, f, v, cumulative_trapezoid(v, t, initial=0.0)
+    x = np.asarray(wall_position, float)
+    if x.shape != t.shape:
+        raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
+    return t, f, v, x
+
+
 def smoothing_samples(t: np.ndarray, table: CycleTable, smoothing: float) -> int:
     """Savitzky–Golay window (odd, ≥ 5 samples) for ``smoothing`` × median slip duration;
     0 when the sampling is not uniform or the window would be under 5 samples."""
@@ -342,17 +361,9 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
     -------
     FilmForceFit
     """
-    if not 0 <= min_velocity_fraction < 1:
-        raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
-    if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
-        raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
-    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
-    if wall_position is None:
-        x = cumulative_trapezoid(v, t, initial=0.0)
-    else:
-        x = np.asarray(wall_position, float)
-        if x.shape != t.shape:
-            raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
+    t, f, v, x = checked_fit_inputs(time, spring_force, wall_velocity, wall_position, mass,
+                                    min_velocity_fraction=min_velocity_fraction,
+                                    smoothing=smoothing)
     w = smoothing_samples(t, table, smoothing)
     # the velocity that picks the samples: from the position, whose noise is not the
     # response's (selecting on the response's own noise would bias the fit)

@@ -72,8 +72,8 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
 
-from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_trace, fit_segments,
-                       jackknife_fit, smoothing_samples)
+from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs,
+                       fit_segments, jackknife_fit, smoothing_samples)
 from .slip_law_branches import Segment
 
 __all__ = ["fit_cycle_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
@@ -186,18 +186,12 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     ValueError
         Fewer than :data:`MIN_CYCLES` slips, or a sampling that is not uniform.
     """
-    if not 0 <= min_velocity_fraction < 1:
-        raise ValueError(f"min_velocity_fraction = {min_velocity_fraction!r}: must be in [0, 1)")
-    if not (math.isfinite(smoothing) and 0 <= smoothing < 1):
-        raise ValueError(f"smoothing = {smoothing!r}: must be in [0, 1) (share of a slip)")
-    t, f, v = checked_trace(time, spring_force, wall_velocity, mass)
+    t, f, v, x = checked_fit_inputs(time, spring_force, wall_velocity, wall_position, mass,
+                                    min_velocity_fraction=min_velocity_fraction,
+                                    smoothing=smoothing)
     dts = np.diff(t)
     if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
         raise ValueError("the cycle ensemble needs a uniform sampling")
-    x = (cumulative_trapezoid(v, t, initial=0.0) if wall_position is None
-         else np.asarray(wall_position, float))
-    if x.shape != t.shape:
-        raise ValueError(f"wall_position has shape {x.shape}, the trace {t.shape}")
     fs, fb = (np.asarray(table.static_force, float), np.asarray(table.backward_force, float))
     with np.errstate(invalid="ignore", divide="ignore"):
         relaxed = (fs - fb) / np.abs(fs)
