@@ -39,7 +39,7 @@ from scipy.signal import savgol_filter
 
 from filmfriction.reduced_model.units import lj_bulk_viscosity
 
-from ..slip_law.slip_law import BRANCHES, film_force, fit_film_force
+from ..slip_law.slip_law import BRANCHES, RESOLVED_SIGMAS, film_force, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..files.trace import unit
 from ..trace_figure import scaled_unit
@@ -244,7 +244,7 @@ class SlipLaw(Observable):
             b = br.get(name) or {}
             rows += [(f"{name}: kinetic force F_k", format_estimate(b.get("kinetic_force"))),
                      (f"{name}: damping B", format_estimate(b.get("damping"))),
-                     (f"{name}: smallest B resolved (2 σ, 95 % power)",
+                     (f"{name}: smallest B resolved ({RESOLVED_SIGMAS:.3g} σ, 95 % power)",
                       format_estimate(b.get("detectable_damping"))),
                      (f"{name}: exponent n = d ln F/d ln v",
                       format_estimate(b.get("exponent"))),

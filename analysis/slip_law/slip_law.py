@@ -49,8 +49,11 @@ law F_k + B·v + m_c·a survives any such filter unchanged (the filter is linear
 and keeps constants), so the smoothing removes noise, not the law.
 
 Verdict (one of :data:`VERDICTS`).  Each term is *resolved* when it exceeds
-2 σ — at the coverage of a normal 2 σ (97.7 % one-sided) with the Student t of
-the errors' degrees of freedom — and carries at least :data:`NUMERICAL_FLOOR` of
+:data:`RESOLVED_SIGMAS` = 2.24 σ — a term that is truly absent is resolved, either sign, in
+:data:`FALSE_ALARM` = 2.5 % of repeats, at the normal's coverage with the Student t of
+the errors' degrees of freedom; the other half of a 5 % budget is left to the power, so
+that a pure law keeps its verdict in ≥ 95 % of repeats of a run that resolves its term
+with 97.5 % power — and carries at least :data:`NUMERICAL_FLOOR` of
 the film force |F_k| + |B·v̄| (on an exact trace the errors vanish and the
 quadrature's own error would read as a term), and *ruled out as dominant* when the run had
 95 % power to resolve it at half the film force F̄ (the power analysis, on the
@@ -73,7 +76,7 @@ holds the wall and it only rattles in its well — is left out, and the reasons 
 how far and how fast the wall moved in it; with no window left every branch is
 ``inconclusive`` (no slip, no law).
 
-``detectable_damping`` is the smallest B the run resolves at 2 σ in 95 % of
+``detectable_damping`` is the smallest B the run resolves at 2.24 σ in 95 % of
 repeats; B, it and the B of a no-slip film of bulk viscosity (η_bulk·A/D,
 computed by the caller) belong side by side.  σ_B and σ_Fk are the standard
 errors of the per-slip fits' mean over the slips (their scatter, n − 1 degrees
@@ -126,13 +129,13 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law_branches import BranchFit, Segment, fit_branch, jackknife, jackknife_branch
-from .slip_law_stats import POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
+from .slip_law_stats import FALSE_ALARM, POWER, RESOLVED_SIGMAS, detectable, mean_se, sigmas
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
            "jackknife_fit", "checked_trace", "checked_fit_inputs", "smoothing_samples",
            "detectable",
-           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "POWER", "DOMINANT_SHARE",
+           "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "FALSE_ALARM", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
 
 #: The branches of a slip; without one law, the verdict is the first one's.
@@ -164,7 +167,7 @@ class FilmForceFit:
         The step of the film force at the peak velocity beyond the one law,
         F_acc − F_dec (positive when the accelerating branch lies above), its
         standard error, its normal-equivalent sigmas and the smallest step the run
-        resolves at 2 σ with 95 % power.
+        resolves at 2.24 σ (:data:`RESOLVED_SIGMAS`) with 95 % power.
     verdict_from : str
         The fit the verdict is: ``one law`` (:data:`ONE_LAW`) or ``decelerating``.
     verdict, reason : str

@@ -47,7 +47,8 @@ class BranchFit:
     kinetic_sigmas, damping_sigmas : float
         F_k and B in normal-equivalent standard errors (signed).
     detectable_damping, detectable_kinetic_force : float
-        The smallest B and F_k the run resolves at 2 σ with 95 % power.
+        The smallest B and F_k the run resolves at 2.24 σ (``RESOLVED_SIGMAS``) with 95 %
+        power.
     dof : int
         Degrees of freedom of the errors.
     verdict, reason : str

@@ -16,10 +16,16 @@ from scipy import stats as sps
 from scipy.optimize import brentq
 
 __all__ = ["sigmas", "detectable", "ols", "correlation_time", "mean_se", "RESOLVED_SIGMAS",
-           "POWER"]
+           "FALSE_ALARM", "POWER"]
 
-#: A fitted term is resolved when it exceeds this many standard errors (at a normal's coverage).
-RESOLVED_SIGMAS = 2.0
+#: The share of repeats in which a term that is truly absent is resolved, either sign.  A
+#: verdict is lost to the absent term's false alarm or to the present term's lack of
+#: power; this half of a 5 % budget leaves the other half to the power (a pure law keeps
+#: its verdict in >= 95 % of repeats when the run resolves its term with 97.5 % power).
+FALSE_ALARM = 0.025
+#: A fitted term is resolved when it exceeds this many standard errors (normal-equivalent):
+#: the two-sided quantile of :data:`FALSE_ALARM`, 2.24.
+RESOLVED_SIGMAS = float(sps.norm.isf(FALSE_ALARM / 2))
 #: The power at which a term the run did not resolve is ruled out.
 POWER = 0.95
 
@@ -49,8 +55,10 @@ def detectable(stderr: float, dof: int, *, resolved: float = RESOLVED_SIGMAS,
     error has ``dof`` degrees of freedom: δ·stderr with δ the noncentrality at
     which a noncentral t exceeds the critical t with probability ``power``.
 
-    >>> round(detectable(1.0, 10**6), 2), round(detectable(1.0, 6), 2)   # 2 + 1.645; 6 dof
-    (3.64, 4.45)
+    >>> round(detectable(1.0, 10**6, resolved=2.0), 2)   # 2 + 1.645
+    3.64
+    >>> round(detectable(1.0, 10**6), 2), round(detectable(1.0, 6), 2)   # 2.24 + 1.645; 6 dof
+    (3.89, 5.03)
     """
     if not (math.isfinite(stderr) and stderr >= 0 and dof >= 1):
         return math.nan

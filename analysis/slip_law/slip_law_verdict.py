@@ -41,7 +41,7 @@ def branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
     r = RESOLVED_SIGMAS
     nums = (f"F_k = {fk:.4g} ± {se_fk:.2g} ({z_fk:+.1f} σ), B = {b:.4g} ± {se_b:.2g} "
             f"({z_b:+.1f} σ) over {n} slip(s); F̄ = {fbar:.4g} at v̄ = {vbar:.4g}; "
-            f"95 % power at 2 σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
+            f"95 % power at {r:.3g} σ for B ≥ {det_b:.3g}, F_k ≥ {det_fk:.3g}")
     if not all(math.isfinite(x) for x in (z_fk, z_b, fbar, vbar)):
         return "inconclusive", f"errors not defined: {nums}"
     # a term counts only above the numerical floor too: on an exact trace its error is
@@ -106,7 +106,7 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     fbar = one_law.mean_force
     z_mc = sigmas(one_law.comoving_mass, one_law.comoving_mass_stderr, one_law.dof)
     nums = (f"loop step F_acc − F_dec = {step:.3g} ± {se:.2g} ({z:+.1f} σ), 95 % power at "
-            f"2 σ for {det:.3g} against F̄/2 = {DOMINANT_SHARE * fbar:.3g}; m_c = "
+            f"{r:.3g} σ for {det:.3g} against F̄/2 = {DOMINANT_SHARE * fbar:.3g}; m_c = "
             f"{one_law.comoving_mass:.3g} ± {one_law.comoving_mass_stderr:.2g} ({z_mc:+.1f} σ)")
     if not all(math.isfinite(q) for q in (z, det, fbar, z_mc)):
         why = "the one law's errors not defined"

@@ -35,11 +35,11 @@ from filmfriction.analysis.groundtruth.release_control import (couette_comoving_
                                                                fit_release_ensemble,
                                                                fit_releases, release_gap,
                                                                release_profile, release_slip)
-from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, detectable
+from filmfriction.analysis.slip_law.slip_law import DOMINANT_SHARE, RESOLVED_SIGMAS, detectable
 
 
 def releases_needed(per_release_sd: float, target: float, most: int = 1000) -> int | None:
-    """Releases at which a term of size ``target`` would be resolved at 95 % power (2 σ),
+    """Releases at which a term of size ``target`` would be resolved at 95 % power (2.24 σ),
     with ``per_release_sd`` the standard deviation of its per-release fits (None: not
     within ``most``)."""
     if not (per_release_sd > 0 and target > 0):
@@ -202,7 +202,7 @@ def main(argv=None) -> int:
     # the one law's condition: the loop step ruled out at half the one law's film force
     step_sd = fit.loop_step_stderr * math.sqrt(len(traces))
     print(f"  loop step beyond m_c, F_acc − F_dec = {fit.loop_step:.2f} ± "
-          f"{fit.loop_step_stderr:.2f} ({fit.loop_step_sigmas:+.1f} σ); 95 % power at 2 σ for "
+          f"{fit.loop_step_stderr:.2f} ({fit.loop_step_sigmas:+.1f} σ); 95 % power at {RESOLVED_SIGMAS:.3g} σ for "
           f"{fit.detectable_loop_step:.2f} against F̄/2 = "
           f"{DOMINANT_SHARE * with_mass.mean_force:.2f}; releases that rules it out: "
           f"{releases_needed(step_sd, DOMINANT_SHARE * with_mass.mean_force)}")

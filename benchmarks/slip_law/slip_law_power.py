@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.groundtruth.md_noise import residual_statistics, run_residuals
-from filmfriction.analysis.slip_law.slip_law import ONE_LAW, VERDICTS, sigmas
+from filmfriction.analysis.slip_law.slip_law import ONE_LAW, RESOLVED_SIGMAS, VERDICTS, sigmas
 from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, control_fits,
                                                                  dynamical_fits, scaled)
 
@@ -63,11 +63,11 @@ def rates(injected: bool = False) -> None:
 
 def power() -> None:
     print(f"\n## power at the MD noise (a random force moving the wall, {MD_NOISE}): share of "
-          f"{REPLICAS} replicas with B resolved (2 σ)")
+          f"{REPLICAS} replicas with B resolved ({RESOLVED_SIGMAS:.3g} σ)")
     for slips in (8, 30):
         for share in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0):
             fits = dynamical_fits("", REPLICAS, slips, share=share)
-            hit = sum(sigmas(f.damping, f.damping_stderr, f.law.dof) >= 2 for f in fits)
+            hit = sum(sigmas(f.damping, f.damping_stderr, f.law.dof) >= RESOLVED_SIGMAS for f in fits)
             r = Counter(f.verdict for f in fits)
             one = sum(f.verdict_from == ONE_LAW for f in fits)
             truth = share * 28.0 / 0.55

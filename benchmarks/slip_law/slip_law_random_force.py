@@ -40,7 +40,7 @@ from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residu
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.slip_law_controls import (
     CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, _dynamical_law, control_fits)
-from filmfriction.analysis.slip_law.slip_law import VERDICTS, fit_film_force
+from filmfriction.analysis.slip_law.slip_law import RESOLVED_SIGMAS, VERDICTS, fit_film_force
 from filmfriction.reduced_model.cycles import cycle_table
 
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.9, "rattle": 0.0}
@@ -63,7 +63,8 @@ def summary(fits) -> str:
         rows.append(f"  {br:12s} F_k {_ms([x.kinetic_force for x in b])}, "
                     f"B {_ms([x.damping for x in b])}, n {_ms([x.exponent for x in b])}")
     rows.append(f"  loop step {_ms([f.loop_step for f in fits])}, "
-                f"resolved (2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}")
+                f"resolved ({RESOLVED_SIGMAS:.3g} σ) in "
+                f"{sum(abs(f.loop_step_sigmas) >= RESOLVED_SIGMAS for f in fits)}")
     return "\n".join(rows)
 
 
@@ -261,7 +262,8 @@ def ensemble_table(laws, slip_counts, replicas: int, noises, shares=SHARES) -> N
                     print(f"  {br:12s} F_k {_coverage(fits, br, 'kinetic_force', law_.kinetic_force)}"
                           f"; B {_coverage(fits, br, 'damping', law_.damping)}")
                 print(f"  loop step {_coverage(fits, 'step', '', exact.loop_step)}, resolved "
-                      f"(2 σ) in {sum(abs(f.loop_step_sigmas) >= 2 for f in fits)}")
+                      f"({RESOLVED_SIGMAS:.3g} σ) in "
+                      f"{sum(abs(f.loop_step_sigmas) >= RESOLVED_SIGMAS for f in fits)}")
                 print(_paths(fits, exact), flush=True)
 
 

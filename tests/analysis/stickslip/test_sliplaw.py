@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from filmfriction.analysis.slip_law.slip_law import (ONE_LAW, VERDICTS, detectable, film_force,
-                                            fit_film_force, sigmas)
+from filmfriction.analysis.slip_law.slip_law import (ONE_LAW, RESOLVED_SIGMAS, VERDICTS, detectable,
+                                            film_force, fit_film_force, sigmas)
 from filmfriction.analysis.groundtruth.synthetic import block_trace, klein_trace, with_wall_noise
 from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.reduced_model.cycles import cycle_table
@@ -153,8 +153,10 @@ def test_significance_and_power_helpers():
     assert sigmas(3.0, 1.0, 10 ** 7) == pytest.approx(3.0, abs=1e-3)
     assert sigmas(-3.0, 1.0, 5) < 0 and abs(sigmas(-3.0, 1.0, 5)) < 3
     assert sigmas(1.0, 0.0, 5) > 30 and math.isnan(sigmas(1.0, math.nan, 5))
-    # 95 % power at 2 σ: with many dof, 2 + 1.645 standard errors
-    assert detectable(2.0, 10 ** 7) == pytest.approx(2 * 3.645, rel=1e-3)
+    # 95 % power at the rule's 2.24 σ: with many dof, 2.24 + 1.645 standard errors
+    assert RESOLVED_SIGMAS == pytest.approx(2.2414, abs=1e-4)   # 2.5 % two-sided
+    assert detectable(2.0, 10 ** 7) == pytest.approx(2 * (2.2414 + 1.6449), rel=1e-3)
+    assert detectable(2.0, 10 ** 7, resolved=2.0) == pytest.approx(2 * 3.645, rel=1e-3)
     assert detectable(1.0, 3) > detectable(1.0, 30)
 
 
@@ -165,9 +167,9 @@ def test_the_power_statement_holds():
     b = detectable(se, dof)
     n = 4000
     est = b + se * rng.standard_normal(n)
-    # the scatter over 7 slips estimates se with 6 dof: resolve est/(se·s) against 2 σ
+    # the scatter over 7 slips estimates se with 6 dof: resolve est/(se·s) against the rule's σ
     s = np.sqrt(rng.chisquare(dof, n) / dof)
-    hits = np.mean([sigmas(e, se * k, dof) >= 2 for e, k in zip(est, s)])
+    hits = np.mean([sigmas(e, se * k, dof) >= RESOLVED_SIGMAS for e, k in zip(est, s)])
     assert 0.94 < hits < 0.96
 
 
