@@ -25,6 +25,7 @@ from filmfriction.reduced_model.cycles import cycle_table
 
 from . import observables, stickslip
 from .extrema import refine_extrema
+from .film_state import lasting_gap_change
 from .files.cycles_csv import write_cycles_csv
 from .observables.observable import Context, Observable
 from .results import AnalysisResult, trace_from_columns
@@ -116,8 +117,25 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
                    trajectory_analyses=structure)
 
 
+def until_state_change(trace: Trace) -> tuple[Trace, dict | None]:
+    """The trace up to the film's lasting change of state (a run's ``gap`` column beyond
+    half a layer to its end: :mod:`filmfriction.analysis.film_state`), and the change as
+    ``analysis.json`` records it (None: no change, or no gap column or film layers)."""
+    n = ((trace.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
+    if not (trace.has("gap") and isinstance(n, int) and n >= 1):
+        return trace, None
+    change = lasting_gap_change(trace.time, trace.columns["gap"], n)
+    if change is None:
+        return trace, None
+    note = change.note(unit(trace.units, "time"))
+    kept = {k: v[:change.index] for k, v in trace.columns.items()}
+    return replace(trace, columns=kept, notes=tuple(trace.notes) + (note,)), {
+        **change.to_dict(), "samples_before": len(trace), "note": note}
+
+
 def analyze(trace, *, skip: int | None = None, structure: bool = True,
-            units: str | None = None, **parameters) -> AnalysisResult:
+            units: str | None = None, whole_trace: bool = False,
+            **parameters) -> AnalysisResult:
     """Analyse a trace: the detection and the regime (:func:`context`), then
     every observable (:mod:`filmfriction.analysis.observables`) in its order.
 
@@ -131,6 +149,10 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
         3 or more slips are found, else 0).
     structure : bool
         Run the trajectory analyses when the run has a trajectory.
+    whole_trace : bool
+        Analyse every sample even after the film changed state (by default a run's
+        trace is analysed up to a lasting change of its gap by half a layer,
+        :func:`until_state_change`, recorded as ``film_state_change``).
     units, **parameters
         For columns in memory only: their unit system (``"lj"``, the default, or
         ``"si"``) and the trace's parameters (``spring_constant``, ``mass``,
@@ -159,8 +181,13 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
         trace = trace_from_columns(trace, units=units or "lj", **parameters)
     elif units is not None or parameters:
         raise TypeError("units and parameters go with columns in memory; a Trace has its own")
+    change = None
+    if not whole_trace:
+        trace, change = until_state_change(trace)
     doc: dict = {"schema": SCHEMA, "units": trace.units, "source": _source(trace),
                  "provenance": _provenance(trace)}
+    if change is not None:
+        doc["film_state_change"] = change
     skipped: dict[str, str] = {}
     if len(trace) < MIN_ROWS:
         n = len(trace)

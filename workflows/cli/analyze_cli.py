@@ -123,6 +123,10 @@ def register(subparsers) -> None:
                         "working directory); --output is an accepted alias")
     p.add_argument("--no-figure", action="store_true",
                    help="do not draw analysis_trace.png")
+    p.add_argument("--whole-trace", action="store_true",
+                   help="analyse every sample of a run even after its film changed state (by "
+                        "default the analysis stops where the gap changed by half a layer for "
+                        "good, a melted film: analysis.json film_state_change)")
     p.set_defaults(func=run)
 
 
@@ -265,8 +269,8 @@ def _analyze(args: argparse.Namespace, stream: Path | None = None) -> int:
         side = Path(out).with_name(Path(out).stem + "_trace.png")
         check_output(side, flag, inputs=sources, ours=names_in(Path(out)), what="its figure")
     try:
-        doc, per_cycle = analyze(trace, skip=args.skip,
-                                 structure=not args.no_structure)
+        doc, per_cycle = analyze(trace, skip=args.skip, structure=not args.no_structure,
+                                 whole_trace=args.whole_trace)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     slips = doc.get("slips", {}).get("count", 0)

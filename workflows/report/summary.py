@@ -115,6 +115,9 @@ def _stick_slip(a: dict) -> Answer:
             f"{_entry(s.get('static_force'), units, 'force')}, period "
             f"{_entry(s.get('period'), units, 'time')}; CV(F_s) = {_fmt(_cv(s.get('static_force')), 2)}, "
             f"CV(period) = {_fmt(_cv(s.get('period')), 2)}")
+    change = a.get("film_state_change")
+    if change:
+        text += f"; {change.get('note', 'analysed up to a change of the film state')}"
     ok = regime in ("stick-slip", "irregular") and n >= 3
     return Answer(q, text, "established" if ok else "inconclusive", rule, SECTIONS["slips"])
 

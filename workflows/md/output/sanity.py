@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.energy import ledger
+from filmfriction.analysis.film_state import GAP_LAYER_CHANGE
 from filmfriction.md_inputs import contract
 from filmfriction.md_inputs.contract import DAT_COLUMNS, TRACE_DAT_FILE
 
@@ -114,9 +115,10 @@ TEMPERATURE_TOLERANCE = 0.3     # |<T_film> - T| / T over the slide's second hal
 
 
 GAP_DRIFT_TOLERANCE = 0.15      # |gap(end) - gap(start)| / gap(start), 10 % windows
-GAP_LAYER_TOLERANCE = 0.5       # ... or more than this share of one film layer's spacing:
-                                # a thick film that gains or loses a layer's worth of gap has
-                                # changed state (a six-layer film melted at +13 %)
+# ... or more than this share of one film layer's spacing: a thick film that gains or loses a
+# layer's worth of gap has changed state (a six-layer film melted at +13 %); the analysis stops
+# at such a change (analysis/film_state.py)
+GAP_LAYER_TOLERANCE = GAP_LAYER_CHANGE
 
 
 WALL_SPEED_TOLERANCE = 0.2      # |<v_wall> - V| / V in steady sliding (never stuck)
@@ -154,7 +156,8 @@ def sanity_warnings(dat: np.ndarray, scene: Scene) -> list[str]:
                    f"{layer:.3g} sigma; tolerance {100 * GAP_DRIFT_TOLERANCE:.0f} % or "
                    f"{GAP_LAYER_TOLERANCE:g} layer): the film is expanding or squeezed out, "
                    f"it may have melted; its slips and Bingham number are not those of the "
-                   f"layered film")
+                   f"layered film (a change lasting to the end: the analysis stops where it "
+                   f"began, analysis.json film_state_change)")
     V = p["drive_velocity"]
     v = col["wall_velocity"][half]
     if V > 0 and np.min(v) > 0.2 * V:       # steady sliding: the wall never sticks
