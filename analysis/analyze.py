@@ -133,6 +133,17 @@ def until_state_change(trace: Trace) -> tuple[Trace, dict | None]:
         **change.to_dict(), "samples_before": len(trace), "note": note}
 
 
+def as_analysed(trace: Trace, doc: dict) -> Trace:
+    """The part of ``trace`` its ``analysis.json`` ``doc`` covers: the samples before a
+    recorded ``film_state_change`` (the whole trace without one), so that what reads the
+    analysis with the trace (the calibration, its replay) reads the same samples."""
+    change = doc.get("film_state_change") or {}
+    index = change.get("index")
+    if not isinstance(index, int) or not 0 < index < len(trace):
+        return trace
+    return replace(trace, columns={k: v[:index] for k, v in trace.columns.items()})
+
+
 def analyze(trace, *, skip: int | None = None, structure: bool = True,
             units: str | None = None, whole_trace: bool = False,
             **parameters) -> AnalysisResult:

@@ -83,7 +83,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
         no analysis.
     """
     from filmfriction.analysis.files.cycles_csv import read_cycles_csv
-    from filmfriction.analysis.analyze import analyze, write_outputs
+    from filmfriction.analysis.analyze import analyze, as_analysed, write_outputs
     from filmfriction.analysis.files.trace_reader import read_trace
 
     run_dir = Path(run_dir)
@@ -110,6 +110,7 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
             pass  # read-only run directory: the analysis stays in memory
         cycles = {k: np.asarray(v, dtype=float) for k, v in per_cycle.items()
                   if not isinstance(v, str)}
+    trace = as_analysed(trace, doc)          # a film that changed state: the analysed part
     for key in ("yield_index", "stick_index"):
         cycles[key] = np.asarray(cycles.get(key, []), dtype=float).astype(int)
     skip = int(doc.get("slips", {}).get("summary_skips_first", 0) or 0)

@@ -79,6 +79,9 @@ def test_the_analysis_stops_where_the_film_changed_state(synthetic_run, run_cli,
     assert "changed state" in " ".join(doc["source"]["notes"])
     cycles = list(csv.DictReader((synthetic_run / "analysis_cycles.csv").open()))
     assert cycles and all(float(c["stick_time"]) < change["time"] for c in cycles)
+    from filmfriction.analysis.calibration.rundata import load_run
+
+    assert len(load_run(synthetic_run).trace) == change["index"]   # calibration: the same samples
     kept = run_cli("analyze", synthetic_run, "--json", "--no-figure", "--whole-trace",
                    "--out", tmp_path / "whole.json")
     assert kept.code == 0, kept.err
