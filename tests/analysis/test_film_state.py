@@ -24,7 +24,7 @@ def test_a_melt_that_lasts_is_found_at_its_onset():
     change = lasting_gap_change(t, _gap(t, rng, [(6000.0, np.inf, 1.0)]), LAYERS)
     assert change is not None
     assert 5990.0 <= change.time <= 6000.0 and change.layers == pytest.approx(1.0, abs=0.05)
-    assert change.index == int(np.searchsorted(t, change.time))
+    assert 23960 <= change.index <= 24000                    # t = 6000 is sample 24000
 
 
 @pytest.mark.parametrize("steps", [
@@ -32,6 +32,8 @@ def test_a_melt_that_lasts_is_found_at_its_onset():
     [(float(s), s + 25.0, 0.45) for s in range(500, 9500, 300)],   # a slip's dilation, each slip
     [(6000.0, 8000.0, 1.0)],                                   # a layer taken and given back
     [(9000.0, np.inf, 0.3)],                                   # a drift under half a layer
+    [(9999.5, np.inf, 1.0)],                                   # the last two samples
+    [(9000.0, np.inf, 0.3), (9975.0, np.inf, 0.25)],           # a drift, then a slip at the end
 ])
 def test_no_change_where_the_film_keeps_or_regains_its_gap(steps):
     rng = np.random.default_rng(1)
@@ -82,6 +84,12 @@ def test_the_analysis_stops_where_the_film_changed_state(synthetic_run, run_cli,
     from filmfriction.analysis.calibration.rundata import load_run
 
     assert len(load_run(synthetic_run).trace) == change["index"]   # calibration: the same samples
+    doc_path = synthetic_run / "analysis.json"
+    stale = json.loads(doc_path.read_text())
+    stale["film_state_change"]["samples_before"] += 1           # a trace changed since
+    doc_path.write_text(json.dumps(stale))
+    with pytest.raises(ValueError, match="analyse it again"):
+        load_run(synthetic_run)
     kept = run_cli("analyze", synthetic_run, "--json", "--no-figure", "--whole-trace",
                    "--out", tmp_path / "whole.json")
     assert kept.code == 0, kept.err
