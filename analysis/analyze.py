@@ -121,16 +121,15 @@ def until_state_change(trace: Trace) -> tuple[Trace, dict | None]:
     """The trace up to the film's lasting change of state (a run's ``gap`` column beyond
     half a layer to its end: :mod:`filmfriction.analysis.film_state`), and the change as
     ``analysis.json`` records it (None: no change, or no gap column or film layers)."""
-    n = (((trace.run or {}).get("scene") or {}).get("parameters") or {}).get("film_layers")
+    n = trace.scene_parameter("film_layers")
     if not (trace.has("gap") and isinstance(n, int) and n >= 1):
         return trace, None
     change = lasting_gap_change(trace.time, trace.columns["gap"], n)
     if change is None:
         return trace, None
     note = change.note(unit(trace.units, "time"))
-    kept = {k: v[:change.index] for k, v in trace.columns.items()}
-    return replace(trace, columns=kept, notes=tuple(trace.notes) + (note,)), {
-        **change.to_dict(), "samples_before": len(trace), "note": note}
+    return trace.head(change.index, note), {**change.to_dict(), "samples_before": len(trace),
+                                            "note": note}
 
 
 def as_analysed(trace: Trace, doc: dict) -> Trace:
@@ -145,7 +144,7 @@ def as_analysed(trace: Trace, doc: dict) -> Trace:
         raise ValueError(f"{trace.path}: the analysis was cut at sample {index} of {before}, "
                          f"the trace now has {len(trace)} samples; analyse it again "
                          f"(filmfriction analyze)")
-    return replace(trace, columns={k: v[:index] for k, v in trace.columns.items()})
+    return trace.head(index)
 
 
 def analyze(trace, *, skip: int | None = None, structure: bool = True,

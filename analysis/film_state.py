@@ -33,7 +33,7 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 __all__ = ["GapChange", "lasting_gap_change", "GAP_LAYER_CHANGE", "ONSET_LAYER",
-           "LASTING_SHARE", "SMOOTHING_SHARE", "REFERENCE_SHARE"]
+           "LASTING_SHARE", "SMOOTHING_SHARE", "REFERENCE_SHARE", "FRAMES_NOT_CUT"]
 
 #: A change of the gap by this share of one layer spacing, lasting to the end, is a change of
 #: the film's state (a slip dilates it by at most a quarter layer).
@@ -44,6 +44,10 @@ ONSET_LAYER = 0.25
 #: A change lasts: the smoothed gap stays beyond :data:`GAP_LAYER_CHANGE` over at least this
 #: share of the samples, to the last one (a slip under way at the run's end dilates it briefly).
 LASTING_SHARE = 0.05
+#: Why a section that reads a run's frames (trajectory, profiles) and cannot cut them at the
+#: change is skipped.
+FRAMES_NOT_CUT = ("the film changed state and {what} frames after the change are not "
+                  "separated (analyze --whole-trace reads them all)")
 #: The gap is smoothed by a running median over this share of the samples (at least 5).
 SMOOTHING_SHARE = 0.001
 #: The starting gap is the median over this first share of the samples (at least 10).

@@ -11,7 +11,7 @@ a plain file or an analysed one is :mod:`~filmfriction.analysis.files.trace_read
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import replace, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -260,13 +260,23 @@ class Trace:
             return float(self.parameters.thickness), "--thickness"
         if self.has("gap"):
             gap = float(np.mean(self.columns["gap"][sel]))
-            n = (((self.run or {}).get("scene") or {}).get("parameters") or {}).get("film_layers")
+            n = self.scene_parameter("film_layers")
             if n:
                 return gap * n / (n + 1), (f"film layers x layer spacing: mean gap x n/(n+1), "
                                            f"n = {n} (the gap between the walls' innermost planes "
                                            f"holds n + 1 spacings)")
             return gap, "mean of gap column (wall plane to wall plane)"
         return self.parameters.require("thickness", "viscosity"), "--thickness"
+
+    def scene_parameter(self, name: str):
+        """A parameter of the scene the run recorded in ``run.json`` (None: not a run, or
+        not recorded)."""
+        return (((self.run or {}).get("scene") or {}).get("parameters") or {}).get(name)
+
+    def head(self, n: int, note: str | None = None) -> "Trace":
+        """The first ``n`` samples of every column (with ``note`` added to the notes)."""
+        notes = tuple(self.notes) + ((note,) if note else ())
+        return replace(self, columns={k: v[:n] for k, v in self.columns.items()}, notes=notes)
 
     def optional_path(self, relative: str) -> Path | None:
         """A file of the run directory when it exists."""

@@ -58,6 +58,7 @@ from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_W
 
 from ..files.chunk_file import read_chunk_file
 from .observable import Context, Observable, format_value
+from ..film_state import FRAMES_NOT_CUT
 
 __all__ = ["ShearLocation", "layer_velocities", "profile_layer_velocities", "read_profile_frames",
            "shear_shares", "MIN_SLIPS_FOR_SCATTER"]
@@ -394,9 +395,7 @@ class ShearLocation(Observable):
             # profiles are, so they are read instead when the run has them
             use_traj = False
             if not prof_v:
-                ctx.skip_part(self.key, "the film changed state and its trajectory's frames "
-                                        "after the change are not separated (analyze "
-                                        "--whole-trace reads them all)")
+                ctx.skip_part(self.key, FRAMES_NOT_CUT.format(what="its trajectory's"))
                 return None, {}
         try:
             if use_traj:

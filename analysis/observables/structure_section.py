@@ -16,6 +16,7 @@ from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_W
 
 from ..files.trace import unit
 from .observable import Context, Observable, format_value, png_bytes, pyplot, shade_slips
+from ..film_state import FRAMES_NOT_CUT
 
 __all__ = ["Structure", "summarize_run", "universe", "fig_film"]
 
@@ -96,9 +97,7 @@ class Structure(Observable):
             ctx.skip_part(self.key, f"no {TRAJECTORY} + {TOPOLOGY} in the run directory")
             return None, {}
         if ctx.sections.get("film_state_change"):
-            ctx.skip_part(self.key, "the film changed state and its trajectory's frames after "
-                                    "the change are not separated (analyze --whole-trace "
-                                    "reads them all)")
+            ctx.skip_part(self.key, FRAMES_NOT_CUT.format(what="its trajectory's"))
             return None, {}
         try:
             return summarize_run(topo, traj, trace=trace, table=ctx.all_slips,

@@ -26,6 +26,7 @@ from ..stickslip import Regime
 from ..files.trace import MissingInput, unit
 from ..files.util import finite_or_none
 from .observable import Context, Observable, format_estimate, format_value, png_bytes, pyplot
+from ..film_state import FRAMES_NOT_CUT
 
 __all__ = ["Viscosity", "read_profiles", "averaged_profile"]
 
@@ -129,9 +130,7 @@ class Viscosity(Observable):
         prof_v = trace.optional_path(VELOCITY_PROFILE)
         prof_d = trace.optional_path(DENSITY_PROFILE)
         if prof_v is not None and ctx.sections.get("film_state_change"):
-            ctx.skip_part("viscosity.profile", "the film changed state: the profiles' last "
-                                               "half is not the layered film's (analyze "
-                                               "--whole-trace reads them)")
+            ctx.skip_part("viscosity.profile", FRAMES_NOT_CUT.format(what="the profiles'"))
         elif prof_v is not None:
             try:
                 visc["profile"] = _profile_section(ctx, prof_v, prof_d)

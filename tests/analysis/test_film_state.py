@@ -27,6 +27,17 @@ def test_a_melt_that_lasts_is_found_at_its_onset():
     assert 23960 <= change.index <= 24000                    # t = 6000 is sample 24000
 
 
+def test_the_change_is_the_same_in_other_units():
+    # SI: seconds and metres (a layer of 0.8 nm, τ of 2 ps): the rule is of ratios only
+    rng = np.random.default_rng(0)
+    t = np.arange(40000) * 0.25
+    g = _gap(t, rng, [(6000.0, np.inf, 1.0)])
+    lj = lasting_gap_change(t, g, LAYERS)
+    si = lasting_gap_change(t * 2e-12, g * 0.85e-9, LAYERS)
+    assert si.index == lj.index and si.layers == pytest.approx(lj.layers)
+    assert si.time == pytest.approx(lj.time * 2e-12)
+
+
 @pytest.mark.parametrize("steps", [
     [],                                                        # a film that keeps its layers
     [(float(s), s + 25.0, 0.45) for s in range(500, 9500, 300)],   # a slip's dilation, each slip
