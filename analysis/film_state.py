@@ -11,7 +11,7 @@ before that: :func:`lasting_gap_change` finds the change, and the analysis
 Measured on nine MD runs of 2.8–4.6 M steps (four and six layers, kT 0.63–0.71;
 docs/analysis.md, "A film that changed state"): the gap smoothed over
 :data:`SMOOTHING_SHARE` of the run stays within 0.24 of a layer of its start in the eight
-that kept their layers, and the one that took a fifth layer sits at +1.00 layer from
+that kept their layers, and the one that took a fifth layer sits at +1.01 layer from
 t ≈ 10 440 τ to its end.
 
 Example
