@@ -1,6 +1,7 @@
 """The noise of a spring-force trace: its standard deviation and decorrelation lag from
-the trace's own local differences (:func:`noise_level`), and what does not repeat from
-one stick-slip cycle to the next (:func:`cycle_noise`).
+the trace's own local differences (:func:`noise_level`), the scale of its increments at
+the noise's own time scale (:func:`increment_noise`), and what does not repeat from one
+stick-slip cycle to the next (:func:`cycle_noise`).
 
 Both serve the slip detector (:func:`filmfriction.analysis.stickslip.detect_slips`),
 whose threshold they set, and the error bars of the yield and re-stick points
@@ -12,8 +13,8 @@ import math
 
 import numpy as np
 
-__all__ = ["noise_level", "noise_correlation", "cycle_noise", "NOISE_QUANTILE",
-           "CYCLE_NOISE_FACTOR"]
+__all__ = ["noise_level", "noise_correlation", "cycle_noise", "increment_noise",
+           "NOISE_QUANTILE", "CYCLE_NOISE_FACTOR"]
 
 # s(2L)/s(L) beyond what stationary noise gives to second differences (at most 4, for a
 # smooth process): the windows at 2L straddle slips
@@ -373,3 +374,59 @@ def _unrepeated(t, f, period, yields=None):
             d = (d - med[group])[big] / np.sqrt(1.0 - 1.0 / size[group][big])
     return float(np.quantile(np.abs(d), NOISE_QUANTILE)) / _Q_NORMAL
 
+
+
+#: the increments' scale has stopped growing (the noise has decorrelated, or an oscillating
+#: noise has passed half its period) when a doubling of the lag grows it by less than this
+INCREMENT_PLATEAU = 1.15
+#: a doubling of the lag that grows the increments' scale by more than this has let the
+#: slips into the windows: smooth noise grows at most as the lag (2× per doubling)
+INCREMENT_JUMP = 2.5
+
+
+def increment_noise(spring_force, *, max_lag: int | None = None) -> tuple[float, int]:
+    """The noise's scale at its own time scale, from the trace's increments: (scale, lag).
+
+    s(L) is the robust scale of f[i + L] − f[i] about its median, over √2 (read from the
+    lower quartile of the absolute values as in :func:`noise_level`): the loading ramp
+    adds the same K·V·L to every increment in a stick, and the median takes it out; the
+    slips, a minority of the windows while L is short against the sticks, give the large
+    ones, which the quartile leaves out.  For white noise s(L) = σ at every L; correlated
+    noise grows it until L passes its decorrelation time; an oscillating one (a wall
+    ringing on the film) until half its period, where its increments are largest.  The
+    lag is doubled from 1 until a doubling grows s by less than ``INCREMENT_PLATEAU``
+    (the scale is s(L) there) or by more than ``INCREMENT_JUMP`` (the slips have entered
+    the windows: s(L) before the jump), at most to ``max_lag`` (default N/20).
+
+    It needs no slips to be found first, so it cannot be biased by slips that were missed:
+    it is the noise estimate of :func:`~filmfriction.analysis.stickslip.detect_slips` where
+    the local one is blind (a trace sampled so finely that it is smooth at its sampling).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> white = rng.normal(0.0, 0.5, 20000)
+    >>> round(increment_noise(white)[0], 1)
+    0.5
+    >>> ramp = 0.01 * np.arange(20000) + white            # a loading ramp changes nothing
+    >>> round(increment_noise(ramp)[0], 1)
+    0.5
+    """
+    f = np.asarray(spring_force, float)
+    n = f.size
+    if n < 8:
+        return 0.0, 1
+    max_lag = max(1, n // 20) if max_lag is None else int(max_lag)
+
+    def scale(lag):
+        d = f[lag:] - f[:-lag]
+        d = np.abs(d - np.median(d))
+        return float(np.quantile(d, NOISE_QUANTILE)) / _Q_NORMAL / math.sqrt(2.0)
+
+    lag, prev = 1, scale(1)
+    while 2 * lag <= max_lag:
+        cur = scale(2 * lag)
+        if cur < INCREMENT_PLATEAU * prev or (prev > 0.0 and cur > INCREMENT_JUMP * prev):
+            break
+        lag, prev = 2 * lag, cur
+    return prev, lag

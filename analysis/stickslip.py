@@ -29,7 +29,7 @@ import numpy as np
 
 from filmfriction.reduced_model.cycles import CycleTable, stats
 
-from .noise import CYCLE_NOISE_FACTOR, noise_level_and_bound, cycle_noise
+from .noise import CYCLE_NOISE_FACTOR, cycle_noise, increment_noise, noise_level_and_bound
 
 __all__ = ["Regime", "sliding_steadily", "STEADY_VELOCITY_TOLERANCE", "SlipEvents", "detect_slips",
            "classify_regime", "REGIME_CV_MAX"]
@@ -94,6 +94,11 @@ class SlipEvents:
         where the local estimate is blind to correlated noise (see
         :func:`detect_slips`); 0 where it was not computed (a rough trace whose
         noise estimate converged, a noise or threshold given, fewer than 2 slips).
+    increment_noise : float
+        The noise's scale at its own time scale, from the trace's increments
+        (:func:`~filmfriction.analysis.noise.increment_noise`), the cap of the threshold
+        where the local estimate is blind (see :func:`detect_slips`); 0 where it was not
+        computed.
     """
 
     yield_index: np.ndarray
@@ -103,6 +108,7 @@ class SlipEvents:
     unfinished_yield: int | None = None
     lag: int = 1
     cycle_noise: float = 0.0
+    increment_noise: float = 0.0
 
     @property
     def count(self) -> int:
@@ -130,6 +136,11 @@ def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,
         size *= 2
 
 
+#: at most this many raises of the threshold by the cycle noise (each re-scans the trace);
+#: the increments' cap bounds them, so they run to where they stop rising
+RAISES = 10
+
+
 def detect_slips(time, spring_force, *, threshold: float | None = None,
                  noise: float | None = None, k: float | None = None,
                  min_drop: float = 0.0, relative_drop: float = 0.1,
@@ -151,13 +162,12 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     correlated noise sampled finely (an MD wall's thermal vibration with
     ``trace_every`` well below its period), whose dips would be counted as
     slips; where its search reached the longest lag with s(L) still growing,
-    it is a lower bound.  There the slips found set a second floor: what does not repeat from
-    one cycle to the next (:func:`cycle_noise`) is noise too.  Where it exceeds
-    σ by more than :data:`CYCLE_NOISE_FACTOR` (it also holds the slips' own
-    variation from cycle to cycle, so within that factor the two agree), ``h``
-    is raised to k times it and the scan repeated (at most 3 times).  A trace
-    that is rough at its sampling keeps its local estimate (it sees white and
-    correlated noise alike): an irregular noise-free sawtooth is not noise.
+    it is a lower bound.  There the threshold is also at least k' times the
+    noise's scale at its own time scale L (:func:`increment_noise`, read from the
+    trace's increments, which needs no slips found first and so cannot be raised
+    by slips that were missed), k' from N/L independent samples.  A trace that is
+    rough at its sampling keeps its local estimate (it sees white and correlated
+    noise alike): an irregular noise-free sawtooth is not noise.
 
     Parameters
     ----------
@@ -177,9 +187,12 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         relaxations during a stick, are not slips.
     ringing_window : float
         A candidate that follows the previous re-stick after less than
-        ``ringing_window`` × that slip's duration, and whose drop is less than
-        half of that slip's drop, is the wall ringing after the re-stick, not
-        a new slip (default 3; 0 turns the rule off).
+        ``ringing_window`` × that slip's duration, whose drop is less than
+        half of that slip's drop, and whose force is back at its yield value in
+        less than 3/4 of the time the drive takes to reload the drop, is the wall
+        ringing after the re-stick, not a new slip (default 3; 0 turns the rule
+        off).  A slip unloads the spring, which the drive reloads at the sticks'
+        loading rate; a bounce of the ringing comes back within a part of its period.
 
     Returns
     -------
@@ -219,18 +232,25 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         threshold = max(kk * noise, floor)
     h = float(threshold)
     yi, si, unfinished = _scan(t, f, h, min_drop, relative_drop, ringing_window)
-    cyc = 0.0
+    cyc = inc = 0.0
     if blind and threshold_given is None:
         # the local estimate does not see noise correlated over longer than its lags
         # (sampled finely, a trace is smooth at its sampling), but what does not
-        # repeat from cycle to cycle is noise too
-        for _ in range(3):
-            cyc = max(cyc, cycle_noise(t, f, yi))
-            if cyc <= CYCLE_NOISE_FACTOR * noise or kk * cyc <= h:
+        # repeat from cycle to cycle is noise too, and so are the increments at the
+        # noise's own time scale, which cap it
+        inc, inc_lag = increment_noise(f)
+        k_inc = 2.0 * math.sqrt(2.0 * math.log(max(f.size / inc_lag, 2.0))) + 1.0
+        cap = max(h, (k_inc if k is None else k) * inc)
+        for _ in range(RAISES):
+            # with fewer than 2 slips left there is no cycle to compare: the cap
+            cyc = max(cyc, cycle_noise(t, f, yi)) if yi.size >= 2 else math.inf
+            new = min(kk * cyc, cap)
+            if cyc <= CYCLE_NOISE_FACTOR * noise or new <= h:
                 break
-            h = kk * cyc
+            h = new
             yi, si, unfinished = _scan(t, f, h, min_drop, relative_drop, ringing_window)
-    return SlipEvents(yi, si, h, float(noise), unfinished, lag, cyc)
+        cyc = cyc if math.isfinite(cyc) else 0.0
+    return SlipEvents(yi, si, h, float(noise), unfinished, lag, cyc, inc)
 
 
 def _scan(t, f, h, min_drop, relative_drop, ringing_window):
@@ -265,14 +285,25 @@ def _scan(t, f, h, min_drop, relative_drop, ringing_window):
 
 
 def _drop_ringing(t, f, yi, si, window):
-    """Remove candidates that are the ringing of the wall after a re-stick."""
+    """Remove candidates that are the ringing of the wall after a re-stick (see
+    ``ringing_window`` in :func:`detect_slips`)."""
+    # the sticks' loading rate: the median rise from a re-stick to the next yield, over
+    # the sticks that no ringing can be (longer than ``window`` slips), else over all
+    stick = t[yi[1:]] - t[si[:-1]]
+    rates = (f[yi[1:]] - f[si[:-1]]) / stick
+    long = stick >= window * (t[si[:-1]] - t[yi[:-1]])
+    rate = float(np.median(rates[long] if long.any() else rates))
     kept = [0]
     for i in range(1, yi.size):
         j = kept[-1]
         stick = t[yi[i]] - t[si[j]]
         slip = t[si[j]] - t[yi[j]]
-        if stick < window * slip and (f[yi[i]] - f[si[i]]) < 0.5 * (f[yi[j]] - f[si[j]]):
-            continue
+        drop = f[yi[i]] - f[si[i]]
+        if stick < window * slip and drop < 0.5 * (f[yi[j]] - f[si[j]]):
+            back = np.flatnonzero(f[si[i]:] >= f[yi[i]])
+            regained = t[si[i] + back[0]] - t[si[i]] if back.size else math.inf
+            if not rate > 0.0 or regained < 0.75 * drop / rate:
+                continue
         kept.append(i)
     return yi[kept], si[kept]
 

@@ -11,7 +11,11 @@
   at a uniform step, as an MD trace is;
 * :func:`with_wall_noise` — an MD wall's noise added to a trace: thermal
   velocity noise on the sampled wall velocity and a correlated random force in
-  the film.
+  the film;
+* :func:`irregular_coulomb_trace` — an undamped Coulomb block whose static force
+  differs from slip to slip (slips of irregular size and timing), in closed form,
+  with its slips' yield and re-stick times;
+* :func:`ringing_noise` — narrow-band noise, a wall ringing thermally on the film.
 
 All return a dict of columns named as in a trace CSV.
 """
@@ -26,7 +30,7 @@ from filmfriction.md_inputs.contract import AtomType, RUN_FILE, TRACE_FILE
 from filmfriction.md_inputs.geometry import fcc111, plane_spacing
 
 __all__ = ["sawtooth", "klein_trace", "smooth_trace", "block_trace", "with_wall_noise",
-           "write_csv"]
+           "irregular_coulomb_trace", "ringing_noise", "write_csv"]
 
 
 def _ar1(n: int, sigma: float, rho: float, rng) -> np.ndarray:
@@ -201,6 +205,92 @@ def with_wall_noise(columns: dict, *, velocity_noise, velocity_correlation=0.0,
     out["spring_force"] = np.asarray(columns["spring_force"], float) + _ar1(
         n, force_noise, force_correlation, rng)
     return out
+
+
+def irregular_coulomb_trace(static_forces, *, kinetic_force: float, stiffness: float,
+                            mass: float, drive_velocity: float, dt: float,
+                            start_force: float = 0.0, tail: float = 0.5) -> dict:
+    """A driven Coulomb block (no damping) whose i-th slip starts at ``static_forces[i]``.
+
+    The block sticks while the spring force F = K(V t − x) rises at K·V; at F_s,i it slips
+    under the kinetic force F_k, and F = F_k + (F_s,i − F_k) cos ωt + (K V/ω) sin ωt
+    (ω = √(K/M)) until its velocity V − F'/K is zero again, at ωt = 2(π − atan(A ω/(K V))),
+    A = F_s,i − F_k: the re-stick.  Slips of irregular size and timing, in closed form,
+    sampled every ``dt`` (the samples of each slip's end are exact).  The trace ends
+    ``tail`` × the last stick's length after the last re-stick.
+
+    Returns the columns ``time, spring_force, drive_position, wall_position,
+    wall_velocity`` and ``yield_time, restick_time, static_force, backward_force`` (one
+    value per slip: the truth).
+
+    Example
+    -------
+    >>> tr = irregular_coulomb_trace([3.0, 2.0], kinetic_force=1.0, stiffness=1.0, mass=1.0,
+    ...                              drive_velocity=0.01, dt=0.01)
+    >>> [round(float(b), 2) for b in tr["backward_force"]]   # about 2 F_k − F_s
+    [-1.0, 0.0]
+    """
+    k, m, v = float(stiffness), float(mass), float(drive_velocity)
+    fk = float(kinetic_force)
+    w = np.sqrt(k / m)
+    # the piecewise solution: (start time, start force, slipping?, slip's amplitude)
+    pieces, now, force = [], 0.0, float(start_force)
+    yields, resticks, fs_true, fb_true = [], [], [], []
+    for fs in np.asarray(static_forces, float):
+        if fs <= force:
+            raise ValueError(f"static force {fs} is not above the force it is loaded from, {force}")
+        stick = (fs - force) / (k * v)
+        pieces.append((now, force, False, 0.0))
+        now += stick
+        a = fs - fk
+        duration = 2.0 * (np.pi - np.arctan(a * w / (k * v))) / w
+        pieces.append((now, fs, True, a))
+        yields.append(now)
+        now += duration
+        force = fk + a * np.cos(w * duration) + k * v / w * np.sin(w * duration)
+        resticks.append(now)
+        fs_true.append(fs)
+        fb_true.append(force)
+    end = now + tail * max(yields[-1] - (resticks[-2] if len(resticks) > 1 else 0.0), 10 * dt)
+    pieces.append((now, force, False, 0.0))
+    t = np.arange(0.0, end, dt)
+    f = np.empty_like(t)
+    vel = np.empty_like(t)
+    starts = np.array([p[0] for p in pieces])
+    which = np.searchsorted(starts, t, side="right") - 1
+    for i, (t0, f0, slipping, a) in enumerate(pieces):
+        sel = which == i
+        u = t[sel] - t0
+        if slipping:
+            f[sel] = fk + a * np.cos(w * u) + k * v / w * np.sin(w * u)
+            vel[sel] = v + a * w / k * np.sin(w * u) - v * np.cos(w * u)
+        else:
+            f[sel] = f0 + k * v * u
+            vel[sel] = 0.0
+    drive = v * t + start_force / k
+    wall = drive - f / k
+    return {"time": t, "spring_force": f, "drive_position": drive, "wall_position": wall,
+            "wall_velocity": vel, "yield_time": np.array(yields),
+            "restick_time": np.array(resticks), "static_force": np.array(fs_true),
+            "backward_force": np.array(fb_true)}
+
+
+def ringing_noise(n: int, *, rms: float, period: float, decay: float, dt: float,
+                  seed: int = 0) -> np.ndarray:
+    """Narrow-band noise of standard deviation ``rms``: an oscillator of ``period`` whose
+    amplitude decays in ``decay`` (both in the time unit of ``dt``), driven by white noise
+    (an AR(2) process).  A wall that rings on the film's stiffness between thermal kicks
+    gives its spring force this: smooth at a fine sampling, correlated over ``decay``.
+
+    >>> x = ringing_noise(200_000, rms=2.0, period=50.0, decay=100.0, dt=0.25)
+    >>> round(float(np.std(x)), 1)
+    2.0
+    """
+    r = np.exp(-dt / float(decay))
+    a1, a2 = 2.0 * r * np.cos(2.0 * np.pi * dt / float(period)), -r * r
+    e = np.random.default_rng(seed).normal(0.0, 1.0, int(n) + 2000)
+    x = lfilter([1.0], [1.0, -a1, -a2], e)[2000:]
+    return x * (float(rms) / np.std(x))
 
 
 def write_csv(path, columns: dict) -> None:

@@ -1,0 +1,84 @@
+"""Ground truth for the slip detector on slips of irregular size under an MD wall's noise.
+
+Exact traces of a driven Coulomb block whose static force differs from slip to slip
+(``synthetic.irregular_coulomb_trace``: K = 8, M = 1e5, V = 0.0025, F_k = 25, F_s drawn
+from 32-55, so drops of 14-60 at irregular times, the sfb-thick-stiff scene's scale) plus
+the noise of a wall ringing on the film (``synthetic.ringing_noise``: rms 1.5, period
+200 τ, decaying in 400 τ, the wiggles of that scene's traces), sampled every 0.25 τ as
+the MD writes them: smooth at its sampling, so the detector's local noise estimate is
+blind and the threshold comes from the noise at its own time scale.  Measured at the
+time of writing: 273 of the 280 slips of 20 traces found, none extra; none in 40 traces
+of the noise alone (flat or loading).  The earlier rule (k times the cycle-to-cycle
+noise, re-estimated from the slips it kept) found 220 of the 280: each missed slip raised
+the next estimate.
+"""
+import numpy as np
+import pytest
+
+from filmfriction.analysis.groundtruth import synthetic
+from filmfriction.analysis.stickslip import detect_slips
+
+DT = 0.25
+NOISE = {"rms": 1.5, "period": 200.0, "decay": 400.0, "dt": DT}
+
+
+def irregular(seed):
+    rng = np.random.default_rng(seed)
+    tr = synthetic.irregular_coulomb_trace(rng.uniform(32.0, 55.0, 14), kinetic_force=25.0,
+                                           stiffness=8.0, mass=1.0e5, drive_velocity=0.0025,
+                                           dt=DT)
+    noise = synthetic.ringing_noise(tr["time"].size, seed=seed + 100, **NOISE)
+    return tr, tr["spring_force"] + noise
+
+
+def test_the_exact_trace_is_the_closed_form():
+    tr = synthetic.irregular_coulomb_trace([40.0, 30.0, 45.0], kinetic_force=25.0,
+                                           stiffness=8.0, mass=1.0e5, drive_velocity=0.0025,
+                                           dt=DT)
+    t, f = tr["time"], tr["spring_force"]
+    # the force at each yield is its static force; each re-stick is about 2 F_k − F_s
+    for ty, fs in zip(tr["yield_time"], tr["static_force"]):
+        assert f[np.searchsorted(t, ty) - 1] == pytest.approx(fs, abs=8.0 * 0.0025 * DT * 2)
+    np.testing.assert_allclose(tr["backward_force"], 50.0 - tr["static_force"], atol=0.5)
+    # the wall is at rest between slips and never moves backwards
+    assert np.all(tr["wall_velocity"] >= -1e-9)
+    ev = detect_slips(t, f)
+    assert ev.count == 3
+
+
+def test_slips_of_irregular_size_are_all_found_under_ringing_noise():
+    found = made = extra = 0
+    for seed in range(20):
+        tr, f = irregular(seed)
+        t = tr["time"]
+        ev = detect_slips(t, f)
+        # a true yield is found when a detected one lies within 300 τ of it (a slip lasts
+        # π √(M/K) ≈ 350 τ)
+        hit = sum(bool(np.any(np.abs(t[ev.yield_index] - y) < 300.0)) for y in tr["yield_time"])
+        found += hit
+        made += tr["yield_time"].size
+        extra += ev.count - hit
+    assert extra == 0
+    assert found >= 0.95 * made, (found, made)        # 273 of 280 measured
+
+
+@pytest.mark.parametrize("loading", [0.0, 0.02], ids=["flat", "loading"])
+def test_the_noise_alone_gives_no_slip(loading):
+    t = np.arange(0.0, 23000.0, DT)
+    counts = [detect_slips(t, 30.0 + loading * t
+                           + synthetic.ringing_noise(t.size, seed=s, **NOISE)).count
+              for s in range(20)]
+    assert sum(counts) == 0, counts
+
+
+def test_a_small_slip_soon_after_a_slow_one_is_a_slip_not_ringing():
+    # a slow slip (≈ 370 τ) from 50 to 14, then after 1 000 τ of stick (< 3 slip durations)
+    # a slip of less than half its drop: the drive reloads it at K·V, so it is kept
+    tr = synthetic.irregular_coulomb_trace([50.0, 34.0, 45.0], kinetic_force=32.0,
+                                           stiffness=8.0, mass=1.0e5, drive_velocity=0.0025,
+                                           dt=DT)
+    drops = tr["static_force"] - tr["backward_force"]
+    stick = tr["yield_time"][1] - tr["restick_time"][0]
+    slip = tr["restick_time"][0] - tr["yield_time"][0]
+    assert stick < 3.0 * slip and drops[1] < 0.5 * drops[0]
+    assert detect_slips(tr["time"], tr["spring_force"]).count == 3
