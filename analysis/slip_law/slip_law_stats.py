@@ -77,7 +77,18 @@ def _noncentrality(dof: int, resolved: float, power: float) -> float:
 
 def ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
     """Least squares y = X·c: (coef, stderr, residuals); the errors widened by the
-    residuals' integrated autocorrelation time (NaN with ``errors=False``)."""
+    residuals' integrated autocorrelation time (NaN with ``errors=False``, and where the
+    design is singular to working precision).
+
+    >>> import warnings
+    >>> x = np.linspace(0.0, 1.0, 50)
+    >>> X = np.column_stack([np.ones(50), x, x])                 # two equal columns
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error")                          # no RuntimeWarning
+    ...     _, se, _ = ols(X, 1.0 + 2.0 * x)
+    >>> np.isnan(se).tolist()
+    [True, True, True]
+    """
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     resid = y - X @ coef
     dof = y.size - X.shape[1]
@@ -85,9 +96,13 @@ def ols(X: np.ndarray, y: np.ndarray, errors: bool = True):
         return coef, np.full(X.shape[1], math.nan), resid
     s2 = float(resid @ resid) / dof
     try:
-        se = np.sqrt(np.diag(s2 * np.linalg.inv(X.T @ X)) * correlation_time(resid))
+        var = np.diag(s2 * np.linalg.inv(X.T @ X)) * correlation_time(resid)
     except np.linalg.LinAlgError:
-        se = np.full(X.shape[1], math.nan)
+        var = np.full(X.shape[1], math.nan)
+    # a design singular to working precision inverts to negative or infinite variances:
+    # its coefficients have no error bar (NaN), not a warning
+    with np.errstate(invalid="ignore"):
+        se = np.where(np.isfinite(var) & (var >= 0.0), np.sqrt(np.abs(var)), math.nan)
     return coef, se, resid
 
 
