@@ -6,10 +6,10 @@ wall's position and velocity respond to it, so the regressors of the integral-fo
 (Δx, and the v whose M·v is in the response) carry the noise the response carries.
 This module integrates that slider, many replicas at once:
 
-    M dv/dt = K(x_d − x) − F(v, ψ) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
+    M dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
 
 with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and
-state), and
+state), γM an MD run's mount dashpot (``mount_damping``, 0 by default), and
 
     ξ = M·du/dt   while the wall slips, 0 while it is stuck,
 
@@ -90,8 +90,8 @@ def _state_rate(code, p, v, psi):
 
 
 @njit(cache=True)
-def _run(code, p, mass, k, vd, xd0, static, start_v, stop_v, backward, armed_below, psi0,
-         h, n_sub, du, out_x, out_v, yields, sticks, counts):
+def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, armed_below,
+         psi0, h, n_sub, du, out_x, out_v, yields, sticks, counts):
     samples, reps = out_x.shape
     for r in range(reps):
         x, v, psi = 0.0, 0.0, psi0
@@ -104,19 +104,20 @@ def _run(code, p, mass, k, vd, xd0, static, start_v, stop_v, backward, armed_bel
                 t = (i * n_sub + j) * h
                 if slipping:
                     xi = mass * du[i * n_sub + j, r] / h
-                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi) + xi) / mass
+                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi) - gamma * (v - vd)
+                          + xi) / mass
                     p1 = _state_rate(code, p, v, psi)
                     x2, v2, s2 = x + 0.5 * h * v, v + 0.5 * h * a1, psi + 0.5 * h * p1
                     a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2) - _friction(code, p, v2, s2)
-                          + xi) / mass
+                          - gamma * (v2 - vd) + xi) / mass
                     p2 = _state_rate(code, p, v2, s2)
                     x3, v3, s3 = x + 0.5 * h * v2, v + 0.5 * h * a2, psi + 0.5 * h * p2
                     a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3) - _friction(code, p, v3, s3)
-                          + xi) / mass
+                          - gamma * (v3 - vd) + xi) / mass
                     p3 = _state_rate(code, p, v3, s3)
                     x4, v4, s4 = x + h * v3, v + h * a3, psi + h * p3
                     a4 = (k * (xd0 + vd * (t + h) - x4) - _friction(code, p, v4, s4)
-                          + xi) / mass
+                          - gamma * (v4 - vd) + xi) / mass
                     p4 = _state_rate(code, p, v4, s4)
                     x = x + h * (v + 2 * v2 + 2 * v3 + v4) / 6
                     vn = v + h * (a1 + 2 * a2 + 2 * a3 + a4) / 6
@@ -157,7 +158,7 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
           seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
           backward_force: float = -math.inf, armed_below: float = math.inf,
           start_velocity: float = 0.0, initial_state: float = 0.0,
-          substeps: int = 1) -> list[dict]:
+          substeps: int = 1, mount_damping: float = 0.0) -> list[dict]:
     """``replicas`` runs of the slider (module text), each with its own noise.
 
     Parameters
@@ -184,6 +185,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
         ψ at t = 0 (``rate-state``: ln(θ·v0/d_c)); while stuck ψ ages (dθ/dt = 1).
     substeps : int
         Runge–Kutta steps per sample.
+    mount_damping : float
+        γM of an MD run's mount dashpot (force per velocity): −γM·(v − V) acts on the
+        slipping wall besides the law (a stuck wall is at rest); 0, none.
 
     Returns
     -------
@@ -202,6 +206,8 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                       ("dt", dt)):
         if not (math.isfinite(val) and val > 0):
             raise ValueError(f"{name} = {val!r}: must be positive and finite")
+    if not (math.isfinite(mount_damping) and mount_damping >= 0):
+        raise ValueError(f"mount_damping = {mount_damping!r}: must be >= 0 and finite")
     if int(replicas) < 1 or int(substeps) < 1:
         raise ValueError(f"replicas = {replicas!r}, substeps = {substeps!r}: must be >= 1")
     sig, rho = np.atleast_1d(np.asarray(velocity_noise, float)), np.atleast_1d(
@@ -230,7 +236,8 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     sticks = np.zeros((reps, most), np.int64)
     counts = np.zeros((reps, 2), np.int64)
     _run(_CODE[law], p, float(mass), float(stiffness), float(drive_velocity),
-         float(initial_force) / stiffness, float(static_force), float(start_velocity),
+         float(initial_force) / stiffness, float(mount_damping), float(static_force),
+         float(start_velocity),
          float(stop_velocity), float(backward_force), float(armed_below), float(initial_state),
          h, n_sub, du, out_x, out_v, yields, sticks, counts)
     t = dt * np.arange(samples)

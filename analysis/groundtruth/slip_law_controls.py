@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from dataclasses import dataclass, field
 from functools import lru_cache, partial
 
 import numpy as np
@@ -56,7 +57,7 @@ from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "CONTROLS",
+__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -97,6 +98,99 @@ def scaled(noise: dict, factor: float) -> dict:
     return {k: (v if k == "velocity_correlation" else
                 tuple(factor * x for x in v) if isinstance(v, (tuple, list)) else factor * v)
             for k, v in noise.items()}
+
+
+@dataclass(frozen=True)
+class Scale:
+    """A slider's scale for the random-force controls: its spring, wall mass, mount dashpot
+    (γM, force per velocity) and sampling, the film's noise calibrated to the MD there, and
+    the controls' laws (the keywords of
+    :func:`~filmfriction.analysis.groundtruth.random_force.slide` and ``period``, a slip
+    cycle's length or a little more).  ``laws`` maps a control's name to them; ``mix``
+    gives the Coulomb + viscous laws of any viscous share: the film force ``film_force``
+    at ``slip_velocity`` split F_k = (1 − share)·F, B = share·F/v, and the rest of the
+    keywords.  ``chunk``: replicas slid at a time (memory), 0 all at once."""
+
+    name: str
+    spring_constant: float
+    mass: float
+    dt: float
+    static_force: float
+    drive_velocity: float
+    noise: dict
+    laws: dict = field(default_factory=dict)
+    mix: dict = field(default_factory=dict)
+    mount_damping: float = 0.0
+    chunk: int = 0
+
+    def law(self, name: str, share: float | None = None) -> dict:
+        """:func:`_dynamical_law` at this scale."""
+        if share is not None:
+            if not 0 <= share <= 1:
+                raise ValueError(f"share = {share!r}: must be in [0, 1]")
+            m = dict(self.mix)
+            f, v = m.pop("film_force"), m.pop("slip_velocity")
+            return dict(law="coulomb-viscous", parameters=((1 - share) * f, share * f / v),
+                        static_force=self.static_force, drive_velocity=self.drive_velocity,
+                        **m)
+        if name not in self.laws:
+            raise ValueError(f"control {name!r} at the {self.name} scale: one of "
+                             f"{', '.join(self.laws)}")
+        return dict(self.laws[name], static_force=self.static_force,
+                    drive_velocity=self.drive_velocity)
+
+
+#: The heavy slider's scale, the scene ``sfb-thick-stiff`` (K = 8 ε/σ², M = 10⁵ m, V = 0.0025
+#: σ/τ, the mount dashpot γ = 0.00034 /τ, i.e. γM = 34 m/τ, sampled every 0.25 τ; static
+#: forces 30–60, F_k ≈ 25 ε/σ, slips of 300–1 000 τ at 0.007–0.02 σ/τ).  Its controls:
+#:
+#: ``coulomb``  F_s = 45, F_k = 25 ε/σ (F_k + 0·v on every sample), re-sticking where the
+#:              wall stops (a noise-free slip: 351 τ, 5 σ, to F_b = 5 ε/σ)
+#: ``viscous``  Klein's Eq. 1 with ζ = B/(2√(KM)) = 1 (B = 1 789 m/τ, Eq. (1)'s Bingham
+#:              number of the runs: 32–87), re-stick imposed at F_b = STIFF_BACKWARD
+#: mixes        F_k + B·v of viscous share s of F = 27 ε/σ at 0.017 σ/τ (the runs' F̄ and v̄),
+#:              re-sticking at F_b = STIFF_BACKWARD or once slowed to STIFF_STOP
+STIFF_B = 2.0 * math.sqrt(8.0 * 1e5)
+#: The film's random force at the heavy slider's scale, calibrated as :data:`MD_NOISE` on the
+#: 50 analysed slips of six ``sfb-thick-stiff`` runs (seeds 11–15 and the scene's; 40
+#: replicas of the stiff ``viscous`` control, measured alike, 10 slips each): u an AR(1) of
+#: 0.0042 σ/τ rms and correlation 0.993 per 0.25 τ (36 τ), no rattling (√(kT/M) = 0.0025
+#: σ/τ white at the sampling would make the wall jitter 34 times the MD's over 0.25 τ: the
+#: heavy wall's thermal motion is slow).  The wall's velocity change over 16 τ (0.00377 σ/τ,
+#: the MD's 0.00377) and the residual with Δt², Δt³ fitted besides (0.00284, the MD's
+#: 0.00287 ± 0.00012; autocorrelation at 16 τ 0.24, the MD's 0.25) are the MD's; over 0.25,
+#: 1, 4 τ the replicas' wall jitters 4.7, 3.0 and 1.7 times the MD's, which is smoother there
+#: than any process of this family (docs/results/slip-law.md, "Controls at the heavy slider's
+#: scale").
+STIFF_NOISE = {"velocity_noise": 0.0042, "velocity_correlation": 0.993, "rattle": 0.0}
+STIFF_BACKWARD = 8.0
+STIFF_STOP = 0.004
+
+#: The scales of the random-force controls, by name.
+SCALES = {
+    "klein": Scale("klein", SCALE["spring_constant"], SCALE["mass"], SCALE["dt"],
+                   SCALE["static_force"], 0.1, MD_NOISE),
+    "stiff": Scale(
+        "stiff", 8.0, 1e5, 0.25, 45.0, 0.0025,
+        STIFF_NOISE,
+        laws={"coulomb": dict(law="linear", parameters=(25.0, 0.0), armed_below=25.0,
+                              initial_force=5.0, period=2400.0),
+              "viscous": dict(law="linear", parameters=(0.0, STIFF_B),
+                              backward_force=STIFF_BACKWARD, stop_velocity=-math.inf,
+                              initial_force=STIFF_BACKWARD, period=2300.0)},
+        mix=dict(film_force=27.0, slip_velocity=0.017, backward_force=STIFF_BACKWARD,
+                 stop_velocity=STIFF_STOP, armed_below=27.0, initial_force=STIFF_BACKWARD,
+                 period=2500.0),
+        mount_damping=34.0, chunk=10),
+}
+
+
+def _scale(scale) -> Scale:
+    if isinstance(scale, Scale):
+        return scale
+    if scale not in SCALES:
+        raise ValueError(f"scale {scale!r}: one of {', '.join(SCALES)}")
+    return SCALES[scale]
 
 
 #: Control name -> what it is.
@@ -196,10 +290,14 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
 RATE_STATE_CREEP = 0.01
 
 
-def _dynamical_law(name: str, share: float | None = None) -> dict:
+def _dynamical_law(name: str, share: float | None = None, scale: str | Scale = "klein") -> dict:
     """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
-    control ``name`` (or :func:`coulomb_viscous` of ``share``): the law, its yield and
-    re-stick, and ``period``, a slip cycle's length or a little more."""
+    control ``name`` (or :func:`coulomb_viscous` of ``share``) at ``scale`` (a name of
+    :data:`SCALES` or a :class:`Scale`): the law, its yield and re-stick, and ``period``,
+    a slip cycle's length or a little more."""
+    sc = _scale(scale)
+    if sc.name != "klein":
+        return sc.law(name, share)
     s = SCALE
     fs = s["static_force"]
     if share is not None:
@@ -229,25 +327,29 @@ def _dynamical_law(name: str, share: float | None = None) -> dict:
 
 
 def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: float | None = None,
-                      noise: dict | None = None, seed: int = 0,
-                      share: float | None = None) -> tuple[list[dict], float]:
+                      noise: dict | None = None, seed: int = 0, share: float | None = None,
+                      scale: str | Scale = "klein") -> tuple[list[dict], float]:
     """``replicas`` runs of control ``name`` (or of :func:`coulomb_viscous`'s law of viscous
-    ``share``) whose film pushes the wall with ``noise`` (:data:`MD_NOISE` by default) as a
-    random force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`), long
-    enough for ``slips`` slips after the start-up one (or ``duration`` long), and the
-    law's drive velocity."""
-    noise = MD_NOISE if noise is None else noise
-    law = _dynamical_law(name, share)
+    ``share``) at ``scale`` whose film pushes the wall with ``noise`` (the scale's
+    calibrated noise, :data:`MD_NOISE` at the Klein-similar one, by default) as a random
+    force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`), long enough for
+    ``slips`` slips after the start-up one (or ``duration`` long), and the law's drive
+    velocity."""
+    sc = _scale(scale)
+    noise = sc.noise if noise is None else noise
+    law = _dynamical_law(name, share, sc)
     period = law.pop("period")
     duration = (slips + 3) * period * 1.3 if duration is None else duration
-    runs = slide(**law, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
-                 duration=duration, dt=SCALE["dt"], replicas=replicas, seed=seed, **noise)
+    extra = {"mount_damping": sc.mount_damping} if sc.mount_damping else {}
+    runs = slide(**law, mass=sc.mass, stiffness=sc.spring_constant, duration=duration,
+                 dt=sc.dt, replicas=replicas, seed=seed, **extra, **noise)
     return runs, law["drive_velocity"]
 
 
 def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | None = None,
                    seed: int = 0, share: float | None = None, ensemble: bool = True,
-                   unfitted: bool = False, **fit) -> list[FilmForceFit | None]:
+                   unfitted: bool = False, scale: str | Scale = "klein",
+                   **fit) -> list[FilmForceFit | None]:
     """The slip-law fit of ``replicas`` runs of control ``name`` whose film pushes the wall
     with the MD's noise as a random force (:mod:`~filmfriction.analysis.groundtruth.random_force`):
     the wall's position and velocity respond to it, as an MD wall's do.
@@ -260,26 +362,37 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
     driven analysis's fit) or, with ``ensemble=False``, slip by slip
     (:func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force`); ``fit`` goes to
     the one called.  With ``unfitted`` a replica the fit refuses (too few slips in the
-    run, at a large noise) is None in the list; else its error is raised.
+    run, at a large noise) is None in the list; else its error is raised.  At ``scale``
+    (a name of :data:`SCALES` or a :class:`Scale`; its mount dashpot is the slider's and
+    the fit's) the replicas are slid ``Scale.chunk`` at a time, chunk j from the seed
+    (``seed``, j) (at the Klein-similar scale all at once from ``seed``).
     """
+    sc = _scale(scale)
     fitter = (partial(fit_cycle_ensemble, min_window_time=MD_NOISE_TIME) if ensemble
               else fit_film_force)
-    runs, velocity = random_force_runs(name, replicas, slips=slips, noise=noise, seed=seed,
-                                       share=share)
+    if sc.mount_damping:
+        fitter = partial(fitter, mount_damping=sc.mount_damping)
+    chunks = ([(replicas, seed)] if not sc.chunk else
+              [(min(sc.chunk, replicas - a), (seed, j))
+               for j, a in enumerate(range(0, replicas, sc.chunk))])
     out = []
-    for tr in runs:
-        t, f = tr["time"], tr["spring_force"]
-        tab = cycle_table(t, f, tr["yield_index"], tr["stick_index"],
-                          spring_constant=SCALE["spring_constant"],
-                          wall_position=tr["wall_position"])[1:slips + 1]
-        try:
-            out.append(fitter(t, f, tr["wall_velocity"], tab, mass=SCALE["mass"],
-                              drive_velocity=velocity,
-                              wall_position=tr["wall_position"], **fit))
-        except ValueError:
-            if not unfitted:
-                raise
-            out.append(None)
+    for n, sd in chunks:
+        runs, velocity = random_force_runs(name, n, slips=slips, noise=noise, seed=sd,
+                                           share=share, scale=sc)
+        for tr in runs:
+            t, f = tr["time"], tr["spring_force"]
+            tab = cycle_table(t, f, tr["yield_index"], tr["stick_index"],
+                              spring_constant=sc.spring_constant,
+                              wall_position=tr["wall_position"])[1:slips + 1]
+            try:
+                out.append(fitter(t, f, tr["wall_velocity"], tab, mass=sc.mass,
+                                  drive_velocity=velocity,
+                                  wall_position=tr["wall_position"], **fit))
+            except ValueError:
+                if not unfitted:
+                    raise
+                out.append(None)
+        del runs
     return out
 
 

@@ -2,6 +2,8 @@
 of random-force replicas, measured the same way (docs/results/slip-law.md, "The MD's noise").
 
     python benchmarks/slip_law/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
+    python benchmarks/slip_law/md_noise_calibration.py RUN ... --scale stiff [--noise U RHO RATTLE ...]
+                                                       [--lags 1 4 16 64 256]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
 control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
@@ -13,6 +15,13 @@ F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean sh
 :func:`~filmfriction.analysis.groundtruth.md_noise.common_shape_share`) and with Δt², Δt³
 fitted besides (``trend 3``).  ``--scan``: besides, u of 1 σ/τ at correlations 0.8–0.999 per
 sample (rattling 0.15): how slow a residual this family of noise can leave.
+
+``--scale stiff``: the replicas are the heavy slider's
+(:data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`, its ``viscous``
+control, 10 slips each, its mount dashpot), the processes its calibrated noise and each
+``--noise`` (u's rms, its correlation per sample, the rattling); ``--lags`` (samples) the
+lags of the residual's autocorrelation, the first three (or, with five or more, the first
+four) those of the jitter; the numbers are printed to 3 significant digits.
 """
 from __future__ import annotations
 
@@ -24,21 +33,23 @@ from filmfriction.analysis.groundtruth.md_noise import (common_shape_share, incr
                                                         replica_slips,
                                                         residual_statistics, residuals, run_slips,
                                                         slip_velocities)
-from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE
+from filmfriction.analysis.groundtruth.md_noise import LAGS
+from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE, SCALES
 
 PROCESSES = {"MD_NOISE": MD_NOISE, "RESIDUAL_AS_NOISE": RESIDUAL_AS_NOISE,
              "the plain residual's rms": {"velocity_noise": 1.9, "velocity_correlation": 0.95,
                                           "rattle": 0.15}}
 
 
-def row(name: str, slips: list[dict]) -> str:
+def row(name: str, slips: list[dict], lags=LAGS, fmt: str = ".3f") -> str:
     inc = increment_rms([v for sl in slips for v in slip_velocities(
-        sl["wall_velocity"], sl["yields"], sl["sticks"])])
-    cells = [", ".join(f"{x:.3f}" for x in inc)]
+        sl["wall_velocity"], sl["yields"], sl["sticks"])],
+        lags=tuple(lags[:3] if len(lags) < 5 else lags[:4]))
+    cells = [", ".join(f"{x:{fmt}}" for x in inc)]
     for trend in (1, 3):
         rs = [r for sl in slips for r in residuals(sl, trend=trend)]
-        st = residual_statistics(rs)
-        cells.append(f"{st['rms']:.3f} ± {st['rms_stderr']:.3f}; " + ", ".join(
+        st = residual_statistics(rs, lags=tuple(lags))
+        cells.append(f"{st['rms']:{fmt}} ± {st['rms_stderr']:{fmt}}; " + ", ".join(
             f"{a:.2f} ± {e:.2f}" for a, e in zip(st["autocorrelation"],
                                                   st["autocorrelation_stderr"])))
         if trend == 1:
@@ -51,6 +62,12 @@ def main(argv=None) -> int:
     ap.add_argument("runs", nargs="+", metavar="RUN", help="run directories (analysed slips)")
     ap.add_argument("--replicas", type=int, default=40)
     ap.add_argument("--scan", action="store_true", help="also u of 1 σ/τ at several correlations")
+    ap.add_argument("--scale", default="klein", choices=list(SCALES),
+                    help="the replicas' scale (stiff: the heavy slider's)")
+    ap.add_argument("--noise", nargs=3, type=float, action="append", default=[],
+                    metavar=("U", "RHO", "RATTLE"), help="a process besides (repeatable)")
+    ap.add_argument("--lags", nargs="+", type=int, default=list(LAGS),
+                    help="lags in samples (residual's autocorrelation; the jitter's)")
     a = ap.parse_args(argv)
     missing = [r for r in a.runs if not (Path(r) / "trace.csv").is_file()]
     if missing:
@@ -59,6 +76,8 @@ def main(argv=None) -> int:
     if a.replicas < 1:
         print(f"error: --replicas {a.replicas}: must be >= 1", file=sys.stderr)
         return 2
+    if a.scale != "klein" or a.noise or a.lags != list(LAGS):
+        return other_scale(a)
     print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
           "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
           "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
@@ -69,6 +88,27 @@ def main(argv=None) -> int:
                                       "rattle": 0.15} for rho in (0.8, 0.9, 0.95, 0.99, 0.999)}
     for name, noise in processes.items():
         print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas)), flush=True)
+    return 0
+
+
+def other_scale(a) -> int:
+    """The table at ``a.scale`` with ``a.lags``: the MD, the scale's noise, each ``--noise``."""
+    sc = SCALES[a.scale]
+    dt = sc.dt
+    lags = a.lags
+    jit = lags[:3] if len(lags) < 5 else lags[:4]
+    print(f"| noise | slips | wall velocity's change over {', '.join(f'{k * dt:g}' for k in jit)} τ "
+          f"(rms, σ/τ) | residual, F_k + B·v: rms; autocorrelation at "
+          f"{', '.join(f'{k * dt:g}' for k in lags)} τ | its mean shape's share | "
+          "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
+    print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs], lags, ".3g"), flush=True)
+    processes = {f"{a.scale} noise": sc.noise} | {
+        f"u {u:g}, {rho:g}, rattle {r:g}": {"velocity_noise": u, "velocity_correlation": rho,
+                                            "rattle": r} for u, rho, r in a.noise}
+    for name, noise in processes.items():
+        print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas, scale=sc,
+                                                   duration=None, slips=10), lags, ".3g"),
+              flush=True)
     return 0
 
 

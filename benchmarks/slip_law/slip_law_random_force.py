@@ -4,6 +4,7 @@ the noise added to the law's trace (docs/results/slip-law.md, "The controls with
     python benchmarks/slip_law/slip_law_random_force.py [--replicas 40] [--laws coulomb viscous ...]
                                                [--slips 8 30] [--residual]
     python benchmarks/slip_law/slip_law_random_force.py --ensemble [--noises md md-1.5x md-2tau residual ...]
+    python benchmarks/slip_law/slip_law_random_force.py --ensemble --scale stiff [--laws coulomb viscous]
 
 With ``--ensemble``: the driven analysis's fit, the slips' mean
 (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`), on the
@@ -24,7 +25,10 @@ and added to the noise-free law's trace (``replica_fits``), and noise-free.  Wit
 its ends, F_k + B·v fitted; :mod:`~filmfriction.analysis.groundtruth.md_noise`), to compare
 with the MD's (``benchmarks/slip_law/md_noise_calibration.py``).  With ``--cycle-mean``: a
 prototype of the remedy, the slips of each replica aligned at the yield and averaged
-before the fit (the noise of the regressors averages down as 1/√slips).
+before the fit (the noise of the regressors averages down as 1/√slips).  With ``--scale
+stiff`` (``--ensemble`` only): the heavy slider's controls
+(:data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`), ``md`` its calibrated
+noise (``STIFF_NOISE``) and ``md-1.5x``, ``md-2tau`` its variants.
 """
 from __future__ import annotations
 
@@ -39,7 +43,7 @@ from scipy.integrate import cumulative_trapezoid
 from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residual_statistics
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.slip_law_controls import (
-    CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, _dynamical_law, control_fits)
+    CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, SCALES, _dynamical_law, control_fits)
 from filmfriction.analysis.slip_law.slip_law import RESOLVED_SIGMAS, VERDICTS, fit_film_force
 from filmfriction.reduced_model.cycles import cycle_table
 
@@ -219,7 +223,7 @@ def _coverage(fits, branch: str, attr: str, truth: float) -> str:
             f" (truth {truth:.3g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
 
 
-def _paths(fits, exact) -> str:
+def _paths(fits, exact, mass: float = SCALE["mass"]) -> str:
     """Which fit each verdict came from and why (choose_law's reason), and the one law's
     co-moving mass: its mean over the replicas, the noise-free fit's, and how often it is
     resolved negative (one of choose_law's reasons for the decelerating branch)."""
@@ -232,28 +236,34 @@ def _paths(fits, exact) -> str:
                      f.one_law.dof) <= -2 for f in fits)
     return ("  paths: " + "; ".join(f"{k} {n}" for k, n in why.most_common())
             + f"\n  one law m_c {mc.mean():+.1f} ± {mc.std(ddof=1) / math.sqrt(mc.size):.1f} "
-            f"(noise-free {exact.one_law.comoving_mass:+.2f}; the wall {SCALE['mass']:g}), "
+            f"(noise-free {exact.one_law.comoving_mass:+.2f}; the wall {mass:g}), "
             f"below −2 s.e. in {neg}")
 
 
-def ensemble_table(laws, slip_counts, replicas: int, noises, shares=SHARES) -> None:
+def ensemble_table(laws, slip_counts, replicas: int, noises, shares=SHARES,
+                   scale: str = "klein") -> None:
     """The cycle ensemble's control table: verdict counts, bias and coverage of F_k and B
     (the decelerating branch and the one law) and of the loop step, the truth being the
     same fit of the noise-free slider (the law's own F_k, B for the linear laws); the
     verdicts' paths and the co-moving mass (:func:`_paths`)."""
     from filmfriction.analysis.groundtruth.slip_law_controls import dynamical_fits
+    sc = SCALES[scale]
+    table = NOISES if scale == "klein" else _variants(sc.noise, "md")
     cases = [(law, None) for law in laws] + [("coulomb-viscous", sh) for sh in shares]
     for noise in noises:
         for law, share in cases:
             name = law if share is None else f"{law} share {share}"
             for slips in slip_counts:
-                exact = dynamical_fits(law, 1, slips, noise=NOISE_FREE, share=share)[0]
-                fits = dynamical_fits(law, replicas, slips, noise=NOISES[noise], share=share,
-                                      unfitted=True)
+                exact = dynamical_fits(law, 1, slips, noise=NOISE_FREE, share=share,
+                                       scale=scale)[0]
+                fits = dynamical_fits(law, replicas, slips, noise=table[noise], share=share,
+                                      unfitted=True, scale=scale)
                 refused = sum(f is None for f in fits)
                 fits = [f for f in fits if f is not None]
                 c = Counter(f.verdict for f in fits) | Counter({"not fitted (< 3 slips)": refused})
-                print(f"\n## {name}, {slips} slips, noise {noise}, {replicas} replicas: "
+                print(f"\n## {name}, {slips} slips, noise {noise}"
+                      + (f" at the {scale} scale {table[noise]}" if scale != "klein" else "")
+                      + f", {replicas} replicas: "
                       + ", ".join(f"{k} {c[k]}" for k in (*VERDICTS, "not fitted (< 3 slips)")
                                   if c[k])
                       + f"; verdict from {dict(Counter(f.verdict_from for f in fits))}")
@@ -264,13 +274,14 @@ def ensemble_table(laws, slip_counts, replicas: int, noises, shares=SHARES) -> N
                 print(f"  loop step {_coverage(fits, 'step', '', exact.loop_step)}, resolved "
                       f"({RESOLVED_SIGMAS:.3g} σ) in "
                       f"{sum(abs(f.loop_step_sigmas) >= RESOLVED_SIGMAS for f in fits)}")
-                print(_paths(fits, exact), flush=True)
+                print(_paths(fits, exact, sc.mass), flush=True)
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--replicas", type=int, default=40)
-    ap.add_argument("--laws", nargs="+", default=list(CONTROLS), choices=list(CONTROLS))
+    ap.add_argument("--laws", nargs="+", default=None, choices=list(CONTROLS),
+                    help="the controls (default: all of the scale's)")
     ap.add_argument("--slips", nargs="+", type=int, default=[8, 30])
     ap.add_argument("--residual", action="store_true", help="only the residual of the replicas")
     ap.add_argument("--instrumented", action="store_true",
@@ -285,7 +296,13 @@ def main(argv=None) -> int:
                     help="with --ensemble: the Coulomb + viscous laws' viscous shares (none: no such rows)")
     ap.add_argument("--share", type=float, default=None,
                     help="with --residual: slips of F_k + B·v of this viscous share")
+    ap.add_argument("--scale", default="klein", choices=list(SCALES),
+                    help="with --ensemble: the controls' scale (stiff: the heavy slider's)")
     a = ap.parse_args(argv)
+    if a.laws is None:
+        a.laws = list(CONTROLS) if a.scale == "klein" else list(SCALES[a.scale].laws)
+    if a.scale != "klein" and not a.ensemble:
+        ap.error("--scale other than klein: with --ensemble only")
     if a.residual:
         residual(a.replicas, a.share)
         return 0
@@ -293,7 +310,7 @@ def main(argv=None) -> int:
         instrumented(a.laws, a.slips, a.replicas)
         return 0
     if a.ensemble:
-        ensemble_table(a.laws, a.slips, a.replicas, a.noises, a.shares)
+        ensemble_table(a.laws, a.slips, a.replicas, a.noises, a.shares, a.scale)
         return 0
     if a.cycle_mean:
         cycle_means(a.laws, a.slips, a.replicas)

@@ -158,3 +158,24 @@ def test_exact_coulomb_viscous_slips_by_their_share(share, verdict):
 def test_the_cycle_ensemble_refuses_too_few_slips():
     with pytest.raises(ValueError, match="needs 3 or more"):
         dynamical_fits("viscous", 1, 2, noise=NOISE_FREE)
+
+
+# --- the heavy slider's scale (SCALES["stiff"]: K = 8, M = 1e5, the mount dashpot 34 m/τ)
+
+@pytest.mark.parametrize("name, share, verdict, kinetic, damping", [
+    ("coulomb", None, "kinetic", 25.0, 0.0), ("viscous", None, "viscous", 0.0, 1788.9),
+    ("", 0.6, "mixed", 10.8, 952.9)])
+def test_stiff_scale_noise_free_controls_give_their_law_back(name, share, verdict, kinetic,
+                                                             damping):
+    # the slider's mount dashpot is the fit's: the law comes back exactly
+    fit = dynamical_fits(name, 1, 8, noise=NOISE_FREE, share=share, scale="stiff")[0]
+    assert fit.verdict == verdict
+    assert fit.decelerating.kinetic_force == pytest.approx(kinetic, abs=0.05)
+    assert fit.decelerating.damping == pytest.approx(damping, abs=1.0)
+
+
+def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
+    # 0 of 200 at 8 and 30 slips (docs/results/slip-law.md, "Controls at the heavy
+    # slider's scale"); 20 replicas of 8 slips here
+    fits = dynamical_fits("coulomb", 20, 8, scale="stiff")
+    assert not any(f.verdict == "viscous" for f in fits), Counter(f.verdict for f in fits)
