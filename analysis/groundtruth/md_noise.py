@@ -150,9 +150,9 @@ def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = No
     gives a run (the start-up slip left out).  At ``scale`` (a name of
     :data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`; ``duration``
     None: long enough for ``slips`` slips) its mount dashpot and drive are the slips'."""
-    from .slip_law_controls import _scale, random_force_runs
+    from .slip_law_controls import random_force_runs, scale_named
 
-    sc = _scale(scale)
+    sc = scale_named(scale)
     runs, vd = random_force_runs(law, replicas, duration=duration, noise=noise, seed=seed,
                                  share=share, scale=sc, slips=slips)
     extra = {"mount_damping": sc.mount_damping, "drive_velocity": vd} if sc.mount_damping else {}

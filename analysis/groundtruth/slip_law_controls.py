@@ -57,7 +57,7 @@ from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "CONTROLS",
+__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "scale_named", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -185,7 +185,12 @@ SCALES = {
 }
 
 
-def _scale(scale) -> Scale:
+def scale_named(scale) -> Scale:
+    """The :class:`Scale` ``scale`` names (a key of :data:`SCALES`), or ``scale`` itself.
+
+    >>> scale_named("stiff").spring_constant
+    8.0
+    """
     if isinstance(scale, Scale):
         return scale
     if scale not in SCALES:
@@ -295,7 +300,7 @@ def _dynamical_law(name: str, share: float | None = None, scale: str | Scale = "
     control ``name`` (or :func:`coulomb_viscous` of ``share``) at ``scale`` (a name of
     :data:`SCALES` or a :class:`Scale`): the law, its yield and re-stick, and ``period``,
     a slip cycle's length or a little more."""
-    sc = _scale(scale)
+    sc = scale_named(scale)
     if sc.name != "klein":
         return sc.law(name, share)
     s = SCALE
@@ -335,7 +340,7 @@ def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: flo
     force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`), long enough for
     ``slips`` slips after the start-up one (or ``duration`` long), and the law's drive
     velocity."""
-    sc = _scale(scale)
+    sc = scale_named(scale)
     noise = sc.noise if noise is None else noise
     law = _dynamical_law(name, share, sc)
     period = law.pop("period")
@@ -367,7 +372,7 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
     the fit's) the replicas are slid ``Scale.chunk`` at a time, chunk j from the seed
     (``seed``, j) (at the Klein-similar scale all at once from ``seed``).
     """
-    sc = _scale(scale)
+    sc = scale_named(scale)
     fitter = (partial(fit_cycle_ensemble, min_window_time=MD_NOISE_TIME) if ensemble
               else fit_film_force)
     if sc.mount_damping:
