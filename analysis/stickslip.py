@@ -162,10 +162,17 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     correlated noise sampled finely (an MD wall's thermal vibration with
     ``trace_every`` well below its period), whose dips would be counted as
     slips; where its search reached the longest lag with s(L) still growing,
-    it is a lower bound.  There the threshold is also at least k' times the
-    noise's scale at its own time scale L (:func:`increment_noise`, read from the
-    trace's increments, which needs no slips found first and so cannot be raised
-    by slips that were missed), k' from N/L independent samples.  A trace that is
+    it is a lower bound.  There the slips found set a second floor: what does not
+    repeat from one cycle to the next (:func:`cycle_noise`) is noise too.  Where it
+    exceeds σ by more than :data:`CYCLE_NOISE_FACTOR` (it also holds the slips' own
+    variation from cycle to cycle, so within that factor the two agree), ``h`` is
+    raised to k times it and the scan repeated (at most :data:`RAISES` times).  Each
+    raise re-estimates it from the slips the last scan kept, and a slip that scan
+    missed counts as noise in the next estimate, so on slips of irregular size the
+    raises would feed on themselves: ``h`` is capped at k' times the noise's scale at
+    its own time scale L, read from the trace's increments (:func:`increment_noise`,
+    which needs no slips found first; k' from N/L independent samples).  Where fewer
+    than 2 slips are left to compare cycles, the cap sets ``h``.  A trace that is
     rough at its sampling keeps its local estimate (it sees white and correlated
     noise alike): an irregular noise-free sawtooth is not noise.
 
@@ -223,8 +230,7 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     lag, blind = 1, False
     if noise is None:
         noise, lag, blind = noise_level_and_bound(f, time=t)
-    n_eff = max(f.size / lag, 2.0)
-    kk = (2.0 * math.sqrt(2.0 * math.log(n_eff)) + 1.0) if k is None else k
+    kk = _peak_to_trough(f.size / lag) if k is None else k
     threshold_given = threshold
     if threshold is None:
         lo, hi = np.percentile(f, [0.5, 99.5])
@@ -239,8 +245,7 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         # repeat from cycle to cycle is noise too, and so are the increments at the
         # noise's own time scale, which cap it
         inc, inc_lag = increment_noise(f)
-        k_inc = 2.0 * math.sqrt(2.0 * math.log(max(f.size / inc_lag, 2.0))) + 1.0
-        cap = max(h, (k_inc if k is None else k) * inc)
+        cap = max(h, (_peak_to_trough(f.size / inc_lag) if k is None else k) * inc)
         for _ in range(RAISES):
             # with fewer than 2 slips left there is no cycle to compare: the cap
             cyc = max(cyc, cycle_noise(t, f, yi)) if yi.size >= 2 else math.inf
@@ -251,6 +256,12 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
             yi, si, unfinished = _scan(t, f, h, min_drop, relative_drop, ringing_window)
         cyc = cyc if math.isfinite(cyc) else 0.0
     return SlipEvents(yi, si, h, float(noise), unfinished, lag, cyc, inc)
+
+
+def _peak_to_trough(n_eff: float) -> float:
+    """k = 2 √(2 ln N_eff) + 1: the largest peak-to-trough excursion of N_eff independent
+    Gaussian samples, in σ, with a margin of one σ (N_eff at least 2)."""
+    return 2.0 * math.sqrt(2.0 * math.log(max(n_eff, 2.0))) + 1.0
 
 
 def _scan(t, f, h, min_drop, relative_drop, ringing_window):

@@ -345,9 +345,9 @@ def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: flo
     law = _dynamical_law(name, share, sc)
     period = law.pop("period")
     duration = (slips + 3) * period * 1.3 if duration is None else duration
-    extra = {"mount_damping": sc.mount_damping} if sc.mount_damping else {}
     runs = slide(**law, mass=sc.mass, stiffness=sc.spring_constant, duration=duration,
-                 dt=sc.dt, replicas=replicas, seed=seed, **extra, **noise)
+                 dt=sc.dt, replicas=replicas, seed=seed, mount_damping=sc.mount_damping,
+                 **noise)
     return runs, law["drive_velocity"]
 
 

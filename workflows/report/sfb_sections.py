@@ -141,8 +141,8 @@ def _bingham_reading(rows) -> str:
                  "controls at that scale give a run of 7–10 slips no power to resolve a viscous "
                  "share (purely viscous slips `viscous` in 11 % of replicas; Coulomb slips never "
                  "`viscous`): the verdict there is not established. At lighter sliders on the "
-                 "same film, eight runs a rung, n is 0.2–0.4 at slip velocities from 0.3 to "
-                 "0.05 σ/τ (Bi 3–17): a sliding force that grows with the velocity far more "
+                 "same film, six to eight runs a rung, n is 0.2–0.4 at slip velocities from 0.3 to "
+                 "0.04 σ/τ (Bi 3–18): a sliding force that grows with the velocity far more "
                  "weakly than a viscous film's (n = 1) and more than a kinetic friction force "
                  "(n = 0). What reaching Klein's Bi would cost: docs/results/mass-ladder.md "
                  "(\"Going further\").")
