@@ -76,7 +76,7 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inpu
                        fit_segments, jackknife_fit, smoothing_samples)
 from .slip_law_branches import Segment
 
-__all__ = ["fit_cycle_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
+__all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
 MIN_CYCLES = 3
@@ -208,7 +208,24 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     dt = float(dts[0])
     window = max(smoothing_samples(t, table, smoothing), int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
-    n = int(keep.sum())
+    return fit_held_ensemble(held, np.arange(int(keep.sum())), window=window, dt=dt, mass=mass,
+                             min_velocity_fraction=min_velocity_fraction,
+                             comoving_mass=comoving_mass, replicas="slips")
+
+
+def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float,
+                      min_velocity_fraction: float = 0.2, comoving_mass: bool = False,
+                      replicas: str = "slips") -> FilmForceFit:
+    """The fit of the mean of held slips (:func:`held_slips`' arrays, shape (slips, lags)),
+    the errors by the jackknife over the groups of slips that ``groups`` labels (one label
+    per slip: each slip its own for one run, the run for slips pooled over runs) — the
+    means that leave one group out, G − 1 degrees of freedom.  ``window``: the mean's
+    velocity's smoothing in samples of ``dt``; ``replicas`` names the groups."""
+    groups = np.asarray(groups)
+    labels = list(dict.fromkeys(groups.tolist()))
+    if len(labels) < 2:
+        raise ValueError(f"{len(labels)} group(s) of slips: the jackknife needs 2 or more")
+    n = groups.size
     # the peak and the fitted lags are the whole ensemble's, for its fit and for the
     # jackknife's (the errors are the data's, not a re-selection's)
     p, peak, lags = _selection(_guide(held["displacement"].mean(axis=0), window, dt), window,
@@ -223,6 +240,10 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
         return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
                             smoothing_window=window)
 
-    loo = [fit({k: (total[k] - held[k][i]) / (n - 1) for k in keys}) for i in range(n)]
+    loo = []
+    for g in labels:
+        out = groups == g
+        loo.append(fit({k: (total[k] - held[k][out].sum(axis=0)) / (n - int(out.sum()))
+                        for k in keys}))
     return jackknife_fit(fit({k: total[k] / n for k in keys}), loo, mass=mass,
-                         replicas="slips")
+                         replicas=replicas)

@@ -22,6 +22,8 @@ COMMANDS = {
     "analyze": "filmfriction.workflows.cli.analyze_cli",
     "map": "filmfriction.workflows.cli.map_cli",
     "calibrate": "filmfriction.workflows.cli.calibrate_cli",
+    # the slip law of several runs pooled
+    "slip-law": "filmfriction.workflows.cli.slip_law_cli",
     "sfb": "filmfriction.workflows.cli.sfb_cli",
     "report": "filmfriction.workflows.cli.report_cli",
     "tradeoff": "filmfriction.workflows.cli.tradeoff_cli",

@@ -1,0 +1,90 @@
+"""Controls of the slip law pooled over runs: known laws, several runs of each, and how often
+each verdict comes out and how often the errors cover the truth.
+
+The pooled fit (:mod:`~filmfriction.analysis.slip_law.slip_law_pooled`) is the mean of the
+slips of G runs with the jackknife over the runs.  Each control replica here is G runs of
+one law at a scale of :data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`
+(the heavy slider's by default), slid by the random-force slider
+(:func:`~filmfriction.analysis.groundtruth.random_force.slide`) with the scale's noise,
+each run with its own noise and, as the MD's runs of one scene, its own yield force
+(``static_spread``: uniform within ± that share of the scale's; the MD's six K = 8 runs
+yield at 30–60 ε/σ) and, with ``law_spread``, its own film (the law's parameters times
+1 + law_spread·z, z standard normal per run: runs that differ by more than their noise,
+whose mean law is the truth).  The slips are the slider's own (the detector is not under
+test); each run's start-up slip is left out and its next ``slips`` fitted.
+
+Example
+-------
+>>> fits = pooled_fits("viscous", replicas=1, runs=3, slips=3)
+>>> fits[0].law.slips, fits[0].law.reason.count("runs")
+(3, 1)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from filmfriction.reduced_model.cycles import cycle_table
+
+from ..slip_law.slip_law import FilmForceFit
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME
+from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
+from .random_force import slide
+from .slip_law_controls import Scale, scale_named
+
+__all__ = ["pooled_runs", "pooled_fits", "STATIC_SPREAD"]
+
+#: The runs' yield forces spread uniformly within ± this share of the scale's (the MD's six
+#: K = 8 runs: 30–60 ε/σ about 45).
+STATIC_SPREAD = 0.3
+
+
+def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,
+                scale: str | Scale = "stiff", static_spread: float = STATIC_SPREAD,
+                law_spread: float = 0.0, noise: dict | None = None,
+                seed=0) -> tuple[list[RunSlips], float]:
+    """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
+    at ``scale``, each with its yield force and film (module text), as the pooled fit takes
+    them, and the drive velocity.  ``seed``: an int or a tuple of ints."""
+    if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
+        raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
+                         "each in [0, 1)")
+    sc = scale_named(scale)
+    law = sc.law(name, share)
+    period = law.pop("period")
+    noise = sc.noise if noise is None else noise
+    key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
+    rng = np.random.default_rng(key + [7919])
+    out = []
+    for g in range(runs):
+        fs = law["static_force"] * (1 + static_spread * rng.uniform(-1, 1))
+        par = tuple(float(p) * (1 + law_spread * rng.standard_normal())
+                    for p in law["parameters"])
+        r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
+                  stiffness=sc.spring_constant,
+                  duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,
+                  seed=tuple(key + [g]), mount_damping=sc.mount_damping, **noise)[0]
+        tab = cycle_table(r["time"], r["spring_force"], r["yield_index"], r["stick_index"],
+                          spring_constant=sc.spring_constant,
+                          wall_position=r["wall_position"])[1:slips + 1]
+        out.append(RunSlips(r["time"], r["spring_force"], r["wall_velocity"], tab,
+                            wall_position=r["wall_position"], name=f"run {g + 1}"))
+    return out, law["drive_velocity"]
+
+
+def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
+                share: float | None = None, scale: str | Scale = "stiff",
+                static_spread: float = STATIC_SPREAD, law_spread: float = 0.0,
+                noise: dict | None = None, seed: int = 0,
+                jackknife: str = "runs") -> list[FilmForceFit]:
+    """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``) of
+    ``replicas`` replicas of :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
+    sc = scale_named(scale)
+    out = []
+    for k in range(replicas):
+        rs, velocity = pooled_runs(name, runs, slips, share=share, scale=sc,
+                                   static_spread=static_spread, law_spread=law_spread,
+                                   noise=noise, seed=(seed, k))
+        out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
+                                       mount_damping=sc.mount_damping,
+                                       min_window_time=MD_NOISE_TIME, jackknife=jackknife))
+    return out

@@ -1,0 +1,168 @@
+"""The slip law of several runs of one scene pooled: the mean of all their slips, errors by
+the jackknife over the runs.
+
+One driven run of the heavy slider holds 7–10 slips, too few for the slip-law test to
+have power (docs/results/slip-law.md, "Controls at the heavy slider's scale": Klein's
+viscous slips read ``viscous`` in 22 of 200 runs of 8 slips, in 186 of 200 of 30), and
+runs of one scene that differ only in their seed differ by more than the jackknife over
+each run's slips says (their exponents scatter with χ² 36 over 5 degrees of freedom:
+docs/results/mass-ladder.md).  Runs of one scene (the same slider mass, spring, drive,
+mount dashpot and sampling) are replicas of one experiment: their slips, each aligned
+at its yield and held at its end (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.held_slips`),
+are one ensemble, whose mean obeys the law as each slip does (the integrated equation of
+motion is linear).  The mean of all the slips is fitted as one slip
+(:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_held_ensemble`), and the
+errors are the jackknife's over the runs, the means that leave one run out (G − 1
+degrees of freedom for G runs): whatever makes runs differ — their yield forces, the
+film's state after each start-up, which slips the detector took — enters the errors,
+which the jackknife over slips, treating the slips as independent, leaves out.  The
+verdict and its power follow from those errors as for one run.
+
+The controls at the heavy slider's scale check it
+(:mod:`~filmfriction.analysis.groundtruth.pooled_controls`, ``python
+benchmarks/slip_law/pooled_controls_rates.py``; docs/results/slip-law.md, "Runs pooled").
+
+Example
+-------
+Three noise-free runs of a Coulomb + viscous slider (F_k = 20, B = 15) pooled give the
+law back:
+
+>>> from filmfriction.analysis.groundtruth.random_force import slide
+>>> from filmfriction.reduced_model.cycles import cycle_table
+>>> runs = []
+>>> for f0 in (30.0, 33.0, 36.0):
+...     r = slide("coulomb-viscous", (20.0, 15.0), mass=30.0, stiffness=2.0,
+...               drive_velocity=0.1, static_force=48.0, armed_below=34.0, initial_force=f0,
+...               stop_velocity=0.15, duration=700.0, dt=0.25)[0]
+...     tab = cycle_table(r["time"], r["spring_force"], r["yield_index"], r["stick_index"],
+...                       spring_constant=2.0)[1:]
+...     runs.append(RunSlips(r["time"], r["spring_force"], r["wall_velocity"], tab,
+...                          wall_position=r["wall_position"]))
+>>> fit = fit_pooled_ensemble(runs, mass=30.0, drive_velocity=0.1)
+>>> round(fit.kinetic_force, 2), round(fit.damping, 2), fit.law.slips
+(20.0, 15.0, 3)
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from filmfriction.reduced_model.cycles import CycleTable
+
+from .slip_law import MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs
+from .slip_law_cycles import fit_held_ensemble, held_slips
+
+__all__ = ["RunSlips", "fit_pooled_ensemble", "MIN_RUNS", "JACKKNIFE"]
+
+#: The fewest runs pooled: the jackknife over runs has G − 1 degrees of freedom.
+MIN_RUNS = 3
+#: The replicas of the jackknife: the runs, or the slips as if they were one run's.
+JACKKNIFE = ("runs", "slips")
+
+
+@dataclass(frozen=True)
+class RunSlips:
+    """One run's trace and its analysed slips (the start-up slip left out): the time,
+    the spring force, the wall's velocity (and position: the integral of the velocity
+    when None), the slips' table; ``name`` says which run in errors."""
+
+    time: np.ndarray
+    spring_force: np.ndarray
+    wall_velocity: np.ndarray
+    table: CycleTable
+    wall_position: np.ndarray | None = None
+    name: str = ""
+
+
+def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
+          min_velocity_fraction, smoothing) -> tuple[dict, float, np.ndarray]:
+    """The run's slips held at their ends, its sampling interval and its slips' durations
+    (ValueError naming the run when its sampling is not uniform or no slip is left)."""
+    name = run.name or f"run {i + 1}"
+    try:
+        t, f, v, x = checked_fit_inputs(run.time, run.spring_force, run.wall_velocity,
+                                        run.wall_position, mass,
+                                        min_velocity_fraction=min_velocity_fraction,
+                                        smoothing=smoothing)
+    except ValueError as err:
+        raise ValueError(f"{name}: {err}") from None
+    dts = np.diff(t)
+    if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
+        raise ValueError(f"{name}: the pooled slips need a uniform sampling")
+    tab = run.table
+    fs, fb = (np.asarray(tab.static_force, float), np.asarray(tab.backward_force, float))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        relaxed = (fs - fb) / np.abs(fs)
+    y, s = np.asarray(tab.yield_index, int), np.asarray(tab.stick_index, int)
+    keep = (relaxed >= MIN_RELAXATION) & (s > y)
+    if not keep.any():
+        raise ValueError(f"{name}: no slip relaxes the spring by {100 * MIN_RELAXATION:g} % "
+                         f"or more ({len(tab)} in its table)")
+    held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
+                      drive_velocity=drive_velocity)
+    return held, float(dts[0]), t[s[keep]] - t[y[keep]]
+
+
+def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
+                        mount_damping: float = 0.0, min_velocity_fraction: float = 0.2,
+                        smoothing: float = SMOOTHING, comoving_mass: bool = False,
+                        min_window_time: float = 0.0, jackknife: str = "runs") -> FilmForceFit:
+    """The slip law of the mean of the slips of ``runs`` (module text), errors by the
+    jackknife over the runs.
+
+    Parameters
+    ----------
+    runs : sequence of RunSlips
+        :data:`MIN_RUNS` or more runs of one scene, sampled at one interval.
+    mass, drive_velocity, mount_damping, min_velocity_fraction, smoothing, comoving_mass, min_window_time
+        As for :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`
+        (the runs share them); the window is ``smoothing`` of the median slip of all runs.
+    jackknife : {"runs", "slips"}
+        The jackknife's replicas: the runs (the errors), or each slip on its own (as if
+        the slips were one run's: the comparison that leaves the runs' differences out).
+
+    Returns
+    -------
+    FilmForceFit
+        The mean's fit; its errors, verdict and power the jackknife's over the runs (the
+        per-slip arrays hold one pseudo-value per run, ``slips`` counts the runs).
+
+    Raises
+    ------
+    ValueError
+        Fewer than :data:`MIN_RUNS` runs, runs sampled at different intervals, a run with
+        no slip that relaxes the spring.
+    """
+    runs = list(runs)
+    if jackknife not in JACKKNIFE:
+        raise ValueError(f"jackknife = {jackknife!r}: one of {', '.join(JACKKNIFE)}")
+    if len(runs) < MIN_RUNS:
+        raise ValueError(f"{len(runs)} run(s): pooling needs {MIN_RUNS} or more (the "
+                         "jackknife over runs)")
+    if not (math.isfinite(min_window_time) and min_window_time >= 0):
+        raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
+    parts = [_held(r, i, mass=mass, drive_velocity=drive_velocity, mount_damping=mount_damping,
+                   min_velocity_fraction=min_velocity_fraction, smoothing=smoothing)
+             for i, r in enumerate(runs)]
+    dt = parts[0][1]
+    for i, (_, d, _) in enumerate(parts):
+        if not math.isclose(d, dt, rel_tol=1e-6):
+            raise ValueError(f"{runs[i].name or f'run {i + 1}'} is sampled every {d:g}, "
+                             f"{runs[0].name or 'run 1'} every {dt:g}: pooled runs share "
+                             "one sampling")
+    lags = max(h["impulse"].shape[1] for h, _, _ in parts)
+    held = {k: np.concatenate([np.pad(h[k], ((0, 0), (0, lags - h[k].shape[1])), mode="edge")
+                               for h, _, _ in parts])
+            for k in ("impulse", "velocity", "displacement", "slipping_time")}
+    groups = (np.concatenate([np.full(h["impulse"].shape[0], i) for i, (h, _, _) in
+                              enumerate(parts)])
+              if jackknife == "runs" else np.arange(held["impulse"].shape[0]))
+    durations = np.concatenate([d for _, _, d in parts])
+    window = int(round(smoothing * float(np.median(durations)) / dt)) if smoothing > 0 else 0
+    window = max(window if window >= 5 else 0, int(math.ceil(min_window_time / dt)))
+    window += (1 - window % 2) if window else 0
+    return fit_held_ensemble(held, groups, window=window, dt=dt, mass=mass,
+                             min_velocity_fraction=min_velocity_fraction,
+                             comoving_mass=comoving_mass, replicas=jackknife)

@@ -1,0 +1,70 @@
+"""The slip law of runs pooled (analysis/slip_law/slip_law_pooled.py) on runs of known law.
+
+Noise-free runs of the heavy slider's controls, each with its own yield force, pooled:
+the mean gives the law back whatever the runs' slip sizes; the jackknife is over the runs
+(G − 1 degrees of freedom) or, asked, over the slips; the inputs the pooling cannot take
+are refused with the run named.  The verdicts' rates and the errors' coverage on noisy
+runs: docs/results/slip-law.md, "Runs pooled" (benchmarks/slip_law/pooled_controls_rates.py).
+"""
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from filmfriction.analysis.groundtruth.pooled_controls import pooled_fits, pooled_runs
+from filmfriction.analysis.groundtruth.slip_law_controls import STIFF_B, SCALES
+from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
+from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
+
+QUIET = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
+STIFF = SCALES["stiff"]
+
+
+def _fit(runs, velocity, **kw):
+    return fit_pooled_ensemble(runs, mass=STIFF.mass, drive_velocity=velocity,
+                               mount_damping=STIFF.mount_damping,
+                               min_window_time=MD_NOISE_TIME, **kw)
+
+
+@pytest.mark.parametrize("law, fk, b", [("viscous", 0.0, STIFF_B), ("coulomb", 25.0, 0.0)])
+def test_noise_free_runs_of_different_yield_give_the_law(law, fk, b):
+    runs, v = pooled_runs(law, 4, 3, noise=QUIET, static_spread=0.3, seed=1)
+    sizes = [float(np.median(r.table.static_force)) for r in runs]
+    assert max(sizes) - min(sizes) > 5.0          # the runs do differ
+    fit = _fit(runs, v)
+    assert fit.decelerating.kinetic_force == pytest.approx(fk, abs=0.05)
+    assert fit.decelerating.damping == pytest.approx(b, abs=2.0)
+    assert fit.decelerating.slips == 4 and fit.decelerating.dof == 3
+
+
+def test_jackknife_over_slips_counts_the_slips_and_keeps_the_estimate():
+    runs, v = pooled_runs("viscous", 3, 3, seed=2)
+    by_runs, by_slips = _fit(runs, v), _fit(runs, v, jackknife="slips")
+    n = sum(len(r.table) for r in runs)
+    assert by_slips.decelerating.slips == n and by_runs.decelerating.slips == 3
+    assert by_slips.decelerating.damping == by_runs.decelerating.damping
+    assert by_slips.decelerating.damping_stderr != by_runs.decelerating.damping_stderr
+
+
+def test_noisy_pooled_runs_are_named_by_their_law():
+    # 6 runs x 8 slips at the heavy slider's calibrated noise: Klein's viscous slips are
+    # not called kinetic and Coulomb's not viscous (the rates: docs/results/slip-law.md)
+    for law, never in (("viscous", "kinetic"), ("coulomb", "viscous")):
+        verdicts = [f.verdict for f in pooled_fits(law, 3, runs=6, slips=8, seed=5)]
+        assert never not in verdicts, (law, verdicts)
+
+
+def test_refusals_name_the_run():
+    runs, v = pooled_runs("viscous", 3, 2, noise=QUIET, seed=3)
+    with pytest.raises(ValueError, match="2 run.*3 or more"):
+        _fit(runs[:2], v)
+    coarse = replace(runs[1], time=runs[1].time * 2.0, name="seed 7")
+    with pytest.raises(ValueError, match="seed 7 is sampled every 0.5"):
+        _fit([runs[0], coarse, runs[2]], v)
+    none = replace(runs[2], table=runs[2].table[:0], name="seed 9")
+    with pytest.raises(ValueError, match="seed 9: no slip"):
+        _fit([runs[0], runs[1], none], v)
+    with pytest.raises(ValueError, match="jackknife = 'seeds'"):
+        _fit(runs, v, jackknife="seeds")
+    assert math.isfinite(_fit(runs, v).damping)

@@ -1,0 +1,40 @@
+"""filmfriction slip-law: runs pooled from their directories, and the inputs it refuses."""
+import json
+
+import pytest
+
+from filmfriction.analysis.groundtruth.synthetic import run_directory
+from filmfriction.workflows.cli.main import main
+
+
+@pytest.fixture
+def runs(tmp_path):
+    return [run_directory(tmp_path / f"seed{i}", trajectory=False, seed=i) for i in range(3)]
+
+
+def test_pooled_runs_printed_and_written(runs, tmp_path, capsys):
+    out = tmp_path / "doc" / "pooled.json"
+    assert main(["slip-law", *map(str, runs), "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("pooled, jackknife over runs (3 runs, 2 dof):")
+    assert "jackknife over slips (comparison) (9 slips, 8 dof)" in text
+    doc = json.loads(out.read_text())
+    assert doc["schema"] == "filmfriction.slip_law_pooled/1" and doc["slips"] == 9
+    assert [r["slips"] for r in doc["runs"]] == [3, 3, 3]
+    # the synthetic runs are Klein's viscous slips, B = 40 m/τ
+    assert doc["pooled"]["damping"]["mean"] == pytest.approx(40.0, rel=0.05)
+    assert doc["pooled"]["damping"]["units"] == "m/τ"
+
+
+def test_runs_of_different_sliders_refused(runs, capsys):
+    doc = json.loads((runs[2] / "run.json").read_text())
+    doc["trace_parameters"]["mass"] = 250.0
+    (runs[2] / "run.json").write_text(json.dumps(doc))
+    assert main(["slip-law", *map(str, runs)]) == 2
+    err = capsys.readouterr().err
+    assert f"{runs[2]}: mass = 250.0" in err and "500.0" in err and "Traceback" not in err
+
+
+def test_two_runs_refused(runs, capsys):
+    assert main(["slip-law", *map(str, runs[:2])]) == 2
+    assert "pooling needs 3 or more" in capsys.readouterr().err
