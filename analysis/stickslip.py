@@ -311,9 +311,13 @@ def _drop_ringing(t, f, yi, si, window):
         slip = t[si[j]] - t[yi[j]]
         drop = f[yi[i]] - f[si[i]]
         if stick < window * slip and drop < 0.5 * (f[yi[j]] - f[si[j]]):
-            back = np.flatnonzero(f[si[i]:] >= f[yi[i]])
-            regained = t[si[i] + back[0]] - t[si[i]] if back.size else math.inf
-            if not rate > 0.0 or regained < 0.75 * drop / rate:
+            if not rate > 0.0:
+                continue
+            # a bounce regains its yield force sooner than the drive could reload it:
+            # only the samples within that time are searched
+            reload = 0.75 * drop / rate
+            end = int(np.searchsorted(t, t[si[i]] + reload, side="left"))
+            if np.any(f[si[i]:end] >= f[yi[i]]):
                 continue
         kept.append(i)
     return yi[kept], si[kept]
