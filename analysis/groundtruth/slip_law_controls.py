@@ -124,20 +124,25 @@ class Scale:
     chunk: int = 0
 
     def law(self, name: str, share: float | None = None) -> dict:
-        """:func:`_dynamical_law` at this scale."""
+        """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
+        control ``name`` (or the Coulomb + viscous law of viscous ``share``) at this scale:
+        the law, its yield and re-stick, and ``period``, a slip cycle's length or a little
+        more."""
         if share is not None:
             if not 0 <= share <= 1:
                 raise ValueError(f"share = {share!r}: must be in [0, 1]")
             m = dict(self.mix)
             f, v = m.pop("film_force"), m.pop("slip_velocity")
-            return dict(law="coulomb-viscous", parameters=((1 - share) * f, share * f / v),
-                        static_force=self.static_force, drive_velocity=self.drive_velocity,
-                        **m)
+            return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
+                    "law": "coulomb-viscous", "parameters": ((1 - share) * f, share * f / v),
+                    **m}
         if name not in self.laws:
             raise ValueError(f"control {name!r} at the {self.name} scale: one of "
                              f"{', '.join(self.laws)}")
-        return dict(self.laws[name], static_force=self.static_force,
-                    drive_velocity=self.drive_velocity)
+        # a law's own yield force or drive (the Klein-similar scale's weakening law is
+        # driven faster) overrides the scale's
+        return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
+                **self.laws[name]}
 
 
 #: The heavy slider's scale, the scene ``sfb-thick-stiff`` (K = 8 ε/σ², M = 10⁵ m, V = 0.0025
@@ -167,9 +172,34 @@ STIFF_BACKWARD = 8.0
 STIFF_STOP = 0.004
 
 #: The scales of the random-force controls, by name.
+#: The controls' laws as the random-force slider integrates them: the rate-and-state slider
+#: yields from, and re-sticks at, this velocity (σ/τ).
+RATE_STATE_CREEP = 0.01
+
 SCALES = {
-    "klein": Scale("klein", SCALE["spring_constant"], SCALE["mass"], SCALE["dt"],
-                   SCALE["static_force"], 0.1, MD_NOISE),
+    "klein": Scale(
+        "klein", SCALE["spring_constant"], SCALE["mass"], SCALE["dt"], SCALE["static_force"],
+        0.1, MD_NOISE,
+        # Coulomb: F_k while slipping, whatever the sign of a recoil the random force gives
+        # the wall: the law is F_k + 0·v on every sample (F_k·sign(v) would make the
+        # noise-averaged force grow with v, a law of its own: docs/results/slip-law.md)
+        laws={"coulomb": dict(law="linear", parameters=(36.0, 0.0), armed_below=36.0,
+                              period=135.0),
+              "weakening": dict(law="weakening", parameters=(25.0, 48.0, 1.0), armed_below=27.5,
+                                drive_velocity=0.3, period=90.0),
+              "viscous": dict(law="linear",
+                              parameters=(0.0, 2 * 4.0 * math.sqrt(SCALE["spring_constant"]
+                                                                 * SCALE["mass"])),
+                              backward_force=24.0, stop_velocity=-math.inf, initial_force=24.0,
+                              period=150.0),
+              # the rate-and-state slider yields where its law's force at the creep
+              # velocity and the aged state is reached: no yield force of its own
+              "rate-state": dict(law="rate-state", parameters=(36.0, 1.0, 4.0, 1.0, 0.1),
+                                 static_force=math.inf, start_velocity=RATE_STATE_CREEP,
+                                 stop_velocity=RATE_STATE_CREEP, armed_below=30.5,
+                                 initial_force=36.0, period=180.0)},
+        mix=dict(film_force=28.0, slip_velocity=0.55, backward_force=20.0, stop_velocity=0.15,
+                 armed_below=34.0, initial_force=20.0, period=150.0)),
     "stiff": Scale(
         "stiff", 8.0, 1e5, 0.25, 45.0, 0.0025,
         STIFF_NOISE,
@@ -290,47 +320,6 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
     return out
 
 
-#: The controls' laws as the random-force slider integrates them (:func:`_dynamical_law`):
-#: the rate-and-state slider yields from, and re-sticks at, this velocity (σ/τ).
-RATE_STATE_CREEP = 0.01
-
-
-def _dynamical_law(name: str, share: float | None = None, scale: str | Scale = "klein") -> dict:
-    """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
-    control ``name`` (or :func:`coulomb_viscous` of ``share``) at ``scale`` (a name of
-    :data:`SCALES` or a :class:`Scale`): the law, its yield and re-stick, and ``period``,
-    a slip cycle's length or a little more."""
-    sc = scale_named(scale)
-    if sc.name != "klein":
-        return sc.law(name, share)
-    s = SCALE
-    fs = s["static_force"]
-    if share is not None:
-        return dict(law="coulomb-viscous", parameters=((1 - share) * 28.0, share * 28.0 / 0.55),
-                    static_force=fs, backward_force=20.0, stop_velocity=0.15,
-                    armed_below=34.0, initial_force=20.0, drive_velocity=0.1, period=150.0)
-    if name == "coulomb":
-        # F_k while slipping, whatever the sign of a recoil the random force gives the wall:
-        # the law is F_k + 0·v on every sample (F_k·sign(v) would make the noise-averaged
-        # force grow with v, a law of its own: docs/results/slip-law.md)
-        return dict(law="linear", parameters=(36.0, 0.0), static_force=fs,
-                    armed_below=36.0, drive_velocity=_DRIVE[name], period=135.0)
-    if name == "weakening":
-        return dict(law="weakening", parameters=(25.0, 48.0, 1.0), static_force=fs,
-                    armed_below=27.5, drive_velocity=_DRIVE[name], period=90.0)
-    if name == "viscous":
-        b = 2 * 4.0 * math.sqrt(s["spring_constant"] * s["mass"])
-        return dict(law="linear", parameters=(0.0, b), static_force=fs, backward_force=24.0,
-                    stop_velocity=-math.inf, initial_force=24.0, drive_velocity=_DRIVE[name],
-                    period=150.0)
-    if name == "rate-state":
-        return dict(law="rate-state", parameters=(36.0, 1.0, 4.0, 1.0, 0.1),
-                    start_velocity=RATE_STATE_CREEP, stop_velocity=RATE_STATE_CREEP,
-                    armed_below=30.5, initial_force=36.0, drive_velocity=_DRIVE[name],
-                    period=180.0)
-    raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
-
-
 def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: float | None = None,
                       noise: dict | None = None, seed: int = 0, share: float | None = None,
                       scale: str | Scale = "klein") -> tuple[list[dict], float]:
@@ -342,7 +331,7 @@ def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: flo
     velocity."""
     sc = scale_named(scale)
     noise = sc.noise if noise is None else noise
-    law = _dynamical_law(name, share, sc)
+    law = sc.law(name, share)
     period = law.pop("period")
     duration = (slips + 3) * period * 1.3 if duration is None else duration
     runs = slide(**law, mass=sc.mass, stiffness=sc.spring_constant, duration=duration,

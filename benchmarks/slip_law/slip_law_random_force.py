@@ -43,7 +43,7 @@ from scipy.integrate import cumulative_trapezoid
 from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residual_statistics
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.slip_law_controls import (
-    CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, SCALES, _dynamical_law, control_fits)
+    CONTROLS, MD_NOISE, RESIDUAL_AS_NOISE, SCALE, SCALES, control_fits)
 from filmfriction.analysis.slip_law.slip_law import RESOLVED_SIGMAS, VERDICTS, fit_film_force
 from filmfriction.reduced_model.cycles import cycle_table
 
@@ -159,7 +159,7 @@ def instrumented_fit(run: dict, slips: int, floor: float = 0.2, edge: int = 3) -
 def _prototype_runs(law: str, slips: int, replicas: int):
     """The random-force replicas of control ``law`` long enough for ``slips`` slips (the
     prototypes' input) and the law's drive velocity."""
-    args = _dynamical_law(law)
+    args = SCALES["klein"].law(law)
     period = args.pop("period")
     runs = slide(**args, mass=SCALE["mass"], stiffness=SCALE["spring_constant"],
                  duration=(slips + 3) * period * 1.3, dt=SCALE["dt"],
