@@ -23,7 +23,9 @@ newest restart file).  ``collect`` reads every finished point
 (``analysis.json``, and the similarity numbers of :mod:`filmfriction.reduced_model.sfb.similarity`
 from :func:`filmfriction.analysis.calibration.contact.contact_from_run`) and gives per rung the
 slips, the slip velocity, F_k and B of both branches of the slip law, B/B_bulk, the exponent
-n, the Bingham number and the slip heating, each with its standard error.
+n, the Bingham number and the slip heating, each with its standard error, and the slip law
+of the rung's slips pooled (the mean of all its seeds' slips, errors and verdict by the
+jackknife over the seeds: ``filmfriction slip-law``).
 
 Slide steps per rung: the spring's end must travel the first extension x0 = F_s/K and then one
 slip length per further slip, at V, and each slip lasts about slip/v̄; v̄ is taken as the
@@ -41,7 +43,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["Rung", "RUNGS", "STAGES", "slide_steps", "sweep_command", "collect_rung",
-           "combine_seeds", "campaign_steps", "HEAVY_STEP_FACTOR"]
+           "combine_seeds", "pooled_law", "campaign_steps", "HEAVY_STEP_FACTOR"]
 
 SCENE = "sfb-similar"
 #: The scene's own slider and mount: M = 30 m, γ = 0.01 /τ.
@@ -303,14 +305,29 @@ def collect_rung(sweep_dir: Path) -> dict:
     """Every finished point of one rung's sweep, and the rung's seed-combined quantities."""
     sweep_dir = Path(sweep_dir)
     plan = json.loads((sweep_dir / "sweep.json").read_text())
-    rows = [point_row(p) for p in sorted((sweep_dir / "points").glob("*"))
-            if (p / "analysis.json").is_file()]
+    points = [p for p in sorted((sweep_dir / "points").glob("*"))
+              if (p / "analysis.json").is_file()]
+    rows = [point_row(p) for p in points]
     out = {"sweep": sweep_dir.name, "fixed": plan.get("fixed"), "points": rows,
            "seeds": len(rows), "slips": sum(r["slips"] for r in rows)}
     for k in QUANTITIES:
         m, e, n = combine_seeds(rows, k)
         out[k] = {"mean": m, "stderr": e, "seeds": n}
+    out["pooled_slip_law"] = pooled_law(points)
     return out
+
+
+def pooled_law(points) -> dict:
+    """The slip law of the rung's points pooled (the mean of all their slips, the
+    jackknife over the points: :mod:`filmfriction.analysis.calibration.slip_law_runs`), or
+    ``{"error": why}`` where it cannot be fitted (fewer than three points, a point without
+    a slip)."""
+    from filmfriction.analysis.calibration.slip_law_runs import pooled_slip_law, to_document
+
+    try:
+        return to_document(pooled_slip_law(points))["pooled"]
+    except ValueError as exc:
+        return {"error": str(exc)}
 
 
 def _fmt(q: dict) -> str:
@@ -320,11 +337,22 @@ def _fmt(q: dict) -> str:
     return f"{m:.3g} ± {e:.2g}" if math.isfinite(e) else f"{m:.3g}"
 
 
+def _pooled_cells(law: dict) -> list[str]:
+    """The pooled slip law's n and verdict as table cells ("–" where it was not fitted)."""
+    if "verdict" not in law:
+        return ["–", "–"]
+    n = law["exponent"]
+    q = {"mean": math.nan if n["mean"] is None else n["mean"],
+         "stderr": math.nan if n["stderr"] is None else n["stderr"]}
+    return [_fmt(q), f"{law['verdict']} ({law['replicas']} seeds)"]
+
+
 def table(rungs: list[dict]) -> str:
     """The markdown table of the collected rungs."""
     head = ("| rung | seeds | slips | v̄_slip (σ/τ) | F_k dec (ε/σ) | B dec (m/τ) | F_k acc | B acc "
-            "| B_dec/B_bulk | n dec | n acc | Bi (Eq. 1) | ΔT/T adiabatic | ΔT/T measured |")
-    lines = [head, "|" + "---|" * 14]
+            "| B_dec/B_bulk | n dec | n acc | Bi (Eq. 1) | ΔT/T adiabatic | ΔT/T measured "
+            "| n, slips pooled | verdict, slips pooled |")
+    lines = [head, "|" + "---|" * 16]
     for r in rungs:
         lines.append("| " + " | ".join([
             r["sweep"], str(r["seeds"]), str(r["slips"]), _fmt(r["slip_velocity"]),
@@ -332,5 +360,6 @@ def table(rungs: list[dict]) -> str:
             _fmt(r["accelerating_kinetic_force"]), _fmt(r["accelerating_damping"]),
             _fmt(r["damping_over_bulk"]), _fmt(r["decelerating_exponent"]),
             _fmt(r["accelerating_exponent"]), _fmt(r["bingham_number"]),
-            _fmt(r["slip_heating"]), _fmt(r["slip_temperature_rise"])]) + " |")
+            _fmt(r["slip_heating"]), _fmt(r["slip_temperature_rise"]),
+            *_pooled_cells(r.get("pooled_slip_law") or {})]) + " |")
     return "\n".join(lines)

@@ -165,3 +165,22 @@ def test_collect_writes_the_rungs_it_finds(tmp_path, capsys):
     assert doc["schema"] == "filmfriction.mass-ladder/1"
     assert [r["mass"] for r in doc["rungs"]] == [ladder.HEAVY.mass]
     assert doc["rungs"][0]["slide_steps"] == ladder.HEAVY.slide_steps
+
+
+def test_collect_pools_the_rungs_slips_over_its_seeds(tmp_path):
+    # three seeds of Klein's viscous slips (B = 40 m/τ): the rung's pooled law is viscous,
+    # its errors the jackknife's over the three seeds
+    from filmfriction.analysis.analyze import analyse_run
+    from filmfriction.analysis.groundtruth.synthetic import run_directory
+
+    rung = tmp_path / "rung"
+    for i in range(3):
+        analyse_run(run_directory(rung / "points" / f"seed={i}", trajectory=False, seed=i))
+    (rung / "sweep.json").write_text('{"fixed": {"wall_mass": 500}}')
+    got = ladder.collect_rung(rung)
+    law = got["pooled_slip_law"]
+    assert law["verdict"] == "viscous" and law["replicas"] == 3 and law["dof"] == 2
+    assert law["damping"]["mean"] == pytest.approx(40.0, rel=0.05)
+    assert ladder.table([got]).splitlines()[2].endswith("| viscous (3 seeds) |")
+    (rung / "points" / "seed=2" / "analysis.json").unlink()
+    assert "pooling needs 3 or more" in ladder.collect_rung(rung)["pooled_slip_law"]["error"]
