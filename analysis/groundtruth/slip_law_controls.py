@@ -151,6 +151,8 @@ class Scale:
 #:
 #: ``coulomb``  F_s = 45, F_k = 25 ε/σ (F_k + 0·v on every sample), re-sticking where the
 #:              wall stops (a noise-free slip: 351 τ, 5 σ, to F_b = 5 ε/σ)
+#: ``weakening`` exponential weakening F_s = 45 → F_k = 25 ε/σ over v_c = 0.01 σ/τ (noise-free a
+#:              slip of 489 τ, 0.021 σ/τ peak, to F_b = 12.7; decelerating B = −430 m/τ)
 #: ``viscous``  Klein's Eq. 1 with ζ = B/(2√(KM)) = 1 (B = 1 789 m/τ, Eq. (1)'s Bingham
 #:              number of the runs: 32–87), re-stick imposed at F_b = STIFF_BACKWARD
 #: mixes        F_k + B·v of viscous share s of F = 27 ε/σ at 0.017 σ/τ (the runs' F̄ and v̄),
@@ -205,6 +207,8 @@ SCALES = {
         STIFF_NOISE,
         laws={"coulomb": dict(law="linear", parameters=(25.0, 0.0), armed_below=25.0,
                               initial_force=5.0, period=2400.0),
+              "weakening": dict(law="weakening", parameters=(25.0, 45.0, 0.01),
+                                armed_below=27.0, initial_force=5.0, period=2200.0),
               "viscous": dict(law="linear", parameters=(0.0, STIFF_B),
                               backward_force=STIFF_BACKWARD, stop_velocity=-math.inf,
                               initial_force=STIFF_BACKWARD, period=2300.0)},

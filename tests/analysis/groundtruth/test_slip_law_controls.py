@@ -174,6 +174,13 @@ def test_stiff_scale_noise_free_controls_give_their_law_back(name, share, verdic
     assert fit.decelerating.damping == pytest.approx(damping, abs=1.0)
 
 
+def test_stiff_weakening_slips_are_weakening_noise_free():
+    # the force falls with the velocity on the slowing branch: B resolved negative
+    fit = dynamical_fits("weakening", 1, 8, noise=NOISE_FREE, scale="stiff")[0]
+    assert fit.verdict == "velocity-weakening", fit.reason
+    assert fit.decelerating.damping < -300.0
+
+
 def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
     # 0 of 200 at 8 and 30 slips (docs/results/slip-law.md, "Controls at the heavy
     # slider's scale"); 20 replicas of 8 slips here
