@@ -33,7 +33,7 @@ from .sweep.aggregate import load_aggregate
 __all__ = ["STUDY_FILE", "ENSEMBLE_FILE", "ENSEMBLE_REPORT_FILE", "REPLICA_DIR",
            "REPLICA_LOG", "STUDY_FILES", "CALIBRATION_FILE", "SFB_FILE", "SFB_TRACES_SUFFIX", "write_sfb", "read_json",
            "read_calibration", "read_sfb", "SFBDocument", "SlipTrace", "ReportInputs",
-           "read_report_inputs", "split_sweeps"]
+           "read_report_inputs", "split_sweeps", "checked_runs"]
 
 #: A study of replicas (``filmfriction run --replicas N``): its record, the combined
 #: analysis and its report in the study directory, one run directory per replica
@@ -391,6 +391,22 @@ def read_report_inputs(run_dir: Path, run_dirs: list, given: list, failures: dic
                                f"`calibration.json`; `{sfb_cmd}` recomputes it.")
         got.missing.append((f"{sfb_path} for this calibration.json", sfb_cmd))
     return got
+
+
+def checked_runs(paths, out=None) -> list:
+    """The run directories ``paths`` give (a sweep its runs: :func:`split_sweeps`), each
+    path checked as one (:func:`filmfriction.workflows.inputs.check_run_source`) and ``out``,
+    a file the command will write, checked writable (``--out``), before any compute
+    (UserError otherwise)."""
+    from .inputs import UserError, check_run_source, check_writable
+
+    for d in paths:
+        if not Path(d).is_dir():
+            raise UserError(f"{d}: not a directory")
+        check_run_source(d)
+    if out is not None:
+        check_writable(out, "--out")
+    return split_sweeps([Path(p) for p in paths])[0]
 
 
 def split_sweeps(paths: list) -> tuple[list, list]:

@@ -13,7 +13,7 @@ import math
 import sys
 from pathlib import Path
 
-from filmfriction.workflows.inputs import check_run_source, check_writable, UserError
+from filmfriction.workflows.inputs import UserError
 
 __all__ = ["register", "run", "format_calibration"]
 
@@ -88,16 +88,10 @@ def run(args) -> int:
     """Entry point; returns the exit code."""
     from filmfriction.analysis import calibrate, write_calibration
 
-    from filmfriction.workflows.rundir import split_sweeps
+    from filmfriction.workflows.rundir import checked_runs
 
-    for d in args.run_dirs:
-        if not d.is_dir():
-            raise UserError(f"{d}: not a directory")
-        check_run_source(d)
-    if args.out is not None:
-        check_writable(args.out, "--out")
     # a sweep contributes its stick-slip runs (aggregate.json: calibration_runs)
-    run_dirs, _ = split_sweeps(list(args.run_dirs))
+    run_dirs = checked_runs(args.run_dirs, args.out)
     from filmfriction.analysis.calibration.calibrate import REPLAY_TRACE_SUFFIX
     from filmfriction.workflows.outputs import check_output, is_project_json, names_in
 

@@ -12,7 +12,7 @@ import json
 import sys
 from pathlib import Path
 
-from filmfriction.workflows.inputs import UserError, check_run_source, check_writable
+from filmfriction.workflows.inputs import UserError
 
 __all__ = ["register", "run", "format_pooled"]
 
@@ -66,15 +66,9 @@ def run(args) -> int:
     """Entry point; returns the exit code."""
     from filmfriction.analysis.calibration.slip_law_runs import pooled_slip_law, to_document
     from filmfriction.analysis.files.util import json_safe, write_atomic
-    from filmfriction.workflows.rundir import split_sweeps
+    from filmfriction.workflows.rundir import checked_runs
 
-    for d in args.run_dirs:
-        if not d.is_dir():
-            raise UserError(f"{d}: not a directory")
-        check_run_source(d)
-    if args.out is not None:
-        check_writable(args.out, "--out")
-    run_dirs, _ = split_sweeps(list(args.run_dirs))
+    run_dirs = checked_runs(args.run_dirs, args.out)
     try:
         doc = to_document(pooled_slip_law(run_dirs))
     except ValueError as exc:
