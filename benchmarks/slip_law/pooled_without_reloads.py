@@ -1,0 +1,68 @@
+"""The pooled slip law of MD runs with and without the slips inside which the spring reloaded.
+
+    python benchmarks/slip_law/pooled_without_reloads.py RUN_DIR... [--rise 5]
+
+A detected slip whose spring force rises, somewhere between its yield and its re-stick, by
+more than ``--rise`` (ε/σ) above its running minimum is not one slip: the wall stopped and the
+drive reloaded the spring (smaller slips merged, their drops below the detector's threshold),
+or it rang.  The runs' slips are pooled (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`,
+the jackknife over the runs) with every analysed slip, and again without those: how much the
+verdict rests on them.  Prints both fits and how many slips each run loses.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from filmfriction.analysis.calibration.rundata import load_run
+from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
+from filmfriction.analysis.slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
+from filmfriction.reduced_model.cycles import cycle_table
+
+
+def inner_rise(force: np.ndarray, a: int, b: int) -> float:
+    """The largest rise of ``force`` over its running minimum between samples a and b."""
+    seg = force[a:b + 1]
+    return float(np.max(seg - np.minimum.accumulate(seg)))
+
+
+def pooled(dirs, rise: float | None):
+    runs, lost = [], []
+    for d in dirs:
+        r = load_run(d)
+        tr, p = r.trace, r.trace.parameters
+        f, t = tr.spring_force, tr.time
+        y, s = r.cycles["yield_index"][r.skip:], r.cycles["stick_index"][r.skip:]
+        keep = [i for i, (a, b) in enumerate(zip(y, s))
+                if rise is None or inner_rise(f, a, b) <= rise]
+        lost.append(len(y) - len(keep))
+        tab = cycle_table(t, f, y[keep], s[keep], spring_constant=p.spring_constant,
+                          wall_position=tr.wall_position())
+        runs.append(RunSlips(t, f, tr.columns["wall_velocity"], tab,
+                             wall_position=tr.wall_position(), name=str(d)))
+    fit = fit_pooled_ensemble(runs, mass=p.mass, drive_velocity=tr.drive_velocity()[0],
+                              mount_damping=p.mount_damping or 0.0,
+                              min_window_time=MD_NOISE_TIME)
+    return fit, sum(len(r.table) for r in runs), lost
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("run_dirs", nargs="+")
+    ap.add_argument("--rise", type=float, default=5.0, help="ε/σ (default 5)")
+    args = ap.parse_args(argv)
+    for rise in (None, args.rise):
+        fit, n, lost = pooled(args.run_dirs, rise)
+        law = fit.law
+        what = "every slip" if rise is None else f"no inner rise > {rise:g}"
+        print(f"{what}: {len(args.run_dirs)} runs, {n} slips (left out per run: {lost}): "
+              f"{fit.verdict}; F_k {law.kinetic_force:.1f} ± {law.kinetic_force_stderr:.1f}, "
+              f"B {law.damping:.0f} ± {law.damping_stderr:.0f} ({law.damping_sigmas:+.1f} σ), "
+              f"n {law.exponent:+.2f} ± {law.exponent_stderr:.2f}, v̄ {law.mean_velocity:.3f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
