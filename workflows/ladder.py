@@ -325,7 +325,7 @@ def pooled_law(points) -> dict:
     from filmfriction.analysis.calibration.slip_law_runs import pooled_slip_law, to_document
 
     try:
-        return to_document(pooled_slip_law(points))["pooled"]
+        return to_document(pooled_slip_law(points, analyse=False))["pooled"]
     except ValueError as exc:
         return {"error": str(exc)}
 

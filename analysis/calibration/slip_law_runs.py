@@ -60,8 +60,8 @@ class PooledSlipLaw:
     units: str
 
 
-def _run_slips(run_dir) -> tuple[RunSlips, dict, int | None]:
-    run = load_run(run_dir)
+def _run_slips(run_dir, analyse: bool) -> tuple[RunSlips, dict, int | None]:
+    run = load_run(run_dir, analyse=analyse)
     tr = run.trace
     p = tr.parameters
     t = tr.time
@@ -91,8 +91,9 @@ def _same(name: str, a, b) -> bool:
     return math.isclose(float(a), float(b), rel_tol=1e-6, abs_tol=0.0)
 
 
-def pooled_slip_law(run_dirs) -> PooledSlipLaw:
-    """The slip law of the runs in ``run_dirs`` pooled (module text).
+def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
+    """The slip law of the runs in ``run_dirs`` pooled (module text); a run not analysed yet
+    is analysed (and its ``analysis.json`` written), or with ``analyse=False`` refused.
 
     Raises
     ------
@@ -103,7 +104,7 @@ def pooled_slip_law(run_dirs) -> PooledSlipLaw:
         :func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`
         refuses (fewer than three runs, a run with no slip).
     """
-    parts = [_run_slips(d) for d in run_dirs]
+    parts = [_run_slips(d, analyse) for d in run_dirs]
     if not parts:
         raise ValueError("no run to pool")
     first = parts[0][1]

@@ -160,8 +160,10 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                               enumerate(parts)])
               if jackknife == "runs" else np.arange(held["impulse"].shape[0]))
     durations = np.concatenate([d for _, _, d in parts])
+    # smoothing_samples' rule (odd, >= 5 samples, else none) on the median slip of all runs
     window = int(round(smoothing * float(np.median(durations)) / dt)) if smoothing > 0 else 0
-    window = max(window if window >= 5 else 0, int(math.ceil(min_window_time / dt)))
+    window += 1 - window % 2
+    window = max(window if 5 <= window < lags else 0, int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
     return fit_held_ensemble(held, groups, window=window, dt=dt, mass=mass,
                              min_velocity_fraction=min_velocity_fraction,

@@ -146,7 +146,7 @@ def _bingham_reading(rows) -> str:
                  "several slips split or left out), at the edge of what ten runs resolve: "
                  "whether the rest is more than a bulk-like viscosity (Braun & Tosatti's "
                  "reading) is not settled. At lighter sliders on the same film the kinetic "
-                 "share grows as the slips slow (n from 0.5 at 0.3 σ/τ to 0.0–0.2 at "
+                 "share grows as the slips slow (n from 0.5 at 0.3 σ/τ to 0.0–0.24 at "
                  "0.04 σ/τ, Bi 3–19). What reaching "
                  "Klein's Bi would cost: docs/results/mass-ladder.md "
                  "(\"Going further\").")

@@ -88,3 +88,15 @@ def test_runs_that_differ_need_the_jackknife_over_runs():
             mixed[j] += fit.verdict == "mixed"
     assert covered["runs"] >= 37 and mixed["runs"] <= 2, (covered, mixed)
     assert covered["slips"] <= 30 and mixed["slips"] >= 5, (covered, mixed)
+
+
+def test_runs_of_unequal_slip_counts_give_the_law():
+    # runs of 2, 3 and 6 slips (their slips held to the longest run's lags): the mean of
+    # all slips is still the law's, and the jackknife over 3 runs has 2 dof
+    runs, v = pooled_runs("viscous", 3, 6, noise=QUIET, seed=4)
+    runs = [replace(r, table=r.table[:k]) for r, k in zip(runs, (2, 3, 6))]
+    fit = _fit(runs, v)
+    assert [len(r.table) for r in runs] == [2, 3, 6]
+    assert fit.decelerating.damping == pytest.approx(STIFF_B, abs=2.0)
+    assert fit.decelerating.kinetic_force == pytest.approx(0.0, abs=0.05)
+    assert fit.decelerating.dof == 2
