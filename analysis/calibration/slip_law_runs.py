@@ -76,6 +76,11 @@ def _run_slips(run_dir, analyse: bool) -> tuple[RunSlips, dict, int | None]:
     shared = {"units": tr.units, "mass": p.mass, "spring_constant": p.spring_constant,
               "drive_velocity": v_drive or 0.0, "mount_damping": p.mount_damping or 0.0,
               "sampling": dt}
+    count = (run.analysis.get("slips") or {}).get("count")
+    if isinstance(count, int) and len(run.cycles["yield_index"]) != count:
+        raise ValueError(f"{run.run_dir}: analysis_cycles.csv holds "
+                         f"{len(run.cycles['yield_index'])} slip(s), analysis.json {count}; "
+                         f"analyse it again (filmfriction analyze {run.run_dir})")
     y, s = run.cycles["yield_index"][run.skip:], run.cycles["stick_index"][run.skip:]
     table = cycle_table(t, tr.spring_force, y, s, spring_constant=p.spring_constant,
                         wall_position=tr.wall_position())

@@ -38,3 +38,15 @@ def test_runs_of_different_sliders_refused(runs, capsys):
 def test_two_runs_refused(runs, capsys):
     assert main(["slip-law", *map(str, runs[:2])]) == 2
     assert "pooling needs 3 or more" in capsys.readouterr().err
+
+
+def test_a_cycles_table_that_disagrees_with_its_analysis_is_refused(runs, capsys):
+    from filmfriction.analysis.analyze import analyse_run
+
+    analyse_run(runs[1])
+    csv = runs[1] / "analysis_cycles.csv"
+    csv.write_text(csv.read_text().splitlines()[0] + "\n")      # the header only
+    assert main(["slip-law", *map(str, runs)]) == 2
+    err = capsys.readouterr().err
+    assert "analysis_cycles.csv holds 0 slip(s), analysis.json 4" in err, err
+    assert "Traceback" not in err
