@@ -240,7 +240,6 @@ CONTROLS = {
     "weakening": "exponential weakening F_s = 48 → F_k = 25 ε/σ over 1 σ/τ (V = 0.3 σ/τ)",
     "viscous": "Klein's Eq. 1, ζ = 4 (B = 62 m/τ), re-stick at F_b = 24 ε/σ (V = 0.1 σ/τ)",
 }
-_DRIVE = {"coulomb": 0.1, "rate-state": 0.1, "weakening": 0.3, "viscous": 0.1}
 _PERIOD = {"coulomb": 125.0, "rate-state": 190.0, "weakening": 90.0, "viscous": 140.0}
 
 
@@ -249,43 +248,48 @@ def _block(law, drive_velocity, damping=0.0) -> SpringBlock:
                        drive_velocity=drive_velocity, damping=damping, law=law)
 
 
-def coulomb_viscous(share: float, *, slips: int = 8, film_force: float = 28.0,
-                    slip_velocity: float = 0.55) -> dict:
+def coulomb_viscous(share: float, *, slips: int = 8, film_force: float | None = None,
+                    slip_velocity: float | None = None) -> dict:
     """Slips resisted by F_k + B·v whose viscous part is ``share`` of ``film_force`` at
-    ``slip_velocity`` (the MD's mean film force and slip velocity), re-sticking at
-    F_b = 20 ε/σ (the MD's) or once slowed to 0.15 σ/τ (a law with F_k would
-    otherwise slide on), noise-free, ``slips`` + 1 slips."""
+    ``slip_velocity`` (the MD's mean film force and slip velocity: the Klein-similar
+    scale's mix, 28 ε/σ at 0.55 σ/τ, by default), re-sticking at F_b = 20 ε/σ (the MD's)
+    or once slowed to 0.15 σ/τ (a law with F_k would otherwise slide on), noise-free,
+    ``slips`` + 1 slips."""
     if not 0 <= share <= 1:
         raise ValueError(f"share = {share!r}: must be in [0, 1]")
-    s = SCALE
+    s, mix = SCALE, SCALES["klein"].mix
+    film_force = mix["film_force"] if film_force is None else film_force
+    slip_velocity = mix["slip_velocity"] if slip_velocity is None else slip_velocity
     return klein_trace(spring_constant=s["spring_constant"], mass=s["mass"],
                        damping=share * film_force / slip_velocity,
-                       kinetic_force=(1 - share) * film_force, drive_velocity=0.1,
-                       static_force=s["static_force"], backward_force=20.0,
-                       restick_velocity=0.15, cycles=slips + 1, dt=s["dt"])
+                       kinetic_force=(1 - share) * film_force,
+                       drive_velocity=SCALES["klein"].drive_velocity,
+                       static_force=s["static_force"], backward_force=mix["backward_force"],
+                       restick_velocity=mix["stop_velocity"], cycles=slips + 1, dt=s["dt"])
 
 
 @lru_cache(maxsize=16)
 def _noise_free(name: str, slips: int):
-    s, v = SCALE, _DRIVE.get(name)
-    duration = (slips + 2.5) * _PERIOD.get(name, 0.0)
+    # the laws the random-force slider integrates (SCALES["klein"]), as the reduced
+    # model's spring-block slides them
+    if name not in CONTROLS:
+        raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
+    s, law = SCALE, SCALES["klein"].law(name)
+    v, p = law["drive_velocity"], law["parameters"]
+    duration = (slips + 2.5) * _PERIOD[name]
     if name == "coulomb":
-        tr = block_trace(_block(laws.Coulomb(static=s["static_force"], kinetic=36.0), v),
+        tr = block_trace(_block(laws.Coulomb(static=law["static_force"], kinetic=p[0]), v),
                          duration, s["dt"])
     elif name == "rate-state":
-        law = laws.RateState(mu0=36.0, a=1.0, b=4.0, dc=1.0, v0=0.1)
+        law = laws.RateState(mu0=p[0], a=p[1], b=p[2], dc=p[3], v0=p[4])
         tr = block_trace(_block(law, v), duration, s["dt"], initial_velocity=0.05)
     elif name == "weakening":
-        law = laws.ExponentialWeakening(static=s["static_force"], kinetic=25.0,
-                                        velocity_scale=1.0)
+        law = laws.ExponentialWeakening(static=p[1], kinetic=p[0], velocity_scale=p[2])
         tr = block_trace(_block(law, v), duration, s["dt"])
-    elif name == "viscous":
-        b = 2 * 4.0 * math.sqrt(s["spring_constant"] * s["mass"])
-        tr = klein_trace(spring_constant=s["spring_constant"], mass=s["mass"], damping=b,
-                         drive_velocity=v, static_force=s["static_force"],
-                         backward_force=24.0, cycles=slips + 1, dt=s["dt"])
-    else:
-        raise ValueError(f"control {name!r}: one of {', '.join(CONTROLS)}")
+    else:                                          # viscous
+        tr = klein_trace(spring_constant=s["spring_constant"], mass=s["mass"], damping=p[1],
+                         drive_velocity=v, static_force=law["static_force"],
+                         backward_force=law["backward_force"], cycles=slips + 1, dt=s["dt"])
     return {k: np.asarray(a, float) for k, a in tr.items()}
 
 
@@ -402,7 +406,8 @@ def control_fits(name: str, replicas: int = 40, slips: int = 8, *, injected: boo
     go to the one called."""
     if injected:
         return replica_fits(control_trace(name, slips), replicas, slips=slips,
-                            drive_velocity=_DRIVE[name], **kwargs)
+                            drive_velocity=SCALES["klein"].law(name)["drive_velocity"],
+                            **kwargs)
     return dynamical_fits(name, replicas, slips, **kwargs)
 
 

@@ -76,7 +76,7 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inpu
                        fit_segments, jackknife_fit, smoothing_samples)
 from .slip_law_branches import Segment
 
-__all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "MIN_CYCLES", "MD_NOISE_TIME"]
+__all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "slipped", "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
 MIN_CYCLES = 3
@@ -84,6 +84,26 @@ MIN_CYCLES = 3
 #: 0.44 at 2 τ and 0.08 at 4 τ (docs/results/slip-law.md, "The MD's noise").  The mean
 #: slip's velocity is smoothed over at least this long (``min_window_time``).
 MD_NOISE_TIME = 3.0
+
+
+def uniform_step(t: np.ndarray, what: str) -> float:
+    """The sampling interval of ``t``, which ``what`` (named in the error) needs uniform
+    (ValueError otherwise)."""
+    dts = np.diff(t)
+    if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
+        raise ValueError(f"{what} needs a uniform sampling")
+    return float(dts[0])
+
+
+def slipped(table: CycleTable) -> np.ndarray:
+    """Which windows of ``table`` are slips: the spring relaxed over them by at least
+    :data:`~filmfriction.analysis.slip_law.slip_law.MIN_RELAXATION` of its force at the
+    yield, and the re-stick comes after the yield."""
+    fs, fb = (np.asarray(table.static_force, float), np.asarray(table.backward_force, float))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        relaxed = (fs - fb) / np.abs(fs)
+    return (relaxed >= MIN_RELAXATION) & (np.asarray(table.stick_index, int)
+                                           > np.asarray(table.yield_index, int))
 
 
 def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
@@ -189,14 +209,9 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     t, f, v, x = checked_fit_inputs(time, spring_force, wall_velocity, wall_position, mass,
                                     min_velocity_fraction=min_velocity_fraction,
                                     smoothing=smoothing)
-    dts = np.diff(t)
-    if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
-        raise ValueError("the cycle ensemble needs a uniform sampling")
-    fs, fb = (np.asarray(table.static_force, float), np.asarray(table.backward_force, float))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        relaxed = (fs - fb) / np.abs(fs)
+    dt = uniform_step(t, "the cycle ensemble")
     y, s = np.asarray(table.yield_index, int), np.asarray(table.stick_index, int)
-    keep = (relaxed >= MIN_RELAXATION) & (s > y)
+    keep = slipped(table)
     if keep.sum() < MIN_CYCLES:
         raise ValueError(f"{int(keep.sum())} slip(s) that relax the spring by "
                          f"{100 * MIN_RELAXATION:g} % or more: the cycle ensemble needs "
@@ -205,7 +220,6 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                       drive_velocity=drive_velocity)
     if not (math.isfinite(min_window_time) and min_window_time >= 0):
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
-    dt = float(dts[0])
     window = max(smoothing_samples(t, table, smoothing), int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
     return fit_held_ensemble(held, np.arange(int(keep.sum())), window=window, dt=dt, mass=mass,

@@ -52,7 +52,7 @@ import numpy as np
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law import MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs
-from .slip_law_cycles import fit_held_ensemble, held_slips
+from .slip_law_cycles import fit_held_ensemble, held_slips, slipped, uniform_step
 
 __all__ = ["RunSlips", "fit_pooled_ensemble", "MIN_RUNS", "JACKKNIFE"]
 
@@ -88,21 +88,16 @@ def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
                                         smoothing=smoothing)
     except ValueError as err:
         raise ValueError(f"{name}: {err}") from None
-    dts = np.diff(t)
-    if not np.allclose(dts, dts[0], rtol=1e-6, atol=0):
-        raise ValueError(f"{name}: the pooled slips need a uniform sampling")
+    dt = uniform_step(t, f"{name}: the pooled slips")
     tab = run.table
-    fs, fb = (np.asarray(tab.static_force, float), np.asarray(tab.backward_force, float))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        relaxed = (fs - fb) / np.abs(fs)
     y, s = np.asarray(tab.yield_index, int), np.asarray(tab.stick_index, int)
-    keep = (relaxed >= MIN_RELAXATION) & (s > y)
+    keep = slipped(tab)
     if not keep.any():
         raise ValueError(f"{name}: no slip relaxes the spring by {100 * MIN_RELAXATION:g} % "
                          f"or more ({len(tab)} in its table)")
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
                       drive_velocity=drive_velocity)
-    return held, float(dts[0]), t[s[keep]] - t[y[keep]]
+    return held, dt, t[s[keep]] - t[y[keep]]
 
 
 def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
