@@ -33,7 +33,8 @@ from ..slip_law.slip_law_cycles import MD_NOISE_TIME
 from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
 from .rundata import load_run
 
-__all__ = ["PooledRun", "PooledSlipLaw", "pooled_slip_law", "to_document", "SHARED", "SCHEMA"]
+__all__ = ["PooledRun", "PooledSlipLaw", "pooled_slip_law", "read_runs", "fit_arguments",
+           "to_document", "SHARED", "SCHEMA"]
 
 #: What the pooled runs must share (a run's trace parameter, or the sampling interval).
 SHARED = ("units", "mass", "spring_constant", "drive_velocity", "mount_damping", "sampling")
@@ -82,11 +83,12 @@ def _run_slips(run_dir, analyse: bool) -> tuple[RunSlips, dict, int | None]:
                          f"{len(run.cycles['yield_index'])} slip(s), analysis.json {count}; "
                          f"analyse it again (filmfriction analyze {run.run_dir})")
     y, s = run.cycles["yield_index"][run.skip:], run.cycles["stick_index"][run.skip:]
+    x = tr.wall_position()
     table = cycle_table(t, tr.spring_force, y, s, spring_constant=p.spring_constant,
-                        wall_position=tr.wall_position())
+                        wall_position=x)
     seed = tr.scene_parameter("seed")
     return (RunSlips(t, tr.spring_force, tr.columns["wall_velocity"], table,
-                     wall_position=tr.wall_position(), name=str(run.run_dir)),
+                     wall_position=x, name=str(run.run_dir)),
             shared, seed if isinstance(seed, int) else None)
 
 
@@ -94,6 +96,34 @@ def _same(name: str, a, b) -> bool:
     if isinstance(a, str) or isinstance(b, str) or a is None or b is None:
         return a == b
     return math.isclose(float(a), float(b), rel_tol=1e-6, abs_tol=0.0)
+
+
+def read_runs(run_dirs, *, analyse: bool = True) -> tuple[list, dict, tuple]:
+    """The runs of ``run_dirs`` as the pooled fit takes them (their analysed slips), what
+    they share (:data:`SHARED`, checked alike) and each one's :class:`PooledRun`; a run
+    not analysed yet is analysed (and its ``analysis.json`` written), or with
+    ``analyse=False`` refused (ValueError, as :func:`pooled_slip_law`)."""
+    parts = [_run_slips(d, analyse) for d in run_dirs]
+    if not parts:
+        raise ValueError("no run to pool")
+    first = parts[0][1]
+    for rs, shared, _ in parts[1:]:
+        for key in SHARED:
+            if not _same(key, shared[key], first[key]):
+                raise ValueError(f"{rs.name}: {key} = {shared[key]!r}, {parts[0][0].name}: "
+                                 f"{first[key]!r}; pooled runs are replicas of one "
+                                 f"experiment and share {', '.join(SHARED)}")
+    info = tuple(PooledRun(Path(rs.name), len(rs.table), seed) for rs, _, seed in parts)
+    return [rs for rs, _, _ in parts], dict(first), info
+
+
+def fit_arguments(shared: dict) -> dict:
+    """The keywords of :func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`
+    for runs that share ``shared`` (the MD noise's correlation time as the smoothing's
+    floor in LJ units)."""
+    return dict(mass=shared["mass"], drive_velocity=shared["drive_velocity"],
+                mount_damping=shared["mount_damping"],
+                min_window_time=MD_NOISE_TIME if shared["units"] == "lj" else 0.0)
 
 
 def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
@@ -109,24 +139,11 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
         :func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`
         refuses (fewer than three runs, a run with no slip).
     """
-    parts = [_run_slips(d, analyse) for d in run_dirs]
-    if not parts:
-        raise ValueError("no run to pool")
-    first = parts[0][1]
-    for rs, shared, _ in parts[1:]:
-        for key in SHARED:
-            if not _same(key, shared[key], first[key]):
-                raise ValueError(f"{rs.name}: {key} = {shared[key]!r}, {parts[0][0].name}: "
-                                 f"{first[key]!r}; pooled runs are replicas of one "
-                                 f"experiment and share {', '.join(SHARED)}")
-    runs = [rs for rs, _, _ in parts]
-    kw = dict(mass=first["mass"], drive_velocity=first["drive_velocity"],
-              mount_damping=first["mount_damping"],
-              min_window_time=MD_NOISE_TIME if first["units"] == "lj" else 0.0)
+    runs, shared, info = read_runs(run_dirs, analyse=analyse)
+    kw = fit_arguments(shared)
     fit = fit_pooled_ensemble(runs, **kw)
     by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips")
-    info = tuple(PooledRun(Path(rs.name), len(rs.table), seed) for rs, _, seed in parts)
-    return PooledSlipLaw(fit, by_slips, info, dict(first), first["units"])
+    return PooledSlipLaw(fit, by_slips, info, shared, shared["units"])
 
 
 #: The schema of the pooled slip law's document.

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 
 import numpy as np
 
-from filmfriction.analysis.calibration.rundata import load_run
-from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
-from filmfriction.analysis.slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
+from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
+from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
 from filmfriction.reduced_model.cycles import cycle_table
 
 
@@ -51,26 +51,22 @@ def split(force: np.ndarray, a: int, b: int, rise: float) -> list[tuple[int, int
 
 
 def pooled(dirs, rise: float | None, cut: bool = False):
-    runs, lost = [], []
-    for d in dirs:
-        r = load_run(d)
-        tr, p = r.trace, r.trace.parameters
-        f, t = tr.spring_force, tr.time
-        y, s = r.cycles["yield_index"][r.skip:], r.cycles["stick_index"][r.skip:]
+    runs, shared, _ = read_runs(dirs)
+    out, lost = [], []
+    for rs in runs:
+        f = rs.spring_force
+        y, s = rs.table.yield_index, rs.table.stick_index
         if cut:
             pairs = [q for a, b in zip(y, s) for q in split(f, int(a), int(b), rise)]
         else:
             pairs = [(a, b) for a, b in zip(y, s) if rise is None or inner_rise(f, a, b) <= rise]
         lost.append(len(y) - len(pairs))
         ya, sa = (np.array([q[i] for q in pairs], int) for i in (0, 1))
-        tab = cycle_table(t, f, ya, sa, spring_constant=p.spring_constant,
-                          wall_position=tr.wall_position())
-        runs.append(RunSlips(t, f, tr.columns["wall_velocity"], tab,
-                             wall_position=tr.wall_position(), name=str(d)))
-    fit = fit_pooled_ensemble(runs, mass=p.mass, drive_velocity=tr.drive_velocity()[0],
-                              mount_damping=p.mount_damping or 0.0,
-                              min_window_time=MD_NOISE_TIME)
-    return fit, sum(len(r.table) for r in runs), lost
+        out.append(replace(rs, table=cycle_table(rs.time, f, ya, sa,
+                                                 spring_constant=shared["spring_constant"],
+                                                 wall_position=rs.wall_position)))
+    fit = fit_pooled_ensemble(out, **fit_arguments(shared))
+    return fit, sum(len(r.table) for r in out), lost
 
 
 def main(argv=None) -> int:
