@@ -100,3 +100,25 @@ def test_runs_of_unequal_slip_counts_give_the_law():
     assert fit.decelerating.damping == pytest.approx(STIFF_B, abs=2.0)
     assert fit.decelerating.kinetic_force == pytest.approx(0.0, abs=0.05)
     assert fit.decelerating.dof == 2
+
+
+def test_runs_in_other_units_give_the_law_in_those_units():
+    # the heavy slider's noise-free viscous runs in SFB-like units (time ×1e-4 s, length
+    # ×1e-9 m, force ×1e-6 N): B comes back as B·F0·T/L, F_k as 0
+    from filmfriction.reduced_model.cycles import cycle_table
+
+    T, L, F0 = 1e-4, 1e-9, 1e-6
+    runs, v = pooled_runs("viscous", 3, 3, noise=QUIET, seed=6)
+    si = []
+    for r in runs:
+        t, f, x = r.time * T, r.spring_force * F0, r.wall_position * L
+        table = cycle_table(t, f, r.table.yield_index, r.table.stick_index,
+                            spring_constant=STIFF.spring_constant * F0 / L, wall_position=x)
+        si.append(replace(r, time=t, spring_force=f, wall_velocity=r.wall_velocity * L / T,
+                          wall_position=x, table=table))
+    fit = fit_pooled_ensemble(si, mass=STIFF.mass * F0 * T ** 2 / L, drive_velocity=v * L / T,
+                              mount_damping=STIFF.mount_damping * F0 * T / L,
+                              min_window_time=MD_NOISE_TIME * T)
+    assert fit.decelerating.damping == pytest.approx(STIFF_B * F0 * T / L, rel=2e-3)
+    assert abs(fit.decelerating.kinetic_force) < 0.05 * F0
+    assert fit.verdict == _fit(runs, v).verdict
