@@ -229,7 +229,9 @@ def analyze(trace, *, skip: int | None = None, structure: bool = True,
         "noise": {"mean": _num(events.noise), "units": lab("force")},
         "threshold": {"mean": _num(events.threshold), "units": lab("force")},
         "unfinished_yield_time": (_num(t[events.unfinished_yield])
-                                  if events.unfinished_yield is not None else None)}
+                                  if events.unfinished_yield is not None else None),
+        # slips the hysteresis scan merged, split where the wall stopped inside them
+        "inner_resticks": int(events.inner_resticks)}
     per_cycle: dict = {}
     for obs in observables.registered():
         if not obs.applies(ctx):

@@ -85,6 +85,9 @@ class SlipEvents:
         Estimated (or given) noise standard deviation of the force.
     lag : int
         Decorrelation lag of the noise in samples (1: white, or noise given).
+    inner_resticks : int
+        Re-sticks found inside the slips of the hysteresis scan, each of which the slip
+        it was in was split at (see ``restick_fraction`` in :func:`detect_slips`).
     unfinished_yield : int or None
         A yield whose drop was seen but whose re-stick was not confirmed
         before the end of the trace (not counted as a slip).
@@ -109,6 +112,7 @@ class SlipEvents:
     lag: int = 1
     cycle_noise: float = 0.0
     increment_noise: float = 0.0
+    inner_resticks: int = 0
 
     @property
     def count(self) -> int:
@@ -136,6 +140,11 @@ def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,
         size *= 2
 
 
+#: A rise inside a slip is a re-stick when, over it, the force rises at no more than this
+#: many times the sticks' loading rate: dF/dt = K(V − ẋ), so 2 K·V is a wall whose mean
+#: velocity is −V, and a wall at rest within ±V gives at most 2 (see :func:`detect_slips`).
+RESTICK_RATE = 2.0
+
 #: at most this many raises of the threshold by the cycle noise (each re-scans the trace);
 #: the increments' cap bounds them, so they run to where they stop rising
 RAISES = 10
@@ -144,7 +153,7 @@ RAISES = 10
 def detect_slips(time, spring_force, *, threshold: float | None = None,
                  noise: float | None = None, k: float | None = None,
                  min_drop: float = 0.0, relative_drop: float = 0.1,
-                 ringing_window: float = 3.0) -> SlipEvents:
+                 ringing_window: float = 3.0, restick_fraction: float = 1.0 / 3.0) -> SlipEvents:
     """Find yield (y) and re-stick (s) points in a noisy spring-force trace.
 
     Criterion: a slip is a fall of the force by more than ``h`` from a
@@ -200,6 +209,16 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         ringing after the re-stick, not a new slip (default 3; 0 turns the rule
         off).  A slip unloads the spring, which the drive reloads at the sticks'
         loading rate; a bounce of the ringing comes back within a part of its period.
+    restick_fraction : float
+        A slip found by the scan holds slips smaller than ``h`` (their sticks reload the
+        spring by less than ``h``): inside it, a rise of the force by more than
+        ``restick_fraction`` × ``h`` above its running minimum is a re-stick when the
+        force rises, over it, at no more than :data:`RESTICK_RATE` times the sticks'
+        loading rate (the wall at rest within ±V; a wall ringing back, faster, is not
+        stuck).  The slip is split there: the first ends at the minimum, the next yields
+        at the rise's top (the highest force before it falls that much again).  Default
+        1/3; 0 turns the rule off.  Ground truth: docs/analysis.md ("Slips inside
+        slips").
 
     Returns
     -------
@@ -237,7 +256,8 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         floor = 1e-6 * max(hi - lo, abs(hi), abs(lo), np.finfo(float).tiny)
         threshold = max(kk * noise, floor)
     h = float(threshold)
-    yi, si, unfinished = _scan(t, f, h, min_drop, relative_drop, ringing_window)
+    rules = (min_drop, relative_drop, ringing_window)
+    yi, si, unfinished = _scan(t, f, h, *rules)
     cyc = inc = 0.0
     if blind and threshold_given is None:
         # the local estimate does not see noise correlated over longer than its lags
@@ -253,9 +273,20 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
             if cyc <= CYCLE_NOISE_FACTOR * noise or new <= h:
                 break
             h = new
-            yi, si, unfinished = _scan(t, f, h, min_drop, relative_drop, ringing_window)
+            yi, si, unfinished = _scan(t, f, h, *rules)
         cyc = cyc if math.isfinite(cyc) else 0.0
-    return SlipEvents(yi, si, h, float(noise), unfinished, lag, cyc, inc)
+    # the slips the scan merged, split where the wall stopped inside them (after the
+    # threshold is set: h is the scan's, with or without the split)
+    inner = 0
+    if yi.size > 1 and restick_fraction > 0:
+        rate = _loading_rate(t, f, yi, si, max(ringing_window, 1.0))
+        if rate > 0.0:
+            pairs = [q for a, b in zip(yi, si)
+                     for q in _split_at_resticks(t, f, int(a), int(b), restick_fraction * h, rate)]
+            inner = len(pairs) - yi.size
+            yi = np.array([q[0] for q in pairs], np.int64)
+            si = np.array([q[1] for q in pairs], np.int64)
+    return SlipEvents(yi, si, h, float(noise), unfinished, lag, cyc, inc, inner)
 
 
 def _peak_to_trough(n_eff: float) -> float:
@@ -295,15 +326,44 @@ def _scan(t, f, h, min_drop, relative_drop, ringing_window):
     return yi, si, unfinished
 
 
-def _drop_ringing(t, f, yi, si, window):
-    """Remove candidates that are the ringing of the wall after a re-stick (see
-    ``ringing_window`` in :func:`detect_slips`)."""
-    # the sticks' loading rate: the median rise from a re-stick to the next yield, over
-    # the sticks that no ringing can be (longer than ``window`` slips), else over all
+def _loading_rate(t, f, yi, si, window):
+    """The sticks' loading rate: the median rise from a re-stick to the next yield, over
+    the sticks that no ringing can be (longer than ``window`` slips), else over all."""
     stick = t[yi[1:]] - t[si[:-1]]
     rates = (f[yi[1:]] - f[si[:-1]]) / stick
     long = stick >= window * (t[si[:-1]] - t[yi[:-1]])
-    rate = float(np.median(rates[long] if long.any() else rates))
+    return float(np.median(rates[long] if long.any() else rates))
+
+
+def _split_at_resticks(t, f, y, s, rise, rate):
+    """Slip (y, s) as the slips it holds (see ``restick_fraction`` in :func:`detect_slips`):
+    a list of (yield, re-stick) index pairs."""
+    out, base = [], y
+    while True:
+        seg = f[base:s + 1]
+        above = np.flatnonzero(seg - np.minimum.accumulate(seg) > rise)
+        if above.size == 0:
+            break
+        j = int(above[0])
+        low = int(np.argmin(seg[:j + 1]))
+        # the rise's top: the highest force before it falls ``rise`` below it
+        fall = np.flatnonzero(seg[j:] < np.maximum.accumulate(seg[j:]) - rise)
+        end = j + int(fall[0]) if fall.size else seg.size
+        top = j + int(np.argmax(seg[j:end]))
+        if seg[top] - seg[low] <= RESTICK_RATE * rate * (t[base + top] - t[base + low]):
+            out.append((y, base + low))     # a re-stick: the wall stopped, the drive reloads
+            y = base + top
+        base += top                         # else a bounce: search on after its top
+        if base >= s:
+            break
+    out.append((y, s))
+    return out
+
+
+def _drop_ringing(t, f, yi, si, window):
+    """Remove candidates that are the ringing of the wall after a re-stick (see
+    ``ringing_window`` in :func:`detect_slips`)."""
+    rate = _loading_rate(t, f, yi, si, window)
     kept = [0]
     for i in range(1, yi.size):
         j = kept[-1]

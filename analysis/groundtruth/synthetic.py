@@ -207,7 +207,7 @@ def with_wall_noise(columns: dict, *, velocity_noise, velocity_correlation=0.0,
     return out
 
 
-def irregular_coulomb_trace(static_forces, *, kinetic_force: float, stiffness: float,
+def irregular_coulomb_trace(static_forces, *, kinetic_force, stiffness: float,
                             mass: float, drive_velocity: float, dt: float,
                             start_force: float = 0.0, tail: float = 0.5) -> dict:
     """A driven Coulomb block (no damping) whose i-th slip starts at ``static_forces[i]``.
@@ -215,7 +215,9 @@ def irregular_coulomb_trace(static_forces, *, kinetic_force: float, stiffness: f
     The block sticks while the spring force F = K(V t − x) rises at K·V; at F_s,i it slips
     under the kinetic force F_k, and F = F_k + (F_s,i − F_k) cos ωt + (K V/ω) sin ωt
     (ω = √(K/M)) until its velocity V − F'/K is zero again, at ωt = 2(π − atan(A ω/(K V))),
-    A = F_s,i − F_k: the re-stick.  Slips of irregular size and timing, in closed form,
+    A = F_s,i − F_k: the re-stick.  ``kinetic_force`` is one F_k or one per slip (a slip
+    under a lower F_k lands lower: slips that end and start again after a short stick).
+    Slips of irregular size and timing, in closed form,
     sampled every ``dt`` (the samples of each slip's end are exact).  The trace ends
     ``tail`` × the last stick's length after the last re-stick.
 
@@ -231,20 +233,23 @@ def irregular_coulomb_trace(static_forces, *, kinetic_force: float, stiffness: f
     [-1.0, 0.0]
     """
     k, m, v = float(stiffness), float(mass), float(drive_velocity)
-    fk = float(kinetic_force)
+    static = np.asarray(static_forces, float)
+    kinetic = np.broadcast_to(np.asarray(kinetic_force, float), static.shape)
     w = np.sqrt(k / m)
     # the piecewise solution: (start time, start force, slipping?, slip's amplitude)
     pieces, now, force = [], 0.0, float(start_force)
     yields, resticks, fs_true, fb_true = [], [], [], []
-    for fs in np.asarray(static_forces, float):
+    for fs, fk in zip(static, kinetic):
         if fs <= force:
             raise ValueError(f"static force {fs} is not above the force it is loaded from, {force}")
+        if fs <= fk:
+            raise ValueError(f"static force {fs} is not above its kinetic force {fk}")
         stick = (fs - force) / (k * v)
-        pieces.append((now, force, False, 0.0))
+        pieces.append((now, force, False, 0.0, 0.0))
         now += stick
         a = fs - fk
         duration = 2.0 * (np.pi - np.arctan(a * w / (k * v))) / w
-        pieces.append((now, fs, True, a))
+        pieces.append((now, fs, True, a, fk))
         yields.append(now)
         now += duration
         force = fk + a * np.cos(w * duration) + k * v / w * np.sin(w * duration)
@@ -252,13 +257,13 @@ def irregular_coulomb_trace(static_forces, *, kinetic_force: float, stiffness: f
         fs_true.append(fs)
         fb_true.append(force)
     end = now + tail * max(yields[-1] - (resticks[-2] if len(resticks) > 1 else 0.0), 10 * dt)
-    pieces.append((now, force, False, 0.0))
+    pieces.append((now, force, False, 0.0, 0.0))
     t = np.arange(0.0, end, dt)
     f = np.empty_like(t)
     vel = np.empty_like(t)
     starts = np.array([p[0] for p in pieces])
     which = np.searchsorted(starts, t, side="right") - 1
-    for i, (t0, f0, slipping, a) in enumerate(pieces):
+    for i, (t0, f0, slipping, a, fk) in enumerate(pieces):
         sel = which == i
         u = t[sel] - t0
         if slipping:

@@ -1,16 +1,19 @@
-"""The pooled slip law of MD runs with and without the slips inside which the spring reloaded.
+"""The pooled slip law of MD runs with the detector's split at re-sticks, without it, and
+without the slips that still hold a rise.
 
     python benchmarks/slip_law/pooled_without_reloads.py RUN_DIR... [--rise 5]
 
-A detected slip whose spring force rises, somewhere between its yield and its re-stick, by
-more than ``--rise`` (ε/σ) above its running minimum is not one slip: the wall stopped and the
-drive reloaded the spring (smaller slips merged, their drops below the detector's threshold),
-or it rang.  The runs' slips are pooled (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`,
-the jackknife over the runs) with every analysed slip, and again without those: how much the
-verdict rests on them; and a third time with those slips split where the spring reloads
-(:func:`split`: each sub-slip from its yield to the running minimum before the rise, the next
-from the top of the rise), as a detector that confirmed each re-stick would find them.  Prints
-the three fits and how many slips each run loses or gains.
+The detector's scan merges slips whose sticks reload the spring by less than its threshold
+h; it then splits each slip it found where, inside it, the force rises by more than h/3 at
+no more than twice the sticks' loading rate (the wall stopped: ``restick_fraction`` in
+:func:`~filmfriction.analysis.stickslip.detect_slips`).  The runs' slips are pooled
+(:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`, the jackknife
+over the runs) three ways: as analysed (split); as the scan alone finds them
+(``restick_fraction=0``, each table built as the analysis builds it: the extrema refined,
+the start-up slip left out); and as analysed without the slips inside which the force
+still rises by more than ``--rise`` (ε/σ) above its running minimum (a wall ringing back,
+or a reload below h/3): how much the verdict rests on the split and on those.  Prints the
+three fits and how many slips each run has fewer than as analysed.
 """
 from __future__ import annotations
 
@@ -21,7 +24,9 @@ from dataclasses import replace
 import numpy as np
 
 from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
+from filmfriction.analysis.extrema import refine_extrema
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
+from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.reduced_model.cycles import cycle_table
 
 
@@ -31,42 +36,40 @@ def inner_rise(force: np.ndarray, a: int, b: int) -> float:
     return float(np.max(seg - np.minimum.accumulate(seg)))
 
 
-def split(force: np.ndarray, a: int, b: int, rise: float) -> list[tuple[int, int]]:
-    """Slip (a, b) as the slips it holds: cut at the running minimum before each rise of more
-    than ``rise``, the next slip yielding at the top of that rise (the highest force before it
-    falls ``rise`` below it)."""
-    seg = force[a:b + 1]
-    up = np.flatnonzero(seg - np.minimum.accumulate(seg) > rise)
-    if up.size == 0:
-        return [(a, b)]
-    j = int(up[0])
-    stick = int(np.argmin(seg[:j + 1]))
-    peak = j
-    for k in range(j, seg.size):
-        if seg[k] > seg[peak]:
-            peak = k
-        if seg[peak] - seg[k] > rise:
-            break
-    return [(a, a + stick)] + split(force, a + peak, b, rise)
+def scan_alone(rs, spring_constant: float, drive_velocity: float):
+    """Run ``rs``'s slips as the detector's scan finds them without the split, tabulated as
+    the analysis tabulates (extrema refined, the start-up slip left out)."""
+    t, f = rs.time, rs.spring_force
+    ev = detect_slips(t, f, restick_fraction=0)
+    table = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=spring_constant,
+                        wall_position=rs.wall_position)
+    table = refine_extrema(t, f, table, noise=ev.noise, lag=ev.lag,
+                           spring_constant=spring_constant, drive_velocity=drive_velocity,
+                           wall_position=rs.wall_position)
+    skip = 1 if len(table) >= 3 else 0
+    return table.yield_index[skip:], table.stick_index[skip:]
 
 
-def pooled(dirs, rise: float | None, cut: bool = False):
+def pooled(dirs, how: str, rise: float):
     runs, shared, _ = read_runs(dirs)
-    out, lost = [], []
+    k = shared["spring_constant"]
+    out, fewer = [], []
     for rs in runs:
         f = rs.spring_force
         y, s = rs.table.yield_index, rs.table.stick_index
-        if cut:
-            pairs = [q for a, b in zip(y, s) for q in split(f, int(a), int(b), rise)]
+        if how == "scan":
+            ya, sa = scan_alone(rs, k, shared["drive_velocity"])
+        elif how == "left out":
+            keep = np.array([inner_rise(f, a, b) <= rise for a, b in zip(y, s)], bool)
+            ya, sa = y[keep], s[keep]
         else:
-            pairs = [(a, b) for a, b in zip(y, s) if rise is None or inner_rise(f, a, b) <= rise]
-        lost.append(len(y) - len(pairs))
-        ya, sa = (np.array([q[i] for q in pairs], int) for i in (0, 1))
-        out.append(replace(rs, table=cycle_table(rs.time, f, ya, sa,
-                                                 spring_constant=shared["spring_constant"],
+            ya, sa = y, s
+        fewer.append(len(y) - len(ya))
+        out.append(replace(rs, table=cycle_table(rs.time, f, np.asarray(ya, int),
+                                                 np.asarray(sa, int), spring_constant=k,
                                                  wall_position=rs.wall_position)))
     fit = fit_pooled_ensemble(out, **fit_arguments(shared))
-    return fit, sum(len(r.table) for r in out), lost
+    return fit, sum(len(r.table) for r in out), fewer
 
 
 def main(argv=None) -> int:
@@ -74,12 +77,13 @@ def main(argv=None) -> int:
     ap.add_argument("run_dirs", nargs="+")
     ap.add_argument("--rise", type=float, default=5.0, help="ε/σ (default 5)")
     args = ap.parse_args(argv)
-    for rise, cut in ((None, False), (args.rise, False), (args.rise, True)):
-        fit, n, lost = pooled(args.run_dirs, rise, cut)
+    for how in ("analysed", "scan", "left out"):
+        fit, n, fewer = pooled(args.run_dirs, how, args.rise)
         law = fit.law
-        what = ("every slip" if rise is None else f"split at each inner rise > {rise:g}" if cut
-                else f"no inner rise > {rise:g}")
-        print(f"{what}: {len(args.run_dirs)} runs, {n} slips (fewer per run: {lost}): "
+        what = {"analysed": "as analysed (split at re-sticks)",
+                "scan": "the scan alone (no split)",
+                "left out": f"as analysed, no inner rise > {args.rise:g}"}[how]
+        print(f"{what}: {len(args.run_dirs)} runs, {n} slips (fewer per run: {fewer}): "
               f"{fit.verdict}; F_k {law.kinetic_force:.1f} ± {law.kinetic_force_stderr:.1f}, "
               f"B {law.damping:.0f} ± {law.damping_stderr:.0f} ({law.damping_sigmas:+.1f} σ), "
               f"n {law.exponent:+.2f} ± {law.exponent_stderr:.2f}, v̄ {law.mean_velocity:.3f}")
