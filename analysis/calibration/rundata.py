@@ -79,10 +79,11 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
     Raises
     ------
     ValueError
-        No run directory, no trace, an unreadable analysis, or (``analyse=False``)
-        no analysis.
+        No run directory, no trace, an unreadable analysis or one of another schema, or
+        (``analyse=False``) no analysis.
     """
     from filmfriction.analysis.files.cycles_csv import read_cycles_csv
+    from filmfriction.analysis.analyze import SCHEMA as ANALYSIS_SCHEMA
     from filmfriction.analysis.analyze import analyze, as_analysed, write_outputs
     from filmfriction.analysis.files.trace_reader import read_trace
 
@@ -95,6 +96,10 @@ def load_run(run_dir, *, analyse: bool = True) -> RunData:
         from filmfriction.analysis.files.documents import read_document
 
         doc = read_document(apath, "analysis")
+        if doc.get("schema") not in (None, ANALYSIS_SCHEMA):
+            raise ValueError(f"{apath}: schema {doc['schema']!r}, not an analysis of this "
+                             f"version ({ANALYSIS_SCHEMA!r}); analyse it again "
+                             f"(filmfriction analyze {run_dir})")
         cycles = read_cycles_csv(cpath)
         # read once, as analysed (not with the run's parameters, then again)
         trace = read_trace(run_dir, **_analysed_parameters(doc))

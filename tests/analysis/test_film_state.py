@@ -101,6 +101,10 @@ def test_the_analysis_stops_where_the_film_changed_state(synthetic_run, run_cli,
     doc_path.write_text(json.dumps(stale))
     with pytest.raises(ValueError, match="analyse it again"):
         load_run(synthetic_run)
+    foreign = dict(stale, schema="someone.else/2")                # another tool's, or version
+    doc_path.write_text(json.dumps(foreign))
+    with pytest.raises(ValueError, match=r"schema 'someone.else/2'.*analyse it again"):
+        load_run(synthetic_run)
     kept = run_cli("analyze", synthetic_run, "--json", "--no-figure", "--whole-trace",
                    "--out", tmp_path / "whole.json")
     assert kept.code == 0, kept.err
