@@ -216,7 +216,10 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         force rises, over it, at no more than :data:`RESTICK_RATE` times the sticks'
         loading rate (the wall at rest within ±V; a wall ringing back, faster, is not
         stuck).  The slip is split there: the first ends at the minimum, the next yields
-        at the rise's top (the highest force before it falls that much again).  Default
+        at the rise's top (the highest force before it falls that much again).  The rise
+        must also exceed the largest peak-to-trough excursion of the noise seen at the
+        sampling over the slips' samples (k σ as for ``h``, from those samples): on white
+        noise that is about ``h`` itself, and no rise inside a slip is told from it.  Default
         1/3; 0 turns the rule off.  Ground truth: docs/analysis.md ("Slips inside
         slips").
 
@@ -280,9 +283,13 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     inner = 0
     if yi.size > 1 and restick_fraction > 0:
         rate = _loading_rate(t, f, yi, si, max(ringing_window, 1.0))
+        # no smaller than the largest excursion the noise seen at the sampling gives over
+        # the slips' samples: on white noise that is about h, and nothing is split
+        inside = int(np.sum(si - yi)) + yi.size
+        rise = max(restick_fraction * h, _peak_to_trough(inside / lag) * float(noise))
         if rate > 0.0:
             pairs = [q for a, b in zip(yi, si)
-                     for q in _split_at_resticks(t, f, int(a), int(b), restick_fraction * h, rate)]
+                     for q in _split_at_resticks(t, f, int(a), int(b), rise, rate)]
             inner = len(pairs) - yi.size
             yi = np.array([q[0] for q in pairs], np.int64)
             si = np.array([q[1] for q in pairs], np.int64)
