@@ -84,12 +84,14 @@ def context(trace: Trace, *, skip: int | None = None, structure: bool = True) ->
     The trace must have at least :data:`MIN_ROWS` rows (:func:`analyze` says
     ``unresolved`` for a shorter one)."""
     t, f = trace.time, trace.spring_force
-    events = stickslip.detect_slips(t, f)
+    v_drive, _ = trace.drive_velocity()
+    k = trace.parameters.spring_constant
+    # the drive's loading rate K·V where both are known (the re-stick rule inside slips)
+    events = stickslip.detect_slips(t, f, loading_rate=k * v_drive if k and v_drive else None)
     wall = trace.wall_position()
     table = cycle_table(t, f, events.yield_index, events.stick_index,
                                   spring_constant=trace.parameters.spring_constant,
                                   wall_position=wall)
-    v_drive, _ = trace.drive_velocity()
     table = refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
                                      spring_constant=trace.parameters.spring_constant,
                                      drive_velocity=v_drive, wall_position=wall)

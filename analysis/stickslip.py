@@ -153,7 +153,8 @@ RAISES = 10
 def detect_slips(time, spring_force, *, threshold: float | None = None,
                  noise: float | None = None, k: float | None = None,
                  min_drop: float = 0.0, relative_drop: float = 0.1,
-                 ringing_window: float = 3.0, restick_fraction: float = 1.0 / 3.0) -> SlipEvents:
+                 ringing_window: float = 3.0, restick_fraction: float = 1.0 / 3.0,
+                 loading_rate: float | None = None) -> SlipEvents:
     """Find yield (y) and re-stick (s) points in a noisy spring-force trace.
 
     Criterion: a slip is a fall of the force by more than ``h`` from a
@@ -213,14 +214,18 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         A slip found by the scan holds slips smaller than ``h`` (their sticks reload the
         spring by less than ``h``): inside it, a rise of the force by more than
         ``restick_fraction`` × ``h`` above its running minimum is a re-stick when the
-        force rises, over it, at no more than :data:`RESTICK_RATE` times the sticks'
-        loading rate (the wall at rest within ±V; a wall ringing back, faster, is not
-        stuck).  The slip is split there: the first ends at the minimum, the next yields
+        force rises, over it, at no more than :data:`RESTICK_RATE` times the loading rate
+        (the wall at rest within ±V; a wall ringing back, faster, is not stuck).  The slip is split there: the first ends at the minimum, the next yields
         at the rise's top (the highest force before it falls that much again).  The rise
         must also exceed the largest peak-to-trough excursion of the noise seen at the
-        sampling over the slips' samples (k σ as for ``h``, from those samples): on white
-        noise that is about ``h`` itself, and no rise inside a slip is told from it.  Default
-        1/3; 0 turns the rule off.  Ground truth: docs/analysis.md ("Slips inside
+        sampling over the slips' samples (2 √(2 ln N) + 1 times σ, N those samples over the
+        lag): on white noise that is about ``h`` itself, and no rise inside a slip is told
+        from it.  The rule needs 2 slips found by the scan (a trace merged into one slip is
+        not split) and a positive loading rate.  Default 1/3; 0 turns the rule off.
+    loading_rate : float, optional
+        K·V, the rate at which the drive loads the spring while the wall is at rest (force
+        per time), for the re-stick rule; default: the median rise rate of the scan's sticks
+        (which sticks that hold slips the scan missed pull down).  Ground truth: docs/analysis.md ("Slips inside
         slips").
 
     Returns
@@ -282,7 +287,8 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     # threshold is set: h is the scan's, with or without the split)
     inner = 0
     if yi.size > 1 and restick_fraction > 0:
-        rate = _loading_rate(t, f, yi, si, max(ringing_window, 1.0))
+        rate = (float(loading_rate) if loading_rate is not None
+                else _loading_rate(t, f, yi, si, max(ringing_window, 1.0)))
         # no smaller than the largest excursion the noise seen at the sampling gives over
         # the slips' samples: on white noise that is about h, and nothing is split
         inside = int(np.sum(si - yi)) + yi.size

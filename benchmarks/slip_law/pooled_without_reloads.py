@@ -5,20 +5,24 @@ without the slips that still hold a rise.
 
 The detector's scan merges slips whose sticks reload the spring by less than its threshold
 h; it then splits each slip it found where, inside it, the force rises by more than h/3 at
-no more than twice the sticks' loading rate (the wall stopped: ``restick_fraction`` in
+no more than twice the loading rate K·V (the wall stopped: ``restick_fraction`` in
 :func:`~filmfriction.analysis.stickslip.detect_slips`).  The runs' slips are pooled
 (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`, the jackknife
 over the runs) three ways: as analysed (split); as the scan alone finds them
 (``restick_fraction=0``, each table built as the analysis builds it: the extrema refined,
-the start-up slip left out); and as analysed without the slips inside which the force
-still rises by more than ``--rise`` (ε/σ) above its running minimum (a wall ringing back,
-or a reload below h/3): how much the verdict rests on the split and on those.  Prints the
-three fits and how many slips each run has fewer than as analysed.
+the start-up slips the analysis left out, left out); and as analysed without the slips
+inside which the force still rises by more than ``--rise`` (ε/σ) above its running minimum
+(rises the rule did not take for re-sticks: faster than 2 K·V, a wall ringing back): how
+much the verdict rests on the split and on those.  Prints the three fits and how many slips
+each run has fewer than as analysed (for the scan alone: the splits, less any start-up slip
+that held one).
 """
 from __future__ import annotations
 
 import argparse
+import json
 import sys
+from pathlib import Path
 from dataclasses import replace
 
 import numpy as np
@@ -38,7 +42,8 @@ def inner_rise(force: np.ndarray, a: int, b: int) -> float:
 
 def scan_alone(rs, spring_constant: float, drive_velocity: float):
     """Run ``rs``'s slips as the detector's scan finds them without the split, tabulated as
-    the analysis tabulates (extrema refined, the start-up slip left out)."""
+    the analysis tabulates (extrema refined, the slips its analysis left out at the start
+    left out: ``summary_skips_first`` of its ``analysis.json``)."""
     t, f = rs.time, rs.spring_force
     ev = detect_slips(t, f, restick_fraction=0)
     table = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=spring_constant,
@@ -46,7 +51,8 @@ def scan_alone(rs, spring_constant: float, drive_velocity: float):
     table = refine_extrema(t, f, table, noise=ev.noise, lag=ev.lag,
                            spring_constant=spring_constant, drive_velocity=drive_velocity,
                            wall_position=rs.wall_position)
-    skip = 1 if len(table) >= 3 else 0
+    doc = json.loads((Path(rs.name) / "analysis.json").read_text())
+    skip = int((doc.get("slips") or {}).get("summary_skips_first") or 0)
     return table.yield_index[skip:], table.stick_index[skip:]
 
 

@@ -14,8 +14,10 @@ the next estimate.
 
 Slips inside slips (``merged``): pairs of slips with a stick between them that reloads the
 spring by 6-10 ε/σ, below h (17-22 here): of 140 true slips in 10 traces the scan alone
-finds 59, with the split at re-sticks inside its slips 112, none extra (measured at the
-time of writing); a bump rising at 5x the reload rate (a wall ringing back) is not split.
+finds 59, with the split at re-sticks inside its slips (the loading rate K·V given, as the
+analysis gives it) 117, none extra, their re-stick forces within the noise (measured at the
+time of writing); a bump rising at 5x the reload rate (a wall ringing back) is not split;
+white noise on model slips is never split.
 """
 import numpy as np
 import pytest
@@ -24,6 +26,7 @@ from filmfriction.analysis.groundtruth import synthetic
 from filmfriction.analysis.stickslip import detect_slips
 
 DT = 0.25
+KV = 8.0 * 0.0025      # the drive's loading rate K·V of these traces (ε/σ per τ)
 NOISE = {"rms": 1.5, "period": 200.0, "decay": 400.0, "dt": DT}
 
 
@@ -115,37 +118,70 @@ def found_yields(t, yields, truth, within=150.0):
 
 
 def test_slips_merged_by_the_threshold_are_split_where_the_wall_stopped():
-    found = found_unsplit = made = extra = inner = 0
+    found = found_unsplit = made = extra = 0
+    restick_errors = []
     for seed in range(10):
         tr, f = merged(seed)
         t = tr["time"]
-        ev = detect_slips(t, f)
+        ev = detect_slips(t, f, loading_rate=KV)        # as the analysis calls it: K·V known
         hit = found_yields(t, ev.yield_index, tr["yield_time"])
         found += hit
         extra += ev.count - hit
-        inner += ev.inner_resticks
+        assert ev.inner_resticks >= 4, (seed, ev.inner_resticks)     # 5-6 measured, of 7
         found_unsplit += found_yields(t, detect_slips(t, f, restick_fraction=0).yield_index,
                                       tr["yield_time"])
         made += tr["yield_time"].size
         assert ev.threshold > 10.0                     # every inner rise is below h
+        # each re-stick found: its force is the true F_b within the noise (rms 1.5)
+        for ts, fb in zip(tr["restick_time"], tr["backward_force"]):
+            near = np.abs(t[ev.stick_index] - ts)
+            if near.min() < 150.0:
+                restick_errors.append(f[ev.stick_index[np.argmin(near)]] - fb)
     assert extra == 0
     assert found_unsplit <= 0.5 * made, (found_unsplit, made)
-    assert found >= 0.75 * made, (found, made)
-    assert inner >= found - found_unsplit
+    assert found >= 0.8 * made, (found, made)              # 117 of 140 measured
+    e = np.abs(restick_errors)
+    assert len(e) >= found - 5 and np.median(e) < 2.5 and e.max() < 6.0, (len(e), np.median(e), e.max())
 
 
-def test_a_bounce_inside_a_slip_is_not_a_restick():
-    # a slip (F_s 50, F_k 32) whose wall rings back near its end: a bump of 8 ε/σ rising in
-    # ≈ 40 τ, five times the drive's reload rate.  Under the ringing noise h is above 8, so
+def test_white_noise_on_model_slips_is_never_split():
+    # 1 % white noise on random Coulomb blocks: a spike of 3 σ just after a rounded yield
+    # rises at the loading rate over one sample; the noise floor of the rise (k σ over the
+    # slips' samples, about h on white noise) keeps it from splitting the slip
+    from filmfriction.analysis.groundtruth import cases as gt
+
+    rng = np.random.default_rng(11)
+    for k in range(12):
+        case = gt.random_case("coulomb", rng, samples_per_slip=50, noise=0.01, seed=k)
+        cols, params = gt.sample(case)
+        ev = detect_slips(cols["time"], cols["spring_force"])
+        assert ev.inner_resticks == 0, case.label()
+
+
+def test_a_bounce_inside_a_slip_is_not_a_restick(monkeypatch):
+    # a slip (F_s 50, F_k 32) whose wall rings back near its end: a bump of 10 ε/σ rising in
+    # ≈ 40 τ, five times the drive's reload rate.  Under the ringing noise h is above 10, so
     # the bump is inside the slip the scan finds; the wall did not stop, so it stays whole.
-    for seed in range(5):
+    # Without the rate test the same bump is taken for a re-stick (each seed).
+    from filmfriction.analysis import stickslip
+
+    def bumped(seed):
         tr = synthetic.irregular_coulomb_trace([50.0, 45.0, 52.0], kinetic_force=32.0,
                                                stiffness=8.0, mass=1.0e5,
                                                drive_velocity=0.0025, dt=DT)
         t = tr["time"]
-        bump = 8.0 * np.exp(-0.5 * ((t - tr["restick_time"][0] + 60.0) / 15.0) ** 2)
-        f = tr["spring_force"] + bump + synthetic.ringing_noise(t.size, seed=seed, **NOISE)
-        ev = detect_slips(t, f)
-        assert ev.threshold > 8.0
+        slip = (t > tr["yield_time"][0]) & (t < tr["restick_time"][0])
+        lowest = t[slip][np.argmin(tr["spring_force"][slip])]     # the slip's force minimum
+        bump = 10.0 * np.exp(-0.5 * ((t - lowest + 60.0) / 15.0) ** 2)
+        return tr, t, tr["spring_force"] + bump + synthetic.ringing_noise(t.size, seed=seed,
+                                                                          **NOISE)
+    for seed in range(5):
+        tr, t, f = bumped(seed)
+        ev = detect_slips(t, f, loading_rate=KV)
+        assert ev.threshold > 10.0
         assert ev.inner_resticks == 0
         assert found_yields(t, ev.yield_index, tr["yield_time"]) == ev.count == 3
+    monkeypatch.setattr(stickslip, "RESTICK_RATE", 1e9)
+    for seed in range(5):
+        tr, t, f = bumped(seed)
+        assert detect_slips(t, f, loading_rate=KV).inner_resticks >= 1, seed
