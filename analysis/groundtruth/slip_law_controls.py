@@ -191,7 +191,9 @@ STIFF_STOP = 0.004
 #: mixes        F_k + B·v of viscous share s of F = 32 ε/σ at 0.045 σ/τ (the runs' F̄ and v̄),
 #:              re-sticking at F_b = M1E4_BACKWARD or once slowed to M1E4_STOP (the stiff
 #:              scale's 0.004 times 0.045/0.017; noise-free cycles of 535 and 612 τ at
-#:              shares 0.3 and 0.6)
+#:              shares 0.3 and 0.6), once the spring force is below 27 ε/σ (as at the stiff
+#:              scale, 4.5 ε/σ below the lowest yield force of the pooled controls' runs,
+#:              45 × 0.7: a slip from there is not ended by the noise at once)
 #:
 #: ``period``: the noise-free slip cycle's length (measured on :func:`random_force_runs`'
 #: noise-free runs) or a little more.
@@ -266,7 +268,7 @@ SCALES = {
                               backward_force=M1E4_BACKWARD, stop_velocity=-math.inf,
                               initial_force=M1E4_BACKWARD, period=600.0)},
         mix=dict(film_force=32.0, slip_velocity=0.045, backward_force=M1E4_BACKWARD,
-                 stop_velocity=M1E4_STOP, armed_below=32.0, initial_force=M1E4_BACKWARD,
+                 stop_velocity=M1E4_STOP, armed_below=27.0, initial_force=M1E4_BACKWARD,
                  period=700.0),
         mount_damping=10.7, chunk=10),
 }

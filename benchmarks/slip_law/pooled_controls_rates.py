@@ -5,9 +5,10 @@
         [--scale stiff]
 
 Each replica is G runs of one law at the heavy slider's scale (``SCALES["stiff"]``, its
-calibrated noise; ``--scale m1e4``: the K = 8 film's slider at M = 10⁴, ``SCALES["m1e4"]``), each run with its own yield force and, with ``--law-spread``, its own
-film (:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are
-pooled and fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
+calibrated noise; ``--scale m1e4``: the K = 8 film's slider at M = 10⁴, ``SCALES["m1e4"]``),
+each run with its own yield force and, with ``--law-spread``, its own film
+(:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are pooled and
+fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
 with the jackknife over the runs, and the same pooled slips with the jackknife over the
 slips (the comparison that treats them as one run's).  Printed per law: the verdicts of
 both, and for the decelerating branch and the one law the bias of F_k and B (mean − truth
