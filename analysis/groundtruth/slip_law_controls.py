@@ -209,7 +209,8 @@ M1E4_B = 2.0 * math.sqrt(8.0 * 1e4)
 #: 1.06 times the MD's (0.0186 for 0.0176 σ/τ); over 0.25, 1, 4 τ the replicas' wall
 #: jitters 3.0, 1.9 and 1.3 times the MD's and their residual is less correlated at 1–4 τ
 #: (0.75, 0.23 for the MD's 0.91, 0.44): below the slip's tenth (≈ 11 τ) the MD's wall is
-#: smoother than any process of this family (docs/results/slip-law.md, "Runs pooled").
+#: smoother than any process of this family (docs/results/slip-law.md, "Controls at the
+#: M = 10⁴ scale of the K = 8 film").
 M1E4_NOISE = {"velocity_noise": 0.024, "velocity_correlation": 0.99, "rattle": 0.0}
 M1E4_BACKWARD = 15.0
 M1E4_STOP = 0.011
