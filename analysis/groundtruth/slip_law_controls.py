@@ -173,6 +173,48 @@ STIFF_NOISE = {"velocity_noise": 0.0042, "velocity_correlation": 0.993, "rattle"
 STIFF_BACKWARD = 8.0
 STIFF_STOP = 0.004
 
+#: The K = 8 film's slider at M = 10⁴ m, the rung of the mass ladder whose pooled slips are
+#: ``kinetic`` (K = 8 ε/σ², V = 0.0079 σ/τ, the mount dashpot γ = 0.00107 /τ, i.e. γM = 10.7
+#: m/τ, sampled every 0.25 τ; static forces ≈ 45 (34–58), re-stick forces ≈ 16 (10–22) ε/σ,
+#: slips of 50–400 τ, median 115, at ≈ 0.045 σ/τ; F̄ 31.7, F_k ≈ 27 ε/σ).  Its controls, as
+#: the stiff scale's with √(M/K) √10 shorter:
+#:
+#: ``coulomb``  F_s = 45, F_k = 27 ε/σ (F_k + 0·v on every sample), re-sticking where the
+#:              wall stops (noise-free a slip of 120 τ at 0.044 σ/τ mean, 0.070 peak, to
+#:              F_b = 10.0 ε/σ; a cycle of 673 τ)
+#: ``weakening`` exponential weakening F_s = 45 → F_k = 27 ε/σ over v_c = 0.03 σ/τ (the stiff
+#:              scale's 0.01 times the slips' speed-up, 0.045/0.017; noise-free a slip of
+#:              155 τ, 0.061 σ/τ peak, to F_b = 16.1; a cycle of 612 τ)
+#: ``viscous``  Klein's Eq. 1 with ζ = B/(2√(KM)) = 1 (B = 566 m/τ), re-stick imposed at
+#:              F_b = M1E4_BACKWARD (the MD runs' re-stick force; noise-free a slip of 97 τ
+#:              at 0.047 σ/τ mean, 0.060 peak; a cycle of 573 τ)
+#: mixes        F_k + B·v of viscous share s of F = 32 ε/σ at 0.045 σ/τ (the runs' F̄ and v̄),
+#:              re-sticking at F_b = M1E4_BACKWARD or once slowed to M1E4_STOP (the stiff
+#:              scale's 0.004 times 0.045/0.017; noise-free cycles of 535 and 612 τ at
+#:              shares 0.3 and 0.6), once the spring force is below 27 ε/σ (as at the stiff
+#:              scale, 4.5 ε/σ below the lowest yield force of the pooled controls' runs,
+#:              45 × 0.7: a slip from there is not ended by the noise at once)
+#:
+#: ``period``: the noise-free slip cycle's length (measured on :func:`random_force_runs`'
+#: noise-free runs) or a little more.
+M1E4_B = 2.0 * math.sqrt(8.0 * 1e4)
+#: The film's random force at M = 10⁴, calibrated as :data:`STIFF_NOISE` on the 137 analysed
+#: slips of the ten M = 10⁴ runs (seeds 1–5, 8–12; 40 replicas of this scale's ``viscous``
+#: control, measured alike, 10 slips each; a grid of u 0.018–0.026 σ/τ at 0.98–0.998 per
+#: sample scanned before, 20 replicas each): u an AR(1) of 0.024 σ/τ rms and correlation
+#: 0.99 per 0.25 τ (25 τ), no rattling (√(kT/M) = 0.0079 σ/τ white would make the wall jitter
+#: 10 times the MD's over 0.25 τ).  The residual with Δt², Δt³ fitted besides (0.0103, the
+#: MD's 0.0102 ± 0.0003), the plain residual (0.0124, the MD's 0.0126 ± 0.0004) and its mean
+#: shape's share (0.09, the MD's 0.09) are the MD's, the wall's velocity change over 8 τ
+#: 1.06 times the MD's (0.0186 for 0.0176 σ/τ); over 0.25, 1, 4 τ the replicas' wall
+#: jitters 3.0, 1.9 and 1.3 times the MD's and their residual is less correlated at 1–4 τ
+#: (0.75, 0.23 for the MD's 0.91, 0.44): below the slip's tenth (≈ 11 τ) the MD's wall is
+#: smoother than any process of this family (docs/results/slip-law.md, "Controls at the
+#: M = 10⁴ scale of the K = 8 film").
+M1E4_NOISE = {"velocity_noise": 0.024, "velocity_correlation": 0.99, "rattle": 0.0}
+M1E4_BACKWARD = 15.0
+M1E4_STOP = 0.011
+
 #: The scales of the random-force controls, by name.
 #: The controls' laws as the random-force slider integrates them: the rate-and-state slider
 #: yields from, and re-sticks at, this velocity (σ/τ).
@@ -216,6 +258,20 @@ SCALES = {
                  stop_velocity=STIFF_STOP, armed_below=27.0, initial_force=STIFF_BACKWARD,
                  period=2500.0),
         mount_damping=34.0, chunk=10),
+    "m1e4": Scale(
+        "m1e4", 8.0, 1e4, 0.25, 45.0, 0.0079,
+        M1E4_NOISE,
+        laws={"coulomb": dict(law="linear", parameters=(27.0, 0.0), armed_below=27.0,
+                              initial_force=9.0, period=700.0),
+              "weakening": dict(law="weakening", parameters=(27.0, 45.0, 0.03),
+                                armed_below=29.0, initial_force=9.0, period=650.0),
+              "viscous": dict(law="linear", parameters=(0.0, M1E4_B),
+                              backward_force=M1E4_BACKWARD, stop_velocity=-math.inf,
+                              initial_force=M1E4_BACKWARD, period=600.0)},
+        mix=dict(film_force=32.0, slip_velocity=0.045, backward_force=M1E4_BACKWARD,
+                 stop_velocity=M1E4_STOP, armed_below=27.0, initial_force=M1E4_BACKWARD,
+                 period=700.0),
+        mount_damping=10.7, chunk=10),
 }
 
 

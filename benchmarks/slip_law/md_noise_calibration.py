@@ -16,8 +16,8 @@ F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean sh
 fitted besides (``trend 3``).  ``--scan``: besides, u of 1 σ/τ at correlations 0.8–0.999 per
 sample (rattling 0.15): how slow a residual this family of noise can leave.
 
-``--scale stiff``: the replicas are the heavy slider's
-(:data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`, its ``viscous``
+``--scale stiff``: the replicas are the heavy slider's (``m1e4``: the K = 8 film's slider at
+M = 10⁴'s) (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`, its ``viscous``
 control, 10 slips each, its mount dashpot), the processes its calibrated noise and each
 ``--noise`` (u's rms, its correlation per sample, the rattling); ``--lags`` (samples) the
 lags of the residual's autocorrelation, the first three (or, with five or more, the first

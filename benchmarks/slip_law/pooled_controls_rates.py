@@ -2,11 +2,14 @@
 
     python benchmarks/slip_law/pooled_controls_rates.py [--runs 6] [--slips 8] [--replicas 100]
         [--laws coulomb viscous] [--shares 0.3 0.6] [--static-spread 0.3] [--law-spread 0.0]
+        [--scale stiff] [--noise-scale 1.0]
 
 Each replica is G runs of one law at the heavy slider's scale (``SCALES["stiff"]``, its
-calibrated noise), each run with its own yield force and, with ``--law-spread``, its own
-film (:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are
-pooled and fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
+calibrated noise; ``--scale m1e4``: the K = 8 film's slider at M = 10⁴, ``SCALES["m1e4"]``),
+``--noise-scale``: the scale's noise with its amplitudes times that (its correlation kept);
+each run with its own yield force and, with ``--law-spread``, its own film
+(:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are pooled and
+fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
 with the jackknife over the runs, and the same pooled slips with the jackknife over the
 slips (the comparison that treats them as one run's).  Printed per law: the verdicts of
 both, and for the decelerating branch and the one law the bias of F_k and B (mean − truth
@@ -24,7 +27,7 @@ from collections import Counter
 import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
-from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, scaled
 from filmfriction.analysis.slip_law.slip_law import VERDICTS
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import JACKKNIFE, fit_pooled_ensemble
@@ -45,23 +48,26 @@ def coverage(fits, branch: str, attr: str, truth: float) -> str:
             f" (truth {truth:.4g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
 
 
-def fit(runs, velocity, jackknife):
-    sc = SCALES["stiff"]
+def fit(runs, velocity, jackknife, scale="stiff"):
+    sc = SCALES[scale]
     return fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=velocity,
                                mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME,
                                jackknife=jackknife)
 
 
 def table(law: str, share, args) -> None:
-    kw = dict(share=share, static_spread=args.static_spread, law_spread=args.law_spread)
+    kw = dict(share=share, static_spread=args.static_spread, law_spread=args.law_spread,
+              scale=args.scale)
+    noisy = {} if args.noise_scale == 1.0 else {
+        "noise": scaled(SCALES[args.scale].noise, args.noise_scale)}
     name = law if share is None else f"coulomb-viscous share {share}"
     exact = fit(*pooled_runs(law, args.runs, args.slips, noise=NOISE_FREE,
-                             **(kw | {"law_spread": 0.0})), "runs")
+                             **(kw | {"law_spread": 0.0})), "runs", args.scale)
     fits = {j: [] for j in JACKKNIFE}
     for k in range(args.replicas):
-        rs, v = pooled_runs(law, args.runs, args.slips, seed=(args.seed, k), **kw)
+        rs, v = pooled_runs(law, args.runs, args.slips, seed=(args.seed, k), **kw, **noisy)
         for j in JACKKNIFE:
-            fits[j].append(fit(rs, v, j))
+            fits[j].append(fit(rs, v, j, args.scale))
     print(f"\n## {name}: {args.replicas} replicas of {args.runs} runs x {args.slips} slips "
           f"(static spread ±{args.static_spread:g}, law spread {args.law_spread:g})",
           flush=True)
@@ -81,13 +87,21 @@ def main(argv=None) -> int:
     ap.add_argument("--slips", type=int, default=8)
     ap.add_argument("--replicas", type=int, default=100)
     ap.add_argument("--laws", nargs="*", default=["coulomb", "viscous"],
-                    choices=sorted(SCALES["stiff"].laws))
+                    choices=sorted({n for sc in SCALES.values() for n in sc.laws}))
     ap.add_argument("--shares", nargs="*", type=float, default=[0.3, 0.6])
     ap.add_argument("--static-spread", type=float, default=STATIC_SPREAD)
     ap.add_argument("--law-spread", type=float, default=0.0)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--scale", default="stiff", choices=[n for n in SCALES if n != "klein"],
+                    help="the controls' scale (SCALES; stiff: K 8, M 1e5; m1e4: K 8, M 1e4)")
+    ap.add_argument("--noise-scale", type=float, default=1.0,
+                    help="the scale's noise amplitudes times this (1: as calibrated)")
     args = ap.parse_args(argv)
-    print(f"pooled slip-law controls at the stiff scale: {vars(args)}")
+    missing = [law for law in args.laws if law not in SCALES[args.scale].laws]
+    if missing:
+        ap.error(f"--laws {' '.join(missing)}: not a control at the {args.scale} scale "
+                 f"({', '.join(SCALES[args.scale].laws)})")
+    print(f"pooled slip-law controls at the {args.scale} scale: {vars(args)}")
     for law in args.laws:
         table(law, None, args)
     for share in args.shares:

@@ -186,3 +186,38 @@ def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
     # slider's scale"); 20 replicas of 8 slips here
     fits = dynamical_fits("coulomb", 20, 8, scale="stiff")
     assert not any(f.verdict == "viscous" for f in fits), Counter(f.verdict for f in fits)
+
+
+# --- the K = 8 film's slider at M = 1e4 (SCALES["m1e4"]: V 0.0079, the mount dashpot 10.7 m/τ)
+
+@pytest.mark.parametrize("name, share, verdict, kinetic, damping", [
+    ("coulomb", None, "kinetic", 27.0, 0.0), ("viscous", None, "viscous", 0.0, 565.7),
+    ("", 0.3, "mixed", 22.4, 213.3)])
+def test_m1e4_scale_noise_free_controls_give_their_law_back(name, share, verdict, kinetic,
+                                                            damping):
+    fit = dynamical_fits(name, 1, 8, noise=NOISE_FREE, share=share, scale="m1e4")[0]
+    assert fit.verdict == verdict
+    assert fit.decelerating.kinetic_force == pytest.approx(kinetic, abs=0.05)
+    assert fit.decelerating.damping == pytest.approx(damping, abs=1.0)
+
+
+def test_m1e4_weakening_slips_are_weakening_noise_free():
+    fit = dynamical_fits("weakening", 1, 8, noise=NOISE_FREE, scale="m1e4")[0]
+    assert fit.verdict == "velocity-weakening", fit.reason
+    assert fit.decelerating.damping < -100.0
+
+
+@pytest.mark.parametrize("name, share", [("coulomb", None), ("weakening", None),
+                                         ("viscous", None), ("", 0.0), ("", 0.3), ("", 1.0)])
+def test_m1e4_periods_hold_a_noise_free_cycle(name, share):
+    # ``period`` is a slip cycle's length or a little more (the mixes' one period, the
+    # longest of their shares'): the runs' durations rest on it
+    from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, random_force_runs
+
+    run = random_force_runs(name, 1, slips=4, noise=NOISE_FREE, share=share, scale="m1e4")[0][0]
+    cycle = np.diff(run["time"][run["yield_index"]])
+    assert cycle.size >= 5
+    period = SCALES["m1e4"].law(name or "coulomb", share)["period"]
+    assert cycle[1:].max() <= period
+    if share is None:
+        assert period < 1.3 * cycle[1:].max()
