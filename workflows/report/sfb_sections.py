@@ -146,8 +146,9 @@ def _bingham_reading(rows) -> str:
                  "rise), at the edge of what twelve runs resolve: "
                  "whether the rest is more than a bulk-like viscosity (Braun & Tosatti's "
                  "reading) is not settled. At lighter sliders on the same film the kinetic "
-                 "share grows as the slips slow (n from 0.54 at 0.3 σ/τ to 0.16 at "
-                 "0.045 σ/τ, `kinetic`, Bi 3–18). What reaching "
+                 "share grows as the slips slow (n from 0.54 at 0.3 σ/τ to 0.19 ± 0.05 at "
+                 "0.042 σ/τ, Bi 3–18, where the verdict turns on how the slips the detector "
+                 "merged are split). What reaching "
                  "Klein's Bi would cost: docs/results/mass-ladder.md "
                  "(\"Going further\").")
     return text
