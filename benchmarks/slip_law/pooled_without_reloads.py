@@ -9,7 +9,8 @@ no more than twice the loading rate K·V (the wall stopped: ``restick_fraction``
 :func:`~filmfriction.analysis.stickslip.detect_slips`).  The runs' slips are pooled
 (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`, the jackknife
 over the runs) three ways: as analysed (split); as the scan alone finds them
-(``restick_fraction=0``, each table built as the analysis builds it: the extrema refined,
+(``restick_fraction=0``, or re-detected with other fractions: ``--fractions``; each table
+built as the analysis builds it, with K·V as the loading rate: the extrema refined,
 the start-up slips the analysis left out, left out); and as analysed without the slips
 inside which the force still rises by more than ``--rise`` (ε/σ) above its running minimum
 (rises the rule did not take for re-sticks: faster than 2 K·V, a wall ringing back): how
@@ -40,12 +41,14 @@ def inner_rise(force: np.ndarray, a: int, b: int) -> float:
     return float(np.max(seg - np.minimum.accumulate(seg)))
 
 
-def scan_alone(rs, spring_constant: float, drive_velocity: float):
-    """Run ``rs``'s slips as the detector's scan finds them without the split, tabulated as
-    the analysis tabulates (extrema refined, the slips its analysis left out at the start
-    left out: ``summary_skips_first`` of its ``analysis.json``)."""
+def redetected(rs, spring_constant: float, drive_velocity: float, restick_fraction: float):
+    """Run ``rs``'s slips as the detector finds them with ``restick_fraction`` (0: the scan
+    alone, without the split) and the loading rate K·V, tabulated as the analysis tabulates
+    (extrema refined, the slips its analysis left out at the start left out:
+    ``summary_skips_first`` of its ``analysis.json``)."""
     t, f = rs.time, rs.spring_force
-    ev = detect_slips(t, f, restick_fraction=0)
+    ev = detect_slips(t, f, restick_fraction=restick_fraction,
+                      loading_rate=spring_constant * drive_velocity)
     table = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=spring_constant,
                         wall_position=rs.wall_position)
     table = refine_extrema(t, f, table, noise=ev.noise, lag=ev.lag,
@@ -56,15 +59,18 @@ def scan_alone(rs, spring_constant: float, drive_velocity: float):
     return table.yield_index[skip:], table.stick_index[skip:]
 
 
-def pooled(dirs, how: str, rise: float):
+def pooled(dirs, how, rise: float):
+    """The pooled fit of ``dirs`` with their slips as analysed (``how`` "analysed"), without
+    those holding a rise > ``rise`` ("left out"), or re-detected with ``how`` as the
+    re-stick fraction (a number; 0 the scan alone)."""
     runs, shared, _ = read_runs(dirs)
     k = shared["spring_constant"]
     out, fewer = [], []
     for rs in runs:
         f = rs.spring_force
         y, s = rs.table.yield_index, rs.table.stick_index
-        if how == "scan":
-            ya, sa = scan_alone(rs, k, shared["drive_velocity"])
+        if not isinstance(how, str):
+            ya, sa = redetected(rs, k, shared["drive_velocity"], how)
         elif how == "left out":
             keep = np.array([inner_rise(f, a, b) <= rise for a, b in zip(y, s)], bool)
             ya, sa = y[keep], s[keep]
@@ -82,13 +88,17 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("run_dirs", nargs="+")
     ap.add_argument("--rise", type=float, default=5.0, help="ε/σ (default 5)")
+    ap.add_argument("--fractions", type=float, nargs="+", default=[0.0],
+                    help="re-stick fractions to re-detect with (default 0: the scan alone); "
+                         "e.g. 0 0.25 0.5 for the split's sensitivity")
     args = ap.parse_args(argv)
-    for how in ("analysed", "scan", "left out"):
+    for how in ("analysed", *args.fractions, "left out"):
         fit, n, fewer = pooled(args.run_dirs, how, args.rise)
         law = fit.law
-        what = {"analysed": "as analysed (split at re-sticks)",
-                "scan": "the scan alone (no split)",
-                "left out": f"as analysed, no inner rise > {args.rise:g}"}[how]
+        what = ("as analysed (split at re-sticks)" if how == "analysed"
+                else f"as analysed, no inner rise > {args.rise:g}" if how == "left out"
+                else "the scan alone (no split)" if how == 0
+                else f"re-detected, re-stick fraction {how:g}")
         print(f"{what}: {len(args.run_dirs)} runs, {n} slips (fewer per run: {fewer}): "
               f"{fit.verdict}; F_k {law.kinetic_force:.1f} ± {law.kinetic_force_stderr:.1f}, "
               f"B {law.damping:.0f} ± {law.damping_stderr:.0f} ({law.damping_sigmas:+.1f} σ), "
