@@ -77,24 +77,34 @@ def _provenance(trace: Trace) -> dict:
     return provenance(inputs)
 
 
+def slip_table(time, spring_force, *, spring_constant=None, drive_velocity=None,
+               wall_position=None, **detection):
+    """The slips of a trace as the analysis tabulates them: (events, table).
+
+    Detected by :func:`~filmfriction.analysis.stickslip.detect_slips` (``detection``: its
+    keywords; the loading rate K·V where both are known), tabulated with ``wall_position``
+    and their extrema refined (:func:`~filmfriction.analysis.extrema.refine_extrema`)."""
+    k, v = spring_constant, drive_velocity
+    detection.setdefault("loading_rate", k * v if k and v else None)
+    events = stickslip.detect_slips(time, spring_force, **detection)
+    table = cycle_table(time, spring_force, events.yield_index, events.stick_index,
+                        spring_constant=k, wall_position=wall_position)
+    table = refine_extrema(time, spring_force, table, noise=events.noise, lag=events.lag,
+                           spring_constant=k, drive_velocity=v, wall_position=wall_position)
+    return events, table
+
+
 def context(trace: Trace, *, skip: int | None = None, structure: bool = True) -> Context:
     """What every section starts from: the slips detected and tabulated, the
     regime (with the sliding check of the last half), the start-up slips left out.
 
     The trace must have at least :data:`MIN_ROWS` rows (:func:`analyze` says
     ``unresolved`` for a shorter one)."""
-    t, f = trace.time, trace.spring_force
+    t = trace.time
     v_drive, _ = trace.drive_velocity()
-    k = trace.parameters.spring_constant
-    # the drive's loading rate K·V where both are known (the re-stick rule inside slips)
-    events = stickslip.detect_slips(t, f, loading_rate=k * v_drive if k and v_drive else None)
-    wall = trace.wall_position()
-    table = cycle_table(t, f, events.yield_index, events.stick_index,
-                                  spring_constant=trace.parameters.spring_constant,
-                                  wall_position=wall)
-    table = refine_extrema(t, f, table, noise=events.noise, lag=events.lag,
-                                     spring_constant=trace.parameters.spring_constant,
-                                     drive_velocity=v_drive, wall_position=wall)
+    events, table = slip_table(t, trace.spring_force,
+                               spring_constant=trace.parameters.spring_constant,
+                               drive_velocity=v_drive, wall_position=trace.wall_position())
     regime = stickslip.classify_regime(table)
     if skip is None:
         skip = 1 if len(table) >= 3 else 0

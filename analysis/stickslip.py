@@ -212,21 +212,21 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         loading rate; a bounce of the ringing comes back within a part of its period.
     restick_fraction : float
         A slip found by the scan holds slips smaller than ``h`` (their sticks reload the
-        spring by less than ``h``): inside it, a rise of the force by more than
-        ``restick_fraction`` × ``h`` above its running minimum is a re-stick when the
-        force rises, over it, at no more than :data:`RESTICK_RATE` times the loading rate
-        (the wall at rest within ±V; a wall ringing back, faster, is not stuck).  The slip is split there: the first ends at the minimum, the next yields
-        at the rise's top (the highest force before it falls that much again).  The rise
-        must also exceed the largest peak-to-trough excursion of the noise seen at the
-        sampling over the slips' samples (2 √(2 ln N) + 1 times σ, N those samples over the
-        lag): on white noise that is about ``h`` itself, and no rise inside a slip is told
-        from it.  The rule needs 2 slips found by the scan (a trace merged into one slip is
-        not split) and a positive loading rate.  Default 1/3; 0 turns the rule off.
+        spring by less than ``h``): inside it, a rise of the force above its running
+        minimum by more than r = max(``restick_fraction`` × ``h``, k σ) is a re-stick when
+        the force rises over it at no more than :data:`RESTICK_RATE` times the loading
+        rate (the wall at rest within ±V; a wall ringing back, faster, is not stuck).  k σ
+        is the largest peak-to-trough excursion of the noise seen at the sampling over the
+        slips' samples (k = 2 √(2 ln N) + 1, N those samples over the lag): on white noise
+        it is about ``h``, and no rise inside a slip is told from the noise.  The slip is
+        split there: the first ends at the minimum, the next yields at the rise's top (the
+        highest force before it falls r again).  The rule needs 2 slips from the scan (a
+        trace merged into one slip is not split) and a positive loading rate.  Default
+        1/3; 0 turns the rule off.  Ground truth: docs/analysis.md ("Slips inside slips").
     loading_rate : float, optional
         K·V, the rate at which the drive loads the spring while the wall is at rest (force
-        per time), for the re-stick rule; default: the median rise rate of the scan's sticks
-        (which sticks that hold slips the scan missed pull down).  Ground truth: docs/analysis.md ("Slips inside
-        slips").
+        per time), for the re-stick rule; default: the median rise rate of the scan's
+        sticks (which sticks that hold slips the scan missed pull down).
 
     Returns
     -------

@@ -29,9 +29,8 @@ from dataclasses import replace
 import numpy as np
 
 from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
-from filmfriction.analysis.extrema import refine_extrema
+from filmfriction.analysis.analyze import slip_table
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
-from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.reduced_model.cycles import cycle_table
 
 
@@ -43,17 +42,12 @@ def inner_rise(force: np.ndarray, a: int, b: int) -> float:
 
 def redetected(rs, spring_constant: float, drive_velocity: float, restick_fraction: float):
     """Run ``rs``'s slips as the detector finds them with ``restick_fraction`` (0: the scan
-    alone, without the split) and the loading rate K·V, tabulated as the analysis tabulates
-    (extrema refined, the slips its analysis left out at the start left out:
-    ``summary_skips_first`` of its ``analysis.json``)."""
-    t, f = rs.time, rs.spring_force
-    ev = detect_slips(t, f, restick_fraction=restick_fraction,
-                      loading_rate=spring_constant * drive_velocity)
-    table = cycle_table(t, f, ev.yield_index, ev.stick_index, spring_constant=spring_constant,
-                        wall_position=rs.wall_position)
-    table = refine_extrema(t, f, table, noise=ev.noise, lag=ev.lag,
-                           spring_constant=spring_constant, drive_velocity=drive_velocity,
-                           wall_position=rs.wall_position)
+    alone, without the split), tabulated as the analysis tabulates (:func:`slip_table`; the
+    slips its analysis left out at the start left out: ``summary_skips_first`` of its
+    ``analysis.json``)."""
+    _, table = slip_table(rs.time, rs.spring_force, spring_constant=spring_constant,
+                          drive_velocity=drive_velocity, wall_position=rs.wall_position,
+                          restick_fraction=restick_fraction)
     doc = json.loads((Path(rs.name) / "analysis.json").read_text())
     skip = int((doc.get("slips") or {}).get("summary_skips_first") or 0)
     return table.yield_index[skip:], table.stick_index[skip:]

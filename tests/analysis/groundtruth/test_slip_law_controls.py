@@ -160,25 +160,31 @@ def test_the_cycle_ensemble_refuses_too_few_slips():
         dynamical_fits("viscous", 1, 2, noise=NOISE_FREE)
 
 
-# --- the heavy slider's scale (SCALES["stiff"]: K = 8, M = 1e5, the mount dashpot 34 m/τ)
+# --- the heavy slider's scales: SCALES["stiff"] (K = 8, M = 1e5, the mount dashpot 34 m/τ)
+# and the K = 8 film's slider at M = 1e4 (SCALES["m1e4"]: V 0.0079, the mount dashpot 10.7 m/τ)
 
-@pytest.mark.parametrize("name, share, verdict, kinetic, damping", [
-    ("coulomb", None, "kinetic", 25.0, 0.0), ("viscous", None, "viscous", 0.0, 1788.9),
-    ("", 0.6, "mixed", 10.8, 952.9)])
-def test_stiff_scale_noise_free_controls_give_their_law_back(name, share, verdict, kinetic,
-                                                             damping):
+@pytest.mark.parametrize("scale, name, share, verdict, kinetic, damping", [
+    ("stiff", "coulomb", None, "kinetic", 25.0, 0.0),
+    ("stiff", "viscous", None, "viscous", 0.0, 1788.9),
+    ("stiff", "", 0.6, "mixed", 10.8, 952.9),
+    ("m1e4", "coulomb", None, "kinetic", 27.0, 0.0),
+    ("m1e4", "viscous", None, "viscous", 0.0, 565.7),
+    ("m1e4", "", 0.3, "mixed", 22.4, 213.3)])
+def test_heavy_scale_noise_free_controls_give_their_law_back(scale, name, share, verdict,
+                                                             kinetic, damping):
     # the slider's mount dashpot is the fit's: the law comes back exactly
-    fit = dynamical_fits(name, 1, 8, noise=NOISE_FREE, share=share, scale="stiff")[0]
+    fit = dynamical_fits(name, 1, 8, noise=NOISE_FREE, share=share, scale=scale)[0]
     assert fit.verdict == verdict
     assert fit.decelerating.kinetic_force == pytest.approx(kinetic, abs=0.05)
     assert fit.decelerating.damping == pytest.approx(damping, abs=1.0)
 
 
-def test_stiff_weakening_slips_are_weakening_noise_free():
+@pytest.mark.parametrize("scale, below", [("stiff", -300.0), ("m1e4", -100.0)])
+def test_heavy_weakening_slips_are_weakening_noise_free(scale, below):
     # the force falls with the velocity on the slowing branch: B resolved negative
-    fit = dynamical_fits("weakening", 1, 8, noise=NOISE_FREE, scale="stiff")[0]
+    fit = dynamical_fits("weakening", 1, 8, noise=NOISE_FREE, scale=scale)[0]
     assert fit.verdict == "velocity-weakening", fit.reason
-    assert fit.decelerating.damping < -300.0
+    assert fit.decelerating.damping < below
 
 
 def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
@@ -188,24 +194,7 @@ def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
     assert not any(f.verdict == "viscous" for f in fits), Counter(f.verdict for f in fits)
 
 
-# --- the K = 8 film's slider at M = 1e4 (SCALES["m1e4"]: V 0.0079, the mount dashpot 10.7 m/τ)
-
-@pytest.mark.parametrize("name, share, verdict, kinetic, damping", [
-    ("coulomb", None, "kinetic", 27.0, 0.0), ("viscous", None, "viscous", 0.0, 565.7),
-    ("", 0.3, "mixed", 22.4, 213.3)])
-def test_m1e4_scale_noise_free_controls_give_their_law_back(name, share, verdict, kinetic,
-                                                            damping):
-    fit = dynamical_fits(name, 1, 8, noise=NOISE_FREE, share=share, scale="m1e4")[0]
-    assert fit.verdict == verdict
-    assert fit.decelerating.kinetic_force == pytest.approx(kinetic, abs=0.05)
-    assert fit.decelerating.damping == pytest.approx(damping, abs=1.0)
-
-
-def test_m1e4_weakening_slips_are_weakening_noise_free():
-    fit = dynamical_fits("weakening", 1, 8, noise=NOISE_FREE, scale="m1e4")[0]
-    assert fit.verdict == "velocity-weakening", fit.reason
-    assert fit.decelerating.damping < -100.0
-
+# --- the M = 1e4 scale's periods
 
 @pytest.mark.parametrize("name, share", [("coulomb", None), ("weakening", None),
                                          ("viscous", None), ("", 0.0), ("", 0.3), ("", 1.0)])

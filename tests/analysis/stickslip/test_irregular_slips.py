@@ -144,6 +144,17 @@ def test_slips_merged_by_the_threshold_are_split_where_the_wall_stopped():
     assert len(e) >= found - 5 and np.median(e) < 2.5 and e.max() < 6.0, (len(e), np.median(e), e.max())
 
 
+def test_the_split_is_the_same_in_other_units():
+    # seconds and newtons (an SFB trace's numbers): the same slips, split at the same samples
+    tr, f = merged(3)
+    t = tr["time"]
+    lj = detect_slips(t, f, loading_rate=KV)
+    si = detect_slips(t * 2.0e-12, f * 3.0e-11, loading_rate=KV * 3.0e-11 / 2.0e-12)
+    assert lj.inner_resticks >= 4 and si.inner_resticks == lj.inner_resticks
+    np.testing.assert_array_equal(si.yield_index, lj.yield_index)
+    np.testing.assert_array_equal(si.stick_index, lj.stick_index)
+
+
 def test_white_noise_on_model_slips_is_never_split():
     # 1 % white noise on random Coulomb blocks: a spike of 3 σ just after a rounded yield
     # rises at the loading rate over one sample; the noise floor of the rise (k σ over the
