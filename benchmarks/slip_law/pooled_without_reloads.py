@@ -16,7 +16,10 @@ inside which the force still rises by more than ``--rise`` (ε/σ) above its run
 (rises the rule did not take for re-sticks: faster than 2 K·V, a wall ringing back): how
 much the verdict rests on the split and on those.  Prints the three fits and how many slips
 each run has fewer than as analysed (for the scan alone: the splits, less any start-up slip
-that held one).
+that held one), and the reloads the split found: each by how much the spring reloaded before
+the slip it begins (over the run's h) and how fast (over K·V; the drive reloads a stuck wall
+at K·V, a wall ringing back rises faster), the test of whether the wall stopped there
+(tests/analysis/stickslip/test_irregular_slips.py: the same at this noise on model slips).
 """
 from __future__ import annotations
 
@@ -51,6 +54,22 @@ def redetected(rs, spring_constant: float, drive_velocity: float, restick_fracti
     doc = json.loads((Path(rs.name) / "analysis.json").read_text())
     skip = int((doc.get("slips") or {}).get("summary_skips_first") or 0)
     return table.yield_index[skip:], table.stick_index[skip:]
+
+
+def split_reloads(rs, spring_constant: float, drive_velocity: float) -> list[tuple[float, float]]:
+    """Each slip the split at re-sticks adds to run ``rs`` (a yield the scan alone does not
+    have): (the reload before it over h, its rate over K·V)."""
+    t, f = rs.time, rs.spring_force
+    split, _ = slip_table(t, f, spring_constant=spring_constant, drive_velocity=drive_velocity)
+    scan, _ = slip_table(t, f, spring_constant=spring_constant, drive_velocity=drive_velocity,
+                         restick_fraction=0)
+    kv, out = spring_constant * drive_velocity, []
+    for i in range(1, split.count):
+        y, s = split.yield_index[i], split.stick_index[i - 1]
+        if y not in scan.yield_index:
+            rise = f[y] - f[s]
+            out.append((rise / split.threshold, rise / (t[y] - t[s]) / kv))
+    return out
 
 
 def pooled(dirs, how, rise: float):
@@ -97,6 +116,14 @@ def main(argv=None) -> int:
               f"{fit.verdict}; F_k {law.kinetic_force:.1f} ± {law.kinetic_force_stderr:.1f}, "
               f"B {law.damping:.0f} ± {law.damping_stderr:.0f} ({law.damping_sigmas:+.1f} σ), "
               f"n {law.exponent:+.2f} ± {law.exponent_stderr:.2f}, v̄ {law.mean_velocity:.3f}")
+    runs, shared, _ = read_runs(args.run_dirs)
+    reloads = np.array([r for rs in runs for r in split_reloads(rs, shared["spring_constant"],
+                                                                 shared["drive_velocity"])])
+    if reloads.size:
+        size, rate = reloads[:, 0], reloads[:, 1]
+        print(f"the split's reloads: {len(size)}; by h/3-h/2 {int(np.sum(size < 0.5))}, "
+              f"h/2-h {int(np.sum(size >= 0.5))}; rate {rate.min():.2f}-{rate.max():.2f} K·V "
+              f"(median {np.median(rate):.2f})")
     return 0
 
 
