@@ -140,9 +140,10 @@ def _first_excursion(f: np.ndarray, start: int, h: float, up: bool,
         size *= 2
 
 
-#: A rise inside a slip is a re-stick when, over it, the force rises at no more than this
-#: many times the sticks' loading rate: dF/dt = K(V − ẋ), so 2 K·V is a wall whose mean
-#: velocity is −V, and a wall at rest within ±V gives at most 2 (see :func:`detect_slips`).
+#: The default ``restick_rate`` of :func:`detect_slips`: a rise inside a slip is a re-stick
+#: when, over it, the force rises at no more than this many times the sticks' loading rate:
+#: dF/dt = K(V − ẋ), so 2 K·V is a wall whose mean velocity is −V, and a wall at rest within
+#: ±V gives at most 2.
 RESTICK_RATE = 2.0
 
 #: at most this many raises of the threshold by the cycle noise (each re-scans the trace);
@@ -154,6 +155,7 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
                  noise: float | None = None, k: float | None = None,
                  min_drop: float = 0.0, relative_drop: float = 0.1,
                  ringing_window: float = 3.0, restick_fraction: float = 1.0 / 3.0,
+                 restick_rate: float = RESTICK_RATE,
                  loading_rate: float | None = None) -> SlipEvents:
     """Find yield (y) and re-stick (s) points in a noisy spring-force trace.
 
@@ -214,7 +216,7 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         A slip found by the scan holds slips smaller than ``h`` (their sticks reload the
         spring by less than ``h``): inside it, a rise of the force above its running
         minimum by more than r = max(``restick_fraction`` × ``h``, k σ) is a re-stick when
-        the force rises over it at no more than :data:`RESTICK_RATE` times the loading
+        the force rises over it at no more than ``restick_rate`` times the loading
         rate (the wall at rest within ±V; a wall ringing back, faster, is not stuck).  k σ
         is the largest peak-to-trough excursion of the noise seen at the sampling over the
         slips' samples (k = 2 √(2 ln N) + 1, N those samples over the lag): on white noise
@@ -223,6 +225,9 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         highest force before it falls r again).  The rule needs 2 slips from the scan (a
         trace merged into one slip is not split) and a positive loading rate.  Default
         1/3; 0 turns the rule off.  Ground truth: docs/analysis.md ("Slips inside slips").
+    restick_rate : float
+        The fastest rise, in loading rates, that counts as a re-stick (default
+        :data:`RESTICK_RATE`, 2; must be positive).
     loading_rate : float, optional
         K·V, the rate at which the drive loads the spring while the wall is at rest (force
         per time), for the re-stick rule; default: the median rise rate of the scan's
@@ -287,6 +292,9 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
     # threshold is set: h is the scan's, with or without the split)
     inner = 0
     if yi.size > 1 and restick_fraction > 0:
+        if not restick_rate > 0.0:
+            raise ValueError(f"restick_rate {restick_rate!r}: must be positive (in loading "
+                             "rates; default 2)")
         rate = (float(loading_rate) if loading_rate is not None
                 else _loading_rate(t, f, yi, si, max(ringing_window, 1.0)))
         # no smaller than the largest excursion the noise seen at the sampling gives over
@@ -295,7 +303,8 @@ def detect_slips(time, spring_force, *, threshold: float | None = None,
         rise = max(restick_fraction * h, _peak_to_trough(inside / lag) * float(noise))
         if rate > 0.0:
             pairs = [q for a, b in zip(yi, si)
-                     for q in _split_at_resticks(t, f, int(a), int(b), rise, rate)]
+                     for q in _split_at_resticks(t, f, int(a), int(b), rise,
+                                                 restick_rate * rate)]
             inner = len(pairs) - yi.size
             yi = np.array([q[0] for q in pairs], np.int64)
             si = np.array([q[1] for q in pairs], np.int64)
@@ -348,9 +357,9 @@ def _loading_rate(t, f, yi, si, window):
     return float(np.median(rates[long] if long.any() else rates))
 
 
-def _split_at_resticks(t, f, y, s, rise, rate):
-    """Slip (y, s) as the slips it holds (see ``restick_fraction`` in :func:`detect_slips`):
-    a list of (yield, re-stick) index pairs."""
+def _split_at_resticks(t, f, y, s, rise, fastest):
+    """Slip (y, s) as the slips it holds (see ``restick_fraction`` in :func:`detect_slips`;
+    ``fastest`` the fastest re-stick's rise rate): a list of (yield, re-stick) index pairs."""
     out, base = [], y
     while True:
         seg = f[base:s + 1]
@@ -363,7 +372,7 @@ def _split_at_resticks(t, f, y, s, rise, rate):
         fall = np.flatnonzero(seg[j:] < np.maximum.accumulate(seg[j:]) - rise)
         end = j + int(fall[0]) if fall.size else seg.size
         top = j + int(np.argmax(seg[j:end]))
-        if seg[top] - seg[low] <= RESTICK_RATE * rate * (t[base + top] - t[base + low]):
+        if seg[top] - seg[low] <= fastest * (t[base + top] - t[base + low]):
             out.append((y, base + low))     # a re-stick: the wall stopped, the drive reloads
             y = base + top
         base += top                         # else a bounce: search on after its top

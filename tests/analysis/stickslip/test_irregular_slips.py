@@ -169,12 +169,11 @@ def test_white_noise_on_model_slips_is_never_split():
         assert ev.inner_resticks == 0, case.label()
 
 
-def test_a_bounce_inside_a_slip_is_not_a_restick(monkeypatch):
+def test_a_bounce_inside_a_slip_is_not_a_restick():
     # a slip (F_s 50, F_k 32) whose wall rings back near its end: a bump of 10 ε/σ rising in
     # ≈ 40 τ, five times the drive's reload rate.  Under the ringing noise h is above 10, so
     # the bump is inside the slip the scan finds; the wall did not stop, so it stays whole.
     # Without the rate test the same bump is taken for a re-stick (each seed).
-    from filmfriction.analysis import stickslip
 
     def bumped(seed):
         tr = synthetic.irregular_coulomb_trace([50.0, 45.0, 52.0], kinetic_force=32.0,
@@ -192,10 +191,15 @@ def test_a_bounce_inside_a_slip_is_not_a_restick(monkeypatch):
         assert ev.threshold > 10.0
         assert ev.inner_resticks == 0
         assert found_yields(t, ev.yield_index, tr["yield_time"]) == ev.count == 3
-    monkeypatch.setattr(stickslip, "RESTICK_RATE", 1e9)
     for seed in range(5):
         tr, t, f = bumped(seed)
-        assert detect_slips(t, f, loading_rate=KV).inner_resticks >= 1, seed
+        assert detect_slips(t, f, loading_rate=KV, restick_rate=1e9).inner_resticks >= 1, seed
+
+
+def test_a_restick_rate_that_is_not_positive_is_refused():
+    tr, f = merged(0)
+    with pytest.raises(ValueError, match="restick_rate"):
+        detect_slips(tr["time"], f, loading_rate=KV, restick_rate=0.0)
 
 
 # ---- the same at the M = 1e4 scale of the K = 8 film, under that scale's noise -------------
