@@ -64,13 +64,25 @@ def table(law: str, share, args) -> None:
     exact = fit(*pooled_runs(law, args.runs, args.slips, noise=NOISE_FREE,
                              **(kw | {"law_spread": 0.0})), "runs", args.scale)
     fits = {j: [] for j in JACKKNIFE}
+    unfitted = []
     for k in range(args.replicas):
         rs, v = pooled_runs(law, args.runs, args.slips, seed=(args.seed, k), **kw, **noisy)
+        try:
+            got = {j: fit(rs, v, j, args.scale) for j in JACKKNIFE}
+        except ValueError as exc:       # a run without slips: its film slid smoothly
+            unfitted.append(str(exc))
+            continue
         for j in JACKKNIFE:
-            fits[j].append(fit(rs, v, j, args.scale))
+            fits[j].append(got[j])
     print(f"\n## {name}: {args.replicas} replicas of {args.runs} runs x {args.slips} slips "
           f"(static spread ±{args.static_spread:g}, law spread {args.law_spread:g})",
           flush=True)
+    if unfitted:
+        print(f"  {len(unfitted)} replicas not fitted (a run in them has no slip to pool, as "
+              f"no MD run of the pools has), e.g. {unfitted[0]}; the counts are of the "
+              f"{args.replicas - len(unfitted)} others")
+    if not fits[JACKKNIFE[0]]:
+        return
     for j in JACKKNIFE:
         c = Counter(f.verdict for f in fits[j])
         print(f"  jackknife over {j}: " + ", ".join(f"{v} {c[v]}" for v in VERDICTS if c[v])
