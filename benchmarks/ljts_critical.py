@@ -2,20 +2,24 @@
 coexistence in a slab (docs/results/wall-load.md, "The state point").
 
     python benchmarks/ljts_critical.py [--temperatures 0.70 0.75 ...] [--seeds 11111 22222]
-                                       [--neq 40000] [--steps 120000] [--nx 7] [--jobs 2]
-                                       [--fit-range 0.70 1.00] [--out DIR] [--analyse-only]
+                                       [--neq 40000] [--steps 120000] [--skip-blocks 6]
+                                       [--nx 7] [--jobs 2] [--fit-range 0.70 1.00]
+                                       [--out DIR] [--analyse-only]
 
 The potential is LJ cut at 2.5 σ and shifted (``pair_style lj/cut 2.5``, ``pair_modify
 shift yes``).  ``ljts_critical/slab.lmp`` puts a liquid slab (2 058 atoms at ``--nx 7``) in
 a box 4 times longer along z than across and runs it at each temperature and seed, NVT
 (Langevin), 1 MPI rank a run, ``--jobs`` runs at a time.  LAMMPS writes the number density
 profile along z, measured from the slab's centre at each sample, once a block of 10 000
-steps.  Per block, a tanh profile gives ρ_l and ρ_v; per run, their means over the blocks,
-the errors the standard error over blocks (or over pairs of blocks, when larger).  Over the
-runs in ``--fit-range``, ρ_l and ρ_v are fitted together by ρ_l,v = ρ_c + B (T_c − T) ±
-(A/2) (T_c − T)^β with β = 0.325 (3D Ising) fixed (:func:`fit_critical`: weighted least
-squares, the errors from its covariance, scaled up by √(χ²/dof) when that exceeds 1).
-``--analyse-only`` reads the profiles of an earlier ``--out`` and runs nothing.
+steps.  Per block (the first 6, ``--skip-blocks``, left out: at the thermostat's damping of
+1 τ the vapour's atoms diffuse, and the vapour fills in some 400 τ), a tanh profile gives
+ρ_l and ρ_v; per run, their means over the blocks, the errors the standard error over
+blocks (or over pairs of blocks, when larger).  Over the runs in ``--fit-range``, ρ_l and
+ρ_v are fitted together by ρ_l,v = ρ_c + B (T_c − T) ± (A/2) (T_c − T)^β with β = 0.325
+(3D Ising) fixed (:func:`fit_critical`: weighted least squares, the errors from its
+covariance, scaled up by √(χ²/dof) when that exceeds 1).
+``--analyse-only`` reads the profiles of earlier runs in ``--out`` (those of the grid of
+``--temperatures`` × ``--seeds`` that exist) and runs nothing.
 """
 from __future__ import annotations
 
@@ -75,11 +79,13 @@ def tanh_profile(z, rho_l, rho_v, z0, w):
     return 0.5 * (rho_l + rho_v) - 0.5 * (rho_l - rho_v) * np.tanh(2.0 * (np.abs(z) - z0) / w)
 
 
-def coexistence(rho: np.ndarray, z: np.ndarray) -> dict:
-    """ρ_l, ρ_v, z0 and w of each block's profile (rows of ``rho``, bin centres ``z``),
-    their means and the means' standard errors (the larger of blocks and pairs of blocks)."""
+def coexistence(rho: np.ndarray, z: np.ndarray, skip: int = 0) -> dict:
+    """ρ_l, ρ_v, z0 and w of each block's profile (rows of ``rho``, bin centres ``z``) after
+    the first ``skip`` blocks, their means and the means' standard errors (the larger of
+    blocks and pairs of blocks); ``half_rho_l``, ``half_rho_v``: the second half's mean minus
+    the first half's (a drift)."""
     fits = []
-    for prof in rho:
+    for prof in rho[skip:]:
         p0 = (prof[np.abs(z) < 2].mean(), prof[np.abs(z) > z.max() - 4].mean(),
               0.5 * np.sum(prof > 0.5 * (prof.max() + prof.min())) * (z[1] - z[0]), 1.5)
         fits.append(curve_fit(tanh_profile, z, prof, p0=p0)[0])
@@ -91,8 +97,10 @@ def coexistence(rho: np.ndarray, z: np.ndarray) -> dict:
         pairs = fits[: len(fits) // 2 * 2].reshape(-1, 2, 4).mean(axis=1)
         err = np.maximum(err, pairs.std(axis=0, ddof=1) / np.sqrt(len(pairs)))
     keys = ("rho_l", "rho_v", "z0", "w")
+    h = len(fits) // 2
+    drift = fits[-h:].mean(axis=0) - fits[:h].mean(axis=0)
     return {**dict(zip(keys, mean)), **{f"d{k}": e for k, e in zip(keys, err)},
-            "blocks": len(fits)}
+            "half_rho_l": drift[0], "half_rho_v": drift[1], "blocks": len(fits)}
 
 
 def _branches(T, Tc, rho_c, A, B, beta=BETA):
@@ -162,19 +170,26 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2, help="LAMMPS runs at a time (1 MPI rank each)")
     ap.add_argument("--fit-range", type=float, nargs=2, default=[0.70, 1.00])
     ap.add_argument("--out", type=Path, default=Path("ljts_critical_runs"))
+    ap.add_argument("--skip-blocks", type=int, default=6,
+                    help="blocks of the sampled run left out (more equilibration: the vapour)")
     ap.add_argument("--analyse-only", action="store_true")
     a = ap.parse_args(argv)
-    if a.steps % NBLOCK or a.steps < 3 * NBLOCK:
-        print(f"error: --steps {a.steps}: a multiple of the block, {NBLOCK} steps, "
-              "and at least 3 blocks", file=sys.stderr)
+    if a.steps % NBLOCK or a.steps < (a.skip_blocks + 3) * NBLOCK:
+        print(f"error: --steps {a.steps}: a multiple of the block, {NBLOCK} steps, and at "
+              f"least 3 blocks after the {a.skip_blocks} skipped", file=sys.stderr)
         return 2
     a.out.mkdir(parents=True, exist_ok=True)
     jobs = [(t, s) for t in a.temperatures for s in a.seeds]
     with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
         files = list(pool.map(lambda ts: _one(a.out, ts[0], ts[1], a), jobs))
+    if a.analyse_only:                  # the runs of a grid that were not made
+        for (temp, seed), (prof, _) in zip(jobs, files):
+            if not prof.is_file():
+                print(f"T {temp:g}, seed {seed}: no {prof.name}, left out", file=sys.stderr)
+        jobs, files = zip(*[(j, f) for j, f in zip(jobs, files) if f[0].is_file()])
     rows = []
-    print("| T | seed | ρ_l | ρ_v | interface width w (σ) | blocks | atoms | steps (eq + sampled) "
-          "| mean T |\n|---|---|---|---|---|---|---|---|---|")
+    print("| T | seed | ρ_l | ρ_v | 2nd − 1st half: ρ_l, ρ_v | interface width w (σ) | blocks "
+          "| atoms | steps (eq + skipped + sampled) | mean T |\n|---|---|---|---|---|---|---|---|---|---|")
     for (temp, seed), (prof, log) in zip(jobs, files):
         lg = LogFile(str(log))
         r = lg.runs[-1]
@@ -183,12 +198,13 @@ def main(argv=None) -> int:
         nb = rho.shape[1]
         dz = lz / nb
         z = -0.5 * lz + (np.arange(nb) + 0.5) * dz
-        c = coexistence(rho / (lx * lx * dz), z)
+        c = coexistence(rho / (lx * lx * dz), z, a.skip_blocks)
         mean_t = float(np.mean(np.asarray(r["Temp"], float)))
         rows.append((temp, seed, c))
         print(f"| {temp:g} | {seed} | {c['rho_l']:.4f} ± {c['drho_l']:.4f} | "
-              f"{c['rho_v']:.4f} ± {c['drho_v']:.4f} | {c['w']:.2f} | {c['blocks']} | {natoms} | "
-              f"{a.neq} + {c['blocks'] * NBLOCK} | {mean_t:.4f} |", flush=True)
+              f"{c['rho_v']:.4f} ± {c['drho_v']:.4f} | {c['half_rho_l']:+.4f}, {c['half_rho_v']:+.4f} | "
+              f"{c['w']:.2f} | {c['blocks']} | {natoms} | {a.neq} + {a.skip_blocks * NBLOCK} + "
+              f"{c['blocks'] * NBLOCK} | {mean_t:.4f} |", flush=True)
     ranges = [tuple(a.fit_range)]
     temps = sorted({t for t, _, _ in rows if a.fit_range[0] <= t <= a.fit_range[1]})
     if len(temps) > 3:                  # the fit's sensitivity to its ends
