@@ -150,11 +150,12 @@ def fit_critical(T, rho_l, rho_v, d_rho_l, d_rho_v, beta: float = BETA) -> dict:
 
 
 def _one(out: Path, temp: float, seed: int, a) -> tuple[Path, Path]:
-    tag = f"T{temp:g}_{seed}_nx{a.nx}"
+    tag = f"T{temp:g}_{seed}_nx{a.nx}" + (f"_v{a.vapour:g}" if a.vapour > 0 else "")
     prof, log = out / f"profile_{tag}.txt", out / f"slab_{tag}.log"
     if not a.analyse_only:
         run(HERE / "slab.lmp", {"T": temp, "seed": seed, "nx": a.nx, "neq": a.neq,
-                                "nrun": a.steps, "nblock": NBLOCK, "prof": prof.name},
+                                "nrun": a.steps, "nblock": NBLOCK, "prof": prof.name,
+                                "rhov0": a.vapour},
             log, out)
     return prof, log
 
@@ -167,6 +168,8 @@ def main(argv=None) -> int:
     ap.add_argument("--neq", type=int, default=40000)
     ap.add_argument("--steps", type=int, default=120000)
     ap.add_argument("--nx", type=int, default=7, help="fcc cells across x and y (Lx = nx/0.78^(1/3)·4^(1/3))")
+    ap.add_argument("--vapour", type=float, default=0.0,
+                    help="σ^-3 of vapour put beside the slab at the start (0: none)")
     ap.add_argument("--jobs", type=int, default=2, help="LAMMPS runs at a time (1 MPI rank each)")
     ap.add_argument("--fit-range", type=float, nargs=2, default=[0.70, 1.00])
     ap.add_argument("--out", type=Path, default=Path("ljts_critical_runs"))
