@@ -3,13 +3,14 @@ coexistence in a slab (docs/results/wall-load.md, "The state point").
 
     python benchmarks/ljts_critical.py [--temperatures 0.70 0.75 ...] [--seeds 11111 22222]
                                        [--neq 40000] [--steps 120000] [--skip-blocks 6]
-                                       [--nx 7] [--jobs 2] [--fit-range 0.70 1.00]
-                                       [--out DIR] [--analyse-only]
+                                       [--nx 7] [--vapour 0 0.15] [--jobs 2]
+                                       [--fit-range 0.70 1.00] [--out DIR] [--analyse-only]
 
 The potential is LJ cut at 2.5 σ and shifted (``pair_style lj/cut 2.5``, ``pair_modify
 shift yes``).  ``ljts_critical/slab.lmp`` puts a liquid slab (2 058 atoms at ``--nx 7``) in
-a box 4 times longer along z than across and runs it at each temperature and seed, NVT
-(Langevin), 1 MPI rank a run, ``--jobs`` runs at a time.  LAMMPS writes the number density
+a box 4 times longer along z than across, with ``--vapour`` σ⁻³ of random atoms beside it
+(0: none; more than the coexisting vapour: it is approached from above), and runs it at each
+temperature, seed and start, NVT (Langevin), 1 MPI rank a run, ``--jobs`` runs at a time.  LAMMPS writes the number density
 profile along z, measured from the slab's centre at each sample, once a block of 10 000
 steps.  Per block (the first 6, ``--skip-blocks``, left out: at the thermostat's damping of
 1 τ the vapour's atoms diffuse, and the vapour fills in some 400 τ), a tanh profile gives
@@ -17,9 +18,9 @@ steps.  Per block (the first 6, ``--skip-blocks``, left out: at the thermostat's
 blocks (or over pairs of blocks, when larger).  Over the runs in ``--fit-range``, ρ_l and
 ρ_v are fitted together by ρ_l,v = ρ_c + B (T_c − T) ± (A/2) (T_c − T)^β with β = 0.325
 (3D Ising) fixed (:func:`fit_critical`: weighted least squares, the errors from its
-covariance, scaled up by √(χ²/dof) when that exceeds 1).
-``--analyse-only`` reads the profiles of earlier runs in ``--out`` (those of the grid of
-``--temperatures`` × ``--seeds`` that exist) and runs nothing.
+covariance, scaled up by √(χ²/dof) when that exceeds 1); then without its lowest or its
+highest temperature, and with each start alone.  ``--analyse-only`` reads the profiles of earlier runs in ``--out`` (those of the grid of
+``--temperatures`` × ``--seeds`` × ``--vapour`` that exist) and runs nothing.
 """
 from __future__ import annotations
 
@@ -149,13 +150,13 @@ def fit_critical(T, rho_l, rho_v, d_rho_l, d_rho_v, beta: float = BETA) -> dict:
             "beta": beta, "n_T": int(np.unique(T).size)}
 
 
-def _one(out: Path, temp: float, seed: int, a) -> tuple[Path, Path]:
-    tag = f"T{temp:g}_{seed}_nx{a.nx}" + (f"_v{a.vapour:g}" if a.vapour > 0 else "")
+def _one(out: Path, temp: float, seed: int, vapour: float, a) -> tuple[Path, Path]:
+    tag = f"T{temp:g}_{seed}_nx{a.nx}" + (f"_v{vapour:g}" if vapour > 0 else "")
     prof, log = out / f"profile_{tag}.txt", out / f"slab_{tag}.log"
     if not a.analyse_only:
         run(HERE / "slab.lmp", {"T": temp, "seed": seed, "nx": a.nx, "neq": a.neq,
                                 "nrun": a.steps, "nblock": NBLOCK, "prof": prof.name,
-                                "rhov0": a.vapour},
+                                "rhov0": vapour},
             log, out)
     return prof, log
 
@@ -168,7 +169,7 @@ def main(argv=None) -> int:
     ap.add_argument("--neq", type=int, default=40000)
     ap.add_argument("--steps", type=int, default=120000)
     ap.add_argument("--nx", type=int, default=7, help="fcc cells across x and y (Lx = nx/0.78^(1/3)·4^(1/3))")
-    ap.add_argument("--vapour", type=float, default=0.0,
+    ap.add_argument("--vapour", type=float, nargs="+", default=[0.0],
                     help="σ^-3 of vapour put beside the slab at the start (0: none)")
     ap.add_argument("--jobs", type=int, default=2, help="LAMMPS runs at a time (1 MPI rank each)")
     ap.add_argument("--fit-range", type=float, nargs=2, default=[0.70, 1.00])
@@ -182,18 +183,16 @@ def main(argv=None) -> int:
               f"least 3 blocks after the {a.skip_blocks} skipped", file=sys.stderr)
         return 2
     a.out.mkdir(parents=True, exist_ok=True)
-    jobs = [(t, s) for t in a.temperatures for s in a.seeds]
+    jobs = [(t, s, v) for t in a.temperatures for s in a.seeds for v in a.vapour]
     with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
-        files = list(pool.map(lambda ts: _one(a.out, ts[0], ts[1], a), jobs))
+        files = list(pool.map(lambda tsv: _one(a.out, *tsv, a), jobs))
     if a.analyse_only:                  # the runs of a grid that were not made
-        for (temp, seed), (prof, _) in zip(jobs, files):
-            if not prof.is_file():
-                print(f"T {temp:g}, seed {seed}: no {prof.name}, left out", file=sys.stderr)
         jobs, files = zip(*[(j, f) for j, f in zip(jobs, files) if f[0].is_file()])
     rows = []
-    print("| T | seed | ρ_l | ρ_v | 2nd − 1st half: ρ_l, ρ_v | interface width w (σ) | blocks "
-          "| atoms | steps (eq + skipped + sampled) | mean T |\n|---|---|---|---|---|---|---|---|---|---|")
-    for (temp, seed), (prof, log) in zip(jobs, files):
+    print("| T | seed | start vapour | ρ_l | ρ_v | 2nd − 1st half: ρ_l, ρ_v | interface width w (σ) "
+          "| blocks | atoms | steps (eq + skipped + sampled) | mean T |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|")
+    for (temp, seed, vapour), (prof, log) in zip(jobs, files):
         lg = LogFile(str(log))
         r = lg.runs[-1]
         natoms, lx, lz = box(log.read_text())
@@ -203,18 +202,22 @@ def main(argv=None) -> int:
         z = -0.5 * lz + (np.arange(nb) + 0.5) * dz
         c = coexistence(rho / (lx * lx * dz), z, a.skip_blocks)
         mean_t = float(np.mean(np.asarray(r["Temp"], float)))
-        rows.append((temp, seed, c))
-        print(f"| {temp:g} | {seed} | {c['rho_l']:.4f} ± {c['drho_l']:.4f} | "
+        rows.append((temp, seed, c, vapour))
+        print(f"| {temp:g} | {seed} | {vapour:g} | {c['rho_l']:.4f} ± {c['drho_l']:.4f} | "
               f"{c['rho_v']:.4f} ± {c['drho_v']:.4f} | {c['half_rho_l']:+.4f}, {c['half_rho_v']:+.4f} | "
               f"{c['w']:.2f} | {c['blocks']} | {natoms} | {a.neq} + {a.skip_blocks * NBLOCK} + "
               f"{c['blocks'] * NBLOCK} | {mean_t:.4f} |", flush=True)
     ranges = [tuple(a.fit_range)]
-    temps = sorted({t for t, _, _ in rows if a.fit_range[0] <= t <= a.fit_range[1]})
+    temps = sorted({x[0] for x in rows if a.fit_range[0] <= x[0] <= a.fit_range[1]})
     if len(temps) > 3:                  # the fit's sensitivity to its ends
         ranges += [(temps[1], temps[-1]), (temps[0], temps[-2])]
+    starts = sorted({x[3] for x in rows})
+    sets = [(lo, hi, None) for lo, hi in ranges]
+    if len(starts) > 1:                 # each start on its own (from below, from above)
+        sets += [(*ranges[0], v) for v in starts]
     print(f"\nβ = {BETA} fixed; errors from the fit's covariance (× √(χ²/dof) when > 1)")
-    for lo, hi in ranges:
-        sel = [x for x in rows if lo <= x[0] <= hi]
+    for lo, hi, start in sets:
+        sel = [x for x in rows if lo <= x[0] <= hi and start in (None, x[3])]
         try:
             f = fit_critical([x[0] for x in sel], [x[2]["rho_l"] for x in sel],
                              [x[2]["rho_v"] for x in sel], [x[2]["drho_l"] for x in sel],
@@ -222,7 +225,8 @@ def main(argv=None) -> int:
         except ValueError as e:
             print(f"T {lo:g}-{hi:g}: {e}", file=sys.stderr)
             continue
-        print(f"T {lo:g}-{hi:g} ({len(sel)} runs, {f['n_T']} temperatures): "
+        only = "" if start is None else f", start vapour {start:g} only"
+        print(f"T {lo:g}-{hi:g} ({len(sel)} runs, {f['n_T']} temperatures{only}): "
               f"T_c = {f['T_c']:.4f} ± {f['dT_c']:.4f}, ρ_c = {f['rho_c']:.4f} ± "
               f"{f['drho_c']:.4f}, A = {f['A']:.3f} ± {f['dA']:.3f}, B = {f['B']:.3f} ± "
               f"{f['dB']:.3f}, χ²/dof = {f['chi2']:.1f}/{f['dof']}")
