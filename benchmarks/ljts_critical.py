@@ -6,21 +6,22 @@ coexistence in a slab (docs/results/wall-load.md, "The state point").
                                        [--nx 7] [--vapour 0 0.15] [--jobs 2]
                                        [--fit-range 0.70 1.00] [--out DIR] [--analyse-only]
 
-The potential is LJ cut at 2.5 σ and shifted (``pair_style lj/cut 2.5``, ``pair_modify
-shift yes``).  ``ljts_critical/slab.lmp`` puts a liquid slab (2 058 atoms at ``--nx 7``) in
-a box 4 times longer along z than across, with ``--vapour`` σ⁻³ of random atoms beside it
-(0: none; more than the coexisting vapour: it is approached from above), and runs it at each
-temperature, seed and start, NVT (Langevin), 1 MPI rank a run, ``--jobs`` runs at a time.  LAMMPS writes the number density
-profile along z, measured from the slab's centre at each sample, once a block of 10 000
-steps.  Per block (the first 6, ``--skip-blocks``, left out: at the thermostat's damping of
-1 τ the vapour's atoms diffuse, and the vapour fills in some 400 τ), a tanh profile gives
-ρ_l and ρ_v; per run, their means over the blocks, the errors the standard error over
-blocks (or over pairs of blocks, when larger).  Over the runs in ``--fit-range``, ρ_l and
-ρ_v are fitted together by ρ_l,v = ρ_c + B (T_c − T) ± (A/2) (T_c − T)^β with β = 0.325
-(3D Ising) fixed (:func:`fit_critical`: weighted least squares, the errors from its
-covariance, scaled up by √(χ²/dof) when that exceeds 1); then without its lowest or its
-highest temperature, and with each start alone.  ``--analyse-only`` reads the profiles of earlier runs in ``--out`` (those of the grid of
-``--temperatures`` × ``--seeds`` × ``--vapour`` that exist) and runs nothing.
+The potential is LJ cut at 2.5 σ and shifted (``pair_style lj/cut 2.5``, ``pair_modify shift
+yes``). ``ljts_critical/slab.lmp`` puts a liquid slab (2 058 atoms at ``--nx 7``) in a box 4
+times longer along z than across, with ``--vapour`` σ⁻³ of random atoms beside it (0: none;
+more than the coexisting vapour: it is approached from above), and runs it at each
+temperature, seed and start, NVT (Langevin), 1 MPI rank a run, ``--jobs`` runs at a time.
+LAMMPS writes the number density profile along z, measured from the slab's centre at each
+sample, once a block of 10 000 steps. Per block (the first 6, ``--skip-blocks``, left out:
+at the thermostat's damping of 1 τ the vapour's atoms diffuse, and the vapour fills in some
+400 τ), a tanh profile gives ρ_l and ρ_v; per run, their means over the blocks, the errors
+the standard error over blocks (or over pairs of blocks, when larger). Over the runs in
+``--fit-range``, ρ_l and ρ_v are fitted together by ρ_l,v = ρ_c + B (T_c − T) ± (A/2) (T_c −
+T)^β with β = 0.325 (3D Ising) fixed (:func:`fit_critical`: weighted least squares, the
+errors from its covariance, scaled up by √(χ²/dof) when that exceeds 1); then without its
+lowest or its highest temperature, and with each start alone. ``--analyse-only`` reads the
+profiles of earlier runs in ``--out`` (those of the grid of ``--temperatures`` × ``--seeds``
+× ``--vapour`` that exist) and runs nothing.
 """
 from __future__ import annotations
 
@@ -168,7 +169,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[11111])
     ap.add_argument("--neq", type=int, default=40000)
     ap.add_argument("--steps", type=int, default=120000)
-    ap.add_argument("--nx", type=int, default=7, help="fcc cells across x and y (Lx = nx/0.78^(1/3)·4^(1/3))")
+    ap.add_argument("--nx", type=int, default=7, help="fcc cells across x and y, 1.72 σ each")
     ap.add_argument("--vapour", type=float, nargs="+", default=[0.0],
                     help="σ^-3 of vapour put beside the slab at the start (0: none)")
     ap.add_argument("--jobs", type=int, default=2, help="LAMMPS runs at a time (1 MPI rank each)")
