@@ -221,3 +221,17 @@ def test_an_own_script_that_breaks_the_contract_is_stopped(tmp_path, run_cli, mo
     rows = [ln for ln in (out / "trace.dat").read_text().splitlines()[1:] if ln.strip()]
     assert len(rows) < 200000 // SMALL["trace_every"] // 10
     assert os.path.exists(out / "lammps.screen")
+
+
+@pytest.mark.md
+def test_run_input_runs_an_input_and_says_why_one_fails(tmp_path):
+    # the bulk benchmarks' helper: a small input runs to its end with the variables given;
+    # a failing one raises with LAMMPS's own message
+    good = tmp_path / "ok.lmp"
+    good.write_text("variable n index 0\nprint \"n is ${n}\"\n")
+    engine.run_input(good, {"n": 3}, log=tmp_path / "ok.log", cwd=tmp_path)
+    assert "n is 3" in (tmp_path / "ok.log").read_text()
+    bad = tmp_path / "bad.lmp"
+    bad.write_text("no_such_command 1\n")
+    with pytest.raises(RuntimeError, match="LAMMPS failed"):
+        engine.run_input(bad, {}, log=tmp_path / "bad.log", cwd=tmp_path)
