@@ -148,10 +148,11 @@ def _bingham_reading(rows) -> str:
                  "controls point to a viscous term well above a bulk-like one beside the "
                  "kinetic force (neither Klein's purely viscous film nor Braun & Tosatti's "
                  "kinetic friction with a bulk-like viscosity alone), but at that power its "
-                 "size is not settled. At lighter sliders on the same film the kinetic "
-                 "share grows as the slips slow (n from 0.54 at 0.3 σ/τ to 0.19 ± 0.05 at "
-                 "0.042 σ/τ, Bi 3–18, where the verdict turns on how the slips the detector "
-                 "merged are split). What reaching "
+                 "size is not settled. At lighter sliders on the same film (Bi 3–18) the "
+                 "slips' decelerating branch grows less rate-dependent as they slow (n from "
+                 "0.48 at 0.34 σ/τ to 0.19 ± 0.05 at 0.042 σ/τ), but with the film's co-moving "
+                 "mass fitted n is 0.16–0.19 at the light sliders too: the trend may be the "
+                 "film's inertia. What reaching "
                  "Klein's Bi would cost: docs/results/mass-ladder.md "
                  "(\"Going further\").")
     return text
