@@ -33,6 +33,7 @@ import numpy as np
 
 from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
 from filmfriction.analysis.analyze import slip_table
+from filmfriction.analysis.stickslip import detect_slips
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
 from filmfriction.reduced_model.cycles import cycle_table
 
@@ -60,10 +61,10 @@ def split_reloads(rs, spring_constant: float, drive_velocity: float) -> list[tup
     """Each slip the split at re-sticks adds to run ``rs`` (a yield the scan alone does not
     have): (the reload before it over h, its rate over K·V)."""
     t, f = rs.time, rs.spring_force
-    split, _ = slip_table(t, f, spring_constant=spring_constant, drive_velocity=drive_velocity)
-    scan, _ = slip_table(t, f, spring_constant=spring_constant, drive_velocity=drive_velocity,
-                         restick_fraction=0)
     kv, out = spring_constant * drive_velocity, []
+    # the detector's events only: the table's refined extrema are not needed here
+    split = detect_slips(t, f, loading_rate=kv)
+    scan = detect_slips(t, f, loading_rate=kv, restick_fraction=0)
     for i in range(1, split.count):
         y, s = split.yield_index[i], split.stick_index[i - 1]
         if y not in scan.yield_index:
@@ -72,11 +73,10 @@ def split_reloads(rs, spring_constant: float, drive_velocity: float) -> list[tup
     return out
 
 
-def pooled(dirs, how, rise: float):
-    """The pooled fit of ``dirs`` with their slips as analysed (``how`` "analysed"), without
+def pooled(runs, shared, how, rise: float):
+    """The pooled fit of ``runs`` (and ``shared``, as :func:`read_runs` gives them) with their slips as analysed (``how`` "analysed"), without
     those holding a rise > ``rise`` ("left out"), or re-detected with ``how`` as the
     re-stick fraction (a number; 0 the scan alone)."""
-    runs, shared, _ = read_runs(dirs)
     k = shared["spring_constant"]
     out, fewer = [], []
     for rs in runs:
@@ -105,8 +105,9 @@ def main(argv=None) -> int:
                     help="re-stick fractions to re-detect with (default 0: the scan alone); "
                          "e.g. 0 0.25 0.5 for the split's sensitivity")
     args = ap.parse_args(argv)
+    runs, shared, _ = read_runs(args.run_dirs)        # each trace parsed once
     for how in ("analysed", *args.fractions, "left out"):
-        fit, n, fewer = pooled(args.run_dirs, how, args.rise)
+        fit, n, fewer = pooled(runs, shared, how, args.rise)
         law = fit.law
         what = ("as analysed (split at re-sticks)" if how == "analysed"
                 else f"as analysed, no inner rise > {args.rise:g}" if how == "left out"
@@ -116,7 +117,6 @@ def main(argv=None) -> int:
               f"{fit.verdict}; F_k {law.kinetic_force:.1f} ± {law.kinetic_force_stderr:.1f}, "
               f"B {law.damping:.0f} ± {law.damping_stderr:.0f} ({law.damping_sigmas:+.1f} σ), "
               f"n {law.exponent:+.2f} ± {law.exponent_stderr:.2f}, v̄ {law.mean_velocity:.3f}")
-    runs, shared, _ = read_runs(args.run_dirs)
     reloads = np.array([r for rs in runs for r in split_reloads(rs, shared["spring_constant"],
                                                                  shared["drive_velocity"])])
     if reloads.size:
