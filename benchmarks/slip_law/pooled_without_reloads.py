@@ -74,7 +74,8 @@ def split_reloads(rs, spring_constant: float, drive_velocity: float) -> list[tup
 
 
 def pooled(runs, shared, how, rise: float):
-    """The pooled fit of ``runs`` (and ``shared``, as :func:`read_runs` gives them) with their slips as analysed (``how`` "analysed"), without
+    """The pooled fit of ``runs`` (with ``shared``, as :func:`read_runs` gives them), their
+    slips as analysed (``how`` "analysed"), without
     those holding a rise > ``rise`` ("left out"), or re-detected with ``how`` as the
     re-stick fraction (a number; 0 the scan alone)."""
     k = shared["spring_constant"]
