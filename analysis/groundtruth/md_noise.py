@@ -142,19 +142,21 @@ def run_slips(run_dir) -> dict:
 
 def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = None,
                   replicas: int = 40, duration: float | None = 1500.0, seed: int = 0,
-                  scale="klein", slips: int = 8) -> list[dict]:
+                  scale="klein", slips: int = 8, comoving_mass: float = 0.0) -> list[dict]:
     """The random-force replicas of control ``law`` (or of slips of viscous ``share``:
     :func:`~filmfriction.analysis.groundtruth.slip_law_controls.coulomb_viscous`) with the
     film's random force of ``noise`` (the keywords of
     :func:`~filmfriction.analysis.groundtruth.random_force.slide`), as :func:`run_slips`
     gives a run (the start-up slip left out).  At ``scale`` (a name of
     :data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`; ``duration``
-    None: long enough for ``slips`` slips) its mount dashpot and drive are the slips'."""
+    None: long enough for ``slips`` slips) its mount dashpot and drive are the slips'; the
+    film carries ``comoving_mass`` with the slipping wall (the fit's mass is the scale's)."""
     from .slip_law_controls import random_force_runs, scale_named
 
     sc = scale_named(scale)
     runs, vd = random_force_runs(law, replicas, duration=duration, noise=noise, seed=seed,
-                                 share=share, scale=sc, slips=slips)
+                                 share=share, scale=sc, slips=slips,
+                                 comoving_mass=comoving_mass)
     extra = {"mount_damping": sc.mount_damping, "drive_velocity": vd} if sc.mount_damping else {}
     return [{k: tr[k] for k in ("time", "spring_force", "wall_velocity", "wall_position")}
             | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:],

@@ -41,10 +41,12 @@ STATIC_SPREAD = 0.3
 def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,
                 scale: str | Scale = "stiff", static_spread: float = STATIC_SPREAD,
                 law_spread: float = 0.0, noise: dict | None = None,
-                seed=0) -> tuple[list[RunSlips], float]:
+                comoving_mass: float = 0.0, seed=0) -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
-    them, and the drive velocity.  ``seed``: an int or a tuple of ints."""
+    them, and the drive velocity.  ``comoving_mass``: the film's mass m_c the slipping wall
+    carries (:func:`~filmfriction.analysis.groundtruth.random_force.slide`; the fit is given
+    the scale's M alone).  ``seed``: an int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
@@ -62,7 +64,8 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
         r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
                   stiffness=sc.spring_constant,
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,
-                  seed=tuple(key + [g]), mount_damping=sc.mount_damping, **noise)[0]
+                  seed=tuple(key + [g]), mount_damping=sc.mount_damping,
+                  comoving_mass=comoving_mass, **noise)[0]
         tab = cycle_table(r["time"], r["spring_force"], r["yield_index"], r["stick_index"],
                           spring_constant=sc.spring_constant,
                           wall_position=r["wall_position"])[1:slips + 1]
@@ -74,7 +77,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
 def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                 share: float | None = None, scale: str | Scale = "stiff",
                 static_spread: float = STATIC_SPREAD, law_spread: float = 0.0,
-                noise: dict | None = None, seed: int = 0,
+                noise: dict | None = None, comoving_mass: float = 0.0, seed: int = 0,
                 jackknife: str = "runs") -> list[FilmForceFit]:
     """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``) of
     ``replicas`` replicas of :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
@@ -83,7 +86,7 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
     for k in range(replicas):
         rs, velocity = pooled_runs(name, runs, slips, share=share, scale=sc,
                                    static_spread=static_spread, law_spread=law_spread,
-                                   noise=noise, seed=(seed, k))
+                                   noise=noise, comoving_mass=comoving_mass, seed=(seed, k))
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
                                        mount_damping=sc.mount_damping,
                                        min_window_time=MD_NOISE_TIME, jackknife=jackknife))

@@ -6,12 +6,14 @@ wall's position and velocity respond to it, so the regressors of the integral-fo
 (Δx, and the v whose M·v is in the response) carry the noise the response carries.
 This module integrates that slider, many replicas at once:
 
-    M dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
+    (M + m_c) dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
 
 with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and
-state), γM an MD run's mount dashpot (``mount_damping``, 0 by default), and
+state), γM an MD run's mount dashpot (``mount_damping``, 0 by default), m_c the film's
+mass that moves with the slipping wall (``comoving_mass``, 0 by default: the fit, which
+knows M alone, reads its m_c·a as film force), and
 
-    ξ = M·du/dt   while the wall slips, 0 while it is stuck,
+    ξ = (M + m_c)·du/dt   while the wall slips, 0 while it is stuck,
 
 u an Ornstein–Uhlenbeck velocity: sampled every ``dt`` it is AR(1) of rms
 ``velocity_noise`` and lag-one correlation ``velocity_correlation`` (or a sum of
@@ -158,7 +160,8 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
           seed: int = 0, initial_force: float = 0.0, stop_velocity: float = 0.0,
           backward_force: float = -math.inf, armed_below: float = math.inf,
           start_velocity: float = 0.0, initial_state: float = 0.0,
-          substeps: int = 1, mount_damping: float = 0.0) -> list[dict]:
+          substeps: int = 1, mount_damping: float = 0.0,
+          comoving_mass: float = 0.0) -> list[dict]:
     """``replicas`` runs of the slider (module text), each with its own noise.
 
     Parameters
@@ -188,6 +191,8 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     mount_damping : float
         γM of an MD run's mount dashpot (force per velocity): −γM·(v − V) acts on the
         slipping wall besides the law (a stuck wall is at rest); 0, none.
+    comoving_mass : float
+        m_c, the film's mass carried by the slipping wall (module text); 0, none.
 
     Returns
     -------
@@ -206,8 +211,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                       ("dt", dt)):
         if not (math.isfinite(val) and val > 0):
             raise ValueError(f"{name} = {val!r}: must be positive and finite")
-    if not (math.isfinite(mount_damping) and mount_damping >= 0):
-        raise ValueError(f"mount_damping = {mount_damping!r}: must be >= 0 and finite")
+    for name, val in (("mount_damping", mount_damping), ("comoving_mass", comoving_mass)):
+        if not (math.isfinite(val) and val >= 0):
+            raise ValueError(f"{name} = {val!r}: must be >= 0 and finite")
     if int(replicas) < 1 or int(substeps) < 1:
         raise ValueError(f"replicas = {replicas!r}, substeps = {substeps!r}: must be >= 1")
     sig, rho = np.atleast_1d(np.asarray(velocity_noise, float)), np.atleast_1d(
@@ -235,7 +241,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     yields = np.zeros((reps, most), np.int64)
     sticks = np.zeros((reps, most), np.int64)
     counts = np.zeros((reps, 2), np.int64)
-    _run(_CODE[law], p, float(mass), float(stiffness), float(drive_velocity),
+    # the inertia of the slipping wall and the film it carries (the random force moves it
+    # by du whatever m_c is: u is the wall's velocity noise the MD's was measured as)
+    _run(_CODE[law], p, float(mass) + float(comoving_mass), float(stiffness), float(drive_velocity),
          float(initial_force) / stiffness, float(mount_damping), float(static_force),
          float(start_velocity),
          float(stop_velocity), float(backward_force), float(armed_below), float(initial_state),

@@ -57,7 +57,7 @@ from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "scale_named", "CONTROLS",
+__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "LIGHT_NOISE", "scale_named", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -215,6 +215,46 @@ M1E4_NOISE = {"velocity_noise": 0.024, "velocity_correlation": 0.99, "rattle": 0
 M1E4_BACKWARD = 15.0
 M1E4_STOP = 0.011
 
+#: The K = 8 film's light sliders, M = 10² and 10³ m (V = 0.079 and 0.025 σ/τ, the mount
+#: dashpots γM = 1.07 and 3.4 m/τ, sampled every 0.25 τ; yields ≈ 57 and 50 ε/σ, re-sticks
+#: ≈ 20 and 22 ε/σ, slips at ≈ 0.34 and 0.11 σ/τ; F̄ 40 and 35 ε/σ), where the film's
+#: co-moving mass is comparable with M (the one law reads 184 and 237 m).  Their controls as
+#: the M = 10⁴ scale's, √(M/K) shorter; the mixes' F at v̄ are the runs' F̄ and v̄, the stop
+#: velocity a quarter of v̄, armed 4.5 ε/σ below the lowest yield of pooled runs whose yields
+#: spread by ± 20 % (the MD's runs: 47–66 ε/σ at M = 10², 10–90 %).
+#: The noise: :data:`LIGHT_NOISE`.
+LIGHT_B = {1e2: 2.0 * math.sqrt(8.0 * 1e2), 1e3: 2.0 * math.sqrt(8.0 * 1e3)}
+#: The film's random force at M = 10² and 10³, calibrated as :data:`M1E4_NOISE` on the MD's
+#: analysed slips of 20 s or longer (93 of the 20 M = 10² runs', 111 of the 8 M = 10³ runs')
+#: against 40 replicas of the scale's mix of viscous share 0.26 (0.25) whose film carries
+#: m_c = 179 m (243 m), the one law's readings (without it the slips are too brief to
+#: measure): u an AR(1) of 0.3 σ/τ rms, 0.94 per 0.25 τ (4 τ) at M = 10²: the wall's
+#: velocity change over 0.25, 1, 2 τ 0.102, 0.188, 0.241 σ/τ (MD 0.103, 0.197, 0.216), the
+#: residual 0.193 (MD 0.190 ± 0.007), with Δt², Δt³ fitted besides 0.125 (MD 0.127); u of
+#: 0.1 σ/τ, 0.98 (12 τ) at M = 10³: 0.020, 0.039, 0.074 over 0.25, 1, 4 τ (MD 0.012, 0.034,
+#: 0.077), residual 0.043 (MD 0.049 ± 0.002), 0.034 with Δt², Δt³ (MD 0.038): as at the
+#: heavier scales the MD's wall is smoother over the shortest lags.
+#: ``python benchmarks/slip_law/md_noise_calibration.py RUN… --scale m1e2 --share 0.26
+#: --comoving-mass 179 --lags 1 4 8 16 --noise U RHO 0`` (m1e3: 0.25, 243, lags 1 4 16 32).
+LIGHT_NOISE = {1e2: {"velocity_noise": 0.3, "velocity_correlation": 0.94, "rattle": 0.0},
+               1e3: {"velocity_noise": 0.1, "velocity_correlation": 0.98, "rattle": 0.0}}
+
+
+def _light_scale(name, mass, velocity, damping, static, backward, force, slip_velocity,
+                 armed, period) -> Scale:
+    return Scale(
+        name, 8.0, mass, 0.25, static, velocity, LIGHT_NOISE[mass],
+        laws={"coulomb": dict(law="linear", parameters=(force - 8.0, 0.0),
+                              armed_below=force - 8.0, initial_force=backward, period=period),
+              "viscous": dict(law="linear", parameters=(0.0, LIGHT_B[mass]),
+                              backward_force=backward, stop_velocity=-math.inf,
+                              initial_force=backward, period=period)},
+        mix=dict(film_force=force, slip_velocity=slip_velocity, backward_force=backward,
+                 stop_velocity=slip_velocity / 4, armed_below=armed, initial_force=backward,
+                 period=period),
+        mount_damping=damping, chunk=10)
+
+
 #: The scales of the random-force controls, by name.
 #: The controls' laws as the random-force slider integrates them: the rate-and-state slider
 #: yields from, and re-sticks at, this velocity (σ/τ).
@@ -272,6 +312,8 @@ SCALES = {
                  stop_velocity=M1E4_STOP, armed_below=27.0, initial_force=M1E4_BACKWARD,
                  period=700.0),
         mount_damping=10.7, chunk=10),
+    "m1e2": _light_scale("m1e2", 1e2, 0.079, 1.07, 57.0, 20.0, 40.0, 0.34, 41.0, 100.0),
+    "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
 }
 
 
@@ -386,13 +428,14 @@ def replica_fits(trace: dict, replicas: int, *, slips: int | None = None,
 
 def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: float | None = None,
                       noise: dict | None = None, seed: int = 0, share: float | None = None,
-                      scale: str | Scale = "klein") -> tuple[list[dict], float]:
+                      scale: str | Scale = "klein",
+                      comoving_mass: float = 0.0) -> tuple[list[dict], float]:
     """``replicas`` runs of control ``name`` (or of :func:`coulomb_viscous`'s law of viscous
     ``share``) at ``scale`` whose film pushes the wall with ``noise`` (the scale's
     calibrated noise, :data:`MD_NOISE` at the Klein-similar one, by default) as a random
-    force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`), long enough for
-    ``slips`` slips after the start-up one (or ``duration`` long), and the law's drive
-    velocity."""
+    force (:func:`~filmfriction.analysis.groundtruth.random_force.slide`; the film carrying
+    ``comoving_mass`` with the slipping wall), long enough for ``slips`` slips after the
+    start-up one (or ``duration`` long), and the law's drive velocity."""
     sc = scale_named(scale)
     noise = sc.noise if noise is None else noise
     law = sc.law(name, share)
@@ -400,7 +443,7 @@ def random_force_runs(name: str, replicas: int, *, slips: int = 8, duration: flo
     duration = (slips + 3) * period * 1.3 if duration is None else duration
     runs = slide(**law, mass=sc.mass, stiffness=sc.spring_constant, duration=duration,
                  dt=sc.dt, replicas=replicas, seed=seed, mount_damping=sc.mount_damping,
-                 **noise)
+                 comoving_mass=comoving_mass, **noise)
     return runs, law["drive_velocity"]
 
 

@@ -169,13 +169,19 @@ def _selection(guide: np.ndarray, window: int, floor: float):
     return p, peak, lags
 
 
-def _segments(mean: dict, guide: np.ndarray, p: int, lags: dict, mass: float) -> dict:
-    """The mean slip's segments (:func:`fit_segments`'s input) at the lags chosen."""
-    x, s = mean["displacement"], mean["slipping_time"]
+def _segments(mean: dict, window: int, p: int, lags: dict, mass: float) -> dict:
+    """The mean slip's segments (:func:`fit_segments`'s input) at the lags chosen.  The m_c
+    term's regressor is the mean's held velocity smoothed over ``window``: a slip held at
+    its end keeps the velocity it ended with in the law's (M + m_c)·(v − v0), where the
+    derivative of the mean displacement counts it as stopped (slips that end before
+    they stop, pooled with longer ones, would bias m_c and with it F_k and B)."""
+    x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
+    w = window if 5 <= window < v.size else 0
+    carried = savgol_filter(v, w, 2) if w else v
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}
     for name, i in lags.items():
-        segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], mean["velocity"][i],
-                              s[i] - s[i[0]], x[i] - x[i[0]], guide[i] - guide[i[0]], mass,
+        segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], v[i],
+                              s[i] - s[i[0]], x[i] - x[i[0]], carried[i] - carried[i[0]], mass,
                               np.maximum(s[i] - s[p], 0.0))]
     return segs
 
@@ -250,7 +256,7 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
     total = {k: held[k].sum(axis=0) for k in keys}
 
     def fit(mean):
-        segs = _segments(mean, _guide(mean["displacement"], window, dt), p, lags, mass)
+        segs = _segments(mean, window, p, lags, mass)
         return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
                             smoothing_window=window)
 

@@ -3,6 +3,7 @@ of random-force replicas, measured the same way (docs/results/slip-law.md, "The 
 
     python benchmarks/slip_law/md_noise_calibration.py RUN [RUN ...] [--replicas 40] [--scan]
     python benchmarks/slip_law/md_noise_calibration.py RUN ... --scale stiff [--noise U RHO RATTLE ...]
+                                                       [--share S] [--comoving-mass MC]
                                                        [--lags 1 4 16 64 256]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
@@ -19,7 +20,10 @@ sample (rattling 0.15): how slow a residual this family of noise can leave.
 ``--scale stiff``: the replicas are the heavy slider's (``m1e4``: the K = 8 film's slider at
 M = 10⁴'s) (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`, its ``viscous``
 control, 10 slips each, its mount dashpot), the processes its calibrated noise and each
-``--noise`` (u's rms, its correlation per sample, the rattling); ``--lags`` (samples) the
+``--noise`` (u's rms, its correlation per sample, the rattling); ``--share S``: the
+replicas slip by the scale's Coulomb + viscous mix of viscous share S, not its ``viscous``
+control (the light sliders' viscous controls slip too briefly); ``--comoving-mass``: the
+film's mass their slipping wall carries (the fit knows the scale's M); ``--lags`` (samples) the
 lags of the residual's autocorrelation, the first three (or, with five or more, the first
 four) those of the jitter; the numbers are printed to 3 significant digits.
 """
@@ -66,6 +70,11 @@ def main(argv=None) -> int:
                     help="the replicas' scale (stiff: the heavy slider's)")
     ap.add_argument("--noise", nargs=3, type=float, action="append", default=[],
                     metavar=("U", "RHO", "RATTLE"), help="a process besides (repeatable)")
+    ap.add_argument("--share", type=float, default=None,
+                    help="the replicas slip by the scale's Coulomb + viscous mix of this "
+                         "viscous share (default: its viscous control)")
+    ap.add_argument("--comoving-mass", type=float, default=0.0,
+                    help="the film's mass the replicas' slipping wall carries (m)")
     ap.add_argument("--lags", nargs="+", type=int, default=list(LAGS),
                     help="lags in samples (residual's autocorrelation; the jitter's)")
     a = ap.parse_args(argv)
@@ -76,7 +85,14 @@ def main(argv=None) -> int:
     if a.replicas < 1:
         print(f"error: --replicas {a.replicas}: must be >= 1", file=sys.stderr)
         return 2
-    if a.scale != "klein" or a.noise or a.lags != list(LAGS):
+    if a.share is not None and not 0 <= a.share <= 1:
+        print(f"error: --share {a.share}: must be in [0, 1]", file=sys.stderr)
+        return 2
+    if not a.comoving_mass >= 0:
+        print(f"error: --comoving-mass {a.comoving_mass}: must be >= 0", file=sys.stderr)
+        return 2
+    if (a.scale != "klein" or a.noise or a.lags != list(LAGS) or a.share is not None
+            or a.comoving_mass):
         return other_scale(a)
     print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
           "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
@@ -107,7 +123,9 @@ def other_scale(a) -> int:
                                             "rattle": r} for u, rho, r in a.noise}
     for name, noise in processes.items():
         print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas, scale=sc,
-                                                   duration=None, slips=10), lags, ".3g"),
+                                                   share=a.share, duration=None, slips=10,
+                                                   comoving_mass=a.comoving_mass),
+                  lags, ".3g"),
               flush=True)
     return 0
 

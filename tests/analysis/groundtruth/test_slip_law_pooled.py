@@ -74,8 +74,8 @@ def test_refusals_name_the_run():
 def test_runs_that_differ_need_the_jackknife_over_runs():
     # Klein's viscous slips, 6 runs x 8 slips, each run's film 15 % off the law (z per run):
     # the jackknife over the runs covers the truth at its nominal rate, the one over the
-    # slips does not and calls the pure viscous law mixed (200 replicas: 197 against 88 of
-    # 200 covered, mixed 2 against 52; docs/results/slip-law.md, "Runs pooled")
+    # slips does not (200 replicas: the one law's B covered in 190 against 163 of 200;
+    # docs/results/slip-law.md, "Runs pooled")
     exact = _fit(*pooled_runs("viscous", 6, 8, noise=QUIET)).one_law
     covered, mixed = {"runs": 0, "slips": 0}, {"runs": 0, "slips": 0}
     for k in range(40):
@@ -87,7 +87,7 @@ def test_runs_that_differ_need_the_jackknife_over_runs():
                                      one.dof)) < 2
             mixed[j] += fit.verdict == "mixed"
     assert covered["runs"] >= 37 and mixed["runs"] <= 2, (covered, mixed)
-    assert covered["slips"] <= 30 and mixed["slips"] >= 5, (covered, mixed)
+    assert covered["slips"] <= covered["runs"] - 5, (covered, mixed)
 
 
 def test_runs_of_unequal_slip_counts_give_the_law():
@@ -100,6 +100,29 @@ def test_runs_of_unequal_slip_counts_give_the_law():
     assert fit.decelerating.damping == pytest.approx(STIFF_B, abs=2.0)
     assert fit.decelerating.kinetic_force == pytest.approx(0.0, abs=0.05)
     assert fit.decelerating.dof == 2
+
+
+def test_slips_held_while_the_wall_moves_give_the_comoving_mass():
+    # the light slider's mix (F_k 33.6, B 18.8, M = 100 m) with the film carrying m_c = 184 m:
+    # runs of different yields whose slips re-stick with the wall still moving (at v̄/4 or
+    # at the re-stick force), each held at its end at that velocity.  The one law of their
+    # mean gives F_k, B and m_c back (m_c's regressor the mean's held velocity, smoothed:
+    # the derivative of the mean displacement counted the ended slips as stopped and read
+    # m_c 151, F_k 41.8, B −1.2); the decelerating branch, which has no m_c, reads the
+    # carried film's deceleration as a viscous force
+    sc = SCALES["m1e2"]
+    runs, v = pooled_runs("", 8, 10, share=0.16, scale=sc, noise=QUIET, comoving_mass=184.0,
+                          seed=(1, 0))
+    ends = np.concatenate([r.wall_velocity[r.table.stick_index] for r in runs])
+    assert ends.min() > 0.05                       # every slip ends with the wall moving
+    fit = fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=v,
+                              mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME)
+    one, dec = fit.one_law, fit.decelerating
+    assert one.comoving_mass == pytest.approx(184.0, abs=1.0)
+    assert one.kinetic_force == pytest.approx(33.6, abs=0.1)
+    assert one.damping == pytest.approx(0.16 * 40.0 / 0.34, abs=0.2)
+    assert fit.verdict_from == "one law" and fit.verdict == "mixed"
+    assert dec.damping > 1.8 * one.damping and dec.kinetic_force < 0.7 * one.kinetic_force
 
 
 def test_runs_in_other_units_give_the_law_in_those_units():

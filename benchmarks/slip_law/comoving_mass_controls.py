@@ -1,0 +1,128 @@
+"""The slip law pooled over runs whose film carries a co-moving mass: what the decelerating
+branch and the one law read, at the light sliders' scales.
+
+    python benchmarks/slip_law/comoving_mass_controls.py [--scale m1e2] [--kinetic 29.1]
+        [--damping 30] [--comoving-mass 179] [--runs 20] [--slips 10] [--replicas 100]
+        [--law-spread 0.15] [--static-spread 0.2] [--noise U RHO RATTLE] [--noise-free]
+
+Each replica is G runs of the scale's slider (:data:`~filmfriction.analysis.groundtruth.
+slip_law_controls.SCALES`; each run with its own yield force, ± ``--static-spread``, and with
+``--law-spread`` its own film) slipping by F_k + B·v while the film carries m_c with the
+wall (:func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs`; the fit is given
+the slider's M alone), pooled and fitted as the MD's runs are (jackknife over the runs).
+The law is given by F_k and B; its force at the scale's slip velocity sets the mix.  Printed
+for m_c = 0 and for ``--comoving-mass``: the rule's branch and verdicts, and per branch
+(decelerating, one law) the replicas' mean ± its standard error of F_k, B, the exponent n and
+m_c, the truth beside them (F_k, B; n = B·v̄/(F_k + B·v̄) at the branch's own mean v̄ of
+the noise-free fit) and how many replicas' 2 σ cover F_k and B.  Seeds fixed: counts are
+deterministic.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections import Counter
+from dataclasses import replace
+
+import numpy as np
+
+from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
+from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
+from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
+from filmfriction.analysis.slip_law.slip_law_stats import sigmas
+
+NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
+
+
+def summary(fits, branch: str, fk: float, b: float) -> str:
+    xs = [getattr(f, branch) for f in fits]
+
+    def ms(attr):
+        a = np.array([getattr(x, attr) for x in xs], float)
+        a = a[np.isfinite(a)]
+        if not a.size:
+            return "–"
+        return f"{a.mean():.3g} ± {a.std(ddof=1) / math.sqrt(a.size) if a.size > 1 else 0:.2g}"
+
+    cov = [sum(abs(sigmas(getattr(x, a) - t, getattr(x, f"{a}_stderr"), x.dof)) < 2
+               for x in xs) for a, t in (("kinetic_force", fk), ("damping", b))]
+    vbar = float(np.nanmean([x.mean_velocity for x in xs]))
+    n_true = b * vbar / (fk + b * vbar)
+    return (f"F_k {ms('kinetic_force')} (truth {fk:.3g}, covered {cov[0]}/{len(xs)}); "
+            f"B {ms('damping')} (truth {b:.3g}, covered {cov[1]}/{len(xs)}); "
+            f"n {ms('exponent')} (truth {n_true:.2f} at v̄ {vbar:.3g}); "
+            f"m_c {ms('comoving_mass')}")
+
+
+def fits_of(sc, a, share, noise, mc) -> tuple[list, int]:
+    """The pooled fits of the replicas, and how many were left out because one of their
+    runs slid without a complete slip (a film drawn off the law that slides smoothly)."""
+    fits, skipped = [], 0
+    for k in range(a.replicas):
+        runs, vd = pooled_runs("", a.runs, a.slips, share=share, scale=sc,
+                               law_spread=a.law_spread, static_spread=a.static_spread,
+                               noise=noise, comoving_mass=mc,
+                               seed=(0, k))
+        if any(len(r.table) == 0 for r in runs):
+            skipped += 1
+            continue
+        fits.append(fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=vd,
+                                        mount_damping=sc.mount_damping,
+                                        min_window_time=MD_NOISE_TIME))
+    return fits, skipped
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scale", default="m1e2", choices=list(SCALES))
+    ap.add_argument("--kinetic", type=float, default=29.1, help="F_k (ε/σ)")
+    ap.add_argument("--damping", type=float, default=30.0, help="B (m/τ)")
+    ap.add_argument("--comoving-mass", type=float, default=179.0, help="m_c (m)")
+    ap.add_argument("--runs", type=int, default=20)
+    ap.add_argument("--slips", type=int, default=10)
+    ap.add_argument("--replicas", type=int, default=100)
+    ap.add_argument("--law-spread", type=float, default=0.15)
+    ap.add_argument("--static-spread", type=float, default=0.2)
+    ap.add_argument("--noise", nargs=3, type=float, default=None,
+                    metavar=("U", "RHO", "RATTLE"), help="the film's random force (default: "
+                                                         "the scale's)")
+    ap.add_argument("--noise-free", action="store_true")
+    a = ap.parse_args(argv)
+    bad = [(k, v) for k, v in (("--kinetic", a.kinetic), ("--damping", a.damping),
+                               ("--comoving-mass", a.comoving_mass)) if not v >= 0]
+    bad += [(k, v) for k, v in (("--runs", a.runs), ("--slips", a.slips),
+                                ("--replicas", a.replicas)) if v < (3 if k == "--runs" else 1)]
+    if (bad or not 0 <= a.law_spread < 1 or not 0 <= a.static_spread < 1
+            or a.kinetic + a.damping <= 0):
+        print(f"error: {bad or [('--law-spread', a.law_spread), ('--static-spread', a.static_spread)]}: "
+              "F_k, B, m_c >= 0 (not both F_k and B zero), --runs >= 3, --slips and --replicas "
+              ">= 1, the spreads in [0, 1)", file=sys.stderr)
+        return 2
+    sc = SCALES[a.scale]
+    v = sc.mix["slip_velocity"]
+    force = a.kinetic + a.damping * v
+    sc = replace(sc, mix={**sc.mix, "film_force": force})
+    share = a.damping * v / force
+    noise = (NOISE_FREE if a.noise_free else
+             None if a.noise is None else dict(zip(("velocity_noise", "velocity_correlation",
+                                                    "rattle"), a.noise)))
+    print(f"co-moving mass controls at the {a.scale} scale: F_k {a.kinetic:g}, B {a.damping:g} "
+          f"(viscous share {share:.3f} of {force:.3g} ε/σ at {v:g} σ/τ), M {sc.mass:g}, "
+          f"{a.replicas} replicas of {a.runs} runs x {a.slips} slips, law spread "
+          f"{a.law_spread:g}, yields ± {a.static_spread:g}, noise {noise or sc.noise}", flush=True)
+    for mc in (0.0, a.comoving_mass):
+        fits, skipped = fits_of(sc, a, share, noise, mc)
+        print(f"\n## m_c = {mc:g}: {len(fits)} replicas fitted ({skipped} left out: a run "
+              f"without a complete slip); verdict {dict(Counter(f.verdict for f in fits))}, "
+              f"from {dict(Counter(f.verdict_from for f in fits))}")
+        if not fits:
+            continue
+        for branch in ("decelerating", "one_law"):
+            print(f"  {branch:12s} {summary(fits, branch, a.kinetic, a.damping)}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
