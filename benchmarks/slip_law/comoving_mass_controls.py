@@ -11,7 +11,8 @@ slip_law_controls.SCALES`; each run with its own yield force, ± ``--static-spre
 wall (:func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs`; the fit is given
 the slider's M alone), pooled and fitted as the MD's runs are (jackknife over the runs).
 The law is given by F_k and B; its force at the scale's slip velocity sets the mix.  Printed
-for m_c = 0 and for ``--comoving-mass``: the rule's branch and verdicts, and per branch
+for m_c = 0 and for ``--comoving-mass``: the runs' median slip duration, the rule's branch
+and verdicts, and per branch
 (decelerating, one law) the replicas' mean ± its standard error of F_k, B, the exponent n and
 m_c, the truth beside them (F_k, B; n = B·v̄/(F_k + B·v̄) at the branch's own mean v̄ of
 the noise-free fit) and how many replicas' 2 σ cover F_k and B.  Seeds fixed: counts are
@@ -56,10 +57,11 @@ def summary(fits, branch: str, fk: float, b: float) -> str:
             f"m_c {ms('comoving_mass')}")
 
 
-def fits_of(sc, a, share, noise, mc) -> tuple[list, int]:
-    """The pooled fits of the replicas, and how many were left out because one of their
-    runs slid without a complete slip (a film drawn off the law that slides smoothly)."""
-    fits, skipped = [], 0
+def fits_of(sc, a, share, noise, mc) -> tuple[list, int, float]:
+    """The pooled fits of the replicas, how many were left out because one of their runs
+    slid without a complete slip (a film drawn off the law that slides smoothly), and the
+    median slip duration of the fitted runs."""
+    fits, skipped, durations = [], 0, []
     for k in range(a.replicas):
         runs, vd = pooled_runs("", a.runs, a.slips, share=share, scale=sc,
                                law_spread=a.law_spread, static_spread=a.static_spread,
@@ -68,10 +70,11 @@ def fits_of(sc, a, share, noise, mc) -> tuple[list, int]:
         if any(len(r.table) == 0 for r in runs):
             skipped += 1
             continue
+        durations += [d for r in runs for d in r.table.slip_duration]
         fits.append(fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=vd,
                                         mount_damping=sc.mount_damping,
                                         min_window_time=MD_NOISE_TIME))
-    return fits, skipped
+    return fits, skipped, float(np.median(durations)) if durations else math.nan
 
 
 def main(argv=None) -> int:
@@ -113,9 +116,9 @@ def main(argv=None) -> int:
           f"{a.replicas} replicas of {a.runs} runs x {a.slips} slips, law spread "
           f"{a.law_spread:g}, yields ± {a.static_spread:g}, noise {noise or sc.noise}", flush=True)
     for mc in (0.0, a.comoving_mass):
-        fits, skipped = fits_of(sc, a, share, noise, mc)
+        fits, skipped, slip = fits_of(sc, a, share, noise, mc)
         print(f"\n## m_c = {mc:g}: {len(fits)} replicas fitted ({skipped} left out: a run "
-              f"without a complete slip); verdict {dict(Counter(f.verdict for f in fits))}, "
+              f"without a complete slip), median slip {slip:.3g}; verdict {dict(Counter(f.verdict for f in fits))}, "
               f"from {dict(Counter(f.verdict_from for f in fits))}")
         if not fits:
             continue

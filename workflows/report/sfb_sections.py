@@ -149,10 +149,10 @@ def _bingham_reading(rows) -> str:
                  "kinetic force (neither Klein's purely viscous film nor Braun & Tosatti's "
                  "kinetic friction with a bulk-like viscosity alone), but at that power its "
                  "size is not settled. At lighter sliders on the same film (Bi 3–18) the "
-                 "slips' decelerating branch grows less rate-dependent as they slow (n from "
-                 "0.48 at 0.34 σ/τ to 0.19 ± 0.05 at 0.042 σ/τ), but with the film's co-moving "
-                 "mass fitted n is 0.16–0.19 at the light sliders too: the trend may be the "
-                 "film's inertia. What reaching "
+                 "film force is sub-linear in the slip velocity (n 0.19–0.37 from 0.34 to "
+                 "0.015 σ/τ); the decelerating branch's larger n at the lightest slider is "
+                 "partly the inertia of film that moves with the wall (controls with that "
+                 "mass), so it is not a trend of the film's friction. What reaching "
                  "Klein's Bi would cost: docs/results/mass-ladder.md "
                  "(\"Going further\").")
     return text
