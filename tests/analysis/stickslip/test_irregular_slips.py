@@ -94,22 +94,32 @@ def test_a_small_slip_soon_after_a_slow_one_is_a_slip_not_ringing():
 
 # ---- slips inside slips: a short stick that reloads the spring by less than h -------------
 
-def merged(seed, rises=(6.0, 10.0)):
-    """Seven pairs of slips: a slip from F_s (40-55) re-sticks at m (20-30), sticks while the
-    drive reloads the spring by r (drawn from ``rises``, below the detector's h of about
-    17-20 here), then slips on from m + r to 5-15 below m (its own kinetic force), and
-    sticks until the next pair.  Exact (per-slip kinetic forces) plus the ringing noise."""
+#: The heavy slider's pairs (K = 8, M = 1e5, V = 0.0025): yields, re-sticks, the second
+#: slip's depth below the re-stick, and the ringing noise; :data:`M1E4_PAIRS` the M = 1e4
+#: scale's (below).
+PAIRS = {"pairs": 7, "static": (40.0, 55.0), "restick": (20.0, 30.0), "below": (5.0, 15.0),
+         "mass": 1.0e5, "drive_velocity": 0.0025}
+
+
+def merged(seed, rises=(6.0, 10.0), scale=None):
+    """Pairs of slips: a slip from F_s (``static``) re-sticks at m (``restick``), sticks
+    while the drive reloads the spring by r (drawn from ``rises``, below the detector's h of
+    about 17-20 here), then slips on from m + r to ``below`` under m (its own kinetic force),
+    and sticks until the next pair.  Exact (per-slip kinetic forces) plus the ringing noise
+    (``NOISE``; ``scale``: the keys of :data:`PAIRS` and the noise of another scale)."""
+    sc = scale or dict(PAIRS, noise=NOISE)
     rng = np.random.default_rng(seed)
     static, kinetic = [], []
-    for _ in range(7):
-        fs, m = rng.uniform(40.0, 55.0), rng.uniform(20.0, 30.0)
-        r, below = rng.uniform(*rises), rng.uniform(5.0, 15.0)
+    for _ in range(sc["pairs"]):
+        fs, m = rng.uniform(*sc["static"]), rng.uniform(*sc["restick"])
+        r, below = rng.uniform(*rises), rng.uniform(*sc["below"])
         static += [fs, m + r]
         kinetic += [(fs + m) / 2.0, (2.0 * m + r - below) / 2.0]
     tr = synthetic.irregular_coulomb_trace(static, kinetic_force=kinetic, stiffness=8.0,
-                                           mass=1.0e5, drive_velocity=0.0025, dt=DT)
+                                           mass=sc["mass"], drive_velocity=sc["drive_velocity"],
+                                           dt=DT)
     return tr, tr["spring_force"] + synthetic.ringing_noise(tr["time"].size, seed=seed + 100,
-                                                            **NOISE)
+                                                            **sc["noise"])
 
 
 def found_yields(t, yields, truth, within=150.0):
@@ -215,18 +225,13 @@ KV4 = 8.0 * 0.0079
 NOISE4 = {"rms": 1.4, "period": 50.0, "decay": 110.0, "dt": DT}
 
 
+#: The M = 1e4 scale's pairs: the runs' F_s and F_b, eight pairs.
+M1E4_PAIRS = {"pairs": 8, "static": (37.0, 59.0), "restick": (13.0, 24.0), "below": (2.0, 8.0),
+              "mass": 1.0e4, "drive_velocity": 0.0079, "noise": NOISE4}
+
+
 def merged4(seed, rises):
-    rng = np.random.default_rng(seed)
-    static, kinetic = [], []
-    for _ in range(8):
-        fs, m = rng.uniform(37.0, 59.0), rng.uniform(13.0, 24.0)    # the runs' F_s and F_b
-        r, below = rng.uniform(*rises), rng.uniform(2.0, 8.0)
-        static += [fs, m + r]
-        kinetic += [(fs + m) / 2.0, (2.0 * m + r - below) / 2.0]
-    tr = synthetic.irregular_coulomb_trace(static, kinetic_force=kinetic, stiffness=8.0,
-                                           mass=1.0e4, drive_velocity=0.0079, dt=DT)
-    return tr, tr["spring_force"] + synthetic.ringing_noise(tr["time"].size, seed=seed + 100,
-                                                            **NOISE4)
+    return merged(seed, rises, scale=M1E4_PAIRS)
 
 
 def test_reloads_of_a_third_to_half_of_h_are_found_at_the_m1e4_scale():
