@@ -1,5 +1,25 @@
 """Fixtures of the analysis tests."""
+import functools
+import importlib.util
+from pathlib import Path
+
 import pytest
+
+
+@functools.cache
+def _benchmark(name: str):
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
+def benchmark_module():
+    """``benchmark_module("wall_load")``: the module of ``benchmarks/wall_load.py`` (the
+    benchmarks are scripts, not a package), loaded once."""
+    return _benchmark
 
 
 @pytest.fixture

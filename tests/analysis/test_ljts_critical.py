@@ -1,24 +1,11 @@
 """benchmarks/ljts_critical.py's estimator on coexistence densities with known answers: T_c and
 ρ_c come back within their error bars, with and without noise, and too few temperatures are
 refused (its measurement: docs/results/wall-load.md, "The state point")."""
-import functools
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 TRUE = {"T_c": 1.08, "rho_c": 0.32, "A": 0.75, "B": 0.20}
 TEMPS = np.array([0.70, 0.75, 0.80, 0.85, 0.90, 0.95, 1.00])
-
-
-@functools.cache
-def _module():
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "ljts_critical.py"
-    spec = importlib.util.spec_from_file_location("ljts_critical", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _densities(T, beta=0.325):
@@ -28,8 +15,8 @@ def _densities(T, beta=0.325):
     return mid + half, mid - half
 
 
-def test_noise_free_densities_give_back_tc_and_rhoc():
-    m = _module()
+def test_noise_free_densities_give_back_tc_and_rhoc(benchmark_module):
+    m = benchmark_module("ljts_critical")
     rl, rv = _densities(TEMPS)
     err = np.full(TEMPS.size, 1e-3)
     f = m.fit_critical(TEMPS, rl, rv, err, err)
@@ -38,8 +25,8 @@ def test_noise_free_densities_give_back_tc_and_rhoc():
     assert f["dT_c"] > 0 and f["drho_c"] > 0 and f["chi2"] < 1e-6
 
 
-def test_noisy_densities_give_back_tc_and_rhoc_within_their_errors():
-    m = _module()
+def test_noisy_densities_give_back_tc_and_rhoc_within_their_errors(benchmark_module):
+    m = benchmark_module("ljts_critical")
     rng = np.random.default_rng(7)
     T = np.repeat(TEMPS, 2)                                  # two seeds a temperature
     rl, rv = _densities(T)
@@ -58,8 +45,8 @@ def test_noisy_densities_give_back_tc_and_rhoc_within_their_errors():
         assert 0.45 * trials <= n <= 0.95 * trials, (key, n)
 
 
-def test_fewer_than_three_temperatures_are_refused():
-    m = _module()
+def test_fewer_than_three_temperatures_are_refused(benchmark_module):
+    m = benchmark_module("ljts_critical")
     rl, rv = _densities(TEMPS[:2])
     with pytest.raises(ValueError, match="at least 3"):
         m.fit_critical(TEMPS[:2], rl, rv, [0.01, 0.01], [0.01, 0.01])
@@ -70,8 +57,8 @@ def test_fewer_than_three_temperatures_are_refused():
         m.fit_critical(T, rl, rv, np.full(4, 0.01), np.full(4, 0.01))
 
 
-def test_bad_errors_and_swapped_phases_are_refused():
-    m = _module()
+def test_bad_errors_and_swapped_phases_are_refused(benchmark_module):
+    m = benchmark_module("ljts_critical")
     rl, rv = _densities(TEMPS)
     ok = np.full(TEMPS.size, 0.01)
     with pytest.raises(ValueError, match="> 0"):

@@ -1,19 +1,9 @@
 """benchmarks/wall_load.py on traces with known answers: the static force of a pinned wall,
 a freely sliding wall, and the fit F_s = F_0 + mu L with error bars that cover the truth
 (its table: docs/results/wall-load.md)."""
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
-
-
-def _module():
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "wall_load.py"
-    spec = importlib.util.spec_from_file_location("wall_load", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _run(tmp_path, name, wall, force, drive, dt=0.1):
@@ -33,8 +23,9 @@ def _run(tmp_path, name, wall, force, drive, dt=0.1):
     return run
 
 
-def test_a_pinned_wall_yields_at_its_static_force_and_a_free_wall_is_not_pinned(tmp_path):
-    wl = _module()
+def test_a_pinned_wall_yields_at_its_static_force_and_a_free_wall_is_not_pinned(
+        tmp_path, benchmark_module):
+    wl = benchmark_module("wall_load")
     rng = np.random.default_rng(3)
     K, V, dt = 20.0, 0.08, 0.1
     t = np.arange(800) * dt
@@ -51,8 +42,8 @@ def test_a_pinned_wall_yields_at_its_static_force_and_a_free_wall_is_not_pinned(
     assert not m["pinned"] and m["static_force"] is None
 
 
-def test_the_fit_recovers_adhesion_and_slope_within_its_errors():
-    wl = _module()
+def test_the_fit_recovers_adhesion_and_slope_within_its_errors(benchmark_module):
+    wl = benchmark_module("wall_load")
     rng = np.random.default_rng(11)
     loads = np.repeat([0.587, 5.87, 17.6, 58.7], 2)
     covered = np.zeros((200, 2), dtype=bool)
