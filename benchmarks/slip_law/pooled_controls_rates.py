@@ -12,7 +12,8 @@ each run with its own yield force and, with ``--law-spread``, its own film
 fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
 with the jackknife over the runs, and the same pooled slips with the jackknife over the
 slips (the comparison that treats them as one run's).  Printed per law: the verdicts of
-both, and for the decelerating branch and the one law the bias of F_k and B (mean − truth
+both (the rule's, which branch it read, and the decelerating branch's alone), and for the
+decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit, the law's
 own F_k, B) and how many replicas' 2 σ cover the truth, for each jackknife.  Seeds are
 fixed: the counts are deterministic.
@@ -85,8 +86,10 @@ def table(law: str, share, args) -> None:
         return
     for j in JACKKNIFE:
         c = Counter(f.verdict for f in fits[j])
+        d = Counter(f.decelerating.verdict for f in fits[j])
         print(f"  jackknife over {j}: " + ", ".join(f"{v} {c[v]}" for v in VERDICTS if c[v])
-              + f"; verdict from {dict(Counter(f.verdict_from for f in fits[j]))}")
+              + f"; verdict from {dict(Counter(f.verdict_from for f in fits[j]))}; the "
+              "decelerating branch alone: " + ", ".join(f"{v} {d[v]}" for v in VERDICTS if d[v]))
         for br in ("decelerating", "one_law"):
             truth = getattr(exact, br)
             print(f"    {br:12s} F_k {coverage(fits[j], br, 'kinetic_force', truth.kinetic_force)}"
