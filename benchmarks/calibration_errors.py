@@ -1,0 +1,67 @@
+"""The calibration's standard errors set by set: are they the scatter of the estimates?
+
+    python benchmarks/calibration_errors.py [--cases 80] [--seed 7]
+
+The calibration sets of ``benchmarks/validate.py`` (Coulomb + viscous blocks in LJ and SI
+numbers, white and AR(1) noise, and Klein's slip, F_k = 0), ``--cases`` each, fitted as
+``filmfriction calibrate`` does (``validate.calibration_scores``).  Per set and observable
+(F_k, B), z = (estimate − truth)/standard error over the fits off their bound: how often
+|z| < 1 (68 % nominal), the rms of z (1 nominal) and its median |z| (0.67 nominal); on
+Klein's set the fits whose F_k sits at its bound of 0 and the others apart.  A set whose
+errors are right has all three near nominal; errors too wide give small z, too narrow
+large ones.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def _validate():
+    path = Path(__file__).resolve().with_name("validate.py")
+    spec = importlib.util.spec_from_file_location("validate", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def line(label: str, z: np.ndarray) -> str:
+    if not z.size:
+        return f"| {label} | 0 | – | – | – |"
+    return (f"| {label} | {z.size} | {np.mean(np.abs(z) < 1):.0%} | "
+            f"{np.sqrt(np.mean(z ** 2)):.2f} | {np.median(np.abs(z)):.2f} |")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", type=int, default=80)
+    ap.add_argument("--seed", type=int, default=7)
+    a = ap.parse_args(argv)
+    if a.cases < 3:
+        print(f"error: --cases {a.cases}: must be >= 3", file=sys.stderr)
+        return 2
+    scores = _validate().calibration_scores(a.cases, a.seed, klein_cases=a.cases)
+    print("| set, observable | fits | |z| < 1 | rms z | median |z| |\n|---|---|---|---|---|")
+    for name, (_, rows) in scores.items():
+        for obs, label in (("kinetic_force", "F_k"), ("film_damping", "B")):
+            z, bound = [], []
+            for r in rows:
+                est, err, at_bound, truth = r[obs]
+                if at_bound or not err > 0 or truth == 0:
+                    continue
+                z.append((est - truth) / err)
+                bound.append(bool(r["kinetic_force"][2]))
+            z, bound = np.asarray(z), np.asarray(bound, bool)
+            print(line(f"{name}, {label}", z))
+            if name == "klein" and obs == "film_damping":
+                print(line(f"{name}, {label}, F_k at its bound", z[bound]))
+                print(line(f"{name}, {label}, F_k off its bound", z[~bound]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
