@@ -57,7 +57,8 @@ from ..stickslip import detect_slips
 from .random_force import slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "LIGHT_NOISE", "scale_named", "CONTROLS",
+__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "LIGHT_B",
+           "LIGHT_NOISE", "scale_named", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -218,7 +219,7 @@ M1E4_STOP = 0.011
 #: The K = 8 film's light sliders, M = 10² and 10³ m (V = 0.079 and 0.025 σ/τ, the mount
 #: dashpots γM = 1.07 and 3.4 m/τ, sampled every 0.25 τ; yields ≈ 57 and 50 ε/σ, re-sticks
 #: ≈ 20 and 22 ε/σ, slips at ≈ 0.34 and 0.11 σ/τ; F̄ 40 and 35 ε/σ), where the film's
-#: co-moving mass is comparable with M (the one law reads 184 and 237 m).  Their controls as
+#: co-moving mass is comparable with M (the one law reads 179 and 243 m).  Their controls as
 #: the M = 10⁴ scale's, √(M/K) shorter; the mixes' F at v̄ are the runs' F̄ and v̄, the stop
 #: velocity a quarter of v̄, armed 4.5 ε/σ below the lowest yield of pooled runs whose yields
 #: spread by ± 20 % (the MD's runs: 47–66 ε/σ at M = 10², 10–90 %).

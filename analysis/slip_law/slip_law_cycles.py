@@ -42,9 +42,12 @@ What is left of the noise's selection, measured on the controls
 on Klein's slips at the MD's noise the decelerating branch is unbiased (F_k +0.04 ± 0.05,
 B −0.07 ± 0.08 over 1000 replicas of 30 slips); where a wall re-sticks when its velocity
 falls (Coulomb), it re-sticks where the noise slowed it, and the decelerating branch's F_k
-is low by ~1.4 ε/σ.  The one law's co-moving mass has as regressor the mean's smoothed
-velocity, which lags a fast start (Klein's overdamped slips: m_c ≈ −18 m of a 30 m wall
-noise-free).
+is low by ~1.4 ε/σ (the one-law figures there were measured before the m_c regressor
+became the held velocity).  The one law's co-moving mass has as regressor the mean's held
+velocity smoothed, which the smoothing blurs at a fast start (Klein's overdamped slips
+pooled noise-free: m_c 44 m of a 30 m wall with a 3 τ window, 0 unsmoothed); its sampled
+velocity carries noise the positions do not (a control's rattle: frozen at each slip's end,
+it biases the one law; docs/results/slip-law.md).
 
 Example
 -------
@@ -202,10 +205,12 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     per slip; ``smoothing_window`` is the window of the mean's velocity: ``smoothing`` of
     the median slip, and at least ``min_window_time`` (the time over which the film's
     noise stays correlated, :data:`MD_NOISE_TIME` for an MD run in LJ units; 0: none).
-    The mean's velocity is the m_c term's regressor and sets the branches' split, so its
-    noise biases the loop step (a window much shorter than the noise's correlation leaves
-    the mean's velocity as noisy as its samples: on the Coulomb controls at the MD's
-    noise, 8 slips, a loop step of +7.5 ε/σ with a window of 1.2 τ, +1.4 with 3 τ).
+    The mean's velocity (from the mean displacement) sets the branches' split and the
+    fitted lags, and the mean's held velocity, smoothed alike, is the m_c term's regressor
+    (:func:`_segments`), so their noise biases the loop step (a window much shorter than the
+    noise's correlation leaves them as noisy as their samples: on the Coulomb controls at
+    the MD's noise, 8 slips, a loop step of +7.5 ε/σ with a window of 1.2 τ, +1.4 with 3 τ,
+    measured with the displacement's derivative as the regressor).
 
     Raises
     ------

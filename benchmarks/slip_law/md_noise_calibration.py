@@ -30,6 +30,7 @@ four) those of the jitter; the numbers are printed to 3 significant digits.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
@@ -88,8 +89,9 @@ def main(argv=None) -> int:
     if a.share is not None and not 0 <= a.share <= 1:
         print(f"error: --share {a.share}: must be in [0, 1]", file=sys.stderr)
         return 2
-    if not a.comoving_mass >= 0:
-        print(f"error: --comoving-mass {a.comoving_mass}: must be >= 0", file=sys.stderr)
+    if not (math.isfinite(a.comoving_mass) and a.comoving_mass >= 0):
+        print(f"error: --comoving-mass {a.comoving_mass}: must be finite and >= 0",
+              file=sys.stderr)
         return 2
     if (a.scale != "klein" or a.noise or a.lags != list(LAGS) or a.share is not None
             or a.comoving_mass):

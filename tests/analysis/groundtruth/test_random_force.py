@@ -68,8 +68,24 @@ def test_the_wall_moves_with_the_noise_and_rattle_is_on_the_velocity_only():
                                                                                      rel=0.1)
 
 
+def test_a_comoving_film_mass_slows_the_slip_as_a_heavier_wall():
+    # the film's m_c adds to the wall's inertia while it slips: a Coulomb slip of M + m_c,
+    # peak velocity (F_s − F_k)/√(K(M + m_c)) (+ about V), the slip distance 2(F_s − F_k)/K
+    # plus about V·τ_s of the longer slip (without m_c: 1.55 σ/τ and 13.2 σ)
+    mc = 90.0
+    run = _run(comoving_mass=mc)[0]
+    y, s = run["yield_index"], run["stick_index"]
+    x, v = run["wall_position"], run["wall_velocity"]
+    tau = math.pi * math.sqrt((M + mc) / K)
+    for a, b in zip(y[1:], s[1:]):
+        assert x[b] - x[a] == pytest.approx(2 * (FS - FK) / K + 0.1 * tau, abs=0.3)
+        assert v[a:b + 1].max() == pytest.approx((FS - FK) / math.sqrt(K * (M + mc)) + 0.1,
+                                                 abs=0.02)
+
+
 @pytest.mark.parametrize("bad", [{"mass": 0.0}, {"dt": -1.0}, {"replicas": 0},
-                                 {"velocity_correlation": 1.0}, {"rattle": -0.1}])
+                                 {"velocity_correlation": 1.0}, {"rattle": -0.1},
+                                 {"comoving_mass": -1.0}, {"comoving_mass": math.inf}])
 def test_bad_arguments_are_refused(bad):
     with pytest.raises(ValueError):
         _run(**bad)
