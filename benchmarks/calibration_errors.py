@@ -14,19 +14,12 @@ large ones.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
-from pathlib import Path
 
 import numpy as np
 
-
-def _validate():
-    path = Path(__file__).resolve().with_name("validate.py")
-    spec = importlib.util.spec_from_file_location("validate", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+# run as a script, this folder is on the path: validate.py's calibration sets
+from validate import calibration_scores
 
 
 def line(label: str, z: np.ndarray) -> str:
@@ -44,7 +37,7 @@ def main(argv=None) -> int:
     if a.cases < 3:
         print(f"error: --cases {a.cases}: must be >= 3", file=sys.stderr)
         return 2
-    scores = _validate().calibration_scores(a.cases, a.seed, klein_cases=a.cases)
+    scores = calibration_scores(a.cases, a.seed, klein_cases=a.cases)
     print("| set, observable | fits | |z| < 1 | rms z | median |z| |\n|---|---|---|---|---|")
     for name, (_, rows) in scores.items():
         for obs, label in (("kinetic_force", "F_k"), ("film_damping", "B")):

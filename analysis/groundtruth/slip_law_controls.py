@@ -223,7 +223,8 @@ M1E4_STOP = 0.011
 #: the M = 10⁴ scale's, √(M/K) shorter; the mixes' F at v̄ are the runs' F̄ and v̄, the stop
 #: velocity a quarter of v̄, armed 4.5 ε/σ below the lowest yield of pooled runs whose yields
 #: spread by ± 20 % (the MD's runs: 47–66 ε/σ at M = 10², 10–90 %).
-#: The noise: :data:`LIGHT_NOISE`.
+#: The Coulomb control's F_k is 8 ε/σ under F̄ (as the M = 10⁴ scale's 27 is 5 under its 32),
+#: re-sticking where the wall stops.  The noise: :data:`LIGHT_NOISE`.
 LIGHT_B = {1e2: 2.0 * math.sqrt(8.0 * 1e2), 1e3: 2.0 * math.sqrt(8.0 * 1e3)}
 #: The film's random force at M = 10² and 10³, calibrated as :data:`M1E4_NOISE` on the MD's
 #: analysed slips of 20 s or longer (93 of the 20 M = 10² runs', 111 of the 8 M = 10³ runs')

@@ -142,12 +142,13 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     return out
 
 
-def _guide(x: np.ndarray, window: int, dt: float) -> np.ndarray:
+def _guide(x: np.ndarray, window: int, dt: float, deriv: int = 1) -> np.ndarray:
     """The velocity from the displacement along the last axis (Savitzky–Golay of
-    ``window``)."""
+    ``window``); with ``deriv`` 0, ``x`` itself smoothed alike."""
     w = window if 5 <= window < x.shape[-1] else 0
-    return (savgol_filter(x, w, 2, deriv=1, delta=dt, axis=-1) if w
-            else np.gradient(x, dt, axis=-1))
+    if not w:
+        return np.gradient(x, dt, axis=-1) if deriv else x
+    return savgol_filter(x, w, 2, deriv=deriv, delta=dt, axis=-1)
 
 
 def _selection(guide: np.ndarray, window: int, floor: float):
@@ -172,15 +173,14 @@ def _selection(guide: np.ndarray, window: int, floor: float):
     return p, peak, lags
 
 
-def _segments(mean: dict, window: int, p: int, lags: dict, mass: float) -> dict:
+def _segments(mean: dict, window: int, dt: float, p: int, lags: dict, mass: float) -> dict:
     """The mean slip's segments (:func:`fit_segments`'s input) at the lags chosen.  The m_c
     term's regressor is the mean's held velocity smoothed over ``window``: a slip held at
     its end keeps the velocity it ended with in the law's (M + m_c)·(v − v0), where the
     derivative of the mean displacement counts it as stopped (slips that end before
     they stop, pooled with longer ones, would bias m_c and with it F_k and B)."""
     x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
-    w = window if 5 <= window < v.size else 0
-    carried = savgol_filter(v, w, 2) if w else v
+    carried = _guide(v, window, dt, deriv=0)
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}
     for name, i in lags.items():
         segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], v[i],
@@ -261,7 +261,7 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
     total = {k: held[k].sum(axis=0) for k in keys}
 
     def fit(mean):
-        segs = _segments(mean, window, p, lags, mass)
+        segs = _segments(mean, window, dt, p, lags, mass)
         return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
                             smoothing_window=window)
 
