@@ -45,9 +45,12 @@ falls (Coulomb), it re-sticks where the noise slowed it, and the decelerating br
 is low by ~1.4 ε/σ (the one-law figures there were measured before the m_c regressor
 became the held velocity).  The one law's co-moving mass has as regressor the mean's held
 velocity smoothed, which the smoothing blurs at a fast start (Klein's overdamped slips
-pooled noise-free: m_c 44 m of a 30 m wall with a 3 τ window, 0 unsmoothed); its sampled
-velocity carries noise the positions do not (a control's rattle: frozen at each slip's end,
-it biases the one law; docs/results/slip-law.md).
+pooled noise-free: m_c 44 m of a 30 m wall with a 3 τ window, 0 unsmoothed).  Each slip's
+held velocity is its own positions' derivative, not the sampled velocity, whose white
+noise (a wall's rattle) the positions do not carry: frozen at each slip's end it biased
+the one law (a loop step of +2.1 ε/σ on Klein's slips with a rattle of 0.15 σ/τ alone,
+0 now; without positions, the integral of the sampled velocity stands in for them and
+keeps part of it).
 
 Example
 -------
@@ -87,6 +90,8 @@ MIN_CYCLES = 3
 #: 0.44 at 2 τ and 0.08 at 4 τ (docs/results/slip-law.md, "The MD's noise").  The mean
 #: slip's velocity is smoothed over at least this long (``min_window_time``).
 MD_NOISE_TIME = 3.0
+#: The per-slip, per-lag arrays of :func:`held_slips`.
+HELD = ("impulse", "velocity", "held_velocity", "displacement", "slipping_time")
 
 
 def uniform_step(t: np.ndarray, what: str) -> float:
@@ -113,9 +118,12 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
                mount_damping: float = 0.0, drive_velocity: float = 0.0) -> dict:
     """Each slip aligned at its yield and held at its end (module text), per slip and lag.
 
-    Returns a dict of arrays of shape (slips, lags): ``impulse``, ``velocity``,
-    ``displacement``, ``slipping_time``; the lags run to the longest slip's end, and
-    ``lag_time`` (lags,) holds their times from the yield.
+    Returns a dict of arrays of shape (slips, lags): ``impulse``, ``velocity`` (the
+    sampled one), ``held_velocity`` (the slip's own positions' derivative, second order,
+    one-sided at its ends: what a sampled velocity's noise does not reach, since the
+    positions integrate the wall's motion), ``displacement``, ``slipping_time``; the lags
+    run to the longest slip's end, and ``lag_time`` (lags,) holds their times from the
+    yield.
     """
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
@@ -127,8 +135,7 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     n = int(d.max()) + 1
     dt = float(t[1] - t[0])
     lag = np.arange(n)
-    out = {k: np.empty((y.size, n)) for k in ("impulse", "velocity", "displacement",
-                                               "slipping_time")}
+    out = {k: np.empty((y.size, n)) for k in HELD}
     for i, (a, b) in enumerate(zip(y, s)):
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
@@ -136,6 +143,8 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
         imp = cumulative_trapezoid(force, t[seg], initial=0.0)
         out["impulse"][i] = imp[k - a]
         out["velocity"][i] = v[k]
+        out["held_velocity"][i] = np.gradient(x[seg], t[seg],
+                                              edge_order=2 if seg.size > 2 else 1)[k - a]
         out["displacement"][i] = x[k] - x[a]
         out["slipping_time"][i] = t[k] - t[a]
     out["lag_time"] = lag * dt
@@ -175,12 +184,15 @@ def _selection(guide: np.ndarray, window: int, floor: float):
 
 def _segments(mean: dict, window: int, dt: float, p: int, lags: dict, mass: float) -> dict:
     """The mean slip's segments (:func:`fit_segments`'s input) at the lags chosen.  The m_c
-    term's regressor is the mean's held velocity smoothed over ``window``: a slip held at
-    its end keeps the velocity it ended with in the law's (M + m_c)·(v − v0), where the
-    derivative of the mean displacement counts it as stopped (slips that end before
-    they stop, pooled with longer ones, would bias m_c and with it F_k and B)."""
+    term's regressor is the mean's held velocity (each slip's from its own positions)
+    smoothed over ``window``: a slip held at its end keeps the velocity it ended with in
+    the law's (M + m_c)·(v − v0), where the derivative of the mean displacement counts it
+    as stopped (slips that end before they stop, pooled with longer ones, would bias m_c
+    and with it F_k and B); the positions' velocity, not the sampled one, because a
+    sampled velocity's white noise (a wall's rattle) would be frozen into the held lags,
+    an error in the regressor that biases the one law and its loop step."""
     x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
-    carried = _guide(v, window, dt, deriv=0)
+    carried = _guide(mean["held_velocity"], window, dt, deriv=0)
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}
     for name, i in lags.items():
         segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], v[i],
@@ -257,8 +269,7 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
                                min_velocity_fraction)
     ranges = [(min_velocity_fraction * peak, peak) if lags else (math.nan, math.nan)]
 
-    keys = ("impulse", "velocity", "displacement", "slipping_time")
-    total = {k: held[k].sum(axis=0) for k in keys}
+    total = {k: held[k].sum(axis=0) for k in HELD}
 
     def fit(mean):
         segs = _segments(mean, window, dt, p, lags, mass)
@@ -269,6 +280,6 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
     for g in labels:
         out = groups == g
         loo.append(fit({k: (total[k] - held[k][out].sum(axis=0)) / (n - int(out.sum()))
-                        for k in keys}))
-    return jackknife_fit(fit({k: total[k] / n for k in keys}), loo, mass=mass,
+                        for k in HELD}))
+    return jackknife_fit(fit({k: total[k] / n for k in HELD}), loo, mass=mass,
                          replicas=replicas)

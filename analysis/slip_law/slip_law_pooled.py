@@ -52,7 +52,7 @@ import numpy as np
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law import MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs
-from .slip_law_cycles import fit_held_ensemble, held_slips, slipped, uniform_step
+from .slip_law_cycles import HELD, fit_held_ensemble, held_slips, slipped, uniform_step
 
 __all__ = ["RunSlips", "fit_pooled_ensemble", "MIN_RUNS", "JACKKNIFE"]
 
@@ -150,7 +150,7 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     lags = max(h["impulse"].shape[1] for h, _, _ in parts)
     held = {k: np.concatenate([np.pad(h[k], ((0, 0), (0, lags - h[k].shape[1])), mode="edge")
                                for h, _, _ in parts])
-            for k in ("impulse", "velocity", "displacement", "slipping_time")}
+            for k in HELD}
     groups = (np.concatenate([np.full(h["impulse"].shape[0], i) for i, (h, _, _) in
                               enumerate(parts)])
               if jackknife == "runs" else np.arange(held["impulse"].shape[0]))

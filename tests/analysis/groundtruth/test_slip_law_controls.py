@@ -210,3 +210,17 @@ def test_m1e4_periods_hold_a_noise_free_cycle(name, share):
     assert cycle[1:].max() <= period
     if share is None:
         assert period < 1.3 * cycle[1:].max()
+
+
+def test_a_rattle_on_the_sampled_velocity_leaves_the_one_law_as_without_it():
+    # white noise on the sampled velocity only (the wall's thermal rattle; the random
+    # force off, so the slides are the noise-free one): the one law's co-moving-mass
+    # regressor is each slip's held velocity from its own positions, which the rattle does
+    # not reach (the sampled one froze it into the held lags: a loop step of +2 ε/σ)
+    rattle = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.15}
+    exact = dynamical_fits("coulomb-viscous", 1, 8, noise=NOISE_FREE, share=0.3)[0]
+    for fit in dynamical_fits("coulomb-viscous", 5, 8, noise=rattle, share=0.3):
+        for attr in ("kinetic_force", "damping", "comoving_mass"):
+            assert getattr(fit.one_law, attr) == pytest.approx(
+                getattr(exact.one_law, attr), abs=1e-6)
+        assert fit.loop_step == pytest.approx(exact.loop_step, abs=1e-6)
