@@ -251,12 +251,15 @@ def slip_temperature_rise(run_dir: Path) -> tuple[float, float]:
     """
     import numpy as np
 
+    from filmfriction.analysis.files.trace_reader import read_trace
+
     trace, cycles = run_dir / "trace.csv", run_dir / "analysis_cycles.csv"
     if not (trace.is_file() and cycles.is_file()):
         return math.nan, math.nan
-    tr = np.genfromtxt(trace, delimiter=",", names=True)
+    # the reader's binary copy of a long trace (the pooled law reads the same)
+    tr = read_trace(trace).columns
     cy = np.genfromtxt(cycles, delimiter=",", names=True, ndmin=1)
-    if "film_temperature" not in tr.dtype.names or cy.size == 0:
+    if "film_temperature" not in tr or cy.size == 0:
         return math.nan, math.nan
     t, temp = tr["time"], tr["film_temperature"]
     rises = []

@@ -113,8 +113,11 @@ class Segment:
         return float(self.dx[-1] / self.dt[-1]) if self.dt[-1] > 0 else math.nan
 
     def response(self, comoving: bool) -> np.ndarray:
-        """The response: y − M·v, or y alone with m_c (M·v joins m_c·v)."""
-        return self.y if comoving else self.y - self.mass * self.v
+        """The response y − M·v (the wall's own momentum from its sampled velocity, which
+        the impulse balances sample by sample; with m_c, its smoothed velocity is the
+        film's regressor alone, so a sampled velocity's noise is response noise there,
+        not an error in a regressor)."""
+        return self.y - self.mass * self.v
 
     def design(self, comoving: bool, intercepts: int = 1, which: int = 0, step: bool = False):
         """Columns [intercepts…, Δt, Δx (, v − v0) (, time past the peak)]."""
@@ -138,9 +141,9 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
         coef, _, res = ols(np.column_stack(seg.design(comoving, step=loop_step)),
                            seg.response(comoving), errors=False)
         resids.append(res)
-        # with m_c, the coefficient of v − v0 is M + m_c; the step's is F_dec − F_acc
+        # with m_c, the coefficient of v − v0 is m_c; the step's is F_dec − F_acc
         per.append((float(coef[1]), float(coef[2]),
-                    float(coef[3]) - seg.mass if comoving else math.nan, seg.mean_velocity,
+                    float(coef[3]) if comoving else math.nan, seg.mean_velocity,
                     -float(coef[-1]) if loop_step else math.nan))
         used.append(seg)
     per = np.array(per, float).reshape(-1, 5)
@@ -170,7 +173,7 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
                        for k, s in enumerate(used)])
         y = np.concatenate([s.response(comoving) for s in used])
         coef, pse, resid = ols(X, y)
-        est = np.array([coef[m], coef[m + 1], coef[m + 2] - used[0].mass if comoving else nan,
+        est = np.array([coef[m], coef[m + 1], coef[m + 2] if comoving else nan,
                         -coef[-1] if loop_step else nan])
         se = np.array([pse[m], pse[m + 1], pse[m + 2] if comoving else nan,
                        pse[-1] if loop_step else nan])

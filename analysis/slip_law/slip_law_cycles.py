@@ -46,11 +46,12 @@ is low by ~1.4 ε/σ (the one-law figures there were measured before the m_c reg
 became the held velocity).  The one law's co-moving mass has as regressor the mean's held
 velocity smoothed, which the smoothing blurs at a fast start (Klein's overdamped slips
 pooled noise-free: m_c 44 m of a 30 m wall with a 3 τ window, 0 unsmoothed).  Each slip's
-held velocity is its own positions' derivative, not the sampled velocity, whose white
-noise (a wall's rattle) the positions do not carry: frozen at each slip's end it biased
-the one law (a loop step of +2.1 ε/σ on Klein's slips with a rattle of 0.15 σ/τ alone,
-0 now; without positions, the integral of the sampled velocity stands in for them and
-keeps part of it).
+held velocity, m_c's regressor, is its own positions' derivative, not the sampled
+velocity, whose white noise (a wall's rattle) the positions do not carry: frozen at each
+slip's end in the regressor it biased the one law (a loop step of +2.1 ± 0.2 ε/σ on
+Klein's slips, share 0.3, with a rattle of 0.15 σ/τ alone; now −0.3 ± 0.3).  The rattle
+stays in the response y − M·v (the wall's own momentum, sampled), where it is noise;
+without positions, the integral of the sampled velocity stands in for them.
 
 Example
 -------
@@ -186,11 +187,12 @@ def _segments(mean: dict, window: int, dt: float, p: int, lags: dict, mass: floa
     """The mean slip's segments (:func:`fit_segments`'s input) at the lags chosen.  The m_c
     term's regressor is the mean's held velocity (each slip's from its own positions)
     smoothed over ``window``: a slip held at its end keeps the velocity it ended with in
-    the law's (M + m_c)·(v − v0), where the derivative of the mean displacement counts it
-    as stopped (slips that end before they stop, pooled with longer ones, would bias m_c
+    the law's m_c·(v − v0), where the derivative of the mean displacement counts it as
+    stopped (slips that end before they stop, pooled with longer ones, would bias m_c
     and with it F_k and B); the positions' velocity, not the sampled one, because a
     sampled velocity's white noise (a wall's rattle) would be frozen into the held lags,
-    an error in the regressor that biases the one law and its loop step."""
+    an error in the regressor that biases the one law and its loop step.  The wall's own
+    M·v is the sampled velocity's, in the response (Segment.response)."""
     x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
     carried = _guide(mean["held_velocity"], window, dt, deriv=0)
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}

@@ -64,8 +64,8 @@ def test_slip_temperature_rise_recovers_a_known_rise(tmp_path):
     temp = 0.71 + 0.005 * rng.standard_normal(t.size)
     for y, s, dt in slips:
         temp[(t >= y) & (t <= s)] += dt
-    (tmp_path / "trace.csv").write_text("time,film_temperature\n" + "".join(
-        f"{a},{b}\n" for a, b in zip(t, temp)))
+    (tmp_path / "trace.csv").write_text("time,spring_force,film_temperature\n" + "".join(
+        f"{a},1.0,{b}\n" for a, b in zip(t, temp)))
     (tmp_path / "analysis_cycles.csv").write_text("yield_time,stick_time\n" + "".join(
         f"{y},{s}\n" for y, s, _ in slips))
     rise, err = ladder.slip_temperature_rise(tmp_path)

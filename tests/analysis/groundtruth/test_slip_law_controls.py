@@ -212,15 +212,16 @@ def test_m1e4_periods_hold_a_noise_free_cycle(name, share):
         assert period < 1.3 * cycle[1:].max()
 
 
-def test_a_rattle_on_the_sampled_velocity_leaves_the_one_law_as_without_it():
+def test_a_rattle_on_the_sampled_velocity_does_not_bias_the_one_law():
     # white noise on the sampled velocity only (the wall's thermal rattle; the random
     # force off, so the slides are the noise-free one): the one law's co-moving-mass
     # regressor is each slip's held velocity from its own positions, which the rattle does
-    # not reach (the sampled one froze it into the held lags: a loop step of +2 ε/σ)
+    # not reach, and the rattle is noise in the response y − M·v alone (the sampled
+    # velocity as the regressor froze it into the held lags: a loop step of +2.1 ε/σ)
     rattle = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.15}
     exact = dynamical_fits("coulomb-viscous", 1, 8, noise=NOISE_FREE, share=0.3)[0]
-    for fit in dynamical_fits("coulomb-viscous", 5, 8, noise=rattle, share=0.3):
-        for attr in ("kinetic_force", "damping", "comoving_mass"):
-            assert getattr(fit.one_law, attr) == pytest.approx(
-                getattr(exact.one_law, attr), abs=1e-6)
-        assert fit.loop_step == pytest.approx(exact.loop_step, abs=1e-6)
+    fits = dynamical_fits("coulomb-viscous", REPLICAS, 8, noise=rattle, share=0.3)
+    for get in (lambda f: f.one_law.kinetic_force, lambda f: f.one_law.damping,
+                lambda f: f.loop_step):
+        err = np.array([get(f) - get(exact) for f in fits])
+        assert abs(err.mean()) < 3 * err.std(ddof=1) / np.sqrt(err.size) + 0.05
