@@ -139,7 +139,7 @@ def _bingham_reading(rows) -> str:
                  "a viscous share (its controls: purely viscous slips `viscous` in 11 % of "
                  "replicas), so the verdict is not established by a run; the slips of eighteen runs "
                  "at Bi 32–55 pooled (`filmfriction slip-law`, errors by the jackknife over "
-                 "the runs) carry a kinetic force of 0.75 of the film's mean force: Klein's "
+                 "the runs) carry a kinetic force of 0.77 of the film's mean force: Klein's "
                  "purely viscous film is rejected there (Eq. (1)'s Bi counts that force as "
                  "viscosity). Beside it a viscous term of 9.0 ± 2.1 times a bulk no-slip film's "
                  "is resolved at 3.5 σ (`mixed`; 3.2 σ without the slips that still hold a "
