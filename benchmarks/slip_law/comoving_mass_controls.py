@@ -4,6 +4,7 @@ branch and the one law read, at the light sliders' scales.
     python benchmarks/slip_law/comoving_mass_controls.py [--scale m1e2] [--kinetic 29.1]
         [--damping 30] [--comoving-mass 179] [--runs 20] [--slips 10] [--replicas 100]
         [--law-spread 0.1] [--static-spread 0.2] [--noise U RHO RATTLE] [--noise-free]
+        [--stop-velocity V]
 
 Each replica is G runs of the scale's slider (:data:`~filmfriction.analysis.groundtruth.
 slip_law_controls.SCALES`; each run with its own yield force, ± ``--static-spread``, and with
@@ -95,6 +96,9 @@ def main(argv=None) -> int:
                     metavar=("U", "RHO", "RATTLE"), help="the film's random force (default: "
                                                          "the scale's)")
     ap.add_argument("--noise-free", action="store_true")
+    ap.add_argument("--stop-velocity", type=float, default=None,
+                    help="the velocity (σ/τ) at which a slip re-sticks once armed (default: "
+                         "the scale's, a quarter of its slip velocity; 0: where the wall stops)")
     a = ap.parse_args(argv)
     problems = [f"{k} {v!r}: must be finite and >= 0" for k, v in (
         ("--kinetic", a.kinetic), ("--damping", a.damping), ("--comoving-mass", a.comoving_mass))
@@ -111,6 +115,9 @@ def main(argv=None) -> int:
                                     and a.noise[2] >= 0):
         problems.append(f"--noise {' '.join(map(str, a.noise))}: U >= 0, RHO in [0, 1), "
                         "RATTLE >= 0")
+    if a.stop_velocity is not None and not (math.isfinite(a.stop_velocity)
+                                            and a.stop_velocity >= 0):
+        problems.append(f"--stop-velocity {a.stop_velocity!r}: must be finite and >= 0")
     if problems:
         for p in problems:
             print(f"error: {p}", file=sys.stderr)
@@ -118,7 +125,8 @@ def main(argv=None) -> int:
     sc = SCALES[a.scale]
     v = sc.mix["slip_velocity"]
     force = a.kinetic + a.damping * v
-    sc = replace(sc, mix={**sc.mix, "film_force": force})
+    sc = replace(sc, mix={**sc.mix, "film_force": force} | (
+        {} if a.stop_velocity is None else {"stop_velocity": a.stop_velocity}))
     share = a.damping * v / force
     noise = (NOISE_FREE if a.noise_free else
              None if a.noise is None else dict(zip(("velocity_noise", "velocity_correlation",
@@ -126,7 +134,8 @@ def main(argv=None) -> int:
     print(f"co-moving mass controls at the {a.scale} scale: F_k {a.kinetic:g}, B {a.damping:g} "
           f"(viscous share {share:.3f} of {force:.3g} ε/σ at {v:g} σ/τ), M {sc.mass:g}, "
           f"{a.replicas} replicas of {a.runs} runs x {a.slips} slips, law spread "
-          f"{a.law_spread:g}, yields ± {a.static_spread:g}, noise {noise or sc.noise}", flush=True)
+          f"{a.law_spread:g}, yields ± {a.static_spread:g}, noise {noise or sc.noise}, "
+          f"re-stick at {sc.mix['stop_velocity']:g} σ/τ once armed", flush=True)
     for mc in (0.0, a.comoving_mass):
         fits, skipped, slip = fits_of(sc, a, share, noise, mc)
         print(f"\n## m_c = {mc:g}: {len(fits)} replicas fitted ({skipped} left out: a run "

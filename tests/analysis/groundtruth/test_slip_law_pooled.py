@@ -145,3 +145,14 @@ def test_runs_in_other_units_give_the_law_in_those_units():
     assert fit.decelerating.damping == pytest.approx(STIFF_B * F0 * T / L, rel=2e-3)
     assert abs(fit.decelerating.kinetic_force) < 0.05 * F0
     assert fit.verdict == _fit(runs, v).verdict
+
+
+def test_the_comoving_mass_benchmark_refuses_bad_input_before_any_compute(benchmark_module,
+                                                                          capsys):
+    main = benchmark_module("slip_law/comoving_mass_controls").main
+    for argv, said in ((["--stop-velocity", "-1"], "--stop-velocity -1.0: must be finite"),
+                       (["--runs", "2"], "--runs 2: must be >= 3"),
+                       (["--comoving-mass", "inf"], "--comoving-mass inf: must be finite"),
+                       (["--noise", "0.1", "1.0", "0"], "RHO in [0, 1)")):
+        assert main(argv) == 2
+        assert said in capsys.readouterr().err
