@@ -109,9 +109,11 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     Standard errors: the diagonal of (JᵀJ)⁻¹ s² c at the solution, J the Jacobian
     of every varied parameter, s² the residual variance per degree of freedom and
     c = (1 + ρ)/(1 − ρ) from the residuals' lag-one autocorrelation ρ (1 for white
-    noise).  A parameter at its bound gets none (``at_bound``); J still holds its
-    column, so that the others' errors carry the freedom the data leave it (where
-    that makes JᵀJ singular, the parameters off their bounds alone).
+    noise).  A parameter at its bound gets none (``at_bound``), and the others' errors
+    are the constrained model's (J over the parameters off their bounds, the one at its
+    bound held there): on Klein's slips (F_k = 0, fitted at its bound in about half the
+    cases) the unconstrained J's errors on B were ten times its scatter
+    (docs/results/validation.md).
 
     Parameters
     ----------
@@ -326,12 +328,11 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     dof = max(r.size - int(free.sum()), 1)
     s2 = float(np.sum(r ** 2)) / dof
     corr = _serial_correlation(r, sizes)
-    # the covariance is over every varied parameter, those at a bound too: the others'
-    # errors then include the freedom of a parameter that the data only bound (F_k = 0 is
-    # as consistent with the slips as a small F_k > 0); without that (a singular matrix)
-    # over the ones off their bounds
+    # the covariance is the constrained model's, over the parameters off their bounds (a
+    # parameter at its bound is held there, as the estimate is); where that matrix is
+    # singular, over every varied one
     err = np.full(p.size, math.nan)
-    for use in (vary, free):
+    for use in (free, vary):
         cols = jmat[:, use[vary]]
         try:
             cov = np.linalg.inv(cols.T @ cols)

@@ -98,7 +98,8 @@ def main(argv=None) -> int:
     ap.add_argument("--noise-free", action="store_true")
     ap.add_argument("--stop-velocity", type=float, default=None,
                     help="the velocity (σ/τ) at which a slip re-sticks once armed (default: "
-                         "the scale's, a quarter of its slip velocity; 0: where the wall stops)")
+                         "the scale's, a quarter of its slip velocity; 0: where the wall stops; "
+                         "-inf: only at the scale's backward force)")
     a = ap.parse_args(argv)
     problems = [f"{k} {v!r}: must be finite and >= 0" for k, v in (
         ("--kinetic", a.kinetic), ("--damping", a.damping), ("--comoving-mass", a.comoving_mass))
@@ -115,9 +116,9 @@ def main(argv=None) -> int:
                                     and a.noise[2] >= 0):
         problems.append(f"--noise {' '.join(map(str, a.noise))}: U >= 0, RHO in [0, 1), "
                         "RATTLE >= 0")
-    if a.stop_velocity is not None and not (math.isfinite(a.stop_velocity)
-                                            and a.stop_velocity >= 0):
-        problems.append(f"--stop-velocity {a.stop_velocity!r}: must be finite and >= 0")
+    if a.stop_velocity is not None and not (a.stop_velocity == -math.inf or (
+            math.isfinite(a.stop_velocity) and a.stop_velocity >= 0)):
+        problems.append(f"--stop-velocity {a.stop_velocity!r}: must be finite and >= 0, or -inf")
     if problems:
         for p in problems:
             print(f"error: {p}", file=sys.stderr)

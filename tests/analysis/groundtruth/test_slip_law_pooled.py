@@ -151,6 +151,7 @@ def test_the_comoving_mass_benchmark_refuses_bad_input_before_any_compute(benchm
                                                                           capsys):
     main = benchmark_module("slip_law/comoving_mass_controls").main
     for argv, said in ((["--stop-velocity", "-1"], "--stop-velocity -1.0: must be finite"),
+                       (["--stop-velocity", "nan"], "--stop-velocity nan: must be finite"),
                        (["--runs", "2"], "--runs 2: must be >= 3"),
                        (["--comoving-mass", "inf"], "--comoving-mass inf: must be finite"),
                        (["--noise", "0.1", "1.0", "0"], "RHO in [0, 1)")):
