@@ -99,7 +99,7 @@ def main(argv=None) -> int:
     ap.add_argument("--stop-velocity", type=float, default=None,
                     help="the velocity (σ/τ) at which a slip re-sticks once armed (default: "
                          "the scale's, a quarter of its slip velocity; 0: where the wall stops; "
-                         "-inf: only at the scale's backward force)")
+                         "--stop-velocity=-inf: only at the scale's backward force)")
     a = ap.parse_args(argv)
     problems = [f"{k} {v!r}: must be finite and >= 0" for k, v in (
         ("--kinetic", a.kinetic), ("--damping", a.damping), ("--comoving-mass", a.comoving_mass))
