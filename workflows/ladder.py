@@ -257,7 +257,10 @@ def slip_temperature_rise(run_dir: Path) -> tuple[float, float]:
     if not (trace.is_file() and cycles.is_file()):
         return math.nan, math.nan
     # the reader's binary copy of a long trace (the pooled law reads the same)
-    tr = read_trace(trace).columns
+    try:
+        tr = read_trace(trace).columns
+    except ValueError:                      # a trace the reader refuses: no rise to give
+        return math.nan, math.nan
     cy = np.genfromtxt(cycles, delimiter=",", names=True, ndmin=1)
     if "film_temperature" not in tr or cy.size == 0:
         return math.nan, math.nan

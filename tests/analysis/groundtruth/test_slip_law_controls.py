@@ -222,6 +222,6 @@ def test_a_rattle_on_the_sampled_velocity_does_not_bias_the_one_law():
     exact = dynamical_fits("coulomb-viscous", 1, 8, noise=NOISE_FREE, share=0.3)[0]
     fits = dynamical_fits("coulomb-viscous", REPLICAS, 8, noise=rattle, share=0.3)
     for get in (lambda f: f.one_law.kinetic_force, lambda f: f.one_law.damping,
-                lambda f: f.loop_step):
+                lambda f: f.one_law.comoving_mass, lambda f: f.loop_step):
         err = np.array([get(f) - get(exact) for f in fits])
         assert abs(err.mean()) < 3 * err.std(ddof=1) / np.sqrt(err.size) + 0.05
