@@ -109,13 +109,13 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     Standard errors: the diagonal of (JᵀJ)⁻¹ s² c at the solution, J the Jacobian
     of every varied parameter, s² the residual variance per degree of freedom and
     c = (1 + ρ)/(1 − ρ) from the residuals' lag-one autocorrelation ρ (1 for white
-    noise).  A parameter at its bound gets none (``at_bound``), and the others' errors
-    are the constrained model's (J over the parameters off their bounds, the one at its
-    bound held there): on Klein's slips (F_k = 0, at its bound in 35 of 80 fits) B's
-    error so covers the truth as often as off the bound (71 %), where the unconstrained J's
-    was nine times B's scatter; where the truth is off the bound and the fit pinned it
-    there (B = 0 for a B > 0), the others' errors are too narrow
-    (docs/results/validation.md).
+    noise).  A parameter at its bound gets none (``at_bound``); J still holds its
+    column, so that the others' errors carry the freedom the data leave it (where
+    that makes JᵀJ singular, the parameters off their bounds alone).  That is the
+    conservative choice: where the truth sits at the bound (Klein's F_k = 0) the errors
+    are too wide (B's about nine times its scatter), but the constrained model's errors,
+    right there, are far too narrow where the fit pinned a parameter whose truth is off
+    the bound (B = 0 for a B > 0: F_k off by 4–55 of its errors; docs/results/validation.md).
 
     Parameters
     ----------
@@ -330,11 +330,12 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
     dof = max(r.size - int(free.sum()), 1)
     s2 = float(np.sum(r ** 2)) / dof
     corr = _serial_correlation(r, sizes)
-    # the covariance is the constrained model's, over the parameters off their bounds (a
-    # parameter at its bound is held there, as the estimate is); where that matrix is
-    # singular, over every varied one
+    # the covariance is over every varied parameter, those at a bound too: the others'
+    # errors then include the freedom of a parameter that the data only bound (F_k = 0 is
+    # as consistent with the slips as a small F_k > 0); without that (a singular matrix)
+    # over the ones off their bounds
     err = np.full(p.size, math.nan)
-    for use in (free, vary):
+    for use in (vary, free):
         cols = jmat[:, use[vary]]
         try:
             cov = np.linalg.inv(cols.T @ cols)

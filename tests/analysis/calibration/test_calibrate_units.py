@@ -136,17 +136,17 @@ def test_the_error_bars_cover_the_truth_on_random_traces():
         assert abs(s["mean_z"]) < 0.8, (q, s)
 
 
-def test_at_the_kinetic_force_bound_the_damping_error_is_the_constrained_fits():
-    """Klein's slips (F_k = 0): where F_k ends at its bound the fit is the model with F_k
-    held at 0, and B's error is that model's. The unconstrained covariance, which also
-    carries F_k's freedom, made the bars about nine times B's scatter there (rms z 0.11
-    over 35 such fits; docs/results/validation.md)."""
+def test_at_the_kinetic_force_bound_the_damping_error_keeps_its_freedom():
+    """Klein's slips (F_k = 0): where F_k ends at its bound, B's error still carries F_k's
+    freedom (the unconstrained covariance), so it is wide rather than narrow: the
+    constrained model's errors, right when the truth is at the bound, were 4–55 times too
+    narrow for F_k where a fit pinned B = 0 for a B > 0 (docs/results/validation.md)."""
     cov = _coverage_module()
     rows = cov.run_set("klein", 16, seed=3)
     z = np.array([(r["film_damping"][0] - r["film_damping"][3]) / r["film_damping"][1]
                   for r in rows if r["kinetic_force"][2]])
     assert z.size >= 4
-    assert 0.4 < math.sqrt(np.mean(z ** 2)) < 3.0, z
+    assert math.sqrt(np.mean(z ** 2)) < 1.0, z        # constrained errors: rms z 1.8 here
 
 
 def test_issue_example_is_recovered_in_both_unit_systems(tmp_path):
