@@ -138,15 +138,16 @@ def test_the_error_bars_cover_the_truth_on_random_traces():
 
 def test_at_the_kinetic_force_bound_the_damping_error_keeps_its_freedom():
     """Klein's slips (F_k = 0): where F_k ends at its bound, B's error still carries F_k's
-    freedom (the unconstrained covariance), so it is wide rather than narrow: the
-    constrained model's errors, right when the truth is at the bound, were 4–55 times too
-    narrow for F_k where a fit pinned B = 0 for a B > 0 (docs/results/validation.md)."""
+    freedom (the unconstrained covariance), so it is wide rather than narrow.  The
+    constrained model's errors suit a truth at the bound, but where a fit pinned B = 0 for
+    a B > 0 (a truth off the bound) they put F_k 4–55 of its errors off the truth, against
+    0.2–2.0 with the unconstrained ones (docs/results/validation.md)."""
     cov = _coverage_module()
     rows = cov.run_set("klein", 16, seed=3)
     z = np.array([(r["film_damping"][0] - r["film_damping"][3]) / r["film_damping"][1]
                   for r in rows if r["kinetic_force"][2]])
     assert z.size >= 4
-    assert math.sqrt(np.mean(z ** 2)) < 1.0, z        # constrained errors: rms z 1.8 here
+    assert 0.03 < math.sqrt(np.mean(z ** 2)) < 1.0, z  # constrained errors: rms z 1.8 here
 
 
 def test_issue_example_is_recovered_in_both_unit_systems(tmp_path):
