@@ -112,7 +112,8 @@ class Segment:
     def mean_velocity(self) -> float:
         return float(self.dx[-1] / self.dt[-1]) if self.dt[-1] > 0 else math.nan
 
-    def response(self, comoving: bool) -> np.ndarray:
+    @property
+    def response(self) -> np.ndarray:
         """The response y − M·v (the wall's own momentum from its sampled velocity, which
         the impulse balances sample by sample; with m_c, its smoothed velocity is the
         film's regressor alone, so a sampled velocity's noise is response noise there,
@@ -139,7 +140,7 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
             per.append((math.nan,) * 5)
             continue
         coef, _, res = ols(np.column_stack(seg.design(comoving, step=loop_step)),
-                           seg.response(comoving), errors=False)
+                           seg.response, errors=False)
         resids.append(res)
         # with m_c, the coefficient of v − v0 is m_c; the step's is F_dec − F_acc
         per.append((float(coef[1]), float(coef[2]),
@@ -171,7 +172,7 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
         # degrees of freedom of its independent samples
         X = np.vstack([np.column_stack(s.design(comoving, m, k, loop_step))
                        for k, s in enumerate(used)])
-        y = np.concatenate([s.response(comoving) for s in used])
+        y = np.concatenate([s.response for s in used])
         coef, pse, resid = ols(X, y)
         est = np.array([coef[m], coef[m + 1], coef[m + 2] if comoving else nan,
                         -coef[-1] if loop_step else nan])
