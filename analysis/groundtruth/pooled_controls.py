@@ -41,17 +41,22 @@ STATIC_SPREAD = 0.3
 def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,
                 scale: str | Scale = "stiff", static_spread: float = STATIC_SPREAD,
                 law_spread: float = 0.0, noise: dict | None = None,
-                comoving_mass: float = 0.0, seed=0) -> tuple[list[RunSlips], float]:
+                comoving_mass: float = 0.0, weakening: tuple[float, float] | None = None,
+                loop_law: str = "melting", seed=0) -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
     them, and the drive velocity.  ``comoving_mass``: the film's mass m_c the slipping wall
     carries (:func:`~filmfriction.analysis.groundtruth.random_force.slide`; the fit is given
-    the scale's M alone).  ``seed``: an int or a tuple of ints."""
+    the scale's M alone).  ``weakening`` = (w, D_c): the mix with a yield loop
+    (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`), ΔF = w·(F_s −
+    F_k) of each run's yield force F_s, of ``loop_law`` (``melting``, D_c a velocity, or
+    ``slip-weakening``, a distance: :data:`~filmfriction.analysis.groundtruth.random_force.LAWS`).  ``seed``: an
+    int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
     sc = scale_named(scale)
-    law = sc.law(name, share)
+    law = sc.law(name, share, weakening, loop_law)
     period = law.pop("period")
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
@@ -61,6 +66,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
         fs = law["static_force"] * (1 + static_spread * rng.uniform(-1, 1))
         par = tuple(float(p) * (1 + law_spread * rng.standard_normal())
                     for p in law["parameters"])
+        if weakening is not None:
+            # the film yields at its own F_s: ΔF the loop's share of the run's F_s − F_k
+            par = par[:2] + (par[2] * max(fs - par[0], 0.0),) + par[3:]
         r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
                   stiffness=sc.spring_constant,
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,

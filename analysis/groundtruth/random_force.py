@@ -67,8 +67,13 @@ __all__ = ["slide", "LAWS"]
 #: * ``weakening`` (F_k, F_s, v_c): sign(v)·(F_k + (F_s − F_k)·exp(−|v|/v_c));
 #: * ``rate-state`` (μ0, a, b, d_c, v0): a·asinh(v/(2v0)·exp((μ0 + bψ)/a)) (the regularized
 #:   Dieterich–Ruina law, :class:`~filmfriction.reduced_model.laws.RateState` at N = 1),
-#:   aging: dψ/dt = (v0·e^{−ψ} − |v|)/d_c.
-LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5}
+#:   aging: dψ/dt = (v0·e^{−ψ} − |v|)/d_c;
+#: * ``slip-weakening`` (F_k, B, ΔF, D_c): sign(v)·(F_k + ΔF·exp(−ψ/D_c)) + B·v, ψ the
+#:   distance slid since the yield (dψ/dt = |v|, 0 at each yield): a film that yields
+#:   solid-like and melts over the slip distance D_c, so the accelerating part of a slip
+#:   meets more force than the decelerating part at the same velocity (a yield loop).
+LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
+        "slip-weakening": 4, "melting": 4, "power": 3}
 _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
@@ -81,6 +86,15 @@ def _friction(code, p, v, psi):
     if code == 2:
         f = p[0] + (p[1] - p[0]) * math.exp(-abs(v) / p[2])
         return f if v >= 0.0 else -f
+    if code == 4:
+        f = p[0] + p[2] * math.exp(-psi / p[3])
+        return (f if v >= 0.0 else -f) + p[1] * v
+    if code == 5:
+        f = p[0] + p[2] * math.exp(-max(psi, abs(v)) / p[3])
+        return (f if v >= 0.0 else -f) + p[1] * v
+    if code == 6:
+        f = p[0] + p[1] * abs(v) ** p[2]
+        return f if v >= 0.0 else -f
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -88,6 +102,8 @@ def _friction(code, p, v, psi):
 def _state_rate(code, p, v, psi):
     if code == 3:
         return (p[4] * math.exp(-psi) - abs(v)) / p[3]
+    if code == 4:
+        return abs(v)
     return 0.0
 
 
@@ -140,6 +156,8 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         ns += 1
                     else:
                         v = vn
+                        if code == 5:
+                            psi = max(psi, abs(v))
                 else:
                     # stuck: at rest, the state aging
                     psi = psi + h * _state_rate(code, p, 0.0, psi)
@@ -147,6 +165,8 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     thr = static if code != 3 else _friction(code, p, start_v, psi)
                     if force >= thr:
                         slipping, v = True, start_v
+                        if code == 4 or code == 5:
+                            psi = 0.0       # the slip's state starts at each yield
                         if ny < yields.shape[1]:
                             yields[r, ny] = i
                         ny += 1
@@ -207,6 +227,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     p = np.asarray(parameters, float)
     if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
         raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
+    if law in ("slip-weakening", "melting") and not p[3] > 0:
+        raise ValueError(f"parameters = {parameters!r}: the slip-weakening distance D_c "
+                         "(the fourth) must be > 0")
     for name, val in (("mass", mass), ("stiffness", stiffness), ("duration", duration),
                       ("dt", dt)):
         if not (math.isfinite(val) and val > 0):

@@ -124,19 +124,31 @@ class Scale:
     mount_damping: float = 0.0
     chunk: int = 0
 
-    def law(self, name: str, share: float | None = None) -> dict:
+    def law(self, name: str, share: float | None = None,
+            weakening: tuple[float, float] | None = None, law: str = "melting") -> dict:
         """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
         control ``name`` (or the Coulomb + viscous law of viscous ``share``) at this scale:
         the law, its yield and re-stick, and ``period``, a slip cycle's length or a little
-        more."""
+        more.  ``weakening`` = (ΔF, D_c), with ``share``: that mix with a yield loop, the
+        kinetic force ΔF higher at the yield and weakening over the slip distance D_c
+        (the ``slip-weakening`` law)."""
         if share is not None:
             if not 0 <= share <= 1:
                 raise ValueError(f"share = {share!r}: must be in [0, 1]")
             m = dict(self.mix)
             f, v = m.pop("film_force"), m.pop("slip_velocity")
+            par = ((1 - share) * f, share * f / v)
+            if weakening is None:
+                return {"static_force": self.static_force,
+                        "drive_velocity": self.drive_velocity,
+                        "law": "coulomb-viscous", "parameters": par, **m}
+            df, dc = (float(w) for w in weakening)
+            if not (math.isfinite(df) and df >= 0 and math.isfinite(dc) and dc > 0):
+                raise ValueError(f"weakening = {weakening!r}: ΔF >= 0 and D_c > 0, finite")
             return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
-                    "law": "coulomb-viscous", "parameters": ((1 - share) * f, share * f / v),
-                    **m}
+                    "law": law, "parameters": par + (df, dc), **m}
+        if weakening is not None:
+            raise ValueError(f"weakening = {weakening!r}: only with a viscous share")
         if name not in self.laws:
             raise ValueError(f"control {name!r} at the {self.name} scale: one of "
                              f"{', '.join(self.laws)}")

@@ -2,7 +2,8 @@
 
     python benchmarks/slip_law/pooled_controls_rates.py [--runs 6] [--slips 8] [--replicas 100]
         [--laws coulomb viscous] [--shares 0.3 0.6] [--static-spread 0.3] [--law-spread 0.0]
-        [--scale stiff] [--noise-scale 1.0]
+        [--scale stiff] [--noise-scale 1.0] [--loop LAW W D] [--stop-velocity V]
+        [--md RUN...]
 
 Each replica is G runs of one law at the heavy slider's scale (``SCALES["stiff"]``, its
 calibrated noise; ``--scale m1e4``: the K = 8 film's slider at M = 10⁴, ``SCALES["m1e4"]``),
@@ -24,6 +25,7 @@ import argparse
 import math
 import sys
 from collections import Counter
+from dataclasses import replace
 
 import numpy as np
 
@@ -49,6 +51,21 @@ def coverage(fits, branch: str, attr: str, truth: float) -> str:
             f" (truth {truth:.4g}), covered {int(np.sum(np.abs(z) < 2))}/{ok.sum()}")
 
 
+def slip_shape(runs) -> str:
+    """The slips' median duration and the median share of a slip after its peak velocity
+    (the peak of the velocity's 10 τ running mean), with their 10–90 % ranges."""
+    dur, after = [], []
+    for r in runs:
+        dt = r.time[1] - r.time[0]
+        w = max(1, int(round(10.0 / dt)))
+        for a, b in zip(r.table.yield_index, r.table.stick_index):
+            v = np.convolve(r.wall_velocity[int(a):int(b) + 1], np.ones(w) / w, "same")
+            dur.append((int(b) - int(a)) * dt)
+            after.append(1.0 - np.argmax(v) / max(v.size, 1))
+    q = lambda x: f"{np.median(x):.3g} ({np.percentile(x, 10):.3g}–{np.percentile(x, 90):.3g})"
+    return f"{len(dur)} slips: duration {q(dur)} τ, share after the peak velocity {q(after)}"
+
+
 def fit(runs, velocity, jackknife, scale="stiff"):
     sc = SCALES[scale]
     return fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=velocity,
@@ -57,17 +74,30 @@ def fit(runs, velocity, jackknife, scale="stiff"):
 
 
 def table(law: str, share, args) -> None:
+    sc = SCALES[args.scale]
+    if args.stop_velocity is not None:
+        sc = replace(sc, mix={**sc.mix, "stop_velocity": args.stop_velocity})
     kw = dict(share=share, static_spread=args.static_spread, law_spread=args.law_spread,
-              scale=args.scale)
+              scale=sc)
+    if share is not None and args.loop:
+        kw |= {"loop_law": args.loop[0], "weakening": tuple(map(float, args.loop[1:]))}
     noisy = {} if args.noise_scale == 1.0 else {
         "noise": scaled(SCALES[args.scale].noise, args.noise_scale)}
-    name = law if share is None else f"coulomb-viscous share {share}"
+    name = law if share is None else f"coulomb-viscous share {share}" + (
+        f" with a yield loop ({' '.join(args.loop)})" if args.loop else "") + (
+        "" if args.stop_velocity is None else
+        f", re-sticking at v <= {args.stop_velocity:g} σ/τ")
+    # the truth: noise-free, re-sticking where the wall stops (a re-stick at a recoil
+    # velocity < 0 never comes without the noise), the law's own F_k, B for the mixes
     exact = fit(*pooled_runs(law, args.runs, args.slips, noise=NOISE_FREE,
-                             **(kw | {"law_spread": 0.0})), "runs", args.scale)
+                             **(kw | {"law_spread": 0.0, "scale": SCALES[args.scale]})),
+                "runs", args.scale)
     fits = {j: [] for j in JACKKNIFE}
     unfitted = []
     for k in range(args.replicas):
         rs, v = pooled_runs(law, args.runs, args.slips, seed=(args.seed, k), **kw, **noisy)
+        if k == 0:
+            shape = slip_shape(rs)
         try:
             got = {j: fit(rs, v, j, args.scale) for j in JACKKNIFE}
         except ValueError as exc:       # a run without slips: its film slid smoothly
@@ -78,6 +108,7 @@ def table(law: str, share, args) -> None:
     print(f"\n## {name}: {args.replicas} replicas of {args.runs} runs x {args.slips} slips "
           f"(static spread ±{args.static_spread:g}, law spread {args.law_spread:g})",
           flush=True)
+    print(f"  the first replica's {shape}")
     if unfitted:
         print(f"  {len(unfitted)} replicas not fitted (a run in them has no slip to pool, as "
               f"no MD run of the pools has), e.g. {unfitted[0]}; the counts are of the "
@@ -90,6 +121,16 @@ def table(law: str, share, args) -> None:
         print(f"  jackknife over {j}: " + ", ".join(f"{v} {c[v]}" for v in VERDICTS if c[v])
               + f"; verdict from {dict(Counter(f.verdict_from for f in fits[j]))}; the "
               "decelerating branch alone: " + ", ".join(f"{v} {d[v]}" for v in VERDICTS if d[v]))
+        both = Counter((f.one_law.verdict, f.decelerating.verdict) for f in fits[j])
+        print("    one law / decelerating branch: " + ", ".join(
+            f"{a}/{b} {n}" for (a, b), n in sorted(both.items(), key=lambda x: -x[1])))
+        zl = np.array([f.loop_step_sigmas for f in fits[j]])
+        zm = np.array([sigmas(f.one_law.comoving_mass, f.one_law.comoving_mass_stderr,
+                              f.one_law.dof) for f in fits[j]])
+        print(f"    loop step ≥ +2 σ in {int(np.sum(zl >= 2))}, m_c ≤ −2 σ in "
+              f"{int(np.sum(zm <= -2))}, both in {int(np.sum((zl >= 2) & (zm <= -2)))}; "
+              f"loop step {np.nanmean(zl):+.2f} ± {np.nanstd(zl):.2f} σ, m_c "
+              f"{np.nanmean(zm):+.2f} ± {np.nanstd(zm):.2f} σ (mean ± sd over the replicas)")
         for br in ("decelerating", "one_law"):
             truth = getattr(exact, br)
             print(f"    {br:12s} F_k {coverage(fits[j], br, 'kinetic_force', truth.kinetic_force)}"
@@ -109,6 +150,14 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--scale", default="stiff", choices=[n for n in SCALES if n != "klein"],
                     help="the controls' scale (SCALES; stiff: K 8, M 1e5; m1e4: K 8, M 1e4)")
+    ap.add_argument("--loop", nargs=3, metavar=("LAW", "W", "D"), default=None,
+                    help="the shares' mixes with a yield loop: LAW melting (D a velocity) or "
+                         "slip-weakening (D a distance), ΔF = W·(F_s − F_k) at the yield")
+    ap.add_argument("--stop-velocity", type=float, default=None,
+                    help="the shares' mixes re-stick once armed at this velocity (σ/τ; "
+                         "negative: once the wall recoils that fast; the scale's by default)")
+    ap.add_argument("--md", nargs="*", default=[], metavar="RUN",
+                    help="MD run directories whose slips' shape to print beside the controls'")
     ap.add_argument("--noise-scale", type=float, default=1.0,
                     help="the scale's noise amplitudes times this (1: as calibrated)")
     args = ap.parse_args(argv)
@@ -116,7 +165,22 @@ def main(argv=None) -> int:
     if missing:
         ap.error(f"--laws {' '.join(missing)}: not a control at the {args.scale} scale "
                  f"({', '.join(SCALES[args.scale].laws)})")
-    print(f"pooled slip-law controls at the {args.scale} scale: {vars(args)}")
+    if args.loop:
+        try:
+            w, d = float(args.loop[1]), float(args.loop[2])
+        except ValueError:
+            w = d = math.nan
+        if args.loop[0] not in ("melting", "slip-weakening") or not (0 <= w <= 1 and d > 0):
+            ap.error(f"--loop {' '.join(args.loop)}: LAW melting or slip-weakening, "
+                     "0 <= W <= 1, D > 0")
+    if args.stop_velocity is not None and not (math.isfinite(args.stop_velocity)
+                                               or args.stop_velocity == -math.inf):
+        ap.error(f"--stop-velocity {args.stop_velocity!r}: finite or -inf")
+    shown = {k: v for k, v in vars(args).items() if k != "md"} | {"md runs": len(args.md)}
+    print(f"pooled slip-law controls at the {args.scale} scale: {shown}")
+    if args.md:
+        from filmfriction.analysis.calibration.slip_law_runs import read_runs
+        print(f"the MD runs' {slip_shape(read_runs(args.md)[0])}")
     for law in args.laws:
         table(law, None, args)
     for share in args.shares:

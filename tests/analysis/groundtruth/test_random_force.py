@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_trapezoid
+from scipy.integrate import cumulative_trapezoid, solve_ivp
 
 from filmfriction.analysis.groundtruth.random_force import slide
 
@@ -83,6 +83,51 @@ def test_a_comoving_film_mass_slows_the_slip_as_a_heavier_wall():
                                                  abs=0.02)
 
 
+def _slip_by_ode(friction_up, friction_down, v0=0.1, f0=FS):
+    """A slip from rest at spring force ``f0`` integrated by solve_ivp, the friction
+    ``friction_up(v, s)`` until the peak velocity, then ``friction_down(v, s, v_peak)`` until
+    the wall stops (s the distance slid): its distance, peak velocity and duration."""
+    def rhs(law):
+        return lambda t, y: [y[1], (f0 + K * (v0 * t - y[0]) - law(y[1], y[0])) / M]
+    peak = lambda t, y: f0 + K * (v0 * t - y[0]) - friction_up(y[1], y[0])
+    peak.terminal, peak.direction = True, -1
+    up = solve_ivp(rhs(friction_up), (0, 500), [0.0, 0.0], events=peak, rtol=1e-10,
+                   atol=1e-12, first_step=1e-6)
+    (t1,), (y1,) = up.t_events[0], up.y_events[0]
+    stop = lambda t, y: y[1]
+    stop.terminal, stop.direction = True, -1
+    down = solve_ivp(rhs(lambda v, s: friction_down(v, s, y1[1])), (t1, 500), y1,
+                     events=stop, rtol=1e-10, atol=1e-12)
+    return down.y_events[0][0][0], y1[1], down.t_events[0][0]
+
+
+@pytest.mark.parametrize("law, parameters, up, down", [
+    # a film that weakens over the slip distance D_c = 1 σ
+    ("slip-weakening", (30.0, 2.0, 15.0, 1.0),
+     lambda v, s: 30.0 + 15.0 * math.exp(-s) + 2.0 * v,
+     lambda v, s, vp: 30.0 + 15.0 * math.exp(-s) + 2.0 * v),
+    # a film that melts with the fastest velocity reached, v_c = 0.5 σ/τ, and stays melted
+    ("melting", (30.0, 2.0, 15.0, 0.5),
+     lambda v, s: 30.0 + 15.0 * math.exp(-v / 0.5) + 2.0 * v,
+     lambda v, s, vp: 30.0 + 15.0 * math.exp(-vp / 0.5) + 2.0 * v)])
+def test_noise_free_yield_loop_slips_are_the_ode(law, parameters, up, down):
+    # the laws with a yield loop, noise-free, slip as solve_ivp integrates them: the slip's
+    # distance, peak velocity and duration (the yield and the stop fall on the sub-steps)
+    run = slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
+                duration=600.0, dt=0.25, substeps=8)[0]
+    y, s = run["yield_index"], run["stick_index"]
+    assert y.size >= 2
+    x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
+    dist, vpeak, dur = _slip_by_ode(up, down)
+    for a, b in zip(y, s):
+        assert x[b + 1] - x[a] == pytest.approx(dist, rel=2e-3)
+        assert v[a:b + 1].max() == pytest.approx(vpeak, rel=2e-3)
+        assert t[b + 1] - t[a] == pytest.approx(dur, abs=0.5)
+    # the loop: at the same velocity the accelerating part meets more force than the
+    # decelerating part
+    assert up(0.5 * vpeak, 0.2 * dist) > down(0.5 * vpeak, 0.8 * dist, vpeak)
+
+
 @pytest.mark.parametrize("bad", [{"mass": 0.0}, {"dt": -1.0}, {"replicas": 0},
                                  {"velocity_correlation": 1.0}, {"rattle": -0.1},
                                  {"comoving_mass": -1.0}, {"comoving_mass": math.inf}])
@@ -92,7 +137,9 @@ def test_bad_arguments_are_refused(bad):
 
 
 @pytest.mark.parametrize("law, parameters", [("stribeck", (1.0,)), ("linear", (1.0,)),
-                                             ("weakening", (25.0, 48.0, math.nan))])
+                                             ("weakening", (25.0, 48.0, math.nan)),
+                                             ("melting", (25.0, 0.0, 10.0, 0.0)),
+                                             ("slip-weakening", (25.0, 0.0, 10.0, -1.0))])
 def test_a_bad_law_is_refused(law, parameters):
     with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
         slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
