@@ -8,8 +8,8 @@ This module integrates that slider, many replicas at once:
 
     (M + m_c) dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
 
-with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and
-state), γM an MD run's mount dashpot (``mount_damping``, 0 by default), m_c the film's
+with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and state;
+the yield-loop laws' slip distance or fastest velocity since the yield), γM an MD run's mount dashpot (``mount_damping``, 0 by default), m_c the film's
 mass that moves with the slipping wall (``comoving_mass``, 0 by default: the fit, which
 knows M alone, reads its m_c·a as film force), and
 
@@ -71,9 +71,12 @@ __all__ = ["slide", "LAWS"]
 #: * ``slip-weakening`` (F_k, B, ΔF, D_c): sign(v)·(F_k + ΔF·exp(−ψ/D_c)) + B·v, ψ the
 #:   distance slid since the yield (dψ/dt = |v|, 0 at each yield): a film that yields
 #:   solid-like and melts over the slip distance D_c, so the accelerating part of a slip
-#:   meets more force than the decelerating part at the same velocity (a yield loop).
+#:   meets more force than the decelerating part at the same velocity (a yield loop);
+#: * ``melting`` (F_k, B, ΔF, v_c): sign(v)·(F_k + ΔF·exp(−ψ/v_c)) + B·v, ψ the fastest
+#:   |v| of the slip so far (0 at each yield): a film that melts with the shear rate and
+#:   stays melted until it re-sticks (another yield loop).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
-        "slip-weakening": 4, "melting": 4, "power": 3}
+        "slip-weakening": 4, "melting": 4}
 _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
@@ -92,9 +95,6 @@ def _friction(code, p, v, psi):
     if code == 5:
         f = p[0] + p[2] * math.exp(-max(psi, abs(v)) / p[3])
         return (f if v >= 0.0 else -f) + p[1] * v
-    if code == 6:
-        f = p[0] + p[1] * abs(v) ** p[2]
-        return f if v >= 0.0 else -f
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -228,7 +228,7 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
         raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
     if law in ("slip-weakening", "melting") and not p[3] > 0:
-        raise ValueError(f"parameters = {parameters!r}: the slip-weakening distance D_c "
+        raise ValueError(f"parameters = {parameters!r}: the weakening scale D_c or v_c "
                          "(the fourth) must be > 0")
     for name, val in (("mass", mass), ("stiffness", stiffness), ("duration", duration),
                       ("dt", dt)):

@@ -127,6 +127,11 @@ def table(law: str, share, args) -> None:
         zl = np.array([f.loop_step_sigmas for f in fits[j]])
         zm = np.array([sigmas(f.one_law.comoving_mass, f.one_law.comoving_mass_stderr,
                               f.one_law.dof) for f in fits[j]])
+        zf = np.array([sigmas(f.loop_force, f.loop_force_stderr, f.one_law.dof)
+                       for f in fits[j]])
+        print(f"    loop force (the branches' own lines apart) ≥ +2 σ in "
+              f"{int(np.sum(zf >= 2))}, ≥ +3 σ in {int(np.sum(zf >= 3))}; "
+              f"{np.nanmean(zf):+.2f} ± {np.nanstd(zf):.2f} σ")
         print(f"    loop step ≥ +2 σ in {int(np.sum(zl >= 2))}, m_c ≤ −2 σ in "
               f"{int(np.sum(zm <= -2))}, both in {int(np.sum((zl >= 2) & (zm <= -2)))}; "
               f"loop step {np.nanmean(zl):+.2f} ± {np.nanstd(zl):.2f} σ, m_c "

@@ -157,3 +157,33 @@ def test_the_comoving_mass_benchmark_refuses_bad_input_before_any_compute(benchm
                        (["--noise", "0.1", "1.0", "0"], "RHO in [0, 1)")):
         assert main(argv) == 2
         assert said in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("loop_law, scale", [("slip-weakening", 0.2), ("melting", 0.005)])
+def test_a_yield_loop_sends_the_verdict_to_the_decelerating_branch_and_its_law(loop_law, scale):
+    # a film that yields at half its excess over F_k and weakens over 0.2 σ of slip (or
+    # melts by 0.005 σ/τ and stays melted), noise-free: the accelerating branch lies above
+    # the decelerating one, the rule sees the loop, and the decelerating branch is the mix's
+    # own F_k + B·v (viscous share 0.2 of 27 ε/σ at 0.017 σ/τ: F_k 21.6, B 318)
+    runs, v = pooled_runs("coulomb", 6, 3, share=0.2, weakening=(0.5, scale),
+                          loop_law=loop_law, noise=QUIET, seed=4)
+    fit = _fit(runs, v)
+    assert fit.loop_force > 0.5
+    assert fit.verdict_from == "decelerating"
+    assert fit.decelerating.kinetic_force == pytest.approx(21.6, abs=0.5)
+    assert fit.decelerating.damping == pytest.approx(0.2 * 27.0 / 0.017, rel=0.05)
+    # the same mix without the loop is one law
+    plain = _fit(*pooled_runs("coulomb", 6, 3, share=0.2, noise=QUIET, seed=4))
+    assert plain.verdict_from == "one law" and abs(plain.loop_force) < 0.05
+
+
+def test_the_pooled_controls_benchmark_refuses_bad_input_before_any_compute(benchmark_module,
+                                                                            capsys):
+    main = benchmark_module("slip_law/pooled_controls_rates").main
+    for argv, said in ((["--loop", "wobble", "0.5", "1"], "LAW melting or slip-weakening"),
+                       (["--loop", "melting", "2", "1"], "0 <= W <= 1"),
+                       (["--stop-velocity", "nan"], "--stop-velocity nan: finite or -inf")):
+        with pytest.raises(SystemExit) as stop:
+            main(argv + ["--replicas", "1"])
+        assert stop.value.code == 2
+        assert said in capsys.readouterr().err
