@@ -16,8 +16,15 @@ slips (the comparison that treats them as one run's).  Printed per law: the verd
 both (the rule's, which branch it read, and the decelerating branch's alone), and for the
 decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit, the law's
-own F_k, B) and how many replicas' 2 σ cover the truth, for each jackknife.  Seeds are
-fixed: the counts are deterministic.
+own F_k, B) and how many replicas' 2 σ cover the truth, for each jackknife; how many
+replicas read the one law and the decelerating branch each way, and resolve the loop (the
+branches' own lines apart, and the step beyond the one law's co-moving mass).  ``--loop LAW W
+D``: the shares' mixes with a yield loop (``melting`` or ``slip-weakening``,
+:mod:`~filmfriction.analysis.groundtruth.random_force`); ``--stop-velocity``: the mixes
+re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
+is still the noise-free slips re-sticking where the wall stops); ``--md RUN…``: the MD runs'
+slips' duration and share after their peak velocity, printed beside each table's first
+replica's.  Seeds are fixed: the counts are deterministic.
 """
 from __future__ import annotations
 
