@@ -187,3 +187,13 @@ def test_the_pooled_controls_benchmark_refuses_bad_input_before_any_compute(benc
             main(argv + ["--replicas", "1"])
         assert stop.value.code == 2
         assert said in capsys.readouterr().err
+
+
+def test_the_pooled_controls_benchmark_skips_a_law_without_noise_free_slips(benchmark_module,
+                                                                              capsys):
+    # at the M = 1e4 scale a Coulomb mix (share 0) has, noise-free, a run that slides
+    # without a slip: no truth to measure against, said so, no traceback
+    main = benchmark_module("slip_law/pooled_controls_rates").main
+    assert main(["--scale", "m1e4", "--runs", "18", "--slips", "14", "--laws",
+                 "--replicas", "1", "--shares", "0"]) == 0
+    assert "not measured: its noise-free truth has no slips to fit" in capsys.readouterr().out
