@@ -31,6 +31,7 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import FilmForceFit
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME
 from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
+from ..slip_law.slip_law_stats import sigmas
 from .rundata import load_run
 
 __all__ = ["PooledRun", "PooledSlipLaw", "pooled_slip_law", "read_runs", "fit_arguments",
@@ -147,6 +148,7 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
 
 
 #: The schema of the pooled slip law's document.
+
 SCHEMA = "filmfriction.slip_law_pooled/1"
 
 
@@ -172,7 +174,11 @@ def _law(fit: FilmForceFit, units: str) -> dict:
             "mean_slip_velocity": q(law.mean_velocity, None, "velocity"),
             "viscous_share": num(law.viscous_share),
             "loop_step": q(fit.loop_step, fit.loop_step_stderr, "force",
-                           sigmas=num(fit.loop_step_sigmas))}
+                           sigmas=num(fit.loop_step_sigmas)),
+            # the mean gap between the two branches' own lines (no co-moving mass taken out)
+            "loop_force": q(fit.loop_force, fit.loop_force_stderr, "force",
+                            sigmas=num(sigmas(fit.loop_force, fit.loop_force_stderr,
+                                              law.dof)))}
 
 
 def to_document(pooled: PooledSlipLaw) -> dict:

@@ -129,9 +129,11 @@ class Scale:
         """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
         control ``name`` (or the Coulomb + viscous law of viscous ``share``) at this scale:
         the law, its yield and re-stick, and ``period``, a slip cycle's length or a little
-        more.  ``weakening`` = (ΔF, D_c), with ``share``: that mix with a yield loop, the
-        kinetic force ΔF higher at the yield and weakening over the slip distance D_c
-        (the ``slip-weakening`` law)."""
+        more.  ``weakening`` = (w, D), with ``share``: that mix with a yield loop of ``law``
+        (``melting``: the kinetic force higher at the yield by w times its parameter slot,
+        fading over the fastest velocity D; ``slip-weakening``: over the slip distance D;
+        :func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs` makes the
+        slot ΔF = w·(F_s − F_k) of each run's yield force F_s)."""
         if share is not None:
             if not 0 <= share <= 1:
                 raise ValueError(f"share = {share!r}: must be in [0, 1]")
@@ -143,8 +145,11 @@ class Scale:
                         "drive_velocity": self.drive_velocity,
                         "law": "coulomb-viscous", "parameters": par, **m}
             df, dc = (float(w) for w in weakening)
-            if not (math.isfinite(df) and df >= 0 and math.isfinite(dc) and dc > 0):
-                raise ValueError(f"weakening = {weakening!r}: ΔF >= 0 and D_c > 0, finite")
+            if not (0 <= df <= 1 and math.isfinite(dc) and dc > 0):
+                raise ValueError(f"weakening = {weakening!r}: w in [0, 1] (a share of the "
+                                 "yield's excess over F_k) and D > 0, finite")
+            if law not in ("melting", "slip-weakening"):
+                raise ValueError(f"law = {law!r}: melting or slip-weakening")
             return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
                     "law": law, "parameters": par + (df, dc), **m}
         if weakening is not None:

@@ -123,9 +123,6 @@ def test_noise_free_yield_loop_slips_are_the_ode(law, parameters, up, down):
         assert x[b + 1] - x[a] == pytest.approx(dist, rel=2e-3)
         assert v[a:b + 1].max() == pytest.approx(vpeak, rel=2e-3)
         assert t[b + 1] - t[a] == pytest.approx(dur, abs=0.5)
-    # the loop: at the same velocity the accelerating part meets more force than the
-    # decelerating part
-    assert up(0.5 * vpeak, 0.2 * dist) > down(0.5 * vpeak, 0.8 * dist, vpeak)
 
 
 @pytest.mark.parametrize("bad", [{"mass": 0.0}, {"dt": -1.0}, {"replicas": 0},

@@ -197,3 +197,9 @@ def test_the_pooled_controls_benchmark_skips_a_law_without_noise_free_slips(benc
     assert main(["--scale", "m1e4", "--runs", "18", "--slips", "14", "--laws",
                  "--replicas", "1", "--shares", "0"]) == 0
     assert "not measured: its noise-free truth has no slips to fit" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("weakening", [(1.5, 0.3), (0.5, 0.0), (0.5, math.inf)])
+def test_a_yield_loop_out_of_range_is_refused(weakening):
+    with pytest.raises(ValueError, match="w in \\[0, 1\\]"):
+        pooled_runs("coulomb", 3, 2, share=0.2, weakening=weakening, noise=QUIET)
