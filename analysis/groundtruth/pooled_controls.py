@@ -85,8 +85,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
 def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                 share: float | None = None, scale: str | Scale = "stiff",
                 static_spread: float = STATIC_SPREAD, law_spread: float = 0.0,
-                noise: dict | None = None, comoving_mass: float = 0.0, seed: int = 0,
-                jackknife: str = "runs") -> list[FilmForceFit]:
+                noise: dict | None = None, comoving_mass: float = 0.0,
+                weakening: tuple[float, float] | None = None, loop_law: str = "melting",
+                seed: int = 0, jackknife: str = "runs") -> list[FilmForceFit]:
     """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``) of
     ``replicas`` replicas of :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
     sc = scale_named(scale)
@@ -94,7 +95,8 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
     for k in range(replicas):
         rs, velocity = pooled_runs(name, runs, slips, share=share, scale=sc,
                                    static_spread=static_spread, law_spread=law_spread,
-                                   noise=noise, comoving_mass=comoving_mass, seed=(seed, k))
+                                   noise=noise, comoving_mass=comoving_mass,
+                                   weakening=weakening, loop_law=loop_law, seed=(seed, k))
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
                                        mount_damping=sc.mount_damping,
                                        min_window_time=MD_NOISE_TIME, jackknife=jackknife))

@@ -15,8 +15,9 @@ with the jackknife over the runs, and the same pooled slips with the jackknife o
 slips (the comparison that treats them as one run's).  Printed per law: the verdicts of
 both (the rule's, which branch it read, and the decelerating branch's alone), and for the
 decelerating branch and the one law the bias of F_k and B (mean − truth
-± its standard error over the replicas; the truth is the noise-free pooled fit, the law's
-own F_k, B) and how many replicas' 2 σ cover the truth, for each jackknife; how many
+± its standard error over the replicas; the truth is the noise-free pooled fit: the law's
+own F_k, B for a law without a loop; with ``--loop``, the loop law's own noise-free fit,
+whose branches still carry what is left of its loop there) and how many replicas' 2 σ cover the truth, for each jackknife; how many
 replicas read the one law and the decelerating branch each way, and resolve the loop (the
 branches' own lines apart, and the step beyond the one law's co-moving mass).  ``--loop LAW W
 D``: the shares' mixes with a yield loop (``melting`` or ``slip-weakening``,
@@ -94,8 +95,9 @@ def table(law: str, share, args) -> None:
         f" with a yield loop ({' '.join(args.loop)})" if args.loop else "") + (
         "" if args.stop_velocity is None else
         f", re-sticking at v <= {args.stop_velocity:g} σ/τ")
-    # the truth: noise-free, re-sticking where the wall stops (a re-stick at a recoil
-    # velocity < 0 never comes without the noise), the law's own F_k, B for the mixes
+    # the truth: noise-free, re-sticking as the scale's mixes do (once slowed to its stop
+    # velocity; a re-stick at a recoil velocity < 0 never comes without the noise): the
+    # law's own F_k, B for a mix without a loop
     try:
         exact = fit(*pooled_runs(law, args.runs, args.slips, noise=NOISE_FREE,
                                  **(kw | {"law_spread": 0.0, "scale": SCALES[args.scale]})),

@@ -172,6 +172,10 @@ def test_a_yield_loop_sends_the_verdict_to_the_decelerating_branch_and_its_law(l
     assert fit.verdict_from == "decelerating"
     assert fit.decelerating.kinetic_force == pytest.approx(21.6, abs=0.5)
     assert fit.decelerating.damping == pytest.approx(0.2 * 27.0 / 0.017, rel=0.05)
+    # pooled_fits passes the loop on
+    (again,) = pooled_fits("coulomb", 1, runs=6, slips=3, share=0.2, weakening=(0.5, scale),
+                           loop_law=loop_law, noise=QUIET, seed=4)
+    assert again.verdict_from == "decelerating" and again.loop_force > 0.5
     # the same mix without the loop is one law
     plain = _fit(*pooled_runs("coulomb", 6, 3, share=0.2, noise=QUIET, seed=4))
     assert plain.verdict_from == "one law" and abs(plain.loop_force) < 0.05
