@@ -148,7 +148,6 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
 
 
 #: The schema of the pooled slip law's document.
-
 SCHEMA = "filmfriction.slip_law_pooled/1"
 
 

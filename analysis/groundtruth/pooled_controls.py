@@ -47,10 +47,11 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
     them, and the drive velocity.  ``comoving_mass``: the film's mass m_c the slipping wall
     carries (:func:`~filmfriction.analysis.groundtruth.random_force.slide`; the fit is given
-    the scale's M alone).  ``weakening`` = (w, D_c): the mix with a yield loop
-    (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`), ΔF = w·(F_s −
-    F_k) of each run's yield force F_s, of ``loop_law`` (``melting``, D_c a velocity, or
-    ``slip-weakening``, a distance: :data:`~filmfriction.analysis.groundtruth.random_force.LAWS`).  ``seed``: an
+    the scale's M alone).  ``weakening`` = (w, D): the mix with a yield loop of
+    ``loop_law`` (:data:`~filmfriction.analysis.groundtruth.random_force.LOOP_LAWS`:
+    ``melting``, D a velocity, or ``slip-weakening``, a distance), ΔF = w·(F_s − F_k) of
+    each run's yield force F_s
+    (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`).  ``seed``: an
     int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "

@@ -9,9 +9,10 @@ This module integrates that slider, many replicas at once:
     (M + m_c) dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
 
 with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and state;
-the yield-loop laws' slip distance or fastest velocity since the yield), γM an MD run's mount dashpot (``mount_damping``, 0 by default), m_c the film's
-mass that moves with the slipping wall (``comoving_mass``, 0 by default: the fit, which
-knows M alone, reads its m_c·a as film force), and
+the yield-loop laws' slip distance or fastest velocity since the yield), γM an MD run's
+mount dashpot (``mount_damping``, 0 by default), m_c the film's mass that moves with the
+slipping wall (``comoving_mass``, 0 by default: the fit, which knows M alone, reads its
+m_c·a as film force), and
 
     ξ = (M + m_c)·du/dt   while the wall slips, 0 while it is stuck,
 
@@ -57,7 +58,7 @@ import numpy as np
 from numba import njit
 from scipy.signal import lfilter
 
-__all__ = ["slide", "LAWS"]
+__all__ = ["slide", "LAWS", "LOOP_LAWS"]
 
 #: The friction laws of the slip, F(v, ψ), and their parameters:
 #:
@@ -77,6 +78,8 @@ __all__ = ["slide", "LAWS"]
 #:   stays melted until it re-sticks (another yield loop).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4}
+#: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield.
+LOOP_LAWS = ("melting", "slip-weakening")
 _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
@@ -227,7 +230,7 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     p = np.asarray(parameters, float)
     if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
         raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
-    if law in ("slip-weakening", "melting") and not p[3] > 0:
+    if law in LOOP_LAWS and not p[3] > 0:
         raise ValueError(f"parameters = {parameters!r}: the weakening scale D_c or v_c "
                          "(the fourth) must be > 0")
     for name, val in (("mass", mass), ("stiffness", stiffness), ("duration", duration),

@@ -54,7 +54,7 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
-from .random_force import slide
+from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
 __all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "SCALE", "Scale", "SCALES", "LIGHT_B",
@@ -148,8 +148,8 @@ class Scale:
             if not (0 <= df <= 1 and math.isfinite(dc) and dc > 0):
                 raise ValueError(f"weakening = {weakening!r}: w in [0, 1] (a share of the "
                                  "yield's excess over F_k) and D > 0, finite")
-            if law not in ("melting", "slip-weakening"):
-                raise ValueError(f"law = {law!r}: melting or slip-weakening")
+            if law not in LOOP_LAWS:
+                raise ValueError(f"law = {law!r}: one of {', '.join(LOOP_LAWS)}")
             return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
                     "law": law, "parameters": par + (df, dc), **m}
         if weakening is not None:

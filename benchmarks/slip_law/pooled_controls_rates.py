@@ -17,13 +17,13 @@ both (the rule's, which branch it read, and the decelerating branch's alone), an
 decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit: the law's
 own F_k, B for a law without a loop; with ``--loop``, the loop law's own noise-free fit,
-whose branches still carry what is left of its loop there) and how many replicas' 2 σ cover the truth, for each jackknife; how many
-replicas read the one law and the decelerating branch each way, and resolve the loop (the
+whose branches still carry what is left of its loop there) and how many replicas' 2 σ
+cover the truth, for each jackknife; how many replicas read the one law and the decelerating branch each way, and resolve the loop (the
 branches' own lines apart, and the step beyond the one law's co-moving mass).  ``--loop LAW W
 D``: the shares' mixes with a yield loop (``melting`` or ``slip-weakening``,
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--stop-velocity``: the mixes
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
-is still the noise-free slips re-sticking where the wall stops); ``--md RUN…``: the MD runs'
+is still the noise-free slips re-sticking at the scale's own stop velocity); ``--md RUN…``: the MD runs'
 slips' duration and share after their peak velocity, printed beside each table's first
 replica's.  Seeds are fixed: the counts are deterministic.
 """
@@ -38,6 +38,7 @@ from dataclasses import replace
 import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
+from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, scaled
 from filmfriction.analysis.slip_law.slip_law import VERDICTS
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
@@ -189,8 +190,8 @@ def main(argv=None) -> int:
             w, d = float(args.loop[1]), float(args.loop[2])
         except ValueError:
             w = d = math.nan
-        if args.loop[0] not in ("melting", "slip-weakening") or not (0 <= w <= 1 and d > 0):
-            ap.error(f"--loop {' '.join(args.loop)}: LAW melting or slip-weakening, "
+        if args.loop[0] not in LOOP_LAWS or not (0 <= w <= 1 and d > 0):
+            ap.error(f"--loop {' '.join(args.loop)}: LAW {' or '.join(LOOP_LAWS)}, "
                      "0 <= W <= 1, D > 0")
     if args.stop_velocity is not None and not (math.isfinite(args.stop_velocity)
                                                or args.stop_velocity == -math.inf):
