@@ -30,7 +30,7 @@ def trace_column_names() -> tuple[str, ...]:
     from filmfriction.md_inputs.contract import TRACE_COLUMNS
     return TRACE_COLUMNS
 PARAMETERS = ("spring_constant", "mass", "area", "thickness", "drive_velocity",
-              "mount_damping")
+              "mount_damping", "film_mass")
 
 #: Unit labels per quantity, per unit system (labels only: no conversion).
 UNITS = {
@@ -86,6 +86,9 @@ class TraceParameters:
     # wall's velocity relative to the drive); subtracted from the fitted slip
     # damping
     mount_damping: float | None = None
+    # the mass of the film between the walls (an MD run's film atoms, 1 m each): the most
+    # a co-moving mass can be (the slip law's rule takes more for a yield loop)
+    film_mass: float | None = None
     units: str = "lj"
 
     def __post_init__(self):

@@ -335,6 +335,11 @@ def _run_parameters(run: dict) -> dict:
     given = dict(run.get("trace_parameters") or {})
     base = {k: given.get(k) for k in PARAMETERS}
     base["units"] = given.get("units", "lj")
+    film = (run.get("atoms") or {}).get("film")
+    if base["film_mass"] is None and base["units"] == "lj" and isinstance(film, int) and film > 0:
+        # a run recorded before its trace parameters carried the film's mass: its film
+        # atoms, 1 m each (the LJ unit of mass is a film atom's)
+        base["film_mass"] = float(film)
     return base
 
 

@@ -99,6 +99,7 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                                    noise=noise, comoving_mass=comoving_mass,
                                    weakening=weakening, loop_law=loop_law, seed=(seed, k))
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
+                                       film_mass=sc.film_mass,
                                        mount_damping=sc.mount_damping,
                                        min_window_time=MD_NOISE_TIME, jackknife=jackknife))
     return out

@@ -110,7 +110,9 @@ class Scale:
     cycle's length or a little more).  ``laws`` maps a control's name to them; ``mix``
     gives the Coulomb + viscous laws of any viscous share: the film force ``film_force``
     at ``slip_velocity`` split F_k = (1 − share)·F, B = share·F/v, and the rest of the
-    keywords.  ``chunk``: replicas slid at a time (memory), 0 all at once."""
+    keywords.  ``chunk``: replicas slid at a time (memory), 0 all at once.  ``film_mass``:
+    the mass of the MD film the scale stands for (its atoms, 1 m each), which the fits are
+    given as the MD's are (the most a co-moving mass can be); None: not given."""
 
     name: str
     spring_constant: float
@@ -123,6 +125,7 @@ class Scale:
     mix: dict = field(default_factory=dict)
     mount_damping: float = 0.0
     chunk: int = 0
+    film_mass: float | None = None
 
     def law(self, name: str, share: float | None = None,
             weakening: tuple[float, float] | None = None, law: str = "melting") -> dict:
@@ -259,6 +262,11 @@ LIGHT_NOISE = {1e2: {"velocity_noise": 0.3, "velocity_correlation": 0.94, "rattl
                1e3: {"velocity_noise": 0.1, "velocity_correlation": 0.98, "rattle": 0.0}}
 
 
+#: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
+#: (336 atoms, 1 m each), and of the Klein-similar scene's (224).
+THICK_FILM_MASS, KLEIN_FILM_MASS = 336.0, 224.0
+
+
 def _light_scale(name, mass, velocity, damping, static, backward, force, slip_velocity,
                  armed, period) -> Scale:
     return Scale(
@@ -271,7 +279,7 @@ def _light_scale(name, mass, velocity, damping, static, backward, force, slip_ve
         mix=dict(film_force=force, slip_velocity=slip_velocity, backward_force=backward,
                  stop_velocity=slip_velocity / 4, armed_below=armed, initial_force=backward,
                  period=period),
-        mount_damping=damping, chunk=10)
+        mount_damping=damping, chunk=10, film_mass=THICK_FILM_MASS)
 
 
 #: The scales of the random-force controls, by name.
@@ -302,7 +310,8 @@ SCALES = {
                                  stop_velocity=RATE_STATE_CREEP, armed_below=30.5,
                                  initial_force=36.0, period=180.0)},
         mix=dict(film_force=28.0, slip_velocity=0.55, backward_force=20.0, stop_velocity=0.15,
-                 armed_below=34.0, initial_force=20.0, period=150.0)),
+                 armed_below=34.0, initial_force=20.0, period=150.0),
+        film_mass=KLEIN_FILM_MASS),
     "stiff": Scale(
         "stiff", 8.0, 1e5, 0.25, 45.0, 0.0025,
         STIFF_NOISE,
@@ -316,7 +325,7 @@ SCALES = {
         mix=dict(film_force=27.0, slip_velocity=0.017, backward_force=STIFF_BACKWARD,
                  stop_velocity=STIFF_STOP, armed_below=27.0, initial_force=STIFF_BACKWARD,
                  period=2500.0),
-        mount_damping=34.0, chunk=10),
+        mount_damping=34.0, chunk=10, film_mass=THICK_FILM_MASS),
     "m1e4": Scale(
         "m1e4", 8.0, 1e4, 0.25, 45.0, 0.0079,
         M1E4_NOISE,
@@ -330,7 +339,7 @@ SCALES = {
         mix=dict(film_force=32.0, slip_velocity=0.045, backward_force=M1E4_BACKWARD,
                  stop_velocity=M1E4_STOP, armed_below=27.0, initial_force=M1E4_BACKWARD,
                  period=700.0),
-        mount_damping=10.7, chunk=10),
+        mount_damping=10.7, chunk=10, film_mass=THICK_FILM_MASS),
     "m1e2": _light_scale("m1e2", 1e2, 0.079, 1.07, 57.0, 20.0, 40.0, 0.34, 41.0, 100.0),
     "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
 }
@@ -506,7 +515,7 @@ def dynamical_fits(name: str, replicas: int, slips: int = 8, *, noise: dict | No
                               wall_position=tr["wall_position"])[1:slips + 1]
             try:
                 out.append(fitter(t, f, tr["wall_velocity"], tab, mass=sc.mass,
-                                  drive_velocity=velocity,
+                                  drive_velocity=velocity, film_mass=sc.film_mass,
                                   wall_position=tr["wall_position"], **fit))
             except ValueError:
                 if not unfitted:

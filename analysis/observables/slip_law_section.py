@@ -94,7 +94,7 @@ class SlipLaw(Observable):
         v_drive, _ = trace.drive_velocity()
         args = dict(mass=p.mass, drive_velocity=v_drive or 0.0,
                     mount_damping=p.mount_damping or 0.0,
-                    wall_position=trace.wall_position())
+                    wall_position=trace.wall_position(), film_mass=p.film_mass)
         t, f, v = trace.time, trace.spring_force, trace.columns["wall_velocity"]
         per_slip = fit_film_force(t, f, v, ctx.table, **args)
         try:

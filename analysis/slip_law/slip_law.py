@@ -334,7 +334,7 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
                    drive_velocity: float = 0.0, mount_damping: float = 0.0,
                    wall_position=None, min_velocity_fraction: float = 0.2,
                    smoothing: float = SMOOTHING, comoving_mass: bool = False,
-                   load_work=None) -> FilmForceFit:
+                   load_work=None, film_mass: float | None = None) -> FilmForceFit:
     """Fit F_film = F_k + B·v [+ m_c·a] on each branch of each slip of ``table``.
 
     Parameters
@@ -359,6 +359,10 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         The work the load did on the wall (an MD trace's ``load_work`` column,
         −P·A·(D − D0)): taken out of the film force, which is then its dissipative
         part (module text).  None: the film force as the equation of motion gives it.
+    film_mass : float, optional
+        The film's own mass, the most a co-moving mass can be: a resolved m_c above it is
+        a yield loop, not inertia (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`).
+        None (a measured trace): not known, no such check.
 
     Returns
     -------
@@ -419,18 +423,20 @@ def fit_film_force(time, spring_force, wall_velocity, table: CycleTable, *, mass
         ranges.append((min_velocity_fraction * peak, peak))
     return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
                         smoothing_window=w, still=still, windows=len(table),
-                        load_work_removed=gap_rate is not None)
+                        load_work_removed=gap_rate is not None, film_mass=film_mass)
 
 
 def fit_segments(segs: dict, ranges: list, *, mass: float, comoving_mass: bool,
                  smoothing_window: int, still=(), windows: int = 0,
-                 load_work_removed: bool = False) -> FilmForceFit:
+                 load_work_removed: bool = False,
+                 film_mass: float | None = None) -> FilmForceFit:
     """The branches, the one law, the loop and the verdict from the slips' segments.
 
     ``segs`` maps ``decelerating``, ``accelerating`` and ``whole`` to one
     :class:`~filmfriction.analysis.slip_law.slip_law_branches.Segment` (or None) per
     slip, ``ranges`` holds each slip's fitted velocity range (floor, peak); ``still``
-    the windows refused (:func:`fit_film_force`), of ``windows`` in all."""
+    the windows refused (:func:`fit_film_force`), of ``windows`` in all; ``film_mass``
+    the most a co-moving mass can be (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`)."""
     still = list(still)
     fits = {name: fit_branch(name, segs[name], comoving_mass) for name in segs}
     # one law F_k + B·v + m_c·a over the whole slip, and the step at the peak beyond it
@@ -448,7 +454,7 @@ def fit_segments(segs: dict, ranges: list, *, mass: float, comoving_mass: bool,
         gap = area / (hi - lo)
     la, lf = mean_se(area), mean_se(gap)
     one, st = fits["one_law"], fits["loop_step"]
-    frm, verdict, reason = choose_law(dec, one, st, mass)
+    frm, verdict, reason = choose_law(dec, one, st, mass, film_mass)
     return FilmForceFit(dec, acc, fits["whole"], one, st.loop_step, st.loop_step_stderr,
                         sigmas(st.loop_step, st.loop_step_stderr, st.dof),
                         detectable(st.loop_step_stderr, st.dof), frm, verdict, reason,
@@ -457,7 +463,7 @@ def fit_segments(segs: dict, ranges: list, *, mass: float, comoving_mass: bool,
 
 
 def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
-                  replicas: str = "releases") -> FilmForceFit:
+                  replicas: str = "releases", film_mass: float | None = None) -> FilmForceFit:
     """The fit of a mean trace with its errors from the jackknife over its replicas.
 
     ``fit`` is :func:`fit_film_force` on the mean of R replicas of one slip (releases
@@ -474,7 +480,8 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
     (:func:`~filmfriction.analysis.slip_law.slip_law_branches.jackknife_branch`); the
     significance, the power, the branches' verdicts and the choice of the law
     (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`) follow from
-    them as on any fit.  ``replicas`` names the replicas in the reasons.
+    them as on any fit (``film_mass`` as for :func:`fit_segments`).  ``replicas`` names the
+    replicas in the reasons.
     """
     loo = list(leave_one_out)
     if len(loo) < 2:
@@ -484,7 +491,7 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
           for name in ("decelerating", "accelerating", "whole", "one_law")}
     st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo], replicas=replicas)
     dof = len(loo) - 1
-    frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass)
+    frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass, film_mass)
     (la_se, la_ps), (lf_se, _) = (jackknife(getattr(fit, k), [getattr(f, k) for f in loo])
                                   for k in ("loop_area", "loop_force"))
     return replace(fit, **br, loop_step_stderr=st.loop_step_stderr,

@@ -209,7 +209,8 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                        drive_velocity: float = 0.0, mount_damping: float = 0.0,
                        wall_position=None, min_velocity_fraction: float = 0.2,
                        smoothing: float = SMOOTHING, comoving_mass: bool = False,
-                       min_window_time: float = 0.0) -> FilmForceFit:
+                       min_window_time: float = 0.0,
+                       film_mass: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``table`` (module text), errors by the
     jackknife over the slips.
 
@@ -251,17 +252,18 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
     window += (1 - window % 2) if window else 0
     return fit_held_ensemble(held, np.arange(int(keep.sum())), window=window, dt=dt, mass=mass,
                              min_velocity_fraction=min_velocity_fraction,
-                             comoving_mass=comoving_mass, replicas="slips")
+                             comoving_mass=comoving_mass, replicas="slips", film_mass=film_mass)
 
 
 def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float,
                       min_velocity_fraction: float = 0.2, comoving_mass: bool = False,
-                      replicas: str = "slips") -> FilmForceFit:
+                      replicas: str = "slips", film_mass: float | None = None) -> FilmForceFit:
     """The fit of the mean of held slips (:func:`held_slips`' arrays, shape (slips, lags)),
     the errors by the jackknife over the groups of slips that ``groups`` labels (one label
     per slip: each slip its own for one run, the run for slips pooled over runs) — the
     means that leave one group out, G − 1 degrees of freedom.  ``window``: the mean's
-    velocity's smoothing in samples of ``dt``; ``replicas`` names the groups."""
+    velocity's smoothing in samples of ``dt``; ``replicas`` names the groups; ``film_mass``
+    the film's own mass (None: not known), the most a co-moving mass can be."""
     groups = np.asarray(groups)
     labels = list(dict.fromkeys(groups.tolist()))
     if len(labels) < 2:
@@ -278,7 +280,7 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
     def fit(mean):
         segs = _segments(mean, window, dt, p, lags, mass)
         return fit_segments(segs, ranges, mass=mass, comoving_mass=comoving_mass,
-                            smoothing_window=window)
+                            smoothing_window=window, film_mass=film_mass)
 
     loo = []
     for g in labels:
@@ -286,4 +288,4 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
         loo.append(fit({k: (total[k] - held[k][out].sum(axis=0)) / (n - int(out.sum()))
                         for k in HELD}))
     return jackknife_fit(fit({k: total[k] / n for k in HELD}), loo, mass=mass,
-                         replicas=replicas)
+                         replicas=replicas, film_mass=film_mass)

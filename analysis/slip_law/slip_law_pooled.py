@@ -103,7 +103,8 @@ def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
 def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                         mount_damping: float = 0.0, min_velocity_fraction: float = 0.2,
                         smoothing: float = SMOOTHING, comoving_mass: bool = False,
-                        min_window_time: float = 0.0, jackknife: str = "runs") -> FilmForceFit:
+                        min_window_time: float = 0.0, jackknife: str = "runs",
+                        film_mass: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``runs`` (module text), errors by the
     jackknife over the runs.
 
@@ -114,6 +115,9 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     mass, drive_velocity, mount_damping, min_velocity_fraction, smoothing, comoving_mass, min_window_time
         As for :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`
         (the runs share them); the window is ``smoothing`` of the median slip of all runs.
+    film_mass : float, optional
+        The film's own mass (the runs share it; None: not known), the most a co-moving
+        mass can be (:func:`~filmfriction.analysis.slip_law.slip_law_verdict.choose_law`).
     jackknife : {"runs", "slips"}
         The jackknife's replicas: the runs (the errors), or each slip on its own (as if
         the slips were one run's: the comparison that leaves the runs' differences out).
@@ -162,4 +166,5 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     window += (1 - window % 2) if window else 0
     return fit_held_ensemble(held, groups, window=window, dt=dt, mass=mass,
                              min_velocity_fraction=min_velocity_fraction,
-                             comoving_mass=comoving_mass, replicas=jackknife)
+                             comoving_mass=comoving_mass, replicas=jackknife,
+                             film_mass=film_mass)

@@ -82,16 +82,22 @@ def branch_verdict(fk, se_fk, z_fk, det_fk, b, se_b, z_b, det_b, vbar, fbar, n):
     return "inconclusive", f"neither term resolved: {nums}"
 
 
-def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str, str]:
+def choose_law(decelerating, one_law, loop_step, mass: float,
+               film_mass: float | None = None) -> tuple[str, str, str]:
     """Which fit the verdict is — :data:`ONE_LAW` or ``decelerating`` — its verdict and why.
 
     The whole slip is one law F_k + B·v + m_c·a (the ``one_law`` fit) when no loop is
     left beyond the co-moving mass: the step of the force at the peak velocity
     (``loop_step``: the whole slip fitted with it too) is not resolved and the run
     had 95 % power to resolve it at :data:`DOMINANT_SHARE` of the one law's mean film
-    force, and m_c is not resolved negative (no mass moves against the wall); as in
+    force, m_c is not resolved negative (no mass moves against the wall) and, where the
+    film's own mass ``film_mass`` is known, not resolved above it (the film's atoms are
+    all the mass that can move with the wall beyond its own: a larger m_c is a yield loop
+    the m_c·a term absorbs, since a is positive while the force is higher and negative
+    after the peak, not inertia); as in
     :func:`branch_verdict`, a step under :data:`NUMERICAL_FLOOR` of F̄ and an m_c under
-    that share of the wall's ``mass`` count as not resolved.  A
+    that share of the wall's ``mass`` (and an m_c that much above the film's) count as not
+    resolved.  A
     liquid's slip (no yield) is such a slip; a film that yields on the accelerating
     branch is not, and its verdict is the decelerating branch's — except that a
     ``viscous`` decelerating branch fitted without a co-moving mass, while the one law
@@ -99,12 +105,17 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
     on that branch reads as a negative intercept and can cancel the kinetic force (the
     release's kinetic control, docs/results/slip-law.md).
     """
+    if film_mass is not None and not (math.isfinite(film_mass) and film_mass > 0):
+        raise ValueError(f"film_mass = {film_mass!r}: a positive mass, or None (not known)")
     r = RESOLVED_SIGMAS
     step, se, dof = loop_step.loop_step, loop_step.loop_step_stderr, loop_step.dof
     z = sigmas(step, se, dof)
     det = detectable(se, dof)
     fbar = one_law.mean_force
     z_mc = sigmas(one_law.comoving_mass, one_law.comoving_mass_stderr, one_law.dof)
+    # the film's atoms are the most mass that can move with the wall
+    excess = -math.inf if film_mass is None else one_law.comoving_mass - film_mass
+    z_above = sigmas(excess, one_law.comoving_mass_stderr, one_law.dof)   # nan: not known
     nums = (f"loop step F_acc − F_dec = {step:.3g} ± {se:.2g} ({z:+.1f} σ), 95 % power at "
             f"{r:.3g} σ for {det:.3g} against F̄/2 = {DOMINANT_SHARE * fbar:.3g}; m_c = "
             f"{one_law.comoving_mass:.3g} ± {one_law.comoving_mass_stderr:.2g} ({z_mc:+.1f} σ)")
@@ -116,6 +127,9 @@ def choose_law(decelerating, one_law, loop_step, mass: float) -> tuple[str, str,
         why = "a loop of half the film force could go unresolved"
     elif z_mc <= -r and -one_law.comoving_mass >= NUMERICAL_FLOOR * mass:
         why = "the co-moving mass resolved negative"
+    elif z_above >= r and excess >= NUMERICAL_FLOOR * mass:
+        why = (f"the co-moving mass resolved above the film's own mass {film_mass:.4g} by "
+               f"{excess:.3g} ({z_above:+.1f} σ): a loop the m_c·a term absorbs, not inertia")
     else:
         return ONE_LAW, one_law.verdict, (f"the whole slip is one law with a co-moving "
                                           f"mass ({nums}): {one_law.reason}")

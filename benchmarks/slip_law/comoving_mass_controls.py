@@ -71,6 +71,7 @@ def fits_of(sc, a, share, noise, mc) -> tuple[list, int, float]:
         try:
             fits.append(fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=vd,
                                             mount_damping=sc.mount_damping,
+                                            film_mass=sc.film_mass,
                                             min_window_time=MD_NOISE_TIME))
         except ValueError:          # a run without a slip that relaxes the spring
             skipped += 1

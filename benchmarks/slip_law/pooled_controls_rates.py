@@ -18,7 +18,10 @@ decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit: the law's
 own F_k, B for a law without a loop; with ``--loop``, the loop law's own noise-free fit,
 whose branches still carry what is left of its loop there) and how many replicas' 2 σ
-cover the truth, for each jackknife; how many replicas read the one law and the decelerating branch each way, and resolve the loop (the
+cover the truth, for each jackknife, and the same for the loop force (the truth the
+noise-free pooled fit's); how many replicas read the one law and the
+decelerating branch each way, what the rule reads without the film's mass
+(``Scale.film_mass``), and resolve the loop (the
 branches' own lines apart, and the step beyond the one law's co-moving mass).  ``--loop LAW W
 D``: the shares' mixes with a yield loop (``melting`` or ``slip-weakening``,
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--stop-velocity``: the mixes
@@ -44,6 +47,7 @@ from filmfriction.analysis.slip_law.slip_law import VERDICTS
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import JACKKNIFE, fit_pooled_ensemble
 from filmfriction.analysis.slip_law.slip_law_stats import sigmas
+from filmfriction.analysis.slip_law.slip_law_verdict import choose_law
 
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 
@@ -79,7 +83,14 @@ def fit(runs, velocity, jackknife, scale="stiff"):
     sc = SCALES[scale]
     return fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=velocity,
                                mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME,
-                               jackknife=jackknife)
+                               jackknife=jackknife, film_mass=sc.film_mass)
+
+
+def without_film_mass(f, mass: float) -> tuple[str, str]:
+    """The rule's branch and verdict on fit ``f`` were the film's mass not known."""
+    step = replace(f.one_law, loop_step=f.loop_step, loop_step_stderr=f.loop_step_stderr)
+    frm, verdict, _ = choose_law(f.decelerating, f.one_law, step, mass)
+    return frm, verdict
 
 
 def table(law: str, share, args) -> None:
@@ -139,14 +150,23 @@ def table(law: str, share, args) -> None:
         both = Counter((f.one_law.verdict, f.decelerating.verdict) for f in fits[j])
         print("    one law / decelerating branch: " + ", ".join(
             f"{a}/{b} {n}" for (a, b), n in sorted(both.items(), key=lambda x: -x[1])))
+        old = Counter(without_film_mass(f, SCALES[args.scale].mass)[1] for f in fits[j])
+        print(f"    the rule without the film's mass ({SCALES[args.scale].film_mass:g} m): "
+              + ", ".join(f"{v} {old[v]}" for v in VERDICTS if old[v]))
         zl = np.array([f.loop_step_sigmas for f in fits[j]])
         zm = np.array([sigmas(f.one_law.comoving_mass, f.one_law.comoving_mass_stderr,
                               f.one_law.dof) for f in fits[j]])
         zf = np.array([sigmas(f.loop_force, f.loop_force_stderr, f.one_law.dof)
                        for f in fits[j]])
+        lf = np.array([f.loop_force for f in fits[j]])
+        lz = np.array([sigmas(f.loop_force - exact.loop_force, f.loop_force_stderr,
+                              f.one_law.dof) for f in fits[j]])
         print(f"    loop force (the branches' own lines apart) ≥ +2 σ in "
               f"{int(np.sum(zf >= 2))}, ≥ +3 σ in {int(np.sum(zf >= 3))}; "
-              f"{np.nanmean(zf):+.2f} ± {np.nanstd(zf):.2f} σ")
+              f"{np.nanmean(zf):+.2f} ± {np.nanstd(zf):.2f} σ; mean − truth "
+              f"{np.nanmean(lf) - exact.loop_force:+.3g} ± "
+              f"{np.nanstd(lf, ddof=1) / math.sqrt(np.isfinite(lf).sum()):.2g} (truth "
+              f"{exact.loop_force:.3g}), covered {int(np.sum(np.abs(lz) < 2))}/{lf.size}")
         print(f"    loop step ≥ +2 σ in {int(np.sum(zl >= 2))}, m_c ≤ −2 σ in "
               f"{int(np.sum(zm <= -2))}, both in {int(np.sum((zl >= 2) & (zm <= -2)))}; "
               f"loop step {np.nanmean(zl):+.2f} ± {np.nanstd(zl):.2f} σ, m_c "

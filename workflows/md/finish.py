@@ -187,6 +187,7 @@ def finish(run_dir, record, scene, outcome, error, status=None):
             record["atoms"] = {"film": outcome.film_atoms, "top_wall": outcome.top_atoms,
                                "total": outcome.total_atoms}
             record["trace_parameters"]["area"] = outcome.area
+            record["trace_parameters"]["film_mass"] = float(outcome.film_atoms) or None
     record["segments"].append(seg)
     record["wall_time"] = sum(s.get("wall_time", 0.0) for s in record["segments"])
     perf = [x for s in record["segments"] for x in s.get("atom_steps_per_second") or []]

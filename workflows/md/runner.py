@@ -86,6 +86,8 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: i
             # without one)
             "area": d["area"], "thickness": None, "drive_velocity": p["drive_velocity"] or None,
             "mount_damping": (p["mount_damping"] * p["wall_mass"]) or None,
+            # the film's atoms weigh 1 m each (film_slide.lmp's type 1, the unit of mass)
+            "film_mass": float(d["film_atoms"]) or None,
             "units": "lj",
         },
         "trace_units": TRACE_UNITS,

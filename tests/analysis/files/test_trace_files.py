@@ -359,3 +359,23 @@ def test_a_cell_that_is_not_a_number_is_an_error_naming_its_line(tmp_path):
     path.write_text("time,spring_force\nnan,1\n,2\n")
     with pytest.raises(ValueError, match="no data rows left"):
         read_trace(path)
+
+
+def test_a_run_gives_its_film_mass_and_an_older_run_its_film_atoms(synthetic_run):
+    # the film's mass (the most a co-moving mass can be: the slip law's rule) is a trace
+    # parameter; a run recorded before it was one gives its film atoms, 1 m each, and a run
+    # without either gives none (the rule then does without)
+    import json
+
+    assert read_trace(synthetic_run).parameters.film_mass is None
+    path = synthetic_run / "run.json"
+    run = json.loads(path.read_text())
+    path.write_text(json.dumps(run | {"atoms": {"film": 336, "top_wall": 180, "total": 696}}))
+    assert read_trace(synthetic_run).parameters.film_mass == 336.0
+    run["trace_parameters"]["film_mass"] = 224.0
+    path.write_text(json.dumps(run | {"atoms": {"film": 336}}))
+    assert read_trace(synthetic_run).parameters.film_mass == 224.0
+    run["trace_parameters"]["film_mass"] = -1.0
+    path.write_text(json.dumps(run))
+    with pytest.raises(ValueError, match="film_mass"):
+        read_trace(synthetic_run)

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.signal import find_peaks
 
+from filmfriction.analysis.files.trace_reader import read_trace
 from filmfriction.workflows.md import runner
 from filmfriction.workflows.md.scene import SceneError
 
@@ -30,6 +31,9 @@ def test_record_and_outputs(short_run):
     record = json.loads((run_dir / "run.json").read_text())
     assert record["status"] == "completed" and record["error"] is None
     assert record["atoms"]["film"] == 3 * 2 * 5 * 3
+    # the film's mass, what the slip law's rule takes for the most a co-moving mass can be
+    assert record["trace_parameters"]["film_mass"] == 3 * 2 * 5 * 3
+    assert read_trace(run_dir).parameters.film_mass == 3 * 2 * 5 * 3
     assert record["outputs"]["trajectory"] and record["outputs"]["profiles"]
     assert (run_dir / "trajectory.dcd").stat().st_size > 0
     assert (run_dir / "topology.data").stat().st_size > 0
