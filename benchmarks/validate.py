@@ -184,6 +184,9 @@ def calibration_scores(cases, seed, klein_cases=None):
                        "film_damping": (b.value, b.stderr, b.at_bound, truth["film_damping"]),
                        "eta_calibration": (b.value * per_area, b.stderr * per_area, b.at_bound,
                                            eta_true)}
+                # a parameter at its bound: its one-sided 95 % upper limit (NaN otherwise)
+                row["limits"] = {"kinetic_force": fit.kinetic_force.limit,
+                                 "film_damping": b.limit}
                 slips = ((run.analysis.get("viscosity") or {}).get("from_slip") or {}).get(
                     "eta_eff") or {}
                 if slips.get("mean") is not None and slips.get("stderr") is not None:

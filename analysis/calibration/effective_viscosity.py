@@ -216,7 +216,7 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
             film_damping.value * thickness / area,
             film_damping.stderr * thickness / area if math.isfinite(film_damping.stderr)
             else math.nan, label, "B D / A from the joint slip fit (D = mean gap)",
-            at_bound=film_damping.at_bound)
+            at_bound=film_damping.at_bound, limit=film_damping.limit * thickness / area)
     steady = (visc.get("steady") or {}).get("eta_eff")
     if steady and steady.get("mean") is not None:
         gap = ((visc.get("steady") or {}).get("thickness") or {}).get("mean") or thickness
@@ -269,7 +269,9 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
                 if regime == "stick-slip" else f"regime {regime}: no slip fit, no steady sliding"
         elif film_damping.at_bound:
             reason = ("the calibration's film damping B is at its bound 0: the slips' shape "
-                      "resolves no film drag beyond the mount's dashpot")
+                      "resolves no film drag beyond the mount's dashpot"
+                      + (f" (B below {film_damping.limit:.3g} {film_damping.units} at 95 %, "
+                         "one-sided)" if math.isfinite(film_damping.limit) else ""))
         elif not _resolved(film_damping):
             reason = (f"the calibration's film damping B = {film_damping.value:.4g} ± "
                       f"{film_damping.stderr:.2g} {film_damping.units} is within "
@@ -328,7 +330,8 @@ def choose(analysis: dict, *, kinetic_force: Estimate | None = None,
             if e is None:
                 return "–"
             if e.at_bound:
-                return f"{e.value:.4g} {e.units} (at bound)"
+                return f"{e.value:.4g} {e.units} (at bound)" + (
+                    f"; below {e.limit:.3g} at 95 %" if math.isfinite(e.limit) else "")
             return f"{e.value:.4g} ± {e.stderr:.2g} {e.units}"
 
         friction = {

@@ -42,6 +42,9 @@ class Estimate:
     at_bound : bool
         The fit ended at the bound of the parameter's range: ``value`` is that bound
         and there is no standard error (``stderr`` NaN, written null).
+    limit : float
+        For a parameter at its lower bound, the one-sided 95 % upper limit the data
+        allow (a profile of the fit's χ²; NaN where not computed, written null).
     """
 
     value: float
@@ -49,10 +52,12 @@ class Estimate:
     units: str
     method: str = ""
     at_bound: bool = False
+    limit: float = math.nan
 
     def as_dict(self) -> dict:
         return {"value": _num(self.value), "stderr": _num(self.stderr), "units": self.units,
-                "method": self.method, "at_bound": self.at_bound}
+                "method": self.method, "at_bound": self.at_bound,
+                "upper_limit_95": _num(self.limit)}
 
     @property
     def rel(self) -> float:

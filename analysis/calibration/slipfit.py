@@ -227,13 +227,16 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
                 out[rows[j]:rows[j + 1], first + j] = (piece - base[j]) / step[first + j]
         return out[:, vary]
 
-    def solve(subset, start, *, freeze=True, tol=1e-8):
-        """least_squares over the parameters (no freeze, F_f = NaN, unless ``freeze``);
-        returns the full parameter vector, the residuals, the Jacobian of the varied
-        ones, which were varied, and scipy's result."""
+    def solve(subset, start, *, freeze=True, tol=1e-8, fixed=None):
+        """least_squares over the parameters (no freeze, F_f = NaN, unless ``freeze``;
+        the parameter ``fixed`` indexes held at its start's value); returns the full
+        parameter vector, the residuals, the Jacobian of the varied ones, which were
+        varied, and scipy's result."""
         lower, upper = bounds(subset)
         vary = np.ones(lower.size, bool)
         vary[2] = freeze
+        if fixed is not None:
+            vary[fixed] = False
         full = np.asarray(start, float).copy()
         full[vary] = np.clip(full[vary], lower[vary], upper[vary])
         if not freeze:
@@ -347,6 +350,19 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
             e_all[use] = np.sqrt(diag * s2 * corr)
             err[free] = e_all[free]
             break
+    # a parameter pinned at its lower bound (F_k = 0, B = 0) has no standard error; what the
+    # data allow is its one-sided 95 % upper limit: where the fit with it held there (the
+    # others refitted) has χ² higher by 2.71 in units of the residual variance times the
+    # serial correlation
+    limits = [math.nan, math.nan]
+    unit = s2 * corr
+    for j in (0, 1):
+        if at_lower[j] and unit > 0:
+            limits[j] = _upper_limit(
+                lambda q, j=j: (float(np.sum(solve(every, np.where(np.arange(p.size) == j, q, p),
+                                                   freeze=bool(vary[2]), fixed=j)[1] ** 2))
+                                - float(np.sum(r ** 2))) / unit,
+                float(upper[j]))
     shifts = p[3:3 + n] * dt
     yield_forces = np.array([(data[i][2] + p[3 + n + i] + rr * p[3 + i] * h) * f0 for i in every])
     noise = _stick_noise(f / f0, spans)
@@ -372,9 +388,12 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
         if not vary[j]:
             est[name] = None
         elif at_bound[j]:
+            lim = limits[j] * scale if j < 2 else math.nan
             est[name] = Estimate(float(p[j] * scale), math.nan, label,
-                                 f"{law}, at the bound of its range ({bound_note})",
-                                 at_bound=True)
+                                 f"{law}, at the bound of its range ({bound_note})"
+                                 + (f"; below {lim:.3g} {label} (95 %, one-sided: the fit's "
+                                    "χ² profile)" if math.isfinite(lim) else ""),
+                                 at_bound=True, limit=lim)
         else:
             est[name] = Estimate(float(p[j] * scale), float(err[j] * scale), label, law)
     fs_err = float(yield_forces.std(ddof=1) / math.sqrt(n)) if n > 1 else math.nan
@@ -389,6 +408,29 @@ def fit_slips(time, spring_force, slips, *, spring_constant: float, mass: float,
         n_slips=n, jackknife=jack, windows=wins, yield_shifts=tuple(float(x) for x in shifts),
         scales={"force": f0, "time": t0, "damping": b0},
         error_method=how, success=bool(sol.success), message=str(sol.message))
+
+
+
+#: Δχ² (in noise units) of a one-sided 95 % limit on one parameter: the χ²₁ quantile 0.90.
+ONE_SIDED_95 = 2.7055
+
+
+def _upper_limit(excess, upper: float) -> float:
+    """The q > 0 where ``excess(q)`` (the fit's χ² with the parameter held at q, less its
+    minimum, in noise units) reaches :data:`ONE_SIDED_95`, by doubling from a small q and
+    then bisection (brentq); ``upper`` if even the parameter's upper bound is allowed, NaN
+    if no bracket is found."""
+    from scipy.optimize import brentq
+
+    g = lambda q: excess(q) - ONE_SIDED_95            # noqa: E731
+    lo, q = 0.0, min(1e-3, upper)
+    for _ in range(40):
+        if g(q) >= 0:
+            return float(brentq(g, lo, q, xtol=1e-4 * q, rtol=1e-3, maxiter=30))
+        if q >= upper:
+            return float(upper)
+        lo, q = q, min(2.0 * q, upper)
+    return math.nan
 
 
 def fit_slip_law(run: RunData, *, stick_stiffness: float | None = None,

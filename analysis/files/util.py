@@ -134,18 +134,26 @@ def format_estimate(e, digits: int = 3) -> str:
     '0.5'
     >>> format_estimate({"value": 0.0, "stderr": None, "units": "N", "at_bound": True})
     '0 N (at bound)'
+    >>> format_estimate({"value": 0.0, "stderr": None, "units": "N", "at_bound": True,
+    ...                  "upper_limit_95": 2.5e-7})
+    '0 N (at bound; below 2.5e-07 N at 95 %)'
     """
     if e is None:
         return "–"
     if isinstance(e, dict):
         v, s, u = e.get("mean", e.get("value")), e.get("stderr"), e.get("units", "")
-        bound = bool(e.get("at_bound"))
+        bound, limit = bool(e.get("at_bound")), e.get("upper_limit_95")
     else:
         v, s, u = e.value, e.stderr, e.units
-        bound = bool(getattr(e, "at_bound", False))
+        bound, limit = bool(getattr(e, "at_bound", False)), getattr(e, "limit", None)
     err = f" ± {format_value(s, 2)}" if s is not None and math.isfinite(float(s)) else ""
     text = f"{format_value(v, digits)}{err} {'' if u == '1' else u}".strip()
-    return text + " (at bound)" if bound else text
+    if not bound:
+        return text
+    if limit is not None and math.isfinite(float(limit)):
+        return (f"{text} (at bound; below {format_value(limit, 2)} "
+                f"{'' if u == '1' else u} at 95 %)").replace("  ", " ")
+    return text + " (at bound)"
 
 
 def format_pm(value, stderr, digits: int = 4) -> str:

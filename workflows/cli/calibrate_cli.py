@@ -41,6 +41,8 @@ def _fmt(e) -> str:
     if e is None:
         return "-"
     err = "" if e.stderr is None or not math.isfinite(e.stderr) else f" ± {e.stderr:.2g}"
+    if e.at_bound and math.isfinite(e.limit):
+        return f"{e.value:.4g} {e.units} (at bound; below {e.limit:.2g} {e.units} at 95 %)"
     return f"{e.value:.4g}{err} {e.units}" + (" (at bound)" if e.at_bound else "")
 
 

@@ -108,7 +108,8 @@ def test_a_parameter_at_its_bound_has_no_error_bar(tmp_path):
     doc = cal.main.as_dict()["kinetic_force"]
     assert doc["at_bound"] is True and doc["stderr"] is None
     text = format_calibration(cal)
-    assert "kinetic_force      0 ε/σ (at bound)" in text, text
+    assert "kinetic_force      0 ε/σ (at bound; below " in text, text
+    assert doc["upper_limit_95"] == pytest.approx(fk.limit) and 0 < fk.limit < 0.1, fk
     assert "± 0 " not in text and "± 0\n" not in text, text
     # the freeze of Klein's film (F_b = 1) is found
     ff = cal.main.slip_fit.freeze_force
