@@ -42,7 +42,8 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 scale: str | Scale = "stiff", static_spread: float = STATIC_SPREAD,
                 law_spread: float = 0.0, noise: dict | None = None,
                 comoving_mass: float = 0.0, weakening: tuple[float, float] | None = None,
-                loop_law: str = "melting", seed=0) -> tuple[list[RunSlips], float]:
+                loop_law: str = "melting", lag: float | None = None,
+                seed=0) -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
     them, and the drive velocity.  ``comoving_mass``: the film's mass m_c the slipping wall
@@ -51,13 +52,14 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     ``loop_law`` (:data:`~filmfriction.analysis.groundtruth.random_force.LOOP_LAWS`:
     ``melting``, D a velocity, or ``slip-weakening``, a distance), ΔF = w·(F_s − F_k) of
     each run's yield force F_s
-    (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`).  ``seed``: an
+    (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`); ``lag`` = τ_r:
+    the mix with its viscous force lagging the velocity by τ_r (``maxwell``).  ``seed``: an
     int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
     sc = scale_named(scale)
-    law = sc.law(name, share, weakening, loop_law)
+    law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
@@ -88,7 +90,8 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                 static_spread: float = STATIC_SPREAD, law_spread: float = 0.0,
                 noise: dict | None = None, comoving_mass: float = 0.0,
                 weakening: tuple[float, float] | None = None, loop_law: str = "melting",
-                seed: int = 0, jackknife: str = "runs") -> list[FilmForceFit]:
+                lag: float | None = None, seed: int = 0,
+                jackknife: str = "runs") -> list[FilmForceFit]:
     """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``) of
     ``replicas`` replicas of :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
     sc = scale_named(scale)
@@ -97,7 +100,8 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
         rs, velocity = pooled_runs(name, runs, slips, share=share, scale=sc,
                                    static_spread=static_spread, law_spread=law_spread,
                                    noise=noise, comoving_mass=comoving_mass,
-                                   weakening=weakening, loop_law=loop_law, seed=(seed, k))
+                                   weakening=weakening, loop_law=loop_law, lag=lag,
+                                   seed=(seed, k))
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
                                        film_mass=sc.film_mass,
                                        mount_damping=sc.mount_damping,

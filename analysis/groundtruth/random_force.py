@@ -9,7 +9,8 @@ This module integrates that slider, many replicas at once:
     (M + m_c) dv/dt = K(x_d − x) − F(v, ψ) − γM·(v − V) + ξ(t),   dx/dt = v,   x_d = x_d0 + V·t
 
 with F the friction law of the slip (one of :data:`LAWS`) and ψ its state (rate and state;
-the yield-loop laws' slip distance or fastest velocity since the yield), γM an MD run's
+the yield-loop laws' slip distance or fastest velocity since the yield; the Maxwell film's
+viscous force), γM an MD run's
 mount dashpot (``mount_damping``, 0 by default), m_c the film's mass that moves with the
 slipping wall (``comoving_mass``, 0 by default: the fit, which knows M alone, reads its
 m_c·a as film force), and
@@ -75,9 +76,12 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS"]
 #:   meets more force than the decelerating part at the same velocity (a yield loop);
 #: * ``melting`` (F_k, B, ΔF, v_c): sign(v)·(F_k + ΔF·exp(−ψ/v_c)) + B·v, ψ the fastest
 #:   |v| of the slip so far (0 at each yield): a film that melts with the shear rate and
-#:   stays melted until it re-sticks (another yield loop).
+#:   stays melted until it re-sticks (another yield loop);
+#: * ``maxwell`` (F_k, B, τ_r): sign(v)·F_k + ψ, ψ the film's viscous force relaxing to B·v
+#:   over τ_r (dψ/dt = (B·v − ψ)/τ_r, 0 at each yield): a viscoelastic film whose shear force
+#:   lags the shear rate (the one law reads it as a co-moving mass of about −B·τ_r).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
-        "slip-weakening": 4, "melting": 4}
+        "slip-weakening": 4, "melting": 4, "maxwell": 3}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield.
 LOOP_LAWS = ("melting", "slip-weakening")
 _CODE = {name: k for k, name in enumerate(LAWS)}
@@ -98,6 +102,8 @@ def _friction(code, p, v, psi):
     if code == 5:
         f = p[0] + p[2] * math.exp(-max(psi, abs(v)) / p[3])
         return (f if v >= 0.0 else -f) + p[1] * v
+    if code == 6:
+        return (p[0] if v >= 0.0 else -p[0]) + psi
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -107,6 +113,8 @@ def _state_rate(code, p, v, psi):
         return (p[4] * math.exp(-psi) - abs(v)) / p[3]
     if code == 4:
         return abs(v)
+    if code == 6:
+        return (p[1] * v - psi) / p[2]
     return 0.0
 
 
@@ -168,7 +176,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     thr = static if code != 3 else _friction(code, p, start_v, psi)
                     if force >= thr:
                         slipping, v = True, start_v
-                        if code == 4 or code == 5:
+                        if code == 4 or code == 5 or code == 6:
                             psi = 0.0       # the slip's state starts at each yield
                         if ny < yields.shape[1]:
                             yields[r, ny] = i
@@ -230,6 +238,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     p = np.asarray(parameters, float)
     if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
         raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
+    if law == "maxwell" and not p[2] > 0:
+        raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the third) "
+                         "must be > 0")
     if law in LOOP_LAWS and not p[3] > 0:
         raise ValueError(f"parameters = {parameters!r}: the weakening scale D_c or v_c "
                          "(the fourth) must be > 0")

@@ -128,7 +128,8 @@ class Scale:
     film_mass: float | None = None
 
     def law(self, name: str, share: float | None = None,
-            weakening: tuple[float, float] | None = None, law: str = "melting") -> dict:
+            weakening: tuple[float, float] | None = None, law: str = "melting",
+            lag: float | None = None) -> dict:
         """The arguments of :func:`~filmfriction.analysis.groundtruth.random_force.slide` for
         control ``name`` (or the Coulomb + viscous law of viscous ``share``) at this scale:
         the law, its yield and re-stick, and ``period``, a slip cycle's length or a little
@@ -136,13 +137,21 @@ class Scale:
         (``melting``: the kinetic force higher at the yield by w times its parameter slot,
         fading over the fastest velocity D; ``slip-weakening``: over the slip distance D;
         :func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs` makes the
-        slot ΔF = w·(F_s − F_k) of each run's yield force F_s)."""
+        slot ΔF = w·(F_s − F_k) of each run's yield force F_s).  ``lag`` = τ_r, with
+        ``share``: that mix with its viscous force lagging the velocity by τ_r (``maxwell``)."""
         if share is not None:
             if not 0 <= share <= 1:
                 raise ValueError(f"share = {share!r}: must be in [0, 1]")
             m = dict(self.mix)
             f, v = m.pop("film_force"), m.pop("slip_velocity")
             par = ((1 - share) * f, share * f / v)
+            if lag is not None:
+                if weakening is not None or not (math.isfinite(lag) and lag > 0):
+                    raise ValueError(f"lag = {lag!r}: a relaxation time > 0, finite, and not "
+                                     "with a yield loop")
+                return {"static_force": self.static_force,
+                        "drive_velocity": self.drive_velocity, "law": "maxwell",
+                        "parameters": par + (float(lag),), **m}
             if weakening is None:
                 return {"static_force": self.static_force,
                         "drive_velocity": self.drive_velocity,
@@ -155,8 +164,9 @@ class Scale:
                 raise ValueError(f"law = {law!r}: one of {', '.join(LOOP_LAWS)}")
             return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
                     "law": law, "parameters": par + (df, dc), **m}
-        if weakening is not None:
-            raise ValueError(f"weakening = {weakening!r}: only with a viscous share")
+        if weakening is not None or lag is not None:
+            raise ValueError(f"weakening = {weakening!r}, lag = {lag!r}: only with a viscous "
+                             "share")
         if name not in self.laws:
             raise ValueError(f"control {name!r} at the {self.name} scale: one of "
                              f"{', '.join(self.laws)}")

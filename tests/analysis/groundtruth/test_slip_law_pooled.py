@@ -195,7 +195,9 @@ def test_the_pooled_controls_benchmark_refuses_bad_input_before_any_compute(benc
     main = benchmark_module("slip_law/pooled_controls_rates").main
     for argv, said in ((["--loop", "wobble", "0.5", "1"], "LAW melting or slip-weakening"),
                        (["--loop", "melting", "2", "1"], "0 <= W <= 1"),
-                       (["--stop-velocity", "nan"], "--stop-velocity nan: finite or -inf")):
+                       (["--stop-velocity", "nan"], "--stop-velocity nan: finite or -inf"),
+                       (["--lag", "0"], "--lag 0.0: a relaxation time > 0"),
+                       (["--lag", "5", "--loop", "melting", "0.5", "0.01"], "not with --loop")):
         with pytest.raises(SystemExit) as stop:
             main(argv + ["--replicas", "1"])
         assert stop.value.code == 2
@@ -210,6 +212,17 @@ def test_the_pooled_controls_benchmark_skips_a_law_without_noise_free_slips(benc
     assert main(["--scale", "m1e4", "--runs", "18", "--slips", "14", "--laws",
                  "--replicas", "1", "--shares", "0"]) == 0
     assert "not measured: its noise-free truth has no slips to fit" in capsys.readouterr().out
+
+
+def test_a_lagging_mix_is_the_maxwell_law_and_refused_out_of_range():
+    law = STIFF.law("coulomb", 0.2, lag=12.0)
+    assert law["law"] == "maxwell" and law["parameters"][2] == 12.0
+    assert law["parameters"][:2] == STIFF.law("coulomb", 0.2)["parameters"]
+    for bad in (dict(lag=0.0), dict(lag=math.inf), dict(lag=5.0, weakening=(0.5, 0.3))):
+        with pytest.raises(ValueError, match="lag"):
+            STIFF.law("coulomb", 0.2, **bad)
+    with pytest.raises(ValueError, match="only with a viscous share"):
+        STIFF.law("coulomb", lag=5.0)
 
 
 @pytest.mark.parametrize("weakening", [(1.5, 0.3), (0.5, 0.0), (0.5, math.inf)])
