@@ -139,6 +139,7 @@ class Scale:
         :func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs` makes the
         slot ΔF = w·(F_s − F_k) of each run's yield force F_s).  ``lag`` = τ_r, with
         ``share``: that mix with its viscous force lagging the velocity by τ_r (``maxwell``)."""
+        base = {"static_force": self.static_force, "drive_velocity": self.drive_velocity}
         if share is not None:
             if not 0 <= share <= 1:
                 raise ValueError(f"share = {share!r}: must be in [0, 1]")
@@ -149,21 +150,16 @@ class Scale:
                 if weakening is not None or not (math.isfinite(lag) and lag > 0):
                     raise ValueError(f"lag = {lag!r}: a relaxation time > 0, finite, and not "
                                      "with a yield loop")
-                return {"static_force": self.static_force,
-                        "drive_velocity": self.drive_velocity, "law": "maxwell",
-                        "parameters": par + (float(lag),), **m}
+                return {**base, "law": "maxwell", "parameters": par + (float(lag),), **m}
             if weakening is None:
-                return {"static_force": self.static_force,
-                        "drive_velocity": self.drive_velocity,
-                        "law": "coulomb-viscous", "parameters": par, **m}
+                return {**base, "law": "coulomb-viscous", "parameters": par, **m}
             df, dc = (float(w) for w in weakening)
             if not (0 <= df <= 1 and math.isfinite(dc) and dc > 0):
                 raise ValueError(f"weakening = {weakening!r}: w in [0, 1] (a share of the "
                                  "yield's excess over F_k) and D > 0, finite")
             if law not in LOOP_LAWS:
                 raise ValueError(f"law = {law!r}: one of {', '.join(LOOP_LAWS)}")
-            return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
-                    "law": law, "parameters": par + (df, dc), **m}
+            return {**base, "law": law, "parameters": par + (df, dc), **m}
         if weakening is not None or lag is not None:
             raise ValueError(f"weakening = {weakening!r}, lag = {lag!r}: only with a viscous "
                              "share")
@@ -172,8 +168,7 @@ class Scale:
                              f"{', '.join(self.laws)}")
         # a law's own yield force or drive (the Klein-similar scale's weakening law is
         # driven faster) overrides the scale's
-        return {"static_force": self.static_force, "drive_velocity": self.drive_velocity,
-                **self.laws[name]}
+        return {**base, **self.laws[name]}
 
 
 #: The heavy slider's scale, the scene ``sfb-thick-stiff`` (K = 8 ε/σ², M = 10⁵ m, V = 0.0025
