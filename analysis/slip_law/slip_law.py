@@ -133,7 +133,7 @@ from .slip_law_stats import FALSE_ALARM, POWER, RESOLVED_SIGMAS, detectable, mea
 from .slip_law_verdict import DOMINANT_SHARE, NUMERICAL_FLOOR, ONE_LAW, VERDICTS, choose_law
 
 __all__ = ["FilmForceFit", "BranchFit", "film_force", "fit_film_force", "fit_segments",
-           "jackknife_fit", "checked_trace", "checked_fit_inputs", "smoothing_samples",
+           "jackknife_fit", "loop_step_branch", "checked_trace", "checked_fit_inputs", "smoothing_samples",
            "detectable",
            "sigmas", "VERDICTS", "BRANCHES", "RESOLVED_SIGMAS", "FALSE_ALARM", "POWER", "DOMINANT_SHARE",
            "NUMERICAL_FLOOR", "MIN_RELAXATION", "ONE_LAW"]
@@ -489,7 +489,7 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
     br = {name: jackknife_branch(getattr(fit, name), [getattr(f, name) for f in loo],
                                  replicas=replicas)
           for name in ("decelerating", "accelerating", "whole", "one_law")}
-    st = jackknife_branch(_step_branch(fit), [_step_branch(f) for f in loo], replicas=replicas)
+    st = jackknife_branch(loop_step_branch(fit), [loop_step_branch(f) for f in loo], replicas=replicas)
     dof = len(loo) - 1
     frm, verdict, reason = choose_law(br["decelerating"], br["one_law"], st, mass, film_mass)
     (la_se, la_ps), (lf_se, _) = (jackknife(getattr(fit, k), [getattr(f, k) for f in loo])
@@ -501,7 +501,7 @@ def jackknife_fit(fit: FilmForceFit, leave_one_out, *, mass: float,
                    loop_force_stderr=lf_se, per_slip_loop_area=la_ps)
 
 
-def _step_branch(fit: FilmForceFit) -> BranchFit:
+def loop_step_branch(fit: FilmForceFit) -> BranchFit:
     """The one law's fit carrying the loop step (what :func:`choose_law` reads)."""
     return replace(fit.one_law, loop_step=fit.loop_step, loop_step_stderr=fit.loop_step_stderr)
 

@@ -44,7 +44,7 @@ import numpy as np
 from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
 from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, scaled
-from filmfriction.analysis.slip_law.slip_law import VERDICTS
+from filmfriction.analysis.slip_law.slip_law import VERDICTS, loop_step_branch
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import JACKKNIFE, fit_pooled_ensemble
 from filmfriction.analysis.slip_law.slip_law_stats import sigmas
@@ -89,8 +89,7 @@ def fit(runs, velocity, jackknife, scale="stiff"):
 
 def without_film_mass(f, mass: float) -> tuple[str, str]:
     """The rule's branch and verdict on fit ``f`` were the film's mass not known."""
-    step = replace(f.one_law, loop_step=f.loop_step, loop_step_stderr=f.loop_step_stderr)
-    frm, verdict, _ = choose_law(f.decelerating, f.one_law, step, mass)
+    frm, verdict, _ = choose_law(f.decelerating, f.one_law, loop_step_branch(f), mass)
     return frm, verdict
 
 

@@ -252,3 +252,15 @@ def test_the_loop_force_is_the_mean_gap_of_a_known_loop(v_c, low):
     assert fit.decelerating.kinetic_force == pytest.approx(fk + df * math.exp(-vp / v_c),
                                                            abs=0.01)
     assert fit.decelerating.damping == pytest.approx(0.2 * 27.0 / 0.017, rel=0.002)
+
+
+def test_the_scales_film_masses_are_their_scenes_films():
+    # Scale.film_mass, the most a co-moving mass can be in the controls' rule, is the film of
+    # the MD scene each scale stands for (its atoms at 1 m each), as an MD run records it
+    from filmfriction.workflows.md.scene import load
+
+    for scene, scales in (("sfb-thick-stiff", ("stiff", "m1e4", "m1e2", "m1e3")),
+                          ("sfb-similar", ("klein",))):
+        atoms = load(scene).derived()["film_atoms"]
+        for name in scales:
+            assert SCALES[name].film_mass == float(atoms), (name, scene, atoms)
