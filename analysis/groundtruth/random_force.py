@@ -77,18 +77,24 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS"]
 #: * ``melting`` (F_k, B, ΔF, v_c): sign(v)·(F_k + ΔF·exp(−ψ/v_c)) + B·v, ψ the fastest
 #:   |v| of the slip so far (0 at each yield): a film that melts with the shear rate and
 #:   stays melted until it re-sticks (another yield loop);
-#: * ``maxwell`` (F_k, B, τ_r): sign(v)·F_k + ψ, ψ the film's viscous force relaxing to B·v
-#:   over τ_r (dψ/dt = (B·v − ψ)/τ_r, 0 at each yield): a viscoelastic film whose shear force
-#:   lags the shear rate (the one law reads it as a co-moving mass of about −B·τ_r).
+#: * ``maxwell`` (F_k, B, ΔF, τ_r): sign(v)·F_k + ψ, ψ the film's shear force beyond F_k
+#:   relaxing to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r), ΔF at each yield: a viscoelastic film
+#:   whose shear force lags the shear rate (the one law reads the lag as a co-moving mass of
+#:   about −B·τ_r) and, with ΔF > 0, still holds at the yield a stress it releases over τ_r
+#:   (a yield loop that fades with time, on the slip's early, accelerating part);
+#: * ``maxwell-weakening`` (F_k, B, ΔF, D_c, τ_r): sign(v)·(F_k + ΔF·exp(−s/D_c)) + ψ, s the
+#:   distance slid since the yield, ψ the ``maxwell`` film's lagging viscous force (0 at
+#:   each yield): a film that melts over the slip distance and whose viscous force lags.
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
-        "slip-weakening": 4, "melting": 4, "maxwell": 3}
-#: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield.
-LOOP_LAWS = ("melting", "slip-weakening")
+        "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5}
+#: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
+#: distance, a velocity, a time).
+LOOP_LAWS = ("melting", "slip-weakening", "maxwell")
 _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
 @njit(cache=True)
-def _friction(code, p, v, psi):
+def _friction(code, p, v, psi, slid):
     if code == 0:
         return p[0] + p[1] * v
     if code == 1:
@@ -104,6 +110,9 @@ def _friction(code, p, v, psi):
         return (f if v >= 0.0 else -f) + p[1] * v
     if code == 6:
         return (p[0] if v >= 0.0 else -p[0]) + psi
+    if code == 7:
+        f = p[0] + p[2] * math.exp(-slid / p[3])
+        return (f if v >= 0.0 else -f) + psi
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -114,7 +123,9 @@ def _state_rate(code, p, v, psi):
     if code == 4:
         return abs(v)
     if code == 6:
-        return (p[1] * v - psi) / p[2]
+        return (p[1] * v - psi) / p[3]
+    if code == 7:
+        return (p[1] * v - psi) / p[4]
     return 0.0
 
 
@@ -123,7 +134,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
          psi0, h, n_sub, du, out_x, out_v, yields, sticks, counts):
     samples, reps = out_x.shape
     for r in range(reps):
-        x, v, psi = 0.0, 0.0, psi0
+        x, v, psi, x_yield = 0.0, 0.0, psi0, 0.0
         slipping, armed = False, False
         ny, ns = 0, 0
         for i in range(samples):
@@ -133,20 +144,20 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                 t = (i * n_sub + j) * h
                 if slipping:
                     xi = mass * du[i * n_sub + j, r] / h
-                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi) - gamma * (v - vd)
-                          + xi) / mass
+                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi, x - x_yield)
+                          - gamma * (v - vd) + xi) / mass
                     p1 = _state_rate(code, p, v, psi)
                     x2, v2, s2 = x + 0.5 * h * v, v + 0.5 * h * a1, psi + 0.5 * h * p1
-                    a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2) - _friction(code, p, v2, s2)
-                          - gamma * (v2 - vd) + xi) / mass
+                    a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2)
+                          - _friction(code, p, v2, s2, x2 - x_yield) - gamma * (v2 - vd) + xi) / mass
                     p2 = _state_rate(code, p, v2, s2)
                     x3, v3, s3 = x + 0.5 * h * v2, v + 0.5 * h * a2, psi + 0.5 * h * p2
-                    a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3) - _friction(code, p, v3, s3)
-                          - gamma * (v3 - vd) + xi) / mass
+                    a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3)
+                          - _friction(code, p, v3, s3, x3 - x_yield) - gamma * (v3 - vd) + xi) / mass
                     p3 = _state_rate(code, p, v3, s3)
                     x4, v4, s4 = x + h * v3, v + h * a3, psi + h * p3
-                    a4 = (k * (xd0 + vd * (t + h) - x4) - _friction(code, p, v4, s4)
-                          - gamma * (v4 - vd) + xi) / mass
+                    a4 = (k * (xd0 + vd * (t + h) - x4)
+                          - _friction(code, p, v4, s4, x4 - x_yield) - gamma * (v4 - vd) + xi) / mass
                     p4 = _state_rate(code, p, v4, s4)
                     x = x + h * (v + 2 * v2 + 2 * v3 + v4) / 6
                     vn = v + h * (a1 + 2 * a2 + 2 * a3 + a4) / 6
@@ -173,11 +184,14 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     # stuck: at rest, the state aging
                     psi = psi + h * _state_rate(code, p, 0.0, psi)
                     force = k * (xd0 + vd * (t + h) - x)
-                    thr = static if code != 3 else _friction(code, p, start_v, psi)
+                    thr = static if code != 3 else _friction(code, p, start_v, psi, 0.0)
                     if force >= thr:
                         slipping, v = True, start_v
-                        if code == 4 or code == 5 or code == 6:
+                        x_yield = x
+                        if code == 4 or code == 5 or code == 7:
                             psi = 0.0       # the slip's state starts at each yield
+                        elif code == 6:
+                            psi = p[2]      # the stress the film still holds at the yield
                         if ny < yields.shape[1]:
                             yields[r, ny] = i
                         ny += 1
@@ -238,12 +252,12 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     p = np.asarray(parameters, float)
     if p.shape != (LAWS[law],) or not np.all(np.isfinite(p)):
         raise ValueError(f"parameters = {parameters!r}: {LAWS[law]} finite values for {law!r}")
-    if law == "maxwell" and not p[2] > 0:
-        raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the third) "
-                         "must be > 0")
-    if law in LOOP_LAWS and not p[3] > 0:
-        raise ValueError(f"parameters = {parameters!r}: the weakening scale D_c or v_c "
+    if (law in LOOP_LAWS or law == "maxwell-weakening") and not p[3] > 0:
+        raise ValueError(f"parameters = {parameters!r}: the loop's scale D_c, v_c or τ_r "
                          "(the fourth) must be > 0")
+    if law == "maxwell-weakening" and not p[4] > 0:
+        raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
+                         "must be > 0")
     for name, val in (("mass", mass), ("stiffness", stiffness), ("duration", duration),
                       ("dt", dt)):
         if not (math.isfinite(val) and val > 0):

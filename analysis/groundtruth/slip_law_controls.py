@@ -6,22 +6,20 @@ laws here are slid in the reduced model at the Klein-similar MD scene's scale
 (``sfb-similar``: K = 2 ε/σ², M = 30 m, F_s = 48 ε/σ, sampled every 0.25 τ); the
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
-Each replica's film pushes the wall with the MD's noise as a random force ξ = M·du/dt,
-u the velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
-calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`):
-the wall's position and velocity respond to it, as an MD wall's do, and the residual of
-the integrated equation of motion over M, ∫ξ dt/M, is u.  The slips are fitted as the
-driven analysis fits them, as their mean
-(:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, each slip
-held at its end, the jackknife's errors over the slips); ``ensemble=False`` fits each
-slip on its own, which fails the controls so: its regressors (Δx, and the branch split at
-the noisy peak velocity) carry the noise of its response (at :data:`MD_NOISE` Klein's
-viscous slips come out ``mixed`` in 40 of 40 with 30 slips, decelerating B = 48 of
-62 m/τ, F_k = 7.5 of 0 ε/σ; every other law's loop step is resolved, +13 to +14 ε/σ).
-The rates of the mean at :data:`MD_NOISE`: ``python benchmarks/slip_law/slip_law_random_force.py
---ensemble`` (docs/results/slip-law.md).  The noise added to the noise-free law's trace
-instead (``injected=True``: the spring force carries M·du/dt, the motion is the law's;
-:func:`replica_fits`, fitted slip by slip) is kept as the comparison.
+Each replica's film pushes the wall with the MD's noise as a random force ξ = M·du/dt, u the
+velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
+calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`): the wall's
+position and velocity respond to it, as an MD wall's do, and the residual of the integrated
+equation of motion over M, ∫ξ dt/M, is u. The slips are fitted as the driven analysis fits them, as
+their mean (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, each slip
+held at its end, the jackknife's errors over the slips); ``ensemble=False`` fits each slip on its
+own, which fails the controls so: its regressors (Δx, and the branch split at the noisy peak
+velocity) carry the noise of its response (at :data:`MD_NOISE` Klein's viscous slips come out
+``mixed`` in 40 of 40 with 30 slips, decelerating B = 48 of 62 m/τ, F_k = 7.5 of 0 ε/σ; every other
+law's loop step is resolved, +13 to +14 ε/σ). The rates of the mean: ``python
+benchmarks/slip_law/slip_law_random_force.py --ensemble`` (docs/results/slip-law.md). The noise
+added to the noise-free law's trace instead (``injected=True``: the spring force carries M·du/dt,
+the motion is the law's; :func:`replica_fits`, fitted slip by slip) is kept as the comparison.
 
 ``coulomb``      Coulomb, F_s = 48, F_k = 36 ε/σ (B = 0; with the random force F_k while
                  slipping, whatever the sign of a recoil)
@@ -136,9 +134,11 @@ class Scale:
         more.  ``weakening`` = (w, D), with ``share``: that mix with a yield loop of ``law``
         (``melting``: the kinetic force higher at the yield by w times its parameter slot,
         fading over the fastest velocity D; ``slip-weakening``: over the slip distance D;
+        ``maxwell``: over the time D, the viscous force lagging the velocity by D too;
         :func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs` makes the
-        slot ΔF = w·(F_s − F_k) of each run's yield force F_s).  ``lag`` = τ_r, with
-        ``share``: that mix with its viscous force lagging the velocity by τ_r (``maxwell``)."""
+        slot ΔF = w·(F_s − F_k) of each run's yield force F_s).  ``lag`` = τ_r: the viscous
+        force lagging by τ_r (``maxwell``, w 0; with a ``slip-weakening`` loop,
+        ``maxwell-weakening``)."""
         base = {"static_force": self.static_force, "drive_velocity": self.drive_velocity}
         if share is not None:
             if not 0 <= share <= 1:
@@ -146,20 +146,20 @@ class Scale:
             m = dict(self.mix)
             f, v = m.pop("film_force"), m.pop("slip_velocity")
             par = ((1 - share) * f, share * f / v)
-            if lag is not None:
-                if weakening is not None or not (math.isfinite(lag) and lag > 0):
-                    raise ValueError(f"lag = {lag!r}: a relaxation time > 0, finite, and not "
-                                     "with a yield loop")
-                return {**base, "law": "maxwell", "parameters": par + (float(lag),), **m}
+            if lag is not None and not (math.isfinite(lag) and lag > 0):
+                raise ValueError(f"lag = {lag!r}: a relaxation time > 0, finite")
             if weakening is None:
-                return {**base, "law": "coulomb-viscous", "parameters": par, **m}
+                return {**base, **({"law": "maxwell", "parameters": par + (0.0, float(lag))}
+                                   if lag else {"law": "coulomb-viscous", "parameters": par}), **m}
             df, dc = (float(w) for w in weakening)
             if not (0 <= df <= 1 and math.isfinite(dc) and dc > 0):
                 raise ValueError(f"weakening = {weakening!r}: w in [0, 1] (a share of the "
                                  "yield's excess over F_k) and D > 0, finite")
-            if law not in LOOP_LAWS:
-                raise ValueError(f"law = {law!r}: one of {', '.join(LOOP_LAWS)}")
-            return {**base, "law": law, "parameters": par + (df, dc), **m}
+            if law not in LOOP_LAWS or (lag and law != "slip-weakening"):
+                raise ValueError(f"law = {law!r}: one of {', '.join(LOOP_LAWS)}"
+                                 + (f"; with lag = {lag!r}, slip-weakening" if lag else ""))
+            return {**base, **({"law": "maxwell-weakening", "parameters": par + (df, dc, lag)}
+                               if lag else {"law": law, "parameters": par + (df, dc)}), **m}
         if weakening is not None or lag is not None:
             raise ValueError(f"weakening = {weakening!r}, lag = {lag!r}: only with a viscous "
                              "share")

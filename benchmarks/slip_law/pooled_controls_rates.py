@@ -2,7 +2,7 @@
 
     python benchmarks/slip_law/pooled_controls_rates.py [--runs 6] [--slips 8] [--replicas 100]
         [--laws coulomb viscous] [--shares 0.3 0.6] [--static-spread 0.3] [--law-spread 0.0]
-        [--scale stiff] [--noise-scale 1.0] [--loop LAW W D | --lag TAU] [--stop-velocity V]
+        [--scale stiff] [--noise-scale 1.0] [--loop LAW W D] [--lag TAU] [--stop-velocity V]
         [--md RUN...]
 
 Each replica is G runs of one law at the heavy slider's scale (``SCALES["stiff"]``, its
@@ -23,9 +23,10 @@ noise-free pooled fit's); how many replicas read the one law and the
 decelerating branch each way, what the rule reads without the film's mass
 (``Scale.film_mass``), and resolve the loop (the
 branches' own lines apart, and the step beyond the one law's co-moving mass).  ``--loop LAW W
-D``: the shares' mixes with a yield loop (``melting`` or ``slip-weakening``,
+D``: the shares' mixes with a yield loop (``melting``, ``slip-weakening`` or ``maxwell``,
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--lag TAU``: the shares' mixes with
-their viscous force lagging the velocity by TAU (``maxwell``); ``--stop-velocity``: the mixes
+their viscous force lagging the velocity by TAU (``maxwell``; with ``--loop slip-weakening``,
+``maxwell-weakening``); ``--stop-velocity``: the mixes
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
 is still the noise-free slips re-sticking at the scale's own stop velocity); ``--md RUN…``: the MD runs'
 slips' duration and share after their peak velocity, printed beside each table's first
@@ -194,11 +195,12 @@ def main(argv=None) -> int:
     ap.add_argument("--scale", default="stiff", choices=[n for n in SCALES if n != "klein"],
                     help="the controls' scale (SCALES; stiff: K 8, M 1e5; m1e4: K 8, M 1e4)")
     ap.add_argument("--loop", nargs=3, metavar=("LAW", "W", "D"), default=None,
-                    help="the shares' mixes with a yield loop: LAW melting (D a velocity) or "
-                         "slip-weakening (D a distance), ΔF = W·(F_s − F_k) at the yield")
+                    help="the shares' mixes with a yield loop: LAW melting (D a velocity), "
+                         "slip-weakening (D a distance) or maxwell (D a time: the film holds "
+                         "ΔF at the yield, its viscous force lagging by D), ΔF = W·(F_s − F_k)")
     ap.add_argument("--lag", type=float, default=None, metavar="TAU",
                     help="the shares' mixes with their viscous force lagging the velocity by "
-                         "TAU (a Maxwell film, τ)")
+                         "TAU (a Maxwell film, τ); with --loop slip-weakening, that loop too")
     ap.add_argument("--stop-velocity", type=float, default=None,
                     help="the shares' mixes re-stick once armed at this velocity (σ/τ; "
                          "negative: once the wall recoils that fast; the scale's by default)")
@@ -219,8 +221,10 @@ def main(argv=None) -> int:
         if args.loop[0] not in LOOP_LAWS or not (0 <= w <= 1 and d > 0):
             ap.error(f"--loop {' '.join(args.loop)}: LAW {' or '.join(LOOP_LAWS)}, "
                      "0 <= W <= 1, D > 0")
-    if args.lag is not None and (args.loop or not (math.isfinite(args.lag) and args.lag > 0)):
-        ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and not with --loop")
+    if args.lag is not None and (not (math.isfinite(args.lag) and args.lag > 0) or (
+            args.loop and args.loop[0] != "slip-weakening")):
+        ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and with --loop only "
+                 "slip-weakening")
     if args.stop_velocity is not None and not (math.isfinite(args.stop_velocity)
                                                or args.stop_velocity == -math.inf):
         ap.error(f"--stop-velocity {args.stop_velocity!r}: finite or -inf")

@@ -136,32 +136,44 @@ def test_bad_arguments_are_refused(bad):
 @pytest.mark.parametrize("law, parameters", [("stribeck", (1.0,)), ("linear", (1.0,)),
                                              ("weakening", (25.0, 48.0, math.nan)),
                                              ("melting", (25.0, 0.0, 10.0, 0.0)),
-                                             ("slip-weakening", (25.0, 0.0, 10.0, -1.0))])
+                                             ("slip-weakening", (25.0, 0.0, 10.0, -1.0)),
+                                             ("maxwell", (25.0, 3.0, 1.0, 0.0)),
+                                             ("maxwell-weakening", (25.0, 3.0, 1.0, 1.0, 0.0))])
 def test_a_bad_law_is_refused(law, parameters):
     with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
         slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
               duration=10.0, dt=0.25)
 
 
-def test_a_maxwell_film_slips_as_the_ode_and_reads_as_a_negative_comoving_mass():
-    # a viscoelastic film, F = F_k + ψ with ψ relaxing to B·v over τ_r (0 at the yield),
-    # noise-free: its slips are solve_ivp's (distance, peak velocity, duration)
-    fk, b, tau_r = 36.0, 6.0, 3.0
-    run = slide("maxwell", (fk, b, tau_r), mass=M, stiffness=K, drive_velocity=0.1,
+@pytest.mark.parametrize("law, parameters, held, excess", [
+    ("maxwell", (36.0, 6.0, 0.0, 3.0), 0.0, lambda x: 0.0),
+    # the film still holds 6 ε/σ at the yield and releases it over τ_r
+    ("maxwell", (36.0, 6.0, 6.0, 3.0), 6.0, lambda x: 0.0),
+    # the lagging film melts over the slip distance D_c = 1 σ from 36 + 6
+    ("maxwell-weakening", (36.0, 6.0, 6.0, 1.0, 3.0), 0.0, lambda x: 6.0 * math.exp(-x))])
+def test_a_maxwell_film_slips_as_the_ode(law, parameters, held, excess):
+    # a viscoelastic film, F = F_k (+ the excess) + ψ with ψ relaxing to B·v over τ_r
+    # (``held`` at the yield), noise-free: its slips are solve_ivp's (distance, peak
+    # velocity, duration)
+    fk, b, tau_r = parameters[0], parameters[1], parameters[-1]
+    run = slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1,
                 static_force=FS, duration=600.0, dt=0.25, substeps=8)[0]
     y, s = run["yield_index"], run["stick_index"]
     assert y.size >= 2
-    rhs = lambda t, q: [q[1], (FS + K * (0.1 * t - q[0]) - fk - q[2]) / M,
+    rhs = lambda t, q: [q[1], (FS + K * (0.1 * t - q[0]) - fk - excess(q[0]) - q[2]) / M,
                         (b * q[1] - q[2]) / tau_r]
     stop = lambda t, q: q[1]
     stop.terminal, stop.direction = True, -1
-    ode = solve_ivp(rhs, (0, 500), [0.0, 1e-12, 0.0], events=stop, rtol=1e-10, atol=1e-12)
+    ode = solve_ivp(rhs, (0, 500), [0.0, 1e-12, held], events=stop, rtol=1e-10, atol=1e-12)
     dist, dur = ode.y_events[0][0][0], ode.t_events[0][0]
     x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
     for a, c in zip(y, s):
         assert x[c + 1] - x[a] == pytest.approx(dist, rel=2e-3)
         assert v[a:c + 1].max() == pytest.approx(ode.y[1].max(), rel=2e-3)
         assert t[c + 1] - t[a] == pytest.approx(dur, abs=0.5)
+
+
+def test_a_lagging_film_reads_as_a_negative_comoving_mass():
     # the heavy slider's film with a force that lags by τ_r = 12 τ: the one law (F_k + B·v +
     # m_c·a) takes the lag for a co-moving mass of about −B·τ_r (the MD's one law at
     # M = 10⁵ reads −5 590 ± 1 820 m); without the lag, none
@@ -171,7 +183,8 @@ def test_a_maxwell_film_slips_as_the_ode_and_reads_as_a_negative_comoving_mass()
     def one_law(tau):
         runs = []
         for fs in (38.0, 45.0, 52.0):
-            r = slide("maxwell" if tau else "linear", (20.0, 473.0, tau) if tau else (20.0, 473.0),
+            r = slide("maxwell" if tau else "linear",
+                      (20.0, 473.0, 0.0, tau) if tau else (20.0, 473.0),
                       mass=1e5, stiffness=8.0, drive_velocity=0.0025, static_force=fs,
                       duration=16000.0, dt=0.25, substeps=4, mount_damping=34.0,
                       armed_below=27.0, initial_force=10.0)[0]

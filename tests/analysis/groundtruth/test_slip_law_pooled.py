@@ -197,7 +197,7 @@ def test_the_pooled_controls_benchmark_refuses_bad_input_before_any_compute(benc
                        (["--loop", "melting", "2", "1"], "0 <= W <= 1"),
                        (["--stop-velocity", "nan"], "--stop-velocity nan: finite or -inf"),
                        (["--lag", "0"], "--lag 0.0: a relaxation time > 0"),
-                       (["--lag", "5", "--loop", "melting", "0.5", "0.01"], "not with --loop")):
+                       (["--lag", "5", "--loop", "melting", "0.5", "0.01"], "only slip-weakening")):
         with pytest.raises(SystemExit) as stop:
             main(argv + ["--replicas", "1"])
         assert stop.value.code == 2
@@ -216,11 +216,16 @@ def test_the_pooled_controls_benchmark_skips_a_law_without_noise_free_slips(benc
 
 def test_a_lagging_mix_is_the_maxwell_law_and_refused_out_of_range():
     law = STIFF.law("coulomb", 0.2, lag=12.0)
-    assert law["law"] == "maxwell" and law["parameters"][2] == 12.0
+    assert law["law"] == "maxwell" and law["parameters"][2:] == (0.0, 12.0)
     assert law["parameters"][:2] == STIFF.law("coulomb", 0.2)["parameters"]
-    for bad in (dict(lag=0.0), dict(lag=math.inf), dict(lag=5.0, weakening=(0.5, 0.3))):
+    for bad in (dict(lag=0.0), dict(lag=math.inf),
+                dict(lag=5.0, weakening=(0.5, 0.01), law="melting")):
         with pytest.raises(ValueError, match="lag"):
             STIFF.law("coulomb", 0.2, **bad)
+    # with a slip-weakening loop: the loop and the lag, each of its own scale
+    both = STIFF.law("coulomb", 0.2, (0.5, 0.3), "slip-weakening", lag=12.0)
+    assert both["law"] == "maxwell-weakening" and both["parameters"][2:] == (0.5, 0.3, 12.0)
+    assert STIFF.law("coulomb", 0.2, (0.5, 30.0), "maxwell")["parameters"][2:] == (0.5, 30.0)
     with pytest.raises(ValueError, match="only with a viscous share"):
         STIFF.law("coulomb", lag=5.0)
 
