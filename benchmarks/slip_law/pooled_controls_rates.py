@@ -30,7 +30,9 @@ their viscous force lagging the velocity by TAU (``maxwell``; with ``--loop slip
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
 is still the noise-free slips re-sticking at the scale's own stop velocity); ``--md RUN…``: the MD runs'
 slips' duration and share after their peak velocity, printed beside each table's first
-replica's.  Seeds are fixed: the counts are deterministic.
+replica's.  Each table opens with the noise-free pooled fit's signature (the one law's
+co-moving mass, the loop step and force, the decelerating branch; ``--replicas 0``: that
+alone, in seconds).  Seeds are fixed: the counts are deterministic.
 """
 from __future__ import annotations
 
@@ -122,6 +124,13 @@ def table(law: str, share, args) -> None:
         print(f"\n## {name}: not measured: its noise-free truth has no slips to fit ({exc})",
               flush=True)
         return
+    print(f"\n## {name}: noise-free (re-sticking at the scale's stop velocity): one law m_c "
+          f"{exact.one_law.comoving_mass:.4g} m, loop step {exact.loop_step:+.3g}, loop force "
+          f"{exact.loop_force:+.3g} ε/σ; decelerating F_k {exact.decelerating.kinetic_force:.4g}, "
+          f"B {exact.decelerating.damping:.4g} m/τ; the rule: {exact.verdict_from} "
+          f"{exact.verdict}", flush=True)
+    if not args.replicas:
+        return
     fits = {j: [] for j in JACKKNIFE}
     unfitted = []
     for k in range(args.replicas):
@@ -185,7 +194,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=6)
     ap.add_argument("--slips", type=int, default=8)
-    ap.add_argument("--replicas", type=int, default=100)
+    ap.add_argument("--replicas", type=int, default=100,
+                    help="noisy replicas per table (0: the noise-free fit's signature alone)")
     ap.add_argument("--laws", nargs="*", default=["coulomb", "viscous"],
                     choices=sorted({n for sc in SCALES.values() for n in sc.laws}))
     ap.add_argument("--shares", nargs="*", type=float, default=[0.3, 0.6])
@@ -209,6 +219,8 @@ def main(argv=None) -> int:
     ap.add_argument("--noise-scale", type=float, default=1.0,
                     help="the scale's noise amplitudes times this (1: as calibrated)")
     args = ap.parse_args(argv)
+    if args.replicas < 0:
+        ap.error(f"--replicas {args.replicas}: 0 or more")
     missing = [law for law in args.laws if law not in SCALES[args.scale].laws]
     if missing:
         ap.error(f"--laws {' '.join(missing)}: not a control at the {args.scale} scale "
