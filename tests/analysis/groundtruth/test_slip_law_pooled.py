@@ -269,3 +269,26 @@ def test_the_scales_film_masses_are_their_scenes_films():
         atoms = load(scene).derived()["film_atoms"]
         for name in scales:
             assert SCALES[name].film_mass == float(atoms), (name, scene, atoms)
+
+
+def test_the_pooled_controls_benchmark_prints_the_noise_free_signature_alone(benchmark_module,
+                                                                             capsys):
+    # --replicas 0: each table's noise-free pooled fit, its signature only; a loop-free mix
+    # reads no co-moving mass and no loop, a lagging one a negative m_c and the decelerating
+    # branch's B below the law's (the lag takes part of the viscous force off it)
+    main = benchmark_module("slip_law/pooled_controls_rates").main
+    assert main(["--runs", "4", "--slips", "3", "--laws", "--shares", "0.2",
+                 "--replicas", "0"]) == 0
+    plain = capsys.readouterr().out
+    assert main(["--runs", "4", "--slips", "3", "--laws", "--shares", "0.2",
+                 "--replicas", "0", "--lag", "12"]) == 0
+    lagged = capsys.readouterr().out
+    for out in (plain, lagged):
+        assert out.count("noise-free") == 1 and "jackknife" not in out
+    mc = [float(o.split("one law m_c ")[1].split()[0]) for o in (plain, lagged)]
+    b = [float(o.split(", B ")[1].split()[0]) for o in (plain, lagged)]
+    assert abs(mc[0]) < 1.0 and mc[1] < -2000.0, mc
+    assert b[0] == pytest.approx(0.2 * 27.0 / 0.017, rel=0.01) and b[1] < 0.95 * b[0], b
+    with pytest.raises(SystemExit):
+        main(["--replicas", "-1"])
+    assert "--replicas -1: 0 or more" in capsys.readouterr().err
