@@ -304,6 +304,14 @@ class ConfinedFilm:
                       stacking=self.wall_planes + self.film_layers, origin=ORIGIN)
 
     @property
+    def registry_period(self) -> float | None:
+        """The period of the walls' registry along the slide (x) [σ]: the top wall's rows
+        along x, in registry with the bottom wall's, repeat every ``wall_spacing``, and so
+        does the force the film passes between them; None with the top wall twisted (its
+        rows are not the bottom wall's)."""
+        return None if self.top_wall_twisted else self.wall_spacing
+
+    @property
     def vacancies_per_wall(self) -> tuple[int, int]:
         """Atoms taken out of the (bottom, top) wall's plane facing the film."""
         # the nearest whole number, halves up (as film_slide.lmp checks it)

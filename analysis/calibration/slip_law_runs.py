@@ -39,7 +39,7 @@ __all__ = ["PooledRun", "PooledSlipLaw", "pooled_slip_law", "read_runs", "fit_ar
 
 #: What the pooled runs must share (a run's trace parameter, or the sampling interval).
 SHARED = ("units", "mass", "spring_constant", "drive_velocity", "mount_damping", "sampling",
-          "film_mass")
+          "film_mass", "registry_period")
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,7 @@ def _run_slips(run_dir, analyse: bool) -> tuple[RunSlips, dict, int | None]:
     dt = float(np.median(np.diff(t))) if t.size > 1 else math.nan
     shared = {"units": tr.units, "mass": p.mass, "spring_constant": p.spring_constant,
               "drive_velocity": v_drive or 0.0, "mount_damping": p.mount_damping or 0.0,
-              "sampling": dt, "film_mass": p.film_mass}
+              "sampling": dt, "film_mass": p.film_mass, "registry_period": p.registry_period}
     count = (run.analysis.get("slips") or {}).get("count")
     if isinstance(count, int) and len(run.cycles["yield_index"]) != count:
         raise ValueError(f"{run.run_dir}: analysis_cycles.csv holds "
@@ -122,9 +122,11 @@ def read_runs(run_dirs, *, analyse: bool = True) -> tuple[list, dict, tuple]:
 def fit_arguments(shared: dict) -> dict:
     """The keywords of :func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`
     for runs that share ``shared`` (the MD noise's correlation time as the smoothing's
-    floor in LJ units; the film's own mass, None where not known)."""
+    floor in LJ units; the film's own mass and the walls' registry period, None where not
+    known)."""
     return dict(mass=shared["mass"], drive_velocity=shared["drive_velocity"],
                 mount_damping=shared["mount_damping"], film_mass=shared.get("film_mass"),
+                registry_period=shared.get("registry_period"),
                 min_window_time=MD_NOISE_TIME if shared["units"] == "lj" else 0.0)
 
 

@@ -121,7 +121,7 @@ _ESTIMATE = Field("object", nullable=True, fields={"value": _NUM, "mean": _NUM,
                                                    "stderr": _NUM, "units": _STR})
 _PARAMETERS = Field("object", nullable=True, fields={
     "spring_constant": _POS, "mass": _POS, "area": _POS, "thickness": _POS,
-    "drive_velocity": _POS, "mount_damping": _NUM, "film_mass": _POS,
+    "drive_velocity": _POS, "mount_damping": _NUM, "film_mass": _POS, "registry_period": _POS,
     "units": Field("string", nullable=True, hint="lj or si")})
 
 #: An MD calibration (``calibration.json``'s ``md_calibration``, or a file of its own

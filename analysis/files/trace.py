@@ -30,7 +30,7 @@ def trace_column_names() -> tuple[str, ...]:
     from filmfriction.md_inputs.contract import TRACE_COLUMNS
     return TRACE_COLUMNS
 PARAMETERS = ("spring_constant", "mass", "area", "thickness", "drive_velocity",
-              "mount_damping", "film_mass")
+              "mount_damping", "film_mass", "registry_period")
 
 #: Unit labels per quantity, per unit system (labels only: no conversion).
 UNITS = {
@@ -89,6 +89,10 @@ class TraceParameters:
     # the mass of the film between the walls (an MD run's film atoms, 1 m each): the most
     # a co-moving mass can be (the slip law's rule takes more for a yield loop)
     film_mass: float | None = None
+    # the period of the walls' registry along the slide (an MD run's commensurate walls:
+    # their lattice's): the slip law fits a force periodic in the wall's position beside
+    # the film's law
+    registry_period: float | None = None
     units: str = "lj"
 
     def __post_init__(self):

@@ -340,6 +340,13 @@ def _run_parameters(run: dict) -> dict:
         # a run recorded before its trace parameters carried the film's mass: its film
         # atoms, 1 m each (the LJ unit of mass is a film atom's)
         base["film_mass"] = float(film)
+    scene = (run.get("scene") or {}).get("parameters") or {}
+    if ("registry_period" not in given and base["units"] == "lj"
+            and scene.get("top_wall_twist", "aligned") == "aligned"
+            and isinstance(scene.get("wall_spacing"), (int, float))):
+        # a run recorded before its trace parameters carried the registry's period: its
+        # walls' spacing, the period of aligned walls along the slide
+        base["registry_period"] = float(scene["wall_spacing"])
     return base
 
 

@@ -43,6 +43,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 law_spread: float = 0.0, noise: dict | None = None,
                 comoving_mass: float = 0.0, weakening: tuple[float, float] | None = None,
                 loop_law: str = "melting", lag: float | None = None,
+                corrugation: tuple[float, float, float] | None = None,
                 seed=0) -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
@@ -53,14 +54,22 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     ``melting``, D a velocity, or ``slip-weakening``, a distance), ΔF = w·(F_s − F_k) of
     each run's yield force F_s
     (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`); ``lag`` = τ_r:
-    the mix with its viscous force lagging the velocity by τ_r (``maxwell``).  ``seed``: an
-    int or a tuple of ints."""
+    the mix with its viscous force lagging the velocity by τ_r (``maxwell``); ``corrugation``
+    = (ΔF, λ, φ): the mix with a force ΔF·sin(2π·x/λ + φ) of the wall's position x, the
+    registry of commensurate walls (``corrugated``; every run starts at x = 0, as the MD's
+    runs start from one geometry).  ``seed``: an int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
     sc = scale_named(scale)
     law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
+    if corrugation is not None:
+        if law["law"] != "coulomb-viscous" or len(corrugation) != 3:
+            raise ValueError(f"corrugation = {corrugation!r}: (ΔF, λ, φ), on a Coulomb + "
+                             "viscous mix without a loop or a lag")
+        law |= {"law": "corrugated",
+                "parameters": law["parameters"] + tuple(float(c) for c in corrugation)}
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
     rng = np.random.default_rng(key + [7919])
@@ -90,10 +99,12 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                 static_spread: float = STATIC_SPREAD, law_spread: float = 0.0,
                 noise: dict | None = None, comoving_mass: float = 0.0,
                 weakening: tuple[float, float] | None = None, loop_law: str = "melting",
-                lag: float | None = None, seed: int = 0,
-                jackknife: str = "runs") -> list[FilmForceFit]:
-    """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``) of
-    ``replicas`` replicas of :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
+                lag: float | None = None, corrugation=None, seed: int = 0,
+                jackknife: str = "runs",
+                registry_period: float | None = None) -> list[FilmForceFit]:
+    """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``; with the
+    registry's force of period ``registry_period``) of ``replicas`` replicas of
+    :func:`pooled_runs` (replica k from the seed (``seed``, k))."""
     sc = scale_named(scale)
     out = []
     for k in range(replicas):
@@ -101,9 +112,10 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                                    static_spread=static_spread, law_spread=law_spread,
                                    noise=noise, comoving_mass=comoving_mass,
                                    weakening=weakening, loop_law=loop_law, lag=lag,
-                                   seed=(seed, k))
+                                   corrugation=corrugation, seed=(seed, k))
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
                                        film_mass=sc.film_mass,
                                        mount_damping=sc.mount_damping,
-                                       min_window_time=MD_NOISE_TIME, jackknife=jackknife))
+                                       min_window_time=MD_NOISE_TIME, jackknife=jackknife,
+                                       registry_period=registry_period))
     return out

@@ -84,9 +84,13 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS"]
 #:   (a yield loop that fades with time, on the slip's early, accelerating part);
 #: * ``maxwell-weakening`` (F_k, B, ΔF, D_c, τ_r): sign(v)·(F_k + ΔF·exp(−s/D_c)) + ψ, s the
 #:   distance slid since the yield, ψ the ``maxwell`` film's lagging viscous force (0 at
-#:   each yield): a film that melts over the slip distance and whose viscous force lags.
+#:   each yield): a film that melts over the slip distance and whose viscous force lags;
+#: * ``corrugated`` (F_k, B, ΔF, λ, φ): sign(v)·F_k + B·v + ΔF·sin(2π·x/λ + φ), x the wall's
+#:   position: a film whose force is modulated by the registry of commensurate walls (the
+#:   lattice's period λ along the slide; φ, the registry at x = 0).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
-        "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5}
+        "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
+        "corrugated": 5}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
 #: distance, a velocity, a time).
 LOOP_LAWS = ("melting", "slip-weakening", "maxwell")
@@ -94,7 +98,7 @@ _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
 @njit(cache=True)
-def _friction(code, p, v, psi, slid):
+def _friction(code, p, v, psi, x, x_yield):
     if code == 0:
         return p[0] + p[1] * v
     if code == 1:
@@ -111,8 +115,11 @@ def _friction(code, p, v, psi, slid):
     if code == 6:
         return (p[0] if v >= 0.0 else -p[0]) + psi
     if code == 7:
-        f = p[0] + p[2] * math.exp(-slid / p[3])
+        f = p[0] + p[2] * math.exp(-(x - x_yield) / p[3])
         return (f if v >= 0.0 else -f) + psi
+    if code == 8:
+        return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
+                + p[2] * math.sin(2.0 * math.pi * x / p[3] + p[4]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -144,20 +151,20 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                 t = (i * n_sub + j) * h
                 if slipping:
                     xi = mass * du[i * n_sub + j, r] / h
-                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi, x - x_yield)
+                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi, x, x_yield)
                           - gamma * (v - vd) + xi) / mass
                     p1 = _state_rate(code, p, v, psi)
                     x2, v2, s2 = x + 0.5 * h * v, v + 0.5 * h * a1, psi + 0.5 * h * p1
                     a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2)
-                          - _friction(code, p, v2, s2, x2 - x_yield) - gamma * (v2 - vd) + xi) / mass
+                          - _friction(code, p, v2, s2, x2, x_yield) - gamma * (v2 - vd) + xi) / mass
                     p2 = _state_rate(code, p, v2, s2)
                     x3, v3, s3 = x + 0.5 * h * v2, v + 0.5 * h * a2, psi + 0.5 * h * p2
                     a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3)
-                          - _friction(code, p, v3, s3, x3 - x_yield) - gamma * (v3 - vd) + xi) / mass
+                          - _friction(code, p, v3, s3, x3, x_yield) - gamma * (v3 - vd) + xi) / mass
                     p3 = _state_rate(code, p, v3, s3)
                     x4, v4, s4 = x + h * v3, v + h * a3, psi + h * p3
                     a4 = (k * (xd0 + vd * (t + h) - x4)
-                          - _friction(code, p, v4, s4, x4 - x_yield) - gamma * (v4 - vd) + xi) / mass
+                          - _friction(code, p, v4, s4, x4, x_yield) - gamma * (v4 - vd) + xi) / mass
                     p4 = _state_rate(code, p, v4, s4)
                     x = x + h * (v + 2 * v2 + 2 * v3 + v4) / 6
                     vn = v + h * (a1 + 2 * a2 + 2 * a3 + a4) / 6
@@ -184,7 +191,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     # stuck: at rest, the state aging
                     psi = psi + h * _state_rate(code, p, 0.0, psi)
                     force = k * (xd0 + vd * (t + h) - x)
-                    thr = static if code != 3 else _friction(code, p, start_v, psi, 0.0)
+                    thr = static if code != 3 else _friction(code, p, start_v, psi, x, x)
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
@@ -255,6 +262,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     if (law in LOOP_LAWS or law == "maxwell-weakening") and not p[3] > 0:
         raise ValueError(f"parameters = {parameters!r}: the loop's scale D_c, v_c or τ_r "
                          "(the fourth) must be > 0")
+    if law == "corrugated" and not p[3] > 0:
+        raise ValueError(f"parameters = {parameters!r}: the registry's period λ (the fourth) "
+                         "must be > 0")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

@@ -101,7 +101,8 @@ class SlipLaw(Observable):
             # the verdict's fit: the slips' mean, unbiased where the film's random force
             # moves the wall (module text)
             noise_time = MD_NOISE_TIME if ctx.units == "lj" else 0.0
-            fit = fit_cycle_ensemble(t, f, v, ctx.table, **args, min_window_time=noise_time)
+            fit = fit_cycle_ensemble(t, f, v, ctx.table, **args, min_window_time=noise_time,
+                                     registry_period=p.registry_period)
             estimator = ESTIMATORS[0]
         except ValueError as err:
             fit, estimator = per_slip, ESTIMATORS[1]
@@ -133,12 +134,16 @@ class SlipLaw(Observable):
                                           damping_stderr=finite_or_none(one.damping_stderr),
                                           kinetic_force=finite_or_none(one.kinetic_force)),
                "smoothing_window": fit.smoothing_window,
+               "registry_period": ctx.value(p.registry_period, None, "length")
+               if estimator == ESTIMATORS[0] else None,
                "law": "F_film = kinetic_force + damping * v on each branch (+ comoving_mass "
                       "* a over the whole slip: one_law), F_film = F_spring - M a - "
                       "mount_damping (v - V), fitted in the integrated equation of motion "
                       "(estimator: the slips' mean, each slip held at its end, jackknife "
                       "errors over the slips; or each slip's own); the verdict's law is "
-                      "verdict_from's"}
+                      "verdict_from's; with registry_period, the slips' mean is fitted with "
+                      "a force periodic in the wall's position beside the law (two "
+                      "harmonics of that period: commensurate walls)"}
         if estimator == ESTIMATORS[0]:
             out["per_slip_fit"] = self._per_slip_fit(ctx, per_slip)
         if trace.has("load_work"):

@@ -107,6 +107,7 @@ class Segment:
     dv: np.ndarray          # v − v0 of the smoothed velocity (the m_c term)
     mass: float
     after_peak: np.ndarray  # max(Δt − Δt_peak, 0)
+    registry: np.ndarray | None = None  # ∫sin, ∫cos(2π·h·x/λ) dt, (samples, 2·harmonics)
 
     @property
     def mean_velocity(self) -> float:
@@ -121,10 +122,13 @@ class Segment:
         return self.y - self.mass * self.v
 
     def design(self, comoving: bool, intercepts: int = 1, which: int = 0, step: bool = False):
-        """Columns [intercepts…, Δt, Δx (, v − v0) (, time past the peak)]."""
+        """Columns [intercepts…, Δt, Δx (, v − v0) (, the registry's) (, time past the
+        peak)]."""
         cols = [np.full(self.y.size, float(k == which)) for k in range(intercepts)]
         cols += [self.dt, self.dx]
-        return cols + ([self.dv] if comoving else []) + ([self.after_peak] if step else [])
+        reg = list(self.registry.T) if self.registry is not None else []
+        return (cols + ([self.dv] if comoving else []) + reg
+                + ([self.after_peak] if step else []))
 
 
 def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
@@ -132,7 +136,9 @@ def fit_branch(branch: str, segments: list[Segment | None], comoving: bool,
     """Per-slip fits on one branch, their mean, errors, power and verdict; with
     ``loop_step`` (on the whole slip) a step of the force at the peak velocity is
     fitted too, F_acc − F_dec at a common B (and m_c)."""
-    nterms = 3 + comoving + loop_step
+    nterms = 3 + comoving + loop_step + max(
+        (s.registry.shape[1] for s in segments if s is not None and s.registry is not None),
+        default=0)
     per = []                       # (fk, b, mc, vbar, step) per slip
     used, resids = [], []
     for seg in segments:

@@ -85,7 +85,8 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inpu
                        fit_segments, jackknife_fit, smoothing_samples)
 from .slip_law_branches import Segment
 
-__all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "slipped", "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME"]
+__all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "held_keys", "slipped",
+           "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME", "REGISTRY_HARMONICS"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
 MIN_CYCLES = 3
@@ -95,6 +96,16 @@ MIN_CYCLES = 3
 MD_NOISE_TIME = 3.0
 #: The per-slip, per-lag arrays of :func:`held_slips`.
 HELD = ("impulse", "velocity", "held_velocity", "displacement", "slipping_time")
+#: The harmonics of the walls' registry force fitted where its period is given: the
+#: force of commensurate walls repeats with the lattice's period along the slide, and the
+#: MD's has a second harmonic of half the first's amplitude (docs/results/slip-law.md,
+#: "The walls' registry in the film's force").
+REGISTRY_HARMONICS = 2
+
+
+def held_keys(held: dict) -> tuple:
+    """The per-slip arrays of ``held``: :data:`HELD` and the registry's, where fitted."""
+    return HELD + tuple(k for k in held if k.startswith("registry_"))
 
 
 def uniform_step(t: np.ndarray, what: str) -> float:
@@ -118,7 +129,8 @@ def slipped(table: CycleTable) -> np.ndarray:
 
 
 def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
-               mount_damping: float = 0.0, drive_velocity: float = 0.0) -> dict:
+               mount_damping: float = 0.0, drive_velocity: float = 0.0,
+               registry_period: float | None = None) -> dict:
     """Each slip aligned at its yield and held at its end (module text), per slip and lag.
 
     Returns a dict of arrays of shape (slips, lags): ``impulse``, ``velocity`` (the
@@ -126,7 +138,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     one-sided at its ends: what a sampled velocity's noise does not reach, since the
     positions integrate the wall's motion), ``displacement``, ``slipping_time``; the lags
     run to the longest slip's end, and ``lag_time`` (lags,) holds their times from the
-    yield.
+    yield.  With ``registry_period`` λ: ``registry_sin1``, ``registry_cos1``, … to
+    :data:`REGISTRY_HARMONICS`, the time integrals over the slip of sin and cos(2π·h·x/λ)
+    at the wall's position x (the regressors of a force periodic in the walls' registry).
     """
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
@@ -138,7 +152,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     n = int(d.max()) + 1
     dt = float(t[1] - t[0])
     lag = np.arange(n)
-    out = {k: np.empty((y.size, n)) for k in HELD}
+    reg = ([f"registry_{fn}{h}" for h in range(1, REGISTRY_HARMONICS + 1)
+            for fn in ("sin", "cos")] if registry_period is not None else [])
+    out = {k: np.empty((y.size, n)) for k in HELD + tuple(reg)}
     for i, (a, b) in enumerate(zip(y, s)):
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
@@ -150,6 +166,10 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
                                               edge_order=2 if seg.size > 2 else 1)[k - a]
         out["displacement"][i] = x[k] - x[a]
         out["slipping_time"][i] = t[k] - t[a]
+        for key in reg:
+            phase = 2 * math.pi * int(key[-1]) * x[seg] / registry_period
+            wave = np.sin(phase) if "sin" in key else np.cos(phase)
+            out[key][i] = cumulative_trapezoid(wave, t[seg], initial=0.0)[k - a]
     out["lag_time"] = lag * dt
     return out
 
@@ -197,11 +217,13 @@ def _segments(mean: dict, window: int, dt: float, p: int, lags: dict, mass: floa
     M·v is the sampled velocity's, in the response (Segment.response)."""
     x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
     carried = _guide(mean["held_velocity"], window, dt, deriv=0)
+    reg = [mean[k] for k in held_keys(mean)[len(HELD):]]
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}
     for name, i in lags.items():
         segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], v[i],
                               s[i] - s[i[0]], x[i] - x[i[0]], carried[i] - carried[i[0]], mass,
-                              np.maximum(s[i] - s[p], 0.0))]
+                              np.maximum(s[i] - s[p], 0.0),
+                              np.column_stack([r[i] - r[i[0]] for r in reg]) if reg else None)]
     return segs
 
 
@@ -209,10 +231,11 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                        drive_velocity: float = 0.0, mount_damping: float = 0.0,
                        wall_position=None, min_velocity_fraction: float = 0.2,
                        smoothing: float = SMOOTHING, comoving_mass: bool = False,
-                       min_window_time: float = 0.0,
-                       film_mass: float | None = None) -> FilmForceFit:
+                       min_window_time: float = 0.0, film_mass: float | None = None,
+                       registry_period: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``table`` (module text), errors by the
-    jackknife over the slips.
+    jackknife over the slips; with ``registry_period``, beside the law a force periodic in
+    the wall's position (:func:`held_slips`).
 
     Arguments as :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force` (the
     sampling must be uniform).  The slips in which the wall did not slip (the spring
@@ -245,7 +268,7 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                          f"{100 * MIN_RELAXATION:g} % or more: the cycle ensemble needs "
                          f"{MIN_CYCLES} or more")
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
-                      drive_velocity=drive_velocity)
+                      drive_velocity=drive_velocity, registry_period=registry_period)
     if not (math.isfinite(min_window_time) and min_window_time >= 0):
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
     window = max(smoothing_samples(t, table, smoothing), int(math.ceil(min_window_time / dt)))
@@ -275,7 +298,8 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
                                min_velocity_fraction)
     ranges = [(min_velocity_fraction * peak, peak) if lags else (math.nan, math.nan)]
 
-    total = {k: held[k].sum(axis=0) for k in HELD}
+    keys = held_keys(held)
+    total = {k: held[k].sum(axis=0) for k in keys}
 
     def fit(mean):
         segs = _segments(mean, window, dt, p, lags, mass)
@@ -286,6 +310,6 @@ def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float
     for g in labels:
         out = groups == g
         loo.append(fit({k: (total[k] - held[k][out].sum(axis=0)) / (n - int(out.sum()))
-                        for k in HELD}))
-    return jackknife_fit(fit({k: total[k] / n for k in HELD}), loo, mass=mass,
+                        for k in keys}))
+    return jackknife_fit(fit({k: total[k] / n for k in keys}), loo, mass=mass,
                          replicas=replicas, film_mass=film_mass)

@@ -52,7 +52,7 @@ import numpy as np
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law import MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs
-from .slip_law_cycles import HELD, fit_held_ensemble, held_slips, slipped, uniform_step
+from .slip_law_cycles import fit_held_ensemble, held_keys, held_slips, slipped, uniform_step
 
 __all__ = ["RunSlips", "fit_pooled_ensemble", "MIN_RUNS", "JACKKNIFE"]
 
@@ -77,7 +77,8 @@ class RunSlips:
 
 
 def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
-          min_velocity_fraction, smoothing) -> tuple[dict, float, np.ndarray]:
+          min_velocity_fraction, smoothing,
+          registry_period=None) -> tuple[dict, float, np.ndarray]:
     """The run's slips held at their ends, its sampling interval and its slips' durations
     (ValueError naming the run when its sampling is not uniform or no slip is left)."""
     name = run.name or f"run {i + 1}"
@@ -96,7 +97,7 @@ def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
         raise ValueError(f"{name}: no slip relaxes the spring by {100 * MIN_RELAXATION:g} % "
                          f"or more ({len(tab)} in its table)")
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
-                      drive_velocity=drive_velocity)
+                      drive_velocity=drive_velocity, registry_period=registry_period)
     return held, dt, t[s[keep]] - t[y[keep]]
 
 
@@ -104,7 +105,8 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                         mount_damping: float = 0.0, min_velocity_fraction: float = 0.2,
                         smoothing: float = SMOOTHING, comoving_mass: bool = False,
                         min_window_time: float = 0.0, jackknife: str = "runs",
-                        film_mass: float | None = None) -> FilmForceFit:
+                        film_mass: float | None = None,
+                        registry_period: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``runs`` (module text), errors by the
     jackknife over the runs.
 
@@ -121,6 +123,11 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     jackknife : {"runs", "slips"}
         The jackknife's replicas: the runs (the errors), or each slip on its own (as if
         the slips were one run's: the comparison that leaves the runs' differences out).
+    registry_period : float, optional
+        The period λ of the walls' registry along the slide (the runs' wall positions
+        share its origin): a force periodic in the wall's position, of
+        :data:`~filmfriction.analysis.slip_law.slip_law_cycles.REGISTRY_HARMONICS`
+        harmonics, is fitted beside the law (None: none).
 
     Returns
     -------
@@ -142,8 +149,13 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                          "jackknife over runs)")
     if not (math.isfinite(min_window_time) and min_window_time >= 0):
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
+    if registry_period is not None and not (math.isfinite(registry_period)
+                                            and registry_period > 0):
+        raise ValueError(f"registry_period = {registry_period!r}: a period > 0, finite, "
+                         "or None")
     parts = [_held(r, i, mass=mass, drive_velocity=drive_velocity, mount_damping=mount_damping,
-                   min_velocity_fraction=min_velocity_fraction, smoothing=smoothing)
+                   min_velocity_fraction=min_velocity_fraction, smoothing=smoothing,
+                   registry_period=registry_period)
              for i, r in enumerate(runs)]
     dt = parts[0][1]
     for i, (_, d, _) in enumerate(parts):
@@ -154,7 +166,7 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     lags = max(h["impulse"].shape[1] for h, _, _ in parts)
     held = {k: np.concatenate([np.pad(h[k], ((0, 0), (0, lags - h[k].shape[1])), mode="edge")
                                for h, _, _ in parts])
-            for k in HELD}
+            for k in held_keys(parts[0][0])}
     groups = (np.concatenate([np.full(h["impulse"].shape[0], i) for i, (h, _, _) in
                               enumerate(parts)])
               if jackknife == "runs" else np.arange(held["impulse"].shape[0]))

@@ -26,7 +26,10 @@ branches' own lines apart, and the step beyond the one law's co-moving mass).  `
 D``: the shares' mixes with a yield loop (``melting``, ``slip-weakening`` or ``maxwell``,
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--lag TAU``: the shares' mixes with
 their viscous force lagging the velocity by TAU (``maxwell``; with ``--loop slip-weakening``,
-``maxwell-weakening``); ``--stop-velocity``: the mixes
+``maxwell-weakening``); ``--corrugation DF LAMBDA PHI``: the mixes with a force
+periodic in the wall's position (``corrugated``, the registry of commensurate walls);
+``--registry-period LAMBDA``: every fit (the truth's too) with a force of that period
+fitted beside the law (the MD's runs of aligned walls are: ``registry_period``); ``--stop-velocity``: the mixes
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
 is still the noise-free slips re-sticking at the scale's own stop velocity); ``--md RUN…``: the MD runs'
 slips' duration and share after their peak velocity, printed beside each table's first
@@ -83,11 +86,12 @@ def slip_shape(runs) -> str:
     return f"{len(dur)} slips: duration {q(dur)} τ, share after the peak velocity {q(after)}"
 
 
-def fit(runs, velocity, jackknife, scale="stiff"):
+def fit(runs, velocity, jackknife, scale="stiff", registry_period=None):
     sc = SCALES[scale]
     return fit_pooled_ensemble(runs, mass=sc.mass, drive_velocity=velocity,
                                mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME,
-                               jackknife=jackknife, film_mass=sc.film_mass)
+                               jackknife=jackknife, film_mass=sc.film_mass,
+                               registry_period=registry_period)
 
 
 def without_film_mass(f, mass: float) -> tuple[str, str]:
@@ -106,11 +110,17 @@ def table(law: str, share, args) -> None:
         kw |= {"loop_law": args.loop[0], "weakening": tuple(map(float, args.loop[1:]))}
     if share is not None and args.lag is not None:
         kw["lag"] = args.lag
+    if share is not None and args.corrugation:
+        kw["corrugation"] = tuple(args.corrugation)
     noisy = {} if args.noise_scale == 1.0 else {
         "noise": scaled(SCALES[args.scale].noise, args.noise_scale)}
     name = law if share is None else f"coulomb-viscous share {share}" + (
         f" with a yield loop ({' '.join(args.loop)})" if args.loop else "") + (
         f" lagging by τ_r = {args.lag:g} τ" if args.lag is not None else "") + (
+        " with the registry's force {:g} sin(2π x/{:g} + {:g})".format(*args.corrugation)
+        if args.corrugation else "") + (
+        f", fitted with the registry of period {args.registry_period:g} σ"
+        if args.registry_period else "") + (
         "" if args.stop_velocity is None else
         f", re-sticking at v <= {args.stop_velocity:g} σ/τ")
     # the truth: noise-free, re-sticking as the scale's mixes do (once slowed to its stop
@@ -119,7 +129,7 @@ def table(law: str, share, args) -> None:
     try:
         exact = fit(*pooled_runs(law, args.runs, args.slips, noise=NOISE_FREE,
                                  **(kw | {"law_spread": 0.0, "scale": SCALES[args.scale]})),
-                    "runs", args.scale)
+                    "runs", args.scale, args.registry_period)
     except ValueError as exc:       # noise-free, a run of this law slides without a slip
         print(f"\n## {name}: not measured: its noise-free truth has no slips to fit ({exc})",
               flush=True)
@@ -138,7 +148,7 @@ def table(law: str, share, args) -> None:
         if k == 0:
             shape = slip_shape(rs)
         try:
-            got = {j: fit(rs, v, j, args.scale) for j in JACKKNIFE}
+            got = {j: fit(rs, v, j, args.scale, args.registry_period) for j in JACKKNIFE}
         except ValueError as exc:       # a run without slips: its film slid smoothly
             unfitted.append(str(exc))
             continue
@@ -211,6 +221,13 @@ def main(argv=None) -> int:
     ap.add_argument("--lag", type=float, default=None, metavar="TAU",
                     help="the shares' mixes with their viscous force lagging the velocity by "
                          "TAU (a Maxwell film, τ); with --loop slip-weakening, that loop too")
+    ap.add_argument("--corrugation", nargs=3, type=float, default=None,
+                    metavar=("DF", "LAMBDA", "PHI"),
+                    help="the shares' mixes with a force DF·sin(2π·x/LAMBDA + PHI) of the wall's "
+                         "position (commensurate walls' registry; ε/σ, σ, rad)")
+    ap.add_argument("--registry-period", type=float, default=None, metavar="LAMBDA",
+                    help="fit a force periodic in the wall's position, of this period (σ), "
+                         "beside the law (as the MD's runs of aligned walls are fitted)")
     ap.add_argument("--stop-velocity", type=float, default=None,
                     help="the shares' mixes re-stick once armed at this velocity (σ/τ; "
                          "negative: once the wall recoils that fast; the scale's by default)")
@@ -237,6 +254,13 @@ def main(argv=None) -> int:
             args.loop and args.loop[0] != "slip-weakening")):
         ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and with --loop only "
                  "slip-weakening")
+    if args.corrugation and (args.loop or args.lag is not None or not all(
+            map(math.isfinite, args.corrugation)) or not args.corrugation[1] > 0):
+        ap.error(f"--corrugation {args.corrugation!r}: finite, LAMBDA > 0, and not with "
+                 "--loop or --lag")
+    if args.registry_period is not None and not (math.isfinite(args.registry_period)
+                                                 and args.registry_period > 0):
+        ap.error(f"--registry-period {args.registry_period!r}: a period > 0, finite")
     if args.stop_velocity is not None and not (math.isfinite(args.stop_velocity)
                                                or args.stop_velocity == -math.inf):
         ap.error(f"--stop-velocity {args.stop_velocity!r}: finite or -inf")

@@ -88,6 +88,8 @@ def _record(scene: Scene, run_dir: Path, cmd: list[str], nprocs: int, threads: i
             "mount_damping": (p["mount_damping"] * p["wall_mass"]) or None,
             # the film's atoms weigh 1 m each (film_slide.lmp's type 1, the unit of mass)
             "film_mass": float(d["film_atoms"]) or None,
+            # the walls' lattice period along the slide: the film's force repeats with it
+            "registry_period": scene.geometry().registry_period,
             "units": "lj",
         },
         "trace_units": TRACE_UNITS,
