@@ -83,6 +83,30 @@ def test_a_twisted_top_wall_has_its_rows_30_degrees_off_the_bottom_walls():
         resolve({"cells_x": 6, "cells_y": 3, "top_wall_twist": "twisted"})
 
 
+def test_the_registry_period_is_the_aligned_walls_lattice_along_the_slide():
+    # the slip law fits a force periodic in the wall's position with the geometry's
+    # registry_period: aligned, both walls' facing planes map onto themselves shifted by it
+    # along x (and not by half of it); twisted, the top wall's rows are not the bottom's: none
+    from filmfriction.workflows.md.scenes.parameters import geometry
+
+    p = resolve(SMALL_BOX)
+    period = geometry(p).registry_period
+    assert period == p["wall_spacing"]
+    bottom, top = _walls(p)
+    box = np.diag(bottom.cell)[:2]
+
+    def maps(points, shift):
+        moved = (points + [shift, 0.0]) % box
+        d = np.abs(moved[:, None, :] - points[None, :, :] % box)
+        d = np.minimum(d, box - d)
+        return bool(np.all(np.min(np.hypot(d[..., 0], d[..., 1]), axis=1) < 1e-6))
+
+    for wall, facing_up in ((bottom, True), (top, False)):
+        plane = _surface(wall.positions, top=facing_up)
+        assert maps(plane, period) and not maps(plane, period / 2)
+    assert geometry(resolve({**SMALL_BOX, "top_wall_twist": "twisted"})).registry_period is None
+
+
 def test_vacancies_are_taken_from_the_planes_facing_the_film():
     full = resolve(SMALL_BOX)
     plane = 2 * 5 * 3

@@ -379,3 +379,30 @@ def test_a_run_gives_its_film_mass_and_an_older_run_its_film_atoms(synthetic_run
     path.write_text(json.dumps(run))
     with pytest.raises(ValueError, match="film_mass"):
         read_trace(synthetic_run)
+
+
+def test_a_run_gives_its_registry_period_and_an_older_run_its_walls_spacing(synthetic_run):
+    # the walls' registry period (the slip law fits a force periodic in the wall's position
+    # where it is known) is a trace parameter; a run recorded before it was one gives its
+    # scene's wall spacing when its walls are aligned, none when twisted; a recorded None
+    # stays None
+    import json
+
+    path = synthetic_run / "run.json"
+    run = json.loads(path.read_text())
+    assert read_trace(synthetic_run).parameters.registry_period is None
+    scene = {**run.get("scene", {}), "name": "stick-slip",
+             "parameters": {"wall_spacing": 1.1, "top_wall_twist": "aligned"}}
+    path.write_text(json.dumps(run | {"scene": scene}))
+    assert read_trace(synthetic_run).parameters.registry_period == 1.1
+    scene["parameters"]["top_wall_twist"] = "twisted"
+    path.write_text(json.dumps(run | {"scene": scene}))
+    assert read_trace(synthetic_run).parameters.registry_period is None
+    scene["parameters"]["top_wall_twist"] = "aligned"
+    run["trace_parameters"]["registry_period"] = None
+    path.write_text(json.dumps(run | {"scene": scene}))
+    assert read_trace(synthetic_run).parameters.registry_period is None
+    run["trace_parameters"]["registry_period"] = 0.0
+    path.write_text(json.dumps(run))
+    with pytest.raises(ValueError, match="registry_period"):
+        read_trace(synthetic_run)

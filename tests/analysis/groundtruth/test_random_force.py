@@ -138,7 +138,8 @@ def test_bad_arguments_are_refused(bad):
                                              ("melting", (25.0, 0.0, 10.0, 0.0)),
                                              ("slip-weakening", (25.0, 0.0, 10.0, -1.0)),
                                              ("maxwell", (25.0, 3.0, 1.0, 0.0)),
-                                             ("maxwell-weakening", (25.0, 3.0, 1.0, 1.0, 0.0))])
+                                             ("maxwell-weakening", (25.0, 3.0, 1.0, 1.0, 0.0)),
+                                             ("corrugated", (25.0, 3.0, 1.0, 0.0, 0.0))])
 def test_a_bad_law_is_refused(law, parameters):
     with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
         slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
@@ -171,6 +172,27 @@ def test_a_maxwell_film_slips_as_the_ode(law, parameters, held, excess):
         assert x[c + 1] - x[a] == pytest.approx(dist, rel=2e-3)
         assert v[a:c + 1].max() == pytest.approx(ode.y[1].max(), rel=2e-3)
         assert t[c + 1] - t[a] == pytest.approx(dur, abs=0.5)
+
+
+def test_a_corrugated_films_first_slip_is_the_ode():
+    # a film between commensurate walls: F_k + B·v + ΔF·sin(2π·x/λ + φ) at the wall's
+    # position x; the slider starts stuck at x = 0, so its first slip starts there, as the
+    # ODE's (later slips start at other registries and differ)
+    fk, b, df, lam, phi = 36.0, 2.0, 4.0, 1.1, 0.5
+    run = slide("corrugated", (fk, b, df, lam, phi), mass=M, stiffness=K, drive_velocity=0.1,
+                static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
+    y, s = run["yield_index"], run["stick_index"]
+    assert y.size >= 1
+    rhs = lambda t, q: [q[1], (FS + K * (0.1 * t - q[0]) - fk - b * q[1]
+                               - df * math.sin(2 * math.pi * q[0] / lam + phi)) / M]
+    stop = lambda t, q: q[1]
+    stop.terminal, stop.direction = True, -1
+    ode = solve_ivp(rhs, (0, 300), [0.0, 1e-12], events=stop, rtol=1e-10, atol=1e-12)
+    x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
+    a, c = y[0], s[0]
+    assert x[c + 1] - x[a] == pytest.approx(ode.y_events[0][0][0], rel=2e-3)
+    assert v[a:c + 1].max() == pytest.approx(ode.y[1].max(), rel=2e-3)
+    assert t[c + 1] - t[a] == pytest.approx(ode.t_events[0][0], abs=0.5)
 
 
 def test_a_lagging_film_reads_as_a_negative_comoving_mass():

@@ -292,3 +292,54 @@ def test_the_pooled_controls_benchmark_prints_the_noise_free_signature_alone(ben
     with pytest.raises(SystemExit):
         main(["--replicas", "-1"])
     assert "--replicas -1: 0 or more" in capsys.readouterr().err
+
+
+def test_the_registry_term_takes_a_corrugated_films_periodic_force_off_its_law():
+    # a film between commensurate walls, noise-free: the heavy slider's mix (F_k 21.6, B 318)
+    # with a force 17·sin(2π·x/1.1) of the wall's position (the MD's at M = 1e5: 17–20 ε/σ at
+    # its walls' spacing). Fitted as a film law alone the periodic force reads as a loop
+    # and a co-moving mass of ~10⁴ m and moves B; fitted with the registry's terms the law
+    # comes back on both branches; on a film without it the terms change nothing
+    kw = dict(mass=STIFF.mass, mount_damping=STIFF.mount_damping, film_mass=STIFF.film_mass,
+              min_window_time=3.0)
+    runs, v = pooled_runs("coulomb", 6, 6, share=0.2, corrugation=(17.0, 1.1, 0.0), noise=QUIET,
+                          static_spread=0.3, seed=2)
+    bare = fit_pooled_ensemble(runs, drive_velocity=v, **kw)
+    fitted = fit_pooled_ensemble(runs, drive_velocity=v, registry_period=1.1, **kw)
+    law_b = 0.2 * 27.0 / 0.017
+    assert abs(bare.decelerating.damping - law_b) > 0.05 * law_b
+    assert abs(bare.one_law.comoving_mass) > 3000.0 and abs(bare.loop_force) > 1.0
+    assert fitted.decelerating.damping == pytest.approx(law_b, rel=0.01)
+    assert fitted.decelerating.kinetic_force == pytest.approx(21.6, abs=0.1)
+    assert fitted.one_law.damping == pytest.approx(law_b, rel=0.05)
+    assert abs(fitted.loop_force) < 0.1 * abs(bare.loop_force)
+    plain, v = pooled_runs("coulomb", 6, 6, share=0.2, noise=QUIET, seed=2)
+    a = fit_pooled_ensemble(plain, drive_velocity=v, **kw)
+    b = fit_pooled_ensemble(plain, drive_velocity=v, registry_period=1.1, **kw)
+    assert b.decelerating.damping == pytest.approx(a.decelerating.damping, rel=1e-3)
+    with pytest.raises(ValueError, match="registry_period"):
+        fit_pooled_ensemble(plain, drive_velocity=v, registry_period=0.0, **kw)
+    with pytest.raises(ValueError, match="corrugation"):
+        pooled_runs("coulomb", 3, 2, share=0.2, lag=5.0, corrugation=(1.0, 1.1, 0.0))
+
+
+def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_module, capsys,
+                                                                     tmp_path):
+    spectrum = benchmark_module("slip_law/registry_spectrum").main
+    floor = benchmark_module("slip_law/pooled_velocity_floor").main
+    rates = benchmark_module("slip_law/pooled_controls_rates").main
+    for main, argv, said in (
+            (spectrum, [str(tmp_path), "--periods", "0"], "--periods 0.0: each > 0"),
+            (spectrum, [str(tmp_path), "--window", "nan"], "--window nan"),
+            (floor, ["--control", "4", "2", "--floors", "0.3", "0.1"], "increasing"),
+            (floor, [], "RUN_DIR… or --control"),
+            (rates, ["--registry-period", "-1"], "--registry-period -1.0"),
+            (rates, ["--corrugation", "1", "0", "0"], "LAMBDA > 0"),
+            (rates, ["--corrugation", "1", "1.1", "0", "--lag", "5"], "not with --loop or --lag")):
+        with pytest.raises(SystemExit) as stop:
+            main(argv)
+        assert stop.value.code == 2
+        assert said in capsys.readouterr().err
+    # a directory that is not a run: one line, no traceback
+    assert spectrum([str(tmp_path)]) == 1
+    assert "registry_spectrum:" in capsys.readouterr().err

@@ -34,6 +34,11 @@ def test_record_and_outputs(short_run):
     # the film's mass, what the slip law's rule takes for the most a co-moving mass can be
     assert record["trace_parameters"]["film_mass"] == 3 * 2 * 5 * 3
     assert read_trace(run_dir).parameters.film_mass == 3 * 2 * 5 * 3
+    # the walls' registry period along the slide (aligned walls: their spacing), which the
+    # slip law fits a periodic force of
+    spacing = scene.parameters["wall_spacing"]
+    assert record["trace_parameters"]["registry_period"] == spacing
+    assert read_trace(run_dir).parameters.registry_period == spacing
     assert record["outputs"]["trajectory"] and record["outputs"]["profiles"]
     assert (run_dir / "trajectory.dcd").stat().st_size > 0
     assert (run_dir / "topology.data").stat().st_size > 0
