@@ -198,5 +198,7 @@ def to_document(pooled: PooledSlipLaw) -> dict:
                                                "out (a comparison, not the verdict)"},
             "method": "the mean of all the runs' slips, each aligned at its yield and held at "
                       "its end, fitted as one slip (F_film = F_k + B v on each branch, the "
-                      "one law with a co-moving mass); errors, verdict and power by the "
-                      "jackknife over the runs"}
+                      "one law with a co-moving mass; where shared.registry_period is known, "
+                      "with a force periodic in the wall's position beside the law, two "
+                      "harmonics of that period: the walls' registry); errors, verdict and "
+                      "power by the jackknife over the runs"}

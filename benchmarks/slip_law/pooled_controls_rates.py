@@ -12,7 +12,7 @@ each run with its own yield force and, with ``--law-spread``, its own film
 (:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are pooled and
 fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
 with the jackknife over the runs, and the same pooled slips with the jackknife over the
-slips (the comparison that treats them as one run's).  Printed per law: the verdicts of
+slips (the comparison that treats them as one run's; `--jackknife runs`: the first alone).  Printed per law: the verdicts of
 both (the rule's, which branch it read, and the decelerating branch's alone), and for the
 decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit: the law's
@@ -141,18 +141,18 @@ def table(law: str, share, args) -> None:
           f"{exact.verdict}", flush=True)
     if not args.replicas:
         return
-    fits = {j: [] for j in JACKKNIFE}
+    fits = {j: [] for j in args.jackknife}
     unfitted = []
     for k in range(args.replicas):
         rs, v = pooled_runs(law, args.runs, args.slips, seed=(args.seed, k), **kw, **noisy)
         if k == 0:
             shape = slip_shape(rs)
         try:
-            got = {j: fit(rs, v, j, args.scale, args.registry_period) for j in JACKKNIFE}
+            got = {j: fit(rs, v, j, args.scale, args.registry_period) for j in args.jackknife}
         except ValueError as exc:       # a run without slips: its film slid smoothly
             unfitted.append(str(exc))
             continue
-        for j in JACKKNIFE:
+        for j in args.jackknife:
             fits[j].append(got[j])
     print(f"\n## {name}: {args.replicas} replicas of {args.runs} runs x {args.slips} slips "
           f"(static spread ±{args.static_spread:g}, law spread {args.law_spread:g})",
@@ -162,9 +162,9 @@ def table(law: str, share, args) -> None:
         print(f"  {len(unfitted)} replicas not fitted (a run in them has no slip to pool, as "
               f"no MD run of the pools has), e.g. {unfitted[0]}; the counts are of the "
               f"{args.replicas - len(unfitted)} others")
-    if not fits[JACKKNIFE[0]]:
+    if not fits[args.jackknife[0]]:
         return
-    for j in JACKKNIFE:
+    for j in args.jackknife:
         c = Counter(f.verdict for f in fits[j])
         d = Counter(f.decelerating.verdict for f in fits[j])
         print(f"  jackknife over {j}: " + ", ".join(f"{v} {c[v]}" for v in VERDICTS if c[v])
@@ -221,6 +221,8 @@ def main(argv=None) -> int:
     ap.add_argument("--lag", type=float, default=None, metavar="TAU",
                     help="the shares' mixes with their viscous force lagging the velocity by "
                          "TAU (a Maxwell film, τ); with --loop slip-weakening, that loop too")
+    ap.add_argument("--jackknife", nargs="+", choices=JACKKNIFE, default=list(JACKKNIFE),
+                    help="the jackknifes measured (runs: the errors; slips: the comparison)")
     ap.add_argument("--corrugation", nargs=3, type=float, default=None,
                     metavar=("DF", "LAMBDA", "PHI"),
                     help="the shares' mixes with a force DF·sin(2π·x/LAMBDA + PHI) of the wall's "

@@ -57,6 +57,10 @@ def format_pooled(doc: dict) -> str:
     out = _row("pooled, jackknife over runs", doc["pooled"])
     out += [""] + _row("the same mean, jackknife over slips (comparison)",
                        doc["jackknife_over_slips"])
+    period = (doc.get("shared") or {}).get("registry_period")
+    if period:
+        out += ["", f"fitted beside the law: the walls' registry force, periodic in the wall's "
+                    f"position with their lattice's period {period:g} (two harmonics)"]
     out += ["", f"{len(doc['runs'])} runs, {doc['slips']} slips:"]
     out += [f"  {r['run_dir']}: {r['slips']} slips, seed {r['seed']}" for r in doc["runs"]]
     return "\n".join(out)
