@@ -57,7 +57,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     the mix with its viscous force lagging the velocity by τ_r (``maxwell``); ``corrugation``
     = (ΔF, λ, φ): the mix with a force ΔF·sin(2π·x/λ + φ) of the wall's position x, the
     registry of commensurate walls (``corrugated``; every run starts at x = 0, as the MD's
-    runs start from one geometry).  ``seed``: an int or a tuple of ints."""
+    runs start from one geometry; ``law_spread`` leaves it alone).  ``seed``: an int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
@@ -81,6 +81,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
         if weakening is not None:
             # the film yields at its own F_s: ΔF the loop's share of the run's F_s − F_k
             par = par[:2] + (par[2] * max(fs - par[0], 0.0),) + par[3:]
+        if corrugation is not None:
+            # the registry is the walls' (one geometry for every run), not the film's
+            par = par[:2] + law["parameters"][2:]
         r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
                   stiffness=sc.spring_constant,
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,

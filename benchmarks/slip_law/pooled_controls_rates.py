@@ -12,8 +12,8 @@ each run with its own yield force and, with ``--law-spread``, its own film
 (:mod:`filmfriction.analysis.groundtruth.pooled_controls`).  The runs' slips are pooled and
 fitted (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`)
 with the jackknife over the runs, and the same pooled slips with the jackknife over the
-slips (the comparison that treats them as one run's; `--jackknife runs`: the first alone).  Printed per law: the verdicts of
-both (the rule's, which branch it read, and the decelerating branch's alone), and for the
+slips (the comparison that treats them as one run's; ``--jackknife runs``: the first
+alone).  Printed per law: the verdicts of both (the rule's, which branch it read, and the decelerating branch's alone), and for the
 decelerating branch and the one law the bias of F_k and B (mean − truth
 ± its standard error over the replicas; the truth is the noise-free pooled fit: the law's
 own F_k, B for a law without a loop; with ``--loop``, the loop law's own noise-free fit,
