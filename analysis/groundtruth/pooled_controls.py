@@ -57,7 +57,8 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     the mix with its viscous force lagging the velocity by τ_r (``maxwell``); ``corrugation``
     = (ΔF, λ, φ): the mix with a force ΔF·sin(2π·x/λ + φ) of the wall's position x, the
     registry of commensurate walls (``corrugated``; every run starts at x = 0, as the MD's
-    runs start from one geometry; ``law_spread`` leaves it alone).  ``seed``: an int or a tuple of ints."""
+    runs start from one geometry; ``law_spread`` leaves it alone; with ``lag``, the
+    viscous force lags too).  ``seed``: an int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
@@ -65,11 +66,12 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
     if corrugation is not None:
-        if law["law"] != "coulomb-viscous" or len(corrugation) != 3:
+        if law["law"] not in ("coulomb-viscous", "maxwell") or len(corrugation) != 3:
             raise ValueError(f"corrugation = {corrugation!r}: (ΔF, λ, φ), on a Coulomb + "
-                             "viscous mix without a loop or a lag")
+                             "viscous mix without a loop (with a lag or not)")
         law |= {"law": "corrugated",
-                "parameters": law["parameters"] + tuple(float(c) for c in corrugation)}
+                "parameters": law["parameters"][:2] + tuple(float(c) for c in corrugation)
+                + (float(lag or 0.0),)}
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
     rng = np.random.default_rng(key + [7919])

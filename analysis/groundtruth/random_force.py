@@ -85,12 +85,13 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS"]
 #: * ``maxwell-weakening`` (F_k, B, ΔF, D_c, τ_r): sign(v)·(F_k + ΔF·exp(−s/D_c)) + ψ, s the
 #:   distance slid since the yield, ψ the ``maxwell`` film's lagging viscous force (0 at
 #:   each yield): a film that melts over the slip distance and whose viscous force lags;
-#: * ``corrugated`` (F_k, B, ΔF, λ, φ): sign(v)·F_k + B·v + ΔF·sin(2π·x/λ + φ), x the wall's
-#:   position: a film whose force is modulated by the registry of commensurate walls (the
-#:   lattice's period λ along the slide; φ, the registry at x = 0).
+#: * ``corrugated`` (F_k, B, ΔF, λ, φ, τ_r): sign(v)·F_k + B·v + ΔF·sin(2π·x/λ + φ), x the
+#:   wall's position: a film whose force is modulated by the registry of commensurate walls
+#:   (the lattice's period λ along the slide; φ, the registry at x = 0); with τ_r > 0 its
+#:   viscous force lags as the ``maxwell`` film's (ψ in place of B·v, 0 at each yield).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
-        "corrugated": 5}
+        "corrugated": 6}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
 #: distance, a velocity, a time).
 LOOP_LAWS = ("melting", "slip-weakening", "maxwell")
@@ -118,7 +119,7 @@ def _friction(code, p, v, psi, x, x_yield):
         f = p[0] + p[2] * math.exp(-(x - x_yield) / p[3])
         return (f if v >= 0.0 else -f) + psi
     if code == 8:
-        return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
+        return ((p[0] if v >= 0.0 else -p[0]) + (psi if p[5] > 0.0 else p[1] * v)
                 + p[2] * math.sin(2.0 * math.pi * x / p[3] + p[4]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
@@ -133,6 +134,8 @@ def _state_rate(code, p, v, psi):
         return (p[1] * v - psi) / p[3]
     if code == 7:
         return (p[1] * v - psi) / p[4]
+    if code == 8 and p[5] > 0.0:
+        return (p[1] * v - psi) / p[5]
     return 0.0
 
 
@@ -195,7 +198,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
-                        if code == 4 or code == 5 or code == 7:
+                        if code == 4 or code == 5 or code == 7 or code == 8:
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
@@ -262,9 +265,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     if (law in LOOP_LAWS or law == "maxwell-weakening") and not p[3] > 0:
         raise ValueError(f"parameters = {parameters!r}: the loop's scale D_c, v_c or τ_r "
                          "(the fourth) must be > 0")
-    if law == "corrugated" and not p[3] > 0:
+    if law == "corrugated" and not (p[3] > 0 and p[5] >= 0):
         raise ValueError(f"parameters = {parameters!r}: the registry's period λ (the fourth) "
-                         "must be > 0")
+                         "must be > 0, the lag τ_r (the sixth) >= 0")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

@@ -27,7 +27,8 @@ D``: the shares' mixes with a yield loop (``melting``, ``slip-weakening`` or ``m
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--lag TAU``: the shares' mixes with
 their viscous force lagging the velocity by TAU (``maxwell``; with ``--loop slip-weakening``,
 ``maxwell-weakening``); ``--corrugation DF LAMBDA PHI``: the mixes with a force
-periodic in the wall's position (``corrugated``, the registry of commensurate walls);
+periodic in the wall's position (``corrugated``, the registry of commensurate walls; with
+``--lag``, lagging too);
 ``--registry-period LAMBDA``: every fit (the truth's too) with a force of that period
 fitted beside the law (the MD's runs of aligned walls are: ``registry_period``); ``--stop-velocity``: the mixes
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth
@@ -256,10 +257,10 @@ def main(argv=None) -> int:
             args.loop and args.loop[0] != "slip-weakening")):
         ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and with --loop only "
                  "slip-weakening")
-    if args.corrugation and (args.loop or args.lag is not None or not all(
+    if args.corrugation and (args.loop or not all(
             map(math.isfinite, args.corrugation)) or not args.corrugation[1] > 0):
         ap.error(f"--corrugation {args.corrugation!r}: finite, LAMBDA > 0, and not with "
-                 "--loop or --lag")
+                 "--loop")
     if args.registry_period is not None and not (math.isfinite(args.registry_period)
                                                  and args.registry_period > 0):
         ap.error(f"--registry-period {args.registry_period!r}: a period > 0, finite")

@@ -139,7 +139,8 @@ def test_bad_arguments_are_refused(bad):
                                              ("slip-weakening", (25.0, 0.0, 10.0, -1.0)),
                                              ("maxwell", (25.0, 3.0, 1.0, 0.0)),
                                              ("maxwell-weakening", (25.0, 3.0, 1.0, 1.0, 0.0)),
-                                             ("corrugated", (25.0, 3.0, 1.0, 0.0, 0.0))])
+                                             ("corrugated", (25.0, 3.0, 1.0, 0.0, 0.0, 0.0)),
+                                             ("corrugated", (25.0, 3.0, 1.0, 1.1, 0.0, -1.0))])
 def test_a_bad_law_is_refused(law, parameters):
     with pytest.raises(ValueError, match=law if law == "stribeck" else "parameters"):
         slide(law, parameters, mass=M, stiffness=K, drive_velocity=0.1, static_force=FS,
@@ -179,7 +180,7 @@ def test_a_corrugated_films_first_slip_is_the_ode():
     # position x; the slider starts stuck at x = 0, so its first slip starts there, as the
     # ODE's (later slips start at other registries and differ)
     fk, b, df, lam, phi = 36.0, 2.0, 4.0, 1.1, 0.5
-    run = slide("corrugated", (fk, b, df, lam, phi), mass=M, stiffness=K, drive_velocity=0.1,
+    run = slide("corrugated", (fk, b, df, lam, phi, 0.0), mass=M, stiffness=K, drive_velocity=0.1,
                 static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
     y, s = run["yield_index"], run["stick_index"]
     assert y.size >= 1
