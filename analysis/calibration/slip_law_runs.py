@@ -29,7 +29,7 @@ import numpy as np
 from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import FilmForceFit
-from ..slip_law.slip_law_cycles import MD_NOISE_TIME
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fitted_registry_period
 from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
 from ..slip_law.slip_law_stats import sigmas
 from .rundata import load_run
@@ -130,9 +130,11 @@ def fit_arguments(shared: dict) -> dict:
                 min_window_time=MD_NOISE_TIME if shared["units"] == "lj" else 0.0)
 
 
-def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
+def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True) -> PooledSlipLaw:
     """The slip law of the runs in ``run_dirs`` pooled (module text); a run not analysed yet
-    is analysed (and its ``analysis.json`` written), or with ``analyse=False`` refused.
+    is analysed (and its ``analysis.json`` written), or with ``analyse=False`` refused;
+    ``registry=False``: the law alone, without the walls' registry force beside it (the
+    comparison; ``shared["registry_period"]`` is then None).
 
     Raises
     ------
@@ -144,6 +146,11 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True) -> PooledSlipLaw:
         refuses (fewer than three runs, a run with no slip).
     """
     runs, shared, info = read_runs(run_dirs, analyse=analyse)
+    # the period the slips are fitted with (None: the law alone, as asked or where the slips
+    # span too little of it), which the document records
+    shared = {**shared, "registry_period": fitted_registry_period(
+        shared.get("registry_period") if registry else None,
+        np.concatenate([np.asarray(r.table.slip_distance) for r in runs]))}
     kw = fit_arguments(shared)
     fit = fit_pooled_ensemble(runs, **kw)
     by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips")

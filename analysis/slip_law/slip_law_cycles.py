@@ -86,6 +86,7 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inpu
 from .slip_law_branches import Segment
 
 __all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "held_keys", "slipped",
+           "fitted_registry_period", "REGISTRY_MIN_PERIODS",
            "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME", "REGISTRY_HARMONICS"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
@@ -101,6 +102,24 @@ HELD = ("impulse", "velocity", "held_velocity", "displacement", "slipping_time")
 #: MD's has a second harmonic of half the first's amplitude (docs/results/slip-law.md,
 #: "The walls' registry in the film's force").
 REGISTRY_HARMONICS = 2
+#: The fewest periods of the registry the median slip must span for its force to be fitted:
+#: over a shorter slip a periodic force is a smooth function of the distance, which the
+#: terms cannot tell from the law's (the fit would lose the branches).
+REGISTRY_MIN_PERIODS = 2.0
+
+
+def fitted_registry_period(registry_period: float | None, slip_distances) -> float | None:
+    """The registry period the slips are fitted with: ``registry_period`` where their median
+    distance spans :data:`REGISTRY_MIN_PERIODS` of it, else None (the law alone).
+
+    >>> fitted_registry_period(1.1, [3.0, 4.8, 6.0]), fitted_registry_period(1.1, [0.4, 1.0])
+    (1.1, None)
+    """
+    d = np.asarray(slip_distances, float)
+    d = d[np.isfinite(d)]
+    if registry_period is None or not d.size:
+        return None
+    return registry_period if np.median(np.abs(d)) >= REGISTRY_MIN_PERIODS * registry_period else None
 
 
 def held_keys(held: dict) -> tuple:
@@ -235,7 +254,8 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
                        registry_period: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``table`` (module text), errors by the
     jackknife over the slips; with ``registry_period``, beside the law a force periodic in
-    the wall's position (:func:`held_slips`).
+    the wall's position (:func:`held_slips`; where the slips span enough of it:
+    :func:`fitted_registry_period`).
 
     Arguments as :func:`~filmfriction.analysis.slip_law.slip_law.fit_film_force` (the
     sampling must be uniform).  The slips in which the wall did not slip (the spring
@@ -267,6 +287,8 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
         raise ValueError(f"{int(keep.sum())} slip(s) that relax the spring by "
                          f"{100 * MIN_RELAXATION:g} % or more: the cycle ensemble needs "
                          f"{MIN_CYCLES} or more")
+    registry_period = fitted_registry_period(registry_period,
+                                             np.asarray(table.slip_distance)[keep])
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
                       drive_velocity=drive_velocity, registry_period=registry_period)
     if not (math.isfinite(min_window_time) and min_window_time >= 0):

@@ -52,7 +52,8 @@ import numpy as np
 from filmfriction.reduced_model.cycles import CycleTable
 
 from .slip_law import MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inputs
-from .slip_law_cycles import fit_held_ensemble, held_keys, held_slips, slipped, uniform_step
+from .slip_law_cycles import (fit_held_ensemble, fitted_registry_period, held_keys, held_slips,
+                              slipped, uniform_step)
 
 __all__ = ["RunSlips", "fit_pooled_ensemble", "MIN_RUNS", "JACKKNIFE"]
 
@@ -127,7 +128,9 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
         The period λ of the walls' registry along the slide (the runs' wall positions
         share its origin): a force periodic in the wall's position, of
         :data:`~filmfriction.analysis.slip_law.slip_law_cycles.REGISTRY_HARMONICS`
-        harmonics, is fitted beside the law (None: none).
+        harmonics, is fitted beside the law where the median slip spans two periods
+        (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fitted_registry_period`;
+        None: none).
 
     Returns
     -------
@@ -153,6 +156,9 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                                             and registry_period > 0):
         raise ValueError(f"registry_period = {registry_period!r}: a period > 0, finite, "
                          "or None")
+    registry_period = fitted_registry_period(
+        registry_period, np.concatenate([np.asarray(r.table.slip_distance)[slipped(r.table)]
+                                         for r in runs]))
     parts = [_held(r, i, mass=mass, drive_velocity=drive_velocity, mount_damping=mount_damping,
                    min_velocity_fraction=min_velocity_fraction, smoothing=smoothing,
                    registry_period=registry_period)

@@ -1,4 +1,5 @@
-"""``filmfriction slip-law RUN_DIR… [--json] [--out FILE.json]``: the slip law of runs pooled.
+"""``filmfriction slip-law RUN_DIR… [--no-registry] [--json] [--out FILE.json]``: the slip law
+of runs pooled.
 
 Runs of one scene that differ in their seed (or a finished sweep over seeds) are replicas
 of one experiment: their slips are fitted together as one mean slip, and the errors, the
@@ -27,6 +28,9 @@ def register(subparsers) -> None:
     p.add_argument("run_dirs", nargs="+", type=Path, metavar="RUN_DIR",
                    help="three or more run directories of one scene (trace.csv + run.json), "
                         "or finished sweeps (aggregate.json) over seeds")
+    p.add_argument("--no-registry", action="store_true",
+                   help="fit the film's law alone, without the walls' registry force beside it "
+                        "(by default fitted where the runs record its period: aligned walls)")
     p.add_argument("--json", action="store_true", help="print the document")
     p.add_argument("--out", type=Path, default=None, metavar="FILE.json",
                    help="write the document there (its folder created if missing)")
@@ -74,7 +78,7 @@ def run(args) -> int:
 
     run_dirs = checked_runs(args.run_dirs, args.out)
     try:
-        doc = to_document(pooled_slip_law(run_dirs))
+        doc = to_document(pooled_slip_law(run_dirs, registry=not args.no_registry))
     except ValueError as exc:
         raise UserError(str(exc)) from None
     text = json.dumps(json_safe(doc), indent=2, ensure_ascii=False, allow_nan=False) + "\n"

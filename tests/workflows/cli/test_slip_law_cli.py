@@ -50,3 +50,32 @@ def test_a_cycles_table_that_disagrees_with_its_analysis_is_refused(runs, capsys
     err = capsys.readouterr().err
     assert "analysis_cycles.csv holds 0 slip(s), analysis.json 4" in err, err
     assert "Traceback" not in err
+
+
+def test_the_registry_fitted_where_recorded_and_left_out_on_request(runs, capsys):
+    # runs that record their walls' registry period have a force periodic in the wall's
+    # position fitted beside the law where their slips span two periods, and say so;
+    # --no-registry fits the law alone; a period longer than half the slips is not fitted.
+    # These synthetic slips (0.38 σ) carry no such force: every fit reads Klein's B = 40 m/τ
+    def record(period):
+        for r in runs:
+            doc = json.loads((r / "run.json").read_text())
+            doc["trace_parameters"]["registry_period"] = period
+            (r / "run.json").write_text(json.dumps(doc))
+
+    def pooled(*more):
+        assert main(["slip-law", *map(str, runs), "--json", *more]) == 0
+        return json.loads(capsys.readouterr().out)
+
+    record(0.15)
+    fitted, alone = pooled(), pooled("--no-registry")
+    assert main(["slip-law", *map(str, runs)]) == 0
+    assert "the walls' registry force" in capsys.readouterr().out
+    record(1.1)
+    short = pooled()
+    assert fitted["shared"]["registry_period"] == 0.15
+    assert alone["shared"]["registry_period"] is None and short["shared"]["registry_period"] is None
+    for doc in (fitted, alone, short):
+        assert doc["pooled"]["damping"]["mean"] == pytest.approx(40.0, rel=0.05)
+    assert fitted["pooled"]["damping"]["stderr"] != alone["pooled"]["damping"]["stderr"]
+    assert short["pooled"]["damping"] == alone["pooled"]["damping"]
