@@ -29,7 +29,7 @@ import numpy as np
 from filmfriction.reduced_model.cycles import cycle_table
 
 from ..slip_law.slip_law import FilmForceFit
-from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fitted_registry_period
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME
 from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
 from ..slip_law.slip_law_stats import sigmas
 from .rundata import load_run
@@ -146,14 +146,12 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True) ->
         refuses (fewer than three runs, a run with no slip).
     """
     runs, shared, info = read_runs(run_dirs, analyse=analyse)
-    # the period the slips are fitted with (None: the law alone, as asked or where the slips
-    # span too little of it), which the document records
-    shared = {**shared, "registry_period": fitted_registry_period(
-        shared.get("registry_period") if registry else None,
-        np.concatenate([np.asarray(r.table.slip_distance) for r in runs]))}
-    kw = fit_arguments(shared)
+    kw = fit_arguments(shared if registry else {**shared, "registry_period": None})
     fit = fit_pooled_ensemble(runs, **kw)
     by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips")
+    # the document records the period the slips were fitted with (None: the law alone, as
+    # asked or where the slips span too little of it)
+    shared = {**shared, "registry_period": fit.registry_period}
     return PooledSlipLaw(fit, by_slips, info, shared, shared["units"])
 
 

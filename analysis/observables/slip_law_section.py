@@ -40,7 +40,7 @@ from scipy.signal import savgol_filter
 from filmfriction.reduced_model.units import lj_bulk_viscosity
 
 from ..slip_law.slip_law import BRANCHES, RESOLVED_SIGMAS, film_force, fit_film_force
-from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble, fitted_registry_period
+from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..files.trace import unit
 from ..trace_figure import scaled_unit
 from ..files.util import finite_or_none
@@ -109,8 +109,6 @@ class SlipLaw(Observable):
             ctx.skip_part("slip_law.cycle_ensemble", f"the slips' mean not fitted: {err}; "
                           "the verdict is the per-slip fit's")
         law, one = fit.law, fit.one_law          # the verdict's law; the whole slip with m_c
-        # the registry period the slips were fitted with (None: too short for it, or none)
-        registry = fitted_registry_period(p.registry_period, ctx.table.slip_distance)
         force_velocity = f"{ctx.unit('force')}·{ctx.unit('velocity')}"
         out = {"verdict": fit.verdict, "reason": fit.reason, "verdict_from": fit.verdict_from,
                "estimator": estimator,
@@ -136,8 +134,9 @@ class SlipLaw(Observable):
                                           damping_stderr=finite_or_none(one.damping_stderr),
                                           kinetic_force=finite_or_none(one.kinetic_force)),
                "smoothing_window": fit.smoothing_window,
-               "registry_period": ctx.value(registry, None, "length")
-               if estimator == ESTIMATORS[0] and registry else None,
+               # the registry period the slips were fitted with (None: none, or too short)
+               "registry_period": ctx.value(fit.registry_period, None, "length")
+               if fit.registry_period else None,
                "law": "F_film = kinetic_force + damping * v on each branch (+ comoving_mass "
                       "* a over the whole slip: one_law), F_film = F_spring - M a - "
                       "mount_damping (v - V), fitted in the integrated equation of motion "

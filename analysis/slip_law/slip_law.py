@@ -190,6 +190,10 @@ class FilmForceFit:
         reasons say by how much it moved.
     load_work_removed : bool
         Whether the load's work on the gap was taken out of the film force (module text).
+    registry_period : float or None
+        The period of the walls' registry whose force was fitted beside the law (the
+        slips' mean: :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fitted_registry_period`);
+        None: none fitted.
     """
 
     decelerating: BranchFit
@@ -212,6 +216,7 @@ class FilmForceFit:
     comoving_mass: bool
     still_windows: int = 0
     load_work_removed: bool = False
+    registry_period: float | None = None
 
     @property
     def law(self) -> BranchFit:

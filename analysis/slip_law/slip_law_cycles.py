@@ -74,6 +74,7 @@ Noise-free slips of a Coulomb + viscous slider (F_k = 20, B = 15) give the law b
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
@@ -171,9 +172,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     n = int(d.max()) + 1
     dt = float(t[1] - t[0])
     lag = np.arange(n)
-    reg = ([f"registry_{fn}{h}" for h in range(1, REGISTRY_HARMONICS + 1)
-            for fn in ("sin", "cos")] if registry_period is not None else [])
-    out = {k: np.empty((y.size, n)) for k in HELD + tuple(reg)}
+    reg = ([(f"registry_{wave.__name__}{h}", h, wave) for h in range(1, REGISTRY_HARMONICS + 1)
+            for wave in (np.sin, np.cos)] if registry_period is not None else [])
+    out = {k: np.empty((y.size, n)) for k in HELD + tuple(key for key, _, _ in reg)}
     for i, (a, b) in enumerate(zip(y, s)):
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
@@ -185,10 +186,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
                                               edge_order=2 if seg.size > 2 else 1)[k - a]
         out["displacement"][i] = x[k] - x[a]
         out["slipping_time"][i] = t[k] - t[a]
-        for key in reg:
-            phase = 2 * math.pi * int(key[-1]) * x[seg] / registry_period
-            wave = np.sin(phase) if "sin" in key else np.cos(phase)
-            out[key][i] = cumulative_trapezoid(wave, t[seg], initial=0.0)[k - a]
+        for key, h, wave in reg:
+            out[key][i] = cumulative_trapezoid(wave(2 * math.pi * h * x[seg] / registry_period),
+                                               t[seg], initial=0.0)[k - a]
     out["lag_time"] = lag * dt
     return out
 
@@ -295,9 +295,10 @@ def fit_cycle_ensemble(time, spring_force, wall_velocity, table: CycleTable, *, 
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
     window = max(smoothing_samples(t, table, smoothing), int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
-    return fit_held_ensemble(held, np.arange(int(keep.sum())), window=window, dt=dt, mass=mass,
-                             min_velocity_fraction=min_velocity_fraction,
-                             comoving_mass=comoving_mass, replicas="slips", film_mass=film_mass)
+    fit = fit_held_ensemble(held, np.arange(int(keep.sum())), window=window, dt=dt, mass=mass,
+                            min_velocity_fraction=min_velocity_fraction,
+                            comoving_mass=comoving_mass, replicas="slips", film_mass=film_mass)
+    return replace(fit, registry_period=registry_period)
 
 
 def fit_held_ensemble(held: dict, groups, *, window: int, dt: float, mass: float,

@@ -45,7 +45,7 @@ law back:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -182,7 +182,8 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
     window += 1 - window % 2
     window = max(window if 5 <= window < lags else 0, int(math.ceil(min_window_time / dt)))
     window += (1 - window % 2) if window else 0
-    return fit_held_ensemble(held, groups, window=window, dt=dt, mass=mass,
-                             min_velocity_fraction=min_velocity_fraction,
-                             comoving_mass=comoving_mass, replicas=jackknife,
-                             film_mass=film_mass)
+    fit = fit_held_ensemble(held, groups, window=window, dt=dt, mass=mass,
+                            min_velocity_fraction=min_velocity_fraction,
+                            comoving_mass=comoving_mass, replicas=jackknife,
+                            film_mass=film_mass)
+    return replace(fit, registry_period=registry_period)
