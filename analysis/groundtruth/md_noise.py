@@ -39,6 +39,8 @@ import math
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from ..slip_law.slip_law_cycles import REGISTRY_HARMONICS
+
 __all__ = ["slip_residuals", "residual_statistics", "common_shape_share", "slip_velocities", "increment_rms",
            "run_slips", "replica_slips", "residuals", "run_residuals", "replica_residuals",
            "LAGS", "EDGE", "MIN_SAMPLES"]
@@ -54,11 +56,15 @@ MIN_SAMPLES = 60
 def slip_residuals(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
                    mass: float, mount_damping: float = 0.0, drive_velocity: float = 0.0,
                    edge: int = EDGE, min_samples: int = MIN_SAMPLES,
-                   trend: int = 1) -> list[np.ndarray]:
+                   trend: int = 1, registry_period: float | None = None) -> list[np.ndarray]:
     """The integral-form residual over M of each slip (module text), one array per slip
     long enough.  ``trend`` > 1 fits Δt², …, Δt^trend besides: what is left is the part of
     the residual faster than the slip's own shape (a law's misfit over the slip, or a noise
-    slower than the slip, is taken out with it)."""
+    slower than the slip, is taken out with it).  With ``registry_period`` λ the walls'
+    registry force is fitted besides, as the slip-law fit fits it (the time integrals of
+    sin and cos(2π·h·x/λ), h to
+    :data:`~filmfriction.analysis.slip_law.slip_law_cycles.REGISTRY_HARMONICS`): what is
+    left is the noise beside a force periodic in the wall's position."""
     t, f, v, x = (np.asarray(a, float) for a in (time, spring_force, wall_velocity,
                                                  wall_position))
     imp = cumulative_trapezoid(f, t, initial=0.0)
@@ -69,7 +75,12 @@ def slip_residuals(time, spring_force, wall_velocity, wall_position, yields, sti
             continue
         dt, dx = t[i] - t[i[0]], x[i] - x[i[0]]
         resp = imp[i] - imp[i[0]] - mount_damping * (dx - drive_velocity * dt) - mass * v[i]
-        X = np.column_stack([np.ones(i.size), dt, dx] + [dt ** k for k in range(2, trend + 1)])
+        cols = [np.ones(i.size), dt, dx] + [dt ** k for k in range(2, trend + 1)]
+        if registry_period is not None:
+            cols += [cumulative_trapezoid(wave(2 * math.pi * h * x[i] / registry_period), t[i],
+                                          initial=0.0)
+                     for h in range(1, REGISTRY_HARMONICS + 1) for wave in (np.sin, np.cos)]
+        X = np.column_stack(cols)
         out.append((resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / mass)
     return out
 
@@ -127,7 +138,7 @@ def increment_rms(velocities, lags=(1, 4, 8)) -> list[float]:
 def run_slips(run_dir) -> dict:
     """A run directory's analysed slips as :func:`slip_residuals` takes them: its columns,
     ``yields``, ``sticks`` (the slips its analysis keeps), ``mass``, ``mount_damping``,
-    ``drive_velocity``."""
+    ``drive_velocity``, ``registry_period`` (None where the walls' registry is not known)."""
     from ..calibration.rundata import load_run
 
     run = load_run(run_dir)
@@ -137,12 +148,14 @@ def run_slips(run_dir) -> dict:
             "wall_velocity": tr.columns["wall_velocity"], "wall_position": tr.wall_position(),
             "yields": np.asarray(run.cycles["yield_index"])[run.skip:],
             "sticks": np.asarray(run.cycles["stick_index"])[run.skip:], "mass": p.mass,
-            "mount_damping": p.mount_damping or 0.0, "drive_velocity": vd or 0.0}
+            "mount_damping": p.mount_damping or 0.0, "drive_velocity": vd or 0.0,
+            "registry_period": p.registry_period}
 
 
 def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = None,
                   replicas: int = 40, duration: float | None = 1500.0, seed: int = 0,
-                  scale="klein", slips: int = 8, comoving_mass: float = 0.0) -> list[dict]:
+                  scale="klein", slips: int = 8, comoving_mass: float = 0.0,
+                  corrugation: tuple[float, float, float] | None = None) -> list[dict]:
     """The random-force replicas of control ``law`` (or of slips of viscous ``share``:
     :func:`~filmfriction.analysis.groundtruth.slip_law_controls.coulomb_viscous`) with the
     film's random force of ``noise`` (the keywords of
@@ -150,17 +163,33 @@ def replica_slips(noise: dict, *, law: str = "viscous", share: float | None = No
     gives a run (the start-up slip left out).  At ``scale`` (a name of
     :data:`~filmfriction.analysis.groundtruth.slip_law_controls.SCALES`; ``duration``
     None: long enough for ``slips`` slips) its mount dashpot and drive are the slips'; the
-    film carries ``comoving_mass`` with the slipping wall (the fit's mass is the scale's)."""
+    film carries ``comoving_mass`` with the slipping wall (the fit's mass is the scale's).
+    With ``corrugation`` = (ΔF, λ, φ) the mix of ``share`` carries the walls' registry force
+    ΔF·sin(2π·x/λ + φ) and each replica is a run of
+    :func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs` (its own yield
+    force, as the MD's runs; ``duration`` not used)."""
     from .slip_law_controls import random_force_runs, scale_named
 
     sc = scale_named(scale)
+    extra = {"mass": sc.mass} | ({"mount_damping": sc.mount_damping} if sc.mount_damping else {})
+    if corrugation is not None:
+        from .pooled_controls import pooled_runs
+
+        rs, vd = pooled_runs(law, replicas, slips, share=share, scale=sc, noise=noise,
+                             comoving_mass=comoving_mass, corrugation=corrugation, seed=seed)
+        return [{"time": r.time, "spring_force": r.spring_force,
+                 "wall_velocity": r.wall_velocity, "wall_position": r.wall_position,
+                 "yields": np.asarray(r.table.yield_index),
+                 "sticks": np.asarray(r.table.stick_index), "drive_velocity": vd} | extra
+                for r in rs]
     runs, vd = random_force_runs(law, replicas, duration=duration, noise=noise, seed=seed,
                                  share=share, scale=sc, slips=slips,
                                  comoving_mass=comoving_mass)
-    extra = {"mount_damping": sc.mount_damping, "drive_velocity": vd} if sc.mount_damping else {}
+    if sc.mount_damping:
+        extra["drive_velocity"] = vd
     return [{k: tr[k] for k in ("time", "spring_force", "wall_velocity", "wall_position")}
-            | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:],
-               "mass": sc.mass} | extra for tr in runs]
+            | {"yields": tr["yield_index"][1:], "sticks": tr["stick_index"][1:]} | extra
+            for tr in runs]
 
 
 def residuals(slips: dict, **kwargs) -> list[np.ndarray]:

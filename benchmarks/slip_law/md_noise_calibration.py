@@ -5,6 +5,8 @@ of random-force replicas, measured the same way (docs/results/slip-law.md, "The 
     python benchmarks/slip_law/md_noise_calibration.py RUN ... --scale stiff [--noise U RHO RATTLE ...]
                                                        [--share S] [--comoving-mass MC]
                                                        [--lags 1 4 16 64 256]
+                                                       [--registry-period L]
+                                                       [--corrugation DF L PHI]
 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
 control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
@@ -26,6 +28,11 @@ control (the light sliders' viscous controls slip too briefly); ``--comoving-mas
 film's mass their slipping wall carries (the fit knows the scale's M); ``--lags`` (samples) the
 lags of the residual's autocorrelation, the first three (or, with five or more, the first
 four) those of the jitter; the numbers are printed to 3 significant digits.
+``--registry-period L``: the residuals of the MD and of the replicas alike with the walls'
+registry force of period L fitted besides (what is left is the noise beside it, as the
+slip-law fit sees it); ``--corrugation DF L PHI``: the replicas' mix of ``--share`` carries
+the registry force DF·sin(2π·x/L + PHI), each replica a run with its own yield force
+(:func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs`).
 """
 from __future__ import annotations
 
@@ -46,13 +53,15 @@ PROCESSES = {"MD_NOISE": MD_NOISE, "RESIDUAL_AS_NOISE": RESIDUAL_AS_NOISE,
                                           "rattle": 0.15}}
 
 
-def row(name: str, slips: list[dict], lags=LAGS, fmt: str = ".3f") -> str:
+def row(name: str, slips: list[dict], lags=LAGS, fmt: str = ".3f",
+        registry_period: float | None = None) -> str:
     inc = increment_rms([v for sl in slips for v in slip_velocities(
         sl["wall_velocity"], sl["yields"], sl["sticks"])],
         lags=tuple(lags[:3] if len(lags) < 5 else lags[:4]))
     cells = [", ".join(f"{x:{fmt}}" for x in inc)]
     for trend in (1, 3):
-        rs = [r for sl in slips for r in residuals(sl, trend=trend)]
+        rs = [r for sl in slips
+              for r in residuals(sl, trend=trend, registry_period=registry_period)]
         st = residual_statistics(rs, lags=tuple(lags))
         cells.append(f"{st['rms']:{fmt}} ± {st['rms_stderr']:{fmt}}; " + ", ".join(
             f"{a:.2f} ± {e:.2f}" for a, e in zip(st["autocorrelation"],
@@ -78,6 +87,11 @@ def main(argv=None) -> int:
                     help="the film's mass the replicas' slipping wall carries (m)")
     ap.add_argument("--lags", nargs="+", type=int, default=list(LAGS),
                     help="lags in samples (residual's autocorrelation; the jitter's)")
+    ap.add_argument("--registry-period", type=float, default=None, metavar="L",
+                    help="fit the walls' registry force of period L (σ) in every residual")
+    ap.add_argument("--corrugation", nargs=3, type=float, default=None,
+                    metavar=("DF", "L", "PHI"),
+                    help="the replicas' mix (--share) carries DF·sin(2π·x/L + PHI)")
     a = ap.parse_args(argv)
     missing = [r for r in a.runs if not (Path(r) / "trace.csv").is_file()]
     if missing:
@@ -93,8 +107,18 @@ def main(argv=None) -> int:
         print(f"error: --comoving-mass {a.comoving_mass}: must be finite and >= 0",
               file=sys.stderr)
         return 2
+    if a.registry_period is not None and not (math.isfinite(a.registry_period)
+                                              and a.registry_period > 0):
+        print(f"error: --registry-period {a.registry_period}: must be finite and > 0",
+              file=sys.stderr)
+        return 2
+    if a.corrugation is not None and (a.share is None or not all(
+            map(math.isfinite, a.corrugation)) or not a.corrugation[1] > 0):
+        print(f"error: --corrugation {a.corrugation}: finite, L > 0, and with --share",
+              file=sys.stderr)
+        return 2
     if (a.scale != "klein" or a.noise or a.lags != list(LAGS) or a.share is not None
-            or a.comoving_mass):
+            or a.comoving_mass or a.registry_period is not None):
         return other_scale(a)
     print("| noise | slips | wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ) | residual, "
           "F_k + B·v: rms; autocorrelation at 0.25, 1, 2, 4 τ | its mean shape's share | "
@@ -119,15 +143,22 @@ def other_scale(a) -> int:
           f"(rms, σ/τ) | residual, F_k + B·v: rms; autocorrelation at "
           f"{', '.join(f'{k * dt:g}' for k in lags)} τ | its mean shape's share | "
           "residual, + Δt², Δt³ |\n|---|---|---|---|---|---|")
-    print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs], lags, ".3g"), flush=True)
+    reg = a.registry_period
+    if reg is not None:
+        print(f"(every residual with the registry force of period {reg:g} σ fitted besides"
+              + (", the replicas' mix carrying {:g}·sin(2π·x/{:g} + {:g}))".format(*a.corrugation)
+                 if a.corrugation else ")"))
+    print(row(f"MD ({len(a.runs)} runs)", [run_slips(r) for r in a.runs], lags, ".3g", reg),
+          flush=True)
     processes = {f"{a.scale} noise": sc.noise} | {
         f"u {u:g}, {rho:g}, rattle {r:g}": {"velocity_noise": u, "velocity_correlation": rho,
                                             "rattle": r} for u, rho, r in a.noise}
     for name, noise in processes.items():
         print(row(f"{name} {noise}", replica_slips(noise, replicas=a.replicas, scale=sc,
                                                    share=a.share, duration=None, slips=10,
-                                                   comoving_mass=a.comoving_mass),
-                  lags, ".3g"),
+                                                   comoving_mass=a.comoving_mass,
+                                                   corrugation=a.corrugation),
+                  lags, ".3g", reg),
               flush=True)
     return 0
 

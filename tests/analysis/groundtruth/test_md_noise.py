@@ -13,7 +13,8 @@ import pytest
 from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_slips,
                                                         residual_statistics, residuals,
                                                         slip_velocities)
-from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE
+from filmfriction.analysis.groundtruth.slip_law_controls import (MD_NOISE, RESIDUAL_AS_NOISE,
+                                                              STIFF_NOISE, STIFF_REGISTRY_NOISE)
 
 #: The MD's: the wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ), and the residual with
 #: Δt², Δt³ fitted besides (rms ± its standard error over the slips).
@@ -71,3 +72,33 @@ def test_residual_statistics_of_a_known_ar1():
     assert s["autocorrelation"] == pytest.approx([rho, rho ** 4], abs=0.03)
     with pytest.raises(ValueError, match="no slip"):
         residual_statistics([])
+
+
+#: The MD's fast residual (with Δt², Δt³) at the heavy slider's scale read with the walls'
+#: registry force fitted besides: ten ``sfb-thick-stiff`` runs, 89 slips (``python
+#: benchmarks/slip_law/md_noise_calibration.py RUN… --scale stiff --share 0.2 --corrugation 20
+#: 1.1 -0.97 --registry-period 1.1``, docs/results/slip-law.md), rms ± its standard error.
+MD_STIFF_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00158, 0.00007)
+CORRUGATION = (20.0, 1.1, -0.97)
+
+
+def _stiff_fast_rms(noise, replicas, registry_period):
+    slips = replica_slips(noise, scale="stiff", share=0.2, replicas=replicas, slips=10,
+                          duration=None, corrugation=CORRUGATION)
+    return residual_statistics([r for s in slips for r in residuals(
+        s, trend=3, registry_period=registry_period)])["rms"]
+
+
+def test_the_registry_terms_take_a_corrugated_films_force_out_of_the_residual():
+    quiet = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
+    unfitted = _stiff_fast_rms(quiet, 2, None)
+    fitted = _stiff_fast_rms(quiet, 2, CORRUGATION[1])
+    assert unfitted > 5e-4                # the registry force is in the law's residual
+    assert fitted < 0.05 * unfitted       # and the terms take it out
+
+
+def test_the_stiff_noise_beside_the_registry_is_the_mds_and_the_older_one_too_loud():
+    md, err = MD_STIFF_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(STIFF_REGISTRY_NOISE, 20, 1.1) == pytest.approx(md, abs=3 * err)
+    # calibrated without the registry's terms, STIFF_NOISE carries the registry force as noise
+    assert _stiff_fast_rms(STIFF_NOISE, 20, 1.1) > md + 6 * err
