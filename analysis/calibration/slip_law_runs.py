@@ -130,11 +130,15 @@ def fit_arguments(shared: dict) -> dict:
                 min_window_time=MD_NOISE_TIME if shared["units"] == "lj" else 0.0)
 
 
-def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True) -> PooledSlipLaw:
+def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True,
+                    viscous_lag: float | None = None) -> PooledSlipLaw:
     """The slip law of the runs in ``run_dirs`` pooled (module text); a run not analysed yet
     is analysed (and its ``analysis.json`` written), or with ``analyse=False`` refused;
     ``registry=False``: the law alone, without the walls' registry force beside it (the
-    comparison; ``shared["registry_period"]`` is then None).
+    comparison; ``shared["registry_period"]`` is then None); ``viscous_lag`` τ_r (the runs'
+    time unit): the film's viscous force lagging the shear rate by τ_r
+    (:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`; recorded
+    as ``shared["viscous_lag"]``).
 
     Raises
     ------
@@ -147,11 +151,11 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True) ->
     """
     runs, shared, info = read_runs(run_dirs, analyse=analyse)
     kw = fit_arguments(shared if registry else {**shared, "registry_period": None})
-    fit = fit_pooled_ensemble(runs, **kw)
-    by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips")
+    fit = fit_pooled_ensemble(runs, **kw, viscous_lag=viscous_lag)
+    by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips", viscous_lag=viscous_lag)
     # the document records the period the slips were fitted with (None: the law alone, as
-    # asked or where the slips span too little of it)
-    shared = {**shared, "registry_period": fit.registry_period}
+    # asked or where the slips span too little of it) and the viscous force's lag
+    shared = {**shared, "registry_period": fit.registry_period, "viscous_lag": viscous_lag}
     return PooledSlipLaw(fit, by_slips, info, shared, shared["units"])
 
 
@@ -205,5 +209,7 @@ def to_document(pooled: PooledSlipLaw) -> dict:
                       "its end, fitted as one slip (F_film = F_k + B v on each branch, the "
                       "one law with a co-moving mass; where shared.registry_period is known, "
                       "with a force periodic in the wall's position beside the law, two "
-                      "harmonics of that period: the walls' registry); errors, verdict and "
-                      "power by the jackknife over the runs"}
+                      "harmonics of that period: the walls' registry; where shared.viscous_lag "
+                      "is given, the viscous force B v_f with v_f the velocity relaxed to "
+                      "over that time from 0 at each yield); errors, verdict and power by "
+                      "the jackknife over the runs"}

@@ -194,6 +194,9 @@ class FilmForceFit:
         The period of the walls' registry whose force was fitted beside the law (the
         slips' mean: :func:`~filmfriction.analysis.slip_law.slip_law_cycles.fitted_registry_period`);
         None: none fitted.
+    viscous_lag : float or None
+        The relaxation time of the viscous force the fit lagged (B's regressor ∫v_f dt:
+        :func:`~filmfriction.analysis.slip_law.slip_law_cycles.held_slips`); None: B·v.
     """
 
     decelerating: BranchFit
@@ -217,6 +220,7 @@ class FilmForceFit:
     still_windows: int = 0
     load_work_removed: bool = False
     registry_period: float | None = None
+    viscous_lag: float | None = None
 
     @property
     def law(self) -> BranchFit:

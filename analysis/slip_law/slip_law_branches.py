@@ -108,6 +108,7 @@ class Segment:
     mass: float
     after_peak: np.ndarray  # max(Δt − Δt_peak, 0)
     registry: np.ndarray | None = None  # ∫sin, ∫cos(2π·h·x/λ) dt, (samples, 2·harmonics)
+    viscous_dx: np.ndarray | None = None  # ∫v_f dt, the lagging film's B regressor (else Δx)
 
     @property
     def mean_velocity(self) -> float:
@@ -125,7 +126,7 @@ class Segment:
         """Columns [intercepts…, Δt, Δx (, v − v0) (, the registry's) (, time past the
         peak)]."""
         cols = [np.full(self.y.size, float(k == which)) for k in range(intercepts)]
-        cols += [self.dt, self.dx]
+        cols += [self.dt, self.dx if self.viscous_dx is None else self.viscous_dx]
         reg = list(self.registry.T) if self.registry is not None else []
         return (cols + ([self.dv] if comoving else []) + reg
                 + ([self.after_peak] if step else []))

@@ -78,7 +78,7 @@ from dataclasses import replace
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
-from scipy.signal import savgol_filter
+from scipy.signal import lfilter, savgol_filter
 
 from filmfriction.reduced_model.cycles import CycleTable
 
@@ -88,7 +88,7 @@ from .slip_law_branches import Segment
 
 __all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "held_keys", "slipped",
            "fitted_registry_period", "REGISTRY_MIN_PERIODS",
-           "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME", "REGISTRY_HARMONICS"]
+           "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME", "REGISTRY_HARMONICS", "LAGGED"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
 MIN_CYCLES = 3
@@ -98,6 +98,8 @@ MIN_CYCLES = 3
 MD_NOISE_TIME = 3.0
 #: The per-slip, per-lag arrays of :func:`held_slips`.
 HELD = ("impulse", "velocity", "held_velocity", "displacement", "slipping_time")
+#: The per-slip array of a viscous force that lags (:func:`held_slips` with ``viscous_lag``).
+LAGGED = "lagged_displacement"
 #: The harmonics of the walls' registry force fitted where its period is given: the
 #: force of commensurate walls repeats with the lattice's period along the slide, and the
 #: MD's has a second harmonic of half the first's amplitude (docs/results/slip-law.md,
@@ -124,8 +126,9 @@ def fitted_registry_period(registry_period: float | None, slip_distances) -> flo
 
 
 def held_keys(held: dict) -> tuple:
-    """The per-slip arrays of ``held``: :data:`HELD` and the registry's, where fitted."""
-    return HELD + tuple(k for k in held if k.startswith("registry_"))
+    """The per-slip arrays of ``held``: :data:`HELD`, the registry's and :data:`LAGGED`,
+    where fitted."""
+    return HELD + tuple(k for k in held if k.startswith("registry_") or k == LAGGED)
 
 
 def uniform_step(t: np.ndarray, what: str) -> float:
@@ -150,7 +153,7 @@ def slipped(table: CycleTable) -> np.ndarray:
 
 def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks, *,
                mount_damping: float = 0.0, drive_velocity: float = 0.0,
-               registry_period: float | None = None) -> dict:
+               registry_period: float | None = None, viscous_lag: float | None = None) -> dict:
     """Each slip aligned at its yield and held at its end (module text), per slip and lag.
 
     Returns a dict of arrays of shape (slips, lags): ``impulse``, ``velocity`` (the
@@ -161,6 +164,10 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     yield.  With ``registry_period`` λ: ``registry_sin1``, ``registry_cos1``, … to
     :data:`REGISTRY_HARMONICS`, the time integrals over the slip of sin and cos(2π·h·x/λ)
     at the wall's position x (the regressors of a force periodic in the walls' registry).
+    With ``viscous_lag`` τ_r: :data:`LAGGED`, ∫v_f dt, v_f the slip's velocity (its
+    positions' derivative) relaxed to over τ_r from 0 at the yield, dv_f/dt = (v − v_f)/τ_r:
+    the regressor of B for a film whose viscous force lags the shear rate (a Maxwell film,
+    the ``maxwell`` law of :mod:`~filmfriction.analysis.groundtruth.random_force`).
     """
     t = np.asarray(time, float)
     f = np.asarray(spring_force, float)
@@ -174,7 +181,10 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     lag = np.arange(n)
     reg = ([(f"registry_{wave.__name__}{h}", h, wave) for h in range(1, REGISTRY_HARMONICS + 1)
             for wave in (np.sin, np.cos)] if registry_period is not None else [])
-    out = {k: np.empty((y.size, n)) for k in HELD + tuple(key for key, _, _ in reg)}
+    lagged = (LAGGED,) if viscous_lag is not None else ()
+    out = {k: np.empty((y.size, n)) for k in HELD + tuple(key for key, _, _ in reg) + lagged}
+    # v_f of a first-order relaxation, exact over a sample for the mean of its ends' v
+    relax = -math.expm1(-dt / viscous_lag) if viscous_lag is not None else 0.0
     for i, (a, b) in enumerate(zip(y, s)):
         k = np.minimum(lag, b - a) + a
         seg = np.arange(a, b + 1)
@@ -182,8 +192,12 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
         imp = cumulative_trapezoid(force, t[seg], initial=0.0)
         out["impulse"][i] = imp[k - a]
         out["velocity"][i] = v[k]
-        out["held_velocity"][i] = np.gradient(x[seg], t[seg],
-                                              edge_order=2 if seg.size > 2 else 1)[k - a]
+        own = np.gradient(x[seg], t[seg], edge_order=2 if seg.size > 2 else 1)
+        out["held_velocity"][i] = own[k - a]
+        if lagged:
+            vf = np.concatenate(([0.0], lfilter([relax], [1.0, relax - 1.0],
+                                                0.5 * (own[1:] + own[:-1]))))
+            out[LAGGED][i] = cumulative_trapezoid(vf, t[seg], initial=0.0)[k - a]
         out["displacement"][i] = x[k] - x[a]
         out["slipping_time"][i] = t[k] - t[a]
         for key, h, wave in reg:
@@ -236,13 +250,15 @@ def _segments(mean: dict, window: int, dt: float, p: int, lags: dict, mass: floa
     M·v is the sampled velocity's, in the response (Segment.response)."""
     x, s, v = mean["displacement"], mean["slipping_time"], mean["velocity"]
     carried = _guide(mean["held_velocity"], window, dt, deriv=0)
-    reg = [mean[k] for k in held_keys(mean)[len(HELD):]]
+    reg = [mean[k] for k in held_keys(mean) if k.startswith("registry_")]
+    lagged = mean.get(LAGGED)
     segs = {name: [None] for name in ("decelerating", "accelerating", "whole")}
     for name, i in lags.items():
         segs[name] = [Segment(mean["impulse"][i] - mean["impulse"][i[0]], v[i],
                               s[i] - s[i[0]], x[i] - x[i[0]], carried[i] - carried[i[0]], mass,
                               np.maximum(s[i] - s[p], 0.0),
-                              np.column_stack([r[i] - r[i[0]] for r in reg]) if reg else None)]
+                              np.column_stack([r[i] - r[i[0]] for r in reg]) if reg else None,
+                              None if lagged is None else lagged[i] - lagged[i[0]])]
     return segs
 
 

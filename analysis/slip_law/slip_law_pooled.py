@@ -79,7 +79,7 @@ class RunSlips:
 
 def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
           min_velocity_fraction, smoothing,
-          registry_period=None) -> tuple[dict, float, np.ndarray]:
+          registry_period=None, viscous_lag=None) -> tuple[dict, float, np.ndarray]:
     """The run's slips held at their ends, its sampling interval and its slips' durations
     (ValueError naming the run when its sampling is not uniform or no slip is left)."""
     name = run.name or f"run {i + 1}"
@@ -98,7 +98,8 @@ def _held(run: RunSlips, i: int, *, mass, drive_velocity, mount_damping,
         raise ValueError(f"{name}: no slip relaxes the spring by {100 * MIN_RELAXATION:g} % "
                          f"or more ({len(tab)} in its table)")
     held = held_slips(t, f, v, x, y[keep], s[keep], mount_damping=mount_damping,
-                      drive_velocity=drive_velocity, registry_period=registry_period)
+                      drive_velocity=drive_velocity, registry_period=registry_period,
+                      viscous_lag=viscous_lag)
     return held, dt, t[s[keep]] - t[y[keep]]
 
 
@@ -107,7 +108,8 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                         smoothing: float = SMOOTHING, comoving_mass: bool = False,
                         min_window_time: float = 0.0, jackknife: str = "runs",
                         film_mass: float | None = None,
-                        registry_period: float | None = None) -> FilmForceFit:
+                        registry_period: float | None = None,
+                        viscous_lag: float | None = None) -> FilmForceFit:
     """The slip law of the mean of the slips of ``runs`` (module text), errors by the
     jackknife over the runs.
 
@@ -131,6 +133,12 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
         harmonics, is fitted beside the law where the median slip spans two periods
         (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fitted_registry_period`;
         None: none).
+    viscous_lag : float, optional
+        τ_r of a film whose viscous force lags the shear rate, dψ/dt = (B·v − ψ)/τ_r from
+        ψ = 0 at each yield: B's regressor is then ∫v_f dt
+        (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.held_slips`), τ_r given,
+        not fitted (a profile over τ_r: ``benchmarks/slip_law/viscous_lag_profile.py``).
+        None: the viscous force B·v.
 
     Returns
     -------
@@ -152,16 +160,15 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                          "jackknife over runs)")
     if not (math.isfinite(min_window_time) and min_window_time >= 0):
         raise ValueError(f"min_window_time = {min_window_time!r}: must be >= 0 and finite")
-    if registry_period is not None and not (math.isfinite(registry_period)
-                                            and registry_period > 0):
-        raise ValueError(f"registry_period = {registry_period!r}: a period > 0, finite, "
-                         "or None")
+    for name, value in (("registry_period", registry_period), ("viscous_lag", viscous_lag)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} = {value!r}: a time or period > 0, finite, or None")
     registry_period = fitted_registry_period(
         registry_period, np.concatenate([np.asarray(r.table.slip_distance)[slipped(r.table)]
                                          for r in runs]))
     parts = [_held(r, i, mass=mass, drive_velocity=drive_velocity, mount_damping=mount_damping,
                    min_velocity_fraction=min_velocity_fraction, smoothing=smoothing,
-                   registry_period=registry_period)
+                   registry_period=registry_period, viscous_lag=viscous_lag)
              for i, r in enumerate(runs)]
     dt = parts[0][1]
     for i, (_, d, _) in enumerate(parts):
@@ -186,4 +193,4 @@ def fit_pooled_ensemble(runs, *, mass: float, drive_velocity: float = 0.0,
                             min_velocity_fraction=min_velocity_fraction,
                             comoving_mass=comoving_mass, replicas=jackknife,
                             film_mass=film_mass)
-    return replace(fit, registry_period=registry_period)
+    return replace(fit, registry_period=registry_period, viscous_lag=viscous_lag)

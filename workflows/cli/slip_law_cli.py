@@ -1,5 +1,5 @@
-"""``filmfriction slip-law RUN_DIR… [--no-registry] [--json] [--out FILE.json]``: the slip law
-of runs pooled.
+"""``filmfriction slip-law RUN_DIR… [--no-registry] [--viscous-lag TAU] [--json] [--out FILE.json]``:
+the slip law of runs pooled.
 
 Runs of one scene that differ in their seed (or a finished sweep over seeds) are replicas
 of one experiment: their slips are fitted together as one mean slip, and the errors, the
@@ -10,6 +10,7 @@ the same mean with the jackknife over the slips; ``--out`` writes the document.
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -31,6 +32,10 @@ def register(subparsers) -> None:
     p.add_argument("--no-registry", action="store_true",
                    help="fit the film's law alone, without the walls' registry force beside it "
                         "(by default fitted where the runs record its period: aligned walls)")
+    p.add_argument("--viscous-lag", type=float, default=None, metavar="TAU",
+                   help="the film's viscous force lagging the shear rate by TAU (the runs' time "
+                        "unit: τ for MD runs), a Maxwell film relaxing from 0 at each yield "
+                        "(default: B·v, no lag)")
     p.add_argument("--json", action="store_true", help="print the document")
     p.add_argument("--out", type=Path, default=None, metavar="FILE.json",
                    help="write the document there (its folder created if missing)")
@@ -65,6 +70,11 @@ def format_pooled(doc: dict) -> str:
     if period:
         out += ["", f"fitted beside the law: the walls' registry force, periodic in the wall's "
                     f"position with their lattice's period {period:g} (two harmonics)"]
+    lag = (doc.get("shared") or {}).get("viscous_lag")
+    if lag:
+        time = {"lj": "τ", "si": "s"}.get(doc.get("units"), "")
+        out += ["", f"the viscous force lagging the shear rate by {lag:g} {time} (a Maxwell film "
+                    f"relaxing from 0 at each yield): B is its steady coefficient"]
     out += ["", f"{len(doc['runs'])} runs, {doc['slips']} slips:"]
     out += [f"  {r['run_dir']}: {r['slips']} slips, seed {r['seed']}" for r in doc["runs"]]
     return "\n".join(out)
@@ -76,9 +86,13 @@ def run(args) -> int:
     from filmfriction.analysis.files.util import json_safe, write_atomic
     from filmfriction.workflows.rundir import checked_runs
 
+    lag = args.viscous_lag
+    if lag is not None and not (math.isfinite(lag) and lag > 0):
+        raise UserError(f"--viscous-lag {lag!r}: a relaxation time > 0 (the runs' time unit)")
     run_dirs = checked_runs(args.run_dirs, args.out)
     try:
-        doc = to_document(pooled_slip_law(run_dirs, registry=not args.no_registry))
+        doc = to_document(pooled_slip_law(run_dirs, registry=not args.no_registry,
+                                          viscous_lag=lag))
     except ValueError as exc:
         raise UserError(str(exc)) from None
     text = json.dumps(json_safe(doc), indent=2, ensure_ascii=False, allow_nan=False) + "\n"

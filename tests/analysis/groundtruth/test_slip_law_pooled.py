@@ -326,12 +326,39 @@ def test_the_registry_term_takes_a_corrugated_films_periodic_force_off_its_law()
                     corrugation=(1.0, 1.1, 0.0))
 
 
+def test_the_viscous_lag_term_gives_a_lagging_films_law_back():
+    # a Maxwell film, noise-free: the heavy slider's mix of share 0.5 (F_k 13.5, B 794) whose
+    # viscous force relaxes to B·v over 30 τ from 0 at each yield. Read as B·v the one law
+    # carries a co-moving mass near −B·τ_r; with B's regressor ∫v_f dt at its τ_r the law
+    # comes back and the co-moving mass goes; at another τ_r it does not
+    kw = dict(mass=STIFF.mass, mount_damping=STIFF.mount_damping, film_mass=STIFF.film_mass,
+              min_window_time=3.0)
+    runs, v = pooled_runs("coulomb", 6, 6, share=0.5, lag=30.0, noise=QUIET, seed=3)
+    law_b = 0.5 * 27.0 / 0.017
+    plain = fit_pooled_ensemble(runs, drive_velocity=v, **kw)
+    lagged = fit_pooled_ensemble(runs, drive_velocity=v, viscous_lag=30.0, **kw)
+    wrong = fit_pooled_ensemble(runs, drive_velocity=v, viscous_lag=15.0, **kw)
+    assert plain.one_law.comoving_mass < -0.5 * law_b * 30.0
+    assert lagged.viscous_lag == 30.0 and plain.viscous_lag is None
+    assert lagged.one_law.damping == pytest.approx(law_b, rel=0.01)
+    assert lagged.one_law.kinetic_force == pytest.approx(13.5, abs=0.1)
+    assert abs(lagged.one_law.comoving_mass) < 0.02 * law_b * 30.0
+    assert lagged.decelerating.damping == pytest.approx(law_b, rel=0.01)
+    assert wrong.one_law.comoving_mass < -0.2 * law_b * 30.0
+    with pytest.raises(ValueError, match="viscous_lag"):
+        fit_pooled_ensemble(runs, drive_velocity=v, viscous_lag=0.0, **kw)
+
+
 def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_module, capsys,
                                                                      tmp_path):
     spectrum = benchmark_module("slip_law/registry_spectrum").main
     floor = benchmark_module("slip_law/pooled_velocity_floor").main
     rates = benchmark_module("slip_law/pooled_controls_rates").main
+    lag = benchmark_module("slip_law/viscous_lag_profile").main
     for main, argv, said in (
+            (lag, ["--control", "0.5", "-1"], "TAU >= 0"),
+            (lag, ["--control", "0.5", "30", "--lags", "10", "5"], "increasing"),
+            (lag, [], "RUN… or --control"),
             (spectrum, [str(tmp_path), "--periods", "0"], "--periods 0.0: each > 0"),
             (spectrum, [str(tmp_path), "--window", "nan"], "--window nan"),
             (floor, ["--control", "4", "2", "--floors", "0.3", "0.1"], "increasing"),

@@ -79,3 +79,17 @@ def test_the_registry_fitted_where_recorded_and_left_out_on_request(runs, capsys
         assert doc["pooled"]["damping"]["mean"] == pytest.approx(40.0, rel=0.05)
     assert fitted["pooled"]["damping"]["stderr"] != alone["pooled"]["damping"]["stderr"]
     assert short["pooled"]["damping"] == alone["pooled"]["damping"]
+
+
+def test_the_viscous_lag_recorded_and_a_bad_one_refused(runs, capsys):
+    # the lag the slips were read with is recorded in the document and said; a lag that is
+    # not a positive time is refused before any fit
+    assert main(["slip-law", *map(str, runs), "--viscous-lag", "2", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["shared"]["viscous_lag"] == 2.0 and "viscous_lag" in doc["method"]
+    assert main(["slip-law", *map(str, runs), "--viscous-lag", "2"]) == 0
+    assert "lagging the shear rate by 2 τ" in capsys.readouterr().out
+    for bad in ("0", "-3", "nan"):
+        assert main(["slip-law", *map(str, runs), "--viscous-lag", bad]) == 2
+        err = capsys.readouterr().err
+        assert f"--viscous-lag {float(bad)!r}" in err and "Traceback" not in err

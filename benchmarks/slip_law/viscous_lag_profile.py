@@ -1,0 +1,179 @@
+"""The slip law pooled over runs with the film's viscous force lagging by τ_r: a profile over τ_r,
+on MD runs or on controls of a known lag.
+
+    python benchmarks/slip_law/viscous_lag_profile.py RUN… [--lags 0 5 10 …] [--no-registry]
+    python benchmarks/slip_law/viscous_lag_profile.py --control SHARE TAU [--replicas 40]
+        [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
+        [--stop-velocity -0.0025] [--lags …]
+
+A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
+yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
+read by the plain pooled fit (B·v, τ_r = 0) with a negative co-moving mass, m_c ≈ −B·τ_r,
+and its decelerating branch low.  With B's regressor ∫v_f dt at the film's own τ_r
+(:func:`~filmfriction.analysis.slip_law.slip_law_pooled.fit_pooled_ensemble`,
+``viscous_lag``) the one law carries no co-moving mass beyond the film's own: the τ_r where
+the one law's m_c crosses zero estimates the lag (linear between the grid's points; its
+error m_c's jackknife error over the slope dm_c/dτ_r there).  Per τ_r of ``--lags`` (τ):
+the one law's F_k, B and m_c, the loop step, the rule's reading; then τ̂.
+
+RUN…: the MD runs' directories (their slips analysed), pooled as ``filmfriction
+slip-law RUN…`` pools them (the walls' registry force fitted where the runs record its
+period; ``--no-registry``: the law alone).  ``--control SHARE TAU``: ``--replicas`` pools
+of ``--runs`` runs of the heavy slider's Coulomb + viscous mix of viscous share SHARE whose
+viscous force lags by TAU (0: no lag, the negative control) (``SCALES["stiff"]``, each run its own yield force and film as in
+:mod:`~filmfriction.analysis.groundtruth.pooled_controls`), with the walls' registry force
+of ``--corrugation`` (fitted at its period) and the noise beside it
+(``slip_law_controls.STIFF_REGISTRY_NOISE`` times ``--noise-scale``), re-sticking at
+``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
+the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
+velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
+and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
+τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.slip_law_controls import (STIFF_REGISTRY_NOISE, SCALES,
+                                                                 scaled)
+from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
+from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
+
+LAGS = (0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 50.0, 60.0)
+NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
+
+
+def profile(runs, lags, **kw) -> list:
+    """The pooled fit at each τ_r of ``lags`` (0: B·v)."""
+    return [fit_pooled_ensemble(runs, **kw, viscous_lag=lag or None) for lag in lags]
+
+
+def crossing(lags, fits) -> tuple[float, float]:
+    """τ̂, where the one law's m_c crosses zero downwards-to-upwards (the first crossing),
+    and its error; (nan, nan) where it does not cross on the grid."""
+    mc = np.array([f.one_law.comoving_mass for f in fits])
+    se = np.array([f.one_law.comoving_mass_stderr for f in fits])
+    for k in range(len(lags) - 1):
+        if mc[k] < 0 <= mc[k + 1]:
+            slope = (mc[k + 1] - mc[k]) / (lags[k + 1] - lags[k])
+            tau = lags[k] - mc[k] / slope
+            w = (tau - lags[k]) / (lags[k + 1] - lags[k])
+            return float(tau), float(((1 - w) * se[k] + w * se[k + 1]) / slope)
+    return math.nan, math.nan
+
+
+def table(lags, fits) -> str:
+    rows = ["| τ_r (τ) | one law F_k (ε/σ) | one law B (m/τ) | one law m_c (m) | loop step "
+            "(ε/σ) | the rule |", "|---|---|---|---|---|---|"]
+    for lag, f in zip(lags, fits):
+        o = f.one_law
+        rows.append(f"| {lag:g} | {o.kinetic_force:.1f} ± {o.kinetic_force_stderr:.1f} | "
+                    f"{o.damping:.0f} ± {o.damping_stderr:.0f} | {o.comoving_mass:.0f} ± "
+                    f"{o.comoving_mass_stderr:.0f} | {f.loop_step:+.1f} ± "
+                    f"{f.loop_step_stderr:.1f} | `{f.verdict}` ({f.verdict_from}) |")
+    tau, err = crossing(lags, fits)
+    rows.append(f"\nτ̂ (the one law's m_c crossing zero): {tau:.1f} ± {err:.1f} τ"
+                if math.isfinite(tau) else "\nthe one law's m_c does not cross zero on the grid")
+    return "\n".join(rows)
+
+
+def md(args) -> int:
+    from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
+
+    runs, shared, _ = read_runs(args.runs_dirs, analyse=False)
+    if args.no_registry:
+        shared = {**shared, "registry_period": None}
+    fits = profile(runs, args.lags, **fit_arguments(shared))
+    print(f"{len(runs)} runs, {sum(len(r.table) for r in runs)} slips; the walls' registry "
+          f"force fitted at period {fits[0].registry_period}\n")
+    print(table(args.lags, fits))
+    return 0
+
+
+def control(args) -> int:
+    share, tau = args.control
+    sc = replace(SCALES["stiff"], mix={**SCALES["stiff"].mix,
+                                       "stop_velocity": args.stop_velocity})
+    law = sc.law("x", share, None, "melting", tau or None)
+    fk, b = law["parameters"][:2]
+    period = args.corrugation[1]
+    kw = dict(mass=sc.mass, film_mass=sc.film_mass, mount_damping=sc.mount_damping,
+              min_window_time=MD_NOISE_TIME, registry_period=period)
+    noise = scaled(STIFF_REGISTRY_NOISE, args.noise_scale)
+    print(f"controls: share {share:g} (F_k {fk:.2f}, B {b:.1f}) lagging by {tau:g} τ, "
+          f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
+          f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}\n")
+
+    def pool(k, noise_, scale=sc):
+        rs, vd = pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
+                             law_spread=args.law_spread, lag=tau or None,
+                             corrugation=tuple(args.corrugation), seed=(0, k))
+        return profile(rs, args.lags, drive_velocity=vd, **kw)
+
+    # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
+    print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
+          + table(args.lags, pool(0, NOISE_FREE, SCALES["stiff"])), flush=True)
+    taus, errs, bs = [], [], []
+    for k in range(args.replicas):
+        fits = pool(k, noise)
+        t, e = crossing(args.lags, fits)
+        taus.append(t)
+        errs.append(e)
+        if math.isfinite(t):
+            bs.append(fits[int(np.argmin(np.abs(np.asarray(args.lags) - t)))].one_law.damping)
+    taus, errs = np.array(taus), np.array(errs)
+    ok = np.isfinite(taus)
+    if not ok.any():
+        print(f"\n{args.replicas} pools: m_c crosses zero on the grid in none")
+        return 0
+    print(f"\n{args.replicas} pools: m_c crosses zero in {ok.sum()}; τ̂ {taus[ok].mean():.1f} "
+          f"(sd {taus[ok].std(ddof=1):.1f}, median error {np.median(errs[ok]):.1f}) τ for "
+          f"{tau:g}; τ̂ ± 2 errors covers it in {int((np.abs(taus[ok] - tau) <= 2 * errs[ok]).sum())}"
+          f"; the one law's B at the grid point nearest τ̂ {np.mean(bs):.0f} ± "
+          f"{np.std(bs, ddof=1) / math.sqrt(len(bs)):.0f} m/τ (law {b:.0f})")
+    return 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs_dirs", nargs="*", type=Path, metavar="RUN")
+    ap.add_argument("--lags", nargs="+", type=float, default=list(LAGS), metavar="TAU")
+    ap.add_argument("--no-registry", action="store_true")
+    ap.add_argument("--control", nargs=2, type=float, default=None, metavar=("SHARE", "TAU"))
+    ap.add_argument("--replicas", type=int, default=40)
+    ap.add_argument("--runs", type=int, default=10)
+    ap.add_argument("--slips", type=int, default=9)
+    ap.add_argument("--noise-scale", type=float, default=1.0)
+    ap.add_argument("--law-spread", type=float, default=0.15)
+    ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97],
+                    metavar=("DF", "L", "PHI"))
+    ap.add_argument("--stop-velocity", type=float, default=-0.0025)
+    a = ap.parse_args(argv)
+    if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
+        ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
+    if (a.control is None) == (not a.runs_dirs):
+        ap.error("RUN… or --control SHARE TAU (one of them)")
+    if a.control is not None:
+        share, tau = a.control
+        if not (0 < share <= 1 and math.isfinite(tau) and tau >= 0):
+            ap.error(f"--control {a.control}: SHARE in (0, 1], TAU >= 0 (0: no lag)")
+        if a.replicas < 1 or a.runs < 3 or a.slips < 1 or not a.noise_scale >= 0:
+            ap.error("--replicas >= 1, --runs >= 3, --slips >= 1, --noise-scale >= 0")
+        if not (all(map(math.isfinite, a.corrugation)) and a.corrugation[1] > 0):
+            ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
+        return control(a)
+    missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
+    if missing:
+        ap.error(f"RUN without trace.csv: {', '.join(missing)}")
+    return md(a)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
