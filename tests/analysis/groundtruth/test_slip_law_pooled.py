@@ -355,7 +355,11 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
     floor = benchmark_module("slip_law/pooled_velocity_floor").main
     rates = benchmark_module("slip_law/pooled_controls_rates").main
     lag = benchmark_module("slip_law/viscous_lag_profile").main
+    stalls = benchmark_module("slip_law/slip_stalls").main
     for main, argv, said in (
+            (stalls, [], "RUN… or --control"),
+            (stalls, ["--control", "2"], "SHARE in [0, 1]"),
+            (stalls, ["--control", "0.5", "--below", "0"], "each > 0"),
             (lag, ["--control", "0.5", "-1"], "TAU >= 0"),
             (lag, ["--control", "0.5", "30", "--lags", "10", "5"], "increasing"),
             (lag, [], "RUN… or --control"),
