@@ -155,7 +155,7 @@ def pooled_slip_law(run_dirs, *, analyse: bool = True, registry: bool = True,
     by_slips = fit_pooled_ensemble(runs, **kw, jackknife="slips", viscous_lag=viscous_lag)
     # the document records the period the slips were fitted with (None: the law alone, as
     # asked or where the slips span too little of it) and the viscous force's lag
-    shared = {**shared, "registry_period": fit.registry_period, "viscous_lag": viscous_lag}
+    shared = {**shared, "registry_period": fit.registry_period, "viscous_lag": fit.viscous_lag}
     return PooledSlipLaw(fit, by_slips, info, shared, shared["units"])
 
 

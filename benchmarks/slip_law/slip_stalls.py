@@ -63,6 +63,10 @@ def main(argv=None) -> int:
     if a.control is not None:
         if not (0 <= a.control <= 1) or a.runs < 3 or a.slips < 1:
             ap.error("--control SHARE in [0, 1], --runs >= 3, --slips >= 1")
+        if not (all(map(math.isfinite, a.corrugation)) and a.corrugation[1] > 0):
+            ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
+        if a.stop_velocity is not None and not math.isfinite(a.stop_velocity):
+            ap.error(f"--stop-velocity {a.stop_velocity}: finite")
         from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
         from filmfriction.analysis.groundtruth.slip_law_controls import (SCALES,
                                                                          STIFF_REGISTRY_NOISE)
@@ -81,7 +85,11 @@ def main(argv=None) -> int:
         if missing:
             ap.error(f"RUN without trace.csv: {', '.join(missing)}")
         from filmfriction.analysis.calibration.slip_law_runs import read_runs
-        runs, _, _ = read_runs(a.runs_dirs, analyse=False)
+        try:
+            runs, _, _ = read_runs(a.runs_dirs, analyse=False)
+        except ValueError as exc:
+            print(f"slip_stalls: {exc}", file=sys.stderr)
+            return 1
         what = f"MD, {len(runs)} runs"
     st = longest_stalls(runs, a.below, a.window)
     print(f"{what}: {st.size} slips; the longest stall (velocity over {a.window:g} below "

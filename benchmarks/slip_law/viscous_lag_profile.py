@@ -87,10 +87,14 @@ def table(lags, fits) -> str:
 def md(args) -> int:
     from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
 
-    runs, shared, _ = read_runs(args.runs_dirs, analyse=False)
-    if args.no_registry:
-        shared = {**shared, "registry_period": None}
-    fits = profile(runs, args.lags, **fit_arguments(shared))
+    try:
+        runs, shared, _ = read_runs(args.runs_dirs, analyse=False)
+        if args.no_registry:
+            shared = {**shared, "registry_period": None}
+        fits = profile(runs, args.lags, **fit_arguments(shared))
+    except ValueError as exc:
+        print(f"viscous_lag_profile: {exc}", file=sys.stderr)
+        return 1
     print(f"{len(runs)} runs, {sum(len(r.table) for r in runs)} slips; the walls' registry "
           f"force fitted at period {fits[0].registry_period}\n")
     print(table(args.lags, fits))
@@ -133,11 +137,13 @@ def control(args) -> int:
     if not ok.any():
         print(f"\n{args.replicas} pools: m_c crosses zero on the grid in none")
         return 0
+    sd = taus[ok].std(ddof=1) if ok.sum() > 1 else math.nan
+    bse = np.std(bs, ddof=1) / math.sqrt(len(bs)) if len(bs) > 1 else math.nan
     print(f"\n{args.replicas} pools: m_c crosses zero in {ok.sum()}; τ̂ {taus[ok].mean():.1f} "
-          f"(sd {taus[ok].std(ddof=1):.1f}, median error {np.median(errs[ok]):.1f}) τ for "
+          f"(sd {sd:.1f}, median error {np.median(errs[ok]):.1f}) τ for "
           f"{tau:g}; τ̂ ± 2 errors covers it in {int((np.abs(taus[ok] - tau) <= 2 * errs[ok]).sum())}"
           f"; the one law's B at the grid point nearest τ̂ {np.mean(bs):.0f} ± "
-          f"{np.std(bs, ddof=1) / math.sqrt(len(bs)):.0f} m/τ (law {b:.0f})")
+          f"{bse:.0f} m/τ (law {b:.0f})")
     return 0
 
 
@@ -168,6 +174,9 @@ def main(argv=None) -> int:
             ap.error("--replicas >= 1, --runs >= 3, --slips >= 1, --noise-scale >= 0")
         if not (all(map(math.isfinite, a.corrugation)) and a.corrugation[1] > 0):
             ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
+        if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
+            ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
+                     f"{a.stop_velocity} finite")
         return control(a)
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:

@@ -360,6 +360,8 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
             (stalls, [], "RUN… or --control"),
             (stalls, ["--control", "2"], "SHARE in [0, 1]"),
             (stalls, ["--control", "0.5", "--below", "0"], "each > 0"),
+            (stalls, ["--control", "0.5", "--corrugation", "20", "0", "0"], "L > 0"),
+            (lag, ["--control", "0.5", "30", "--law-spread", "1"], "--law-spread 1.0"),
             (lag, ["--control", "0.5", "-1"], "TAU >= 0"),
             (lag, ["--control", "0.5", "30", "--lags", "10", "5"], "increasing"),
             (lag, [], "RUN… or --control"),
@@ -378,3 +380,7 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
     # a directory that is not a run: one line, no traceback
     assert spectrum([str(tmp_path)]) == 1
     assert "registry_spectrum:" in capsys.readouterr().err
+    (tmp_path / "trace.csv").write_text("time,spring_force\n")
+    assert lag([str(tmp_path)] * 3) == 1 and stalls([str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "viscous_lag_profile:" in err and "slip_stalls:" in err and "Traceback" not in err

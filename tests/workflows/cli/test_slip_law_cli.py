@@ -86,7 +86,12 @@ def test_the_viscous_lag_recorded_and_a_bad_one_refused(runs, capsys):
     # not a positive time is refused before any fit
     assert main(["slip-law", *map(str, runs), "--viscous-lag", "2", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["shared"]["viscous_lag"] == 2.0 and "viscous_lag" in doc["method"]
+    assert main(["slip-law", *map(str, runs), "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert doc["shared"]["viscous_lag"] == 2.0 and plain["shared"]["viscous_lag"] is None
+    # the fit took it: B's regressor is the lagged slide, which moves B
+    assert doc["pooled"]["damping"]["mean"] != pytest.approx(plain["pooled"]["damping"]["mean"],
+                                                             rel=1e-3)
     assert main(["slip-law", *map(str, runs), "--viscous-lag", "2"]) == 0
     assert "lagging the shear rate by 2 τ" in capsys.readouterr().out
     for bad in ("0", "-3", "nan"):
