@@ -4,7 +4,7 @@ on MD runs or on controls of a known lag.
     python benchmarks/slip_law/viscous_lag_profile.py RUN… [--lags 0 5 10 …] [--no-registry]
     python benchmarks/slip_law/viscous_lag_profile.py --control SHARE TAU [--replicas 40]
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
-        [--stop-velocity -0.0025] [--lags …]
+        [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -25,7 +25,9 @@ viscous force lags by TAU (0: no lag, the negative control) (``SCALES["stiff"]``
 of ``--corrugation`` (fitted at its period) and the noise beside it
 (``slip_law_controls.STIFF_REGISTRY_NOISE`` times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
-the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
+``--scale m1e4``: the M = 10⁴ slider's scale instead, whose noise beside the registry is given
+as ``--noise U RHO`` (u's rms and its correlation per sample; it overrides the stiff one
+at either scale); the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
 velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
 τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
@@ -103,15 +105,18 @@ def md(args) -> int:
 
 def control(args) -> int:
     share, tau = args.control
-    sc = replace(SCALES["stiff"], mix={**SCALES["stiff"].mix,
-                                       "stop_velocity": args.stop_velocity})
+    base = SCALES[args.scale]
+    sc = replace(base, mix={**base.mix, "stop_velocity": args.stop_velocity})
     law = sc.law("x", share, None, "melting", tau or None)
     fk, b = law["parameters"][:2]
     period = args.corrugation[1]
     kw = dict(mass=sc.mass, film_mass=sc.film_mass, mount_damping=sc.mount_damping,
               min_window_time=MD_NOISE_TIME, registry_period=period)
-    noise = scaled(STIFF_REGISTRY_NOISE, args.noise_scale)
-    print(f"controls: share {share:g} (F_k {fk:.2f}, B {b:.1f}) lagging by {tau:g} τ, "
+    noise = scaled(STIFF_REGISTRY_NOISE if args.noise is None else
+                   {"velocity_noise": args.noise[0], "velocity_correlation": args.noise[1],
+                    "rattle": 0.0}, args.noise_scale)
+    print(f"controls at the {args.scale} scale: share {share:g} (F_k {fk:.2f}, B {b:.1f}) "
+          f"lagging by {tau:g} τ, "
           f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}\n")
 
@@ -123,7 +128,7 @@ def control(args) -> int:
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
     print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
-          + table(args.lags, pool(0, NOISE_FREE, SCALES["stiff"])), flush=True)
+          + table(args.lags, pool(0, NOISE_FREE, base)), flush=True)
     taus, errs, bs = [], [], []
     for k in range(args.replicas):
         fits = pool(k, noise)
@@ -161,6 +166,8 @@ def main(argv=None) -> int:
     ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97],
                     metavar=("DF", "L", "PHI"))
     ap.add_argument("--stop-velocity", type=float, default=-0.0025)
+    ap.add_argument("--scale", choices=("stiff", "m1e4"), default="stiff")
+    ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
@@ -174,6 +181,8 @@ def main(argv=None) -> int:
             ap.error("--replicas >= 1, --runs >= 3, --slips >= 1, --noise-scale >= 0")
         if not (all(map(math.isfinite, a.corrugation)) and a.corrugation[1] > 0):
             ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
+        if a.noise is not None and not (a.noise[0] >= 0 and 0 <= a.noise[1] < 1):
+            ap.error(f"--noise {a.noise}: U >= 0, RHO in [0, 1)")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

@@ -362,6 +362,8 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
             (stalls, ["--control", "0.5", "--below", "0"], "each > 0"),
             (stalls, ["--control", "0.5", "--corrugation", "20", "0", "0"], "L > 0"),
             (lag, ["--control", "0.5", "30", "--law-spread", "1"], "--law-spread 1.0"),
+            (lag, ["--control", "0.5", "4", "--scale", "m1e4", "--noise", "0.01", "1"],
+             "RHO in [0, 1)"),
             (lag, ["--control", "0.5", "-1"], "TAU >= 0"),
             (lag, ["--control", "0.5", "30", "--lags", "10", "5"], "increasing"),
             (lag, [], "RUN… or --control"),
