@@ -25,7 +25,7 @@ viscous force lags by TAU (0: no lag, the negative control) (``SCALES["stiff"]``
 of ``--corrugation`` (fitted at its period) and the noise beside it
 (``slip_law_controls.STIFF_REGISTRY_NOISE`` times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
-``--scale m1e4``: the M = 10⁴ slider's scale instead, whose noise beside the registry is given
+``--scale m1e4`` (``m1e3``): the M = 10⁴ (10³) slider's scale instead, whose noise beside the registry is given
 as ``--noise U RHO`` (u's rms and its correlation per sample; it overrides the stiff one
 at either scale); the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
 velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
@@ -166,7 +166,7 @@ def main(argv=None) -> int:
     ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97],
                     metavar=("DF", "L", "PHI"))
     ap.add_argument("--stop-velocity", type=float, default=-0.0025)
-    ap.add_argument("--scale", choices=("stiff", "m1e4"), default="stiff")
+    ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3"), default="stiff")
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
