@@ -39,7 +39,7 @@ import math
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from ..slip_law.slip_law_cycles import REGISTRY_HARMONICS
+from ..slip_law.slip_law_cycles import registry_integrals
 
 __all__ = ["slip_residuals", "residual_statistics", "common_shape_share", "slip_velocities", "increment_rms",
            "run_slips", "replica_slips", "residuals", "run_residuals", "replica_residuals",
@@ -61,9 +61,8 @@ def slip_residuals(time, spring_force, wall_velocity, wall_position, yields, sti
     long enough.  ``trend`` > 1 fits Δt², …, Δt^trend besides: what is left is the part of
     the residual faster than the slip's own shape (a law's misfit over the slip, or a noise
     slower than the slip, is taken out with it).  With ``registry_period`` λ the walls'
-    registry force is fitted besides, as the slip-law fit fits it (the time integrals of
-    sin and cos(2π·h·x/λ), h to
-    :data:`~filmfriction.analysis.slip_law.slip_law_cycles.REGISTRY_HARMONICS`): what is
+    registry force is fitted besides, as the slip-law fit fits it
+    (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.registry_integrals`): what is
     left is the noise beside a force periodic in the wall's position."""
     t, f, v, x = (np.asarray(a, float) for a in (time, spring_force, wall_velocity,
                                                  wall_position))
@@ -77,9 +76,7 @@ def slip_residuals(time, spring_force, wall_velocity, wall_position, yields, sti
         resp = imp[i] - imp[i[0]] - mount_damping * (dx - drive_velocity * dt) - mass * v[i]
         cols = [np.ones(i.size), dt, dx] + [dt ** k for k in range(2, trend + 1)]
         if registry_period is not None:
-            cols += [cumulative_trapezoid(wave(2 * math.pi * h * x[i] / registry_period), t[i],
-                                          initial=0.0)
-                     for h in range(1, REGISTRY_HARMONICS + 1) for wave in (np.sin, np.cos)]
+            cols += list(registry_integrals(t[i], x[i], registry_period).values())
         X = np.column_stack(cols)
         out.append((resp - X @ np.linalg.lstsq(X, resp, rcond=None)[0]) / mass)
     return out

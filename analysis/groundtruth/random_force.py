@@ -59,7 +59,7 @@ import numpy as np
 from numba import njit
 from scipy.signal import lfilter
 
-__all__ = ["slide", "LAWS", "LOOP_LAWS"]
+__all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 
 #: The friction laws of the slip, F(v, ψ), and their parameters:
 #:
@@ -92,6 +92,8 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS"]
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
         "corrugated": 6}
+#: :func:`slide`'s random-force keywords for none (the noise-free slider).
+NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
 #: distance, a velocity, a time).
 LOOP_LAWS = ("melting", "slip-weakening", "maxwell")

@@ -87,7 +87,7 @@ from .slip_law import (MIN_RELAXATION, SMOOTHING, FilmForceFit, checked_fit_inpu
 from .slip_law_branches import Segment
 
 __all__ = ["fit_cycle_ensemble", "fit_held_ensemble", "held_slips", "held_keys", "slipped",
-           "fitted_registry_period", "REGISTRY_MIN_PERIODS",
+           "fitted_registry_period", "registry_integrals", "REGISTRY_MIN_PERIODS",
            "uniform_step", "MIN_CYCLES", "MD_NOISE_TIME", "REGISTRY_HARMONICS", "LAGGED"]
 
 #: The fewest slips the ensemble is fitted from (the jackknife needs a scatter).
@@ -123,6 +123,22 @@ def fitted_registry_period(registry_period: float | None, slip_distances) -> flo
     if registry_period is None or not d.size:
         return None
     return registry_period if np.median(np.abs(d)) >= REGISTRY_MIN_PERIODS * registry_period else None
+
+
+def registry_integrals(time, position, registry_period: float) -> dict:
+    """The regressors of a force periodic in the walls' registry over one stretch of slide:
+    ``registry_sin1``, ``registry_cos1``, … to :data:`REGISTRY_HARMONICS`, the time integrals
+    from its start of sin and cos(2π·h·x/λ) at the wall's position x.
+
+    >>> t = np.linspace(0.0, 1.0, 101)
+    >>> r = registry_integrals(t, 0.25 * t, 1.0)     # x/λ from 0 to 1/4 at a steady pace
+    >>> list(r), round(float(r["registry_sin1"][-1]), 4)    # ∫ sin(π t/2) dt = 2/π
+    (['registry_sin1', 'registry_cos1', 'registry_sin2', 'registry_cos2'], 0.6366)
+    """
+    t, x = np.asarray(time, float), np.asarray(position, float)
+    return {f"registry_{wave.__name__}{h}":
+            cumulative_trapezoid(wave(2 * math.pi * h * x / registry_period), t, initial=0.0)
+            for h in range(1, REGISTRY_HARMONICS + 1) for wave in (np.sin, np.cos)}
 
 
 def held_keys(held: dict) -> tuple:
@@ -179,10 +195,10 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
     n = int(d.max()) + 1
     dt = float(t[1] - t[0])
     lag = np.arange(n)
-    reg = ([(f"registry_{wave.__name__}{h}", h, wave) for h in range(1, REGISTRY_HARMONICS + 1)
-            for wave in (np.sin, np.cos)] if registry_period is not None else [])
+    reg = (tuple(registry_integrals(t[:1], x[:1], registry_period))
+           if registry_period is not None else ())
     lagged = (LAGGED,) if viscous_lag is not None else ()
-    out = {k: np.empty((y.size, n)) for k in HELD + tuple(key for key, _, _ in reg) + lagged}
+    out = {k: np.empty((y.size, n)) for k in HELD + reg + lagged}
     # v_f of a first-order relaxation, exact over a sample for the mean of its ends' v
     relax = -math.expm1(-dt / viscous_lag) if viscous_lag is not None else 0.0
     for i, (a, b) in enumerate(zip(y, s)):
@@ -200,9 +216,9 @@ def held_slips(time, spring_force, wall_velocity, wall_position, yields, sticks,
             out[LAGGED][i] = cumulative_trapezoid(vf, t[seg], initial=0.0)[k - a]
         out["displacement"][i] = x[k] - x[a]
         out["slipping_time"][i] = t[k] - t[a]
-        for key, h, wave in reg:
-            out[key][i] = cumulative_trapezoid(wave(2 * math.pi * h * x[seg] / registry_period),
-                                               t[seg], initial=0.0)[k - a]
+        if reg:
+            for key, r in registry_integrals(t[seg], x[seg], registry_period).items():
+                out[key][i] = r[k - a]
     out["lag_time"] = lag * dt
     return out
 

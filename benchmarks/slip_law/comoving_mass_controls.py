@@ -30,12 +30,12 @@ from dataclasses import replace
 import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
 from filmfriction.analysis.slip_law.slip_law_stats import sigmas
 
-NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 
 
 def summary(fits, branch: str, fk: float, b: float) -> str:

@@ -49,7 +49,7 @@ from dataclasses import replace
 import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
-from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS
+from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS, NOISE_FREE
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, scaled
 from filmfriction.analysis.slip_law.slip_law import VERDICTS, loop_step_branch
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
@@ -57,7 +57,6 @@ from filmfriction.analysis.slip_law.slip_law_pooled import JACKKNIFE, fit_pooled
 from filmfriction.analysis.slip_law.slip_law_stats import sigmas
 from filmfriction.analysis.slip_law.slip_law_verdict import choose_law
 
-NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 
 
 def coverage(fits, branch: str, attr: str, truth: float) -> str:

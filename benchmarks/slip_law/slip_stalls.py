@@ -68,14 +68,14 @@ def main(argv=None) -> int:
         if a.stop_velocity is not None and not math.isfinite(a.stop_velocity):
             ap.error(f"--stop-velocity {a.stop_velocity}: finite")
         from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+        from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
         from filmfriction.analysis.groundtruth.slip_law_controls import (SCALES,
                                                                          STIFF_REGISTRY_NOISE)
         sc = SCALES["stiff"]
         if a.stop_velocity is not None:
             sc = replace(sc, mix={**sc.mix, "stop_velocity": a.stop_velocity})
-        quiet = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
         runs, _ = pooled_runs("x", a.runs, a.slips, share=a.control, law_spread=0.15, scale=sc,
-                              noise=quiet if a.noise_free else STIFF_REGISTRY_NOISE,
+                              noise=NOISE_FREE if a.noise_free else STIFF_REGISTRY_NOISE,
                               corrugation=tuple(a.corrugation))
         what = (f"control share {a.control:g}, registry force {a.corrugation}, "
                 + ("noise-free" if a.noise_free else "STIFF_REGISTRY_NOISE")

@@ -43,13 +43,13 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.slip_law_controls import (STIFF_REGISTRY_NOISE, SCALES,
                                                                  scaled)
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
 
 LAGS = (0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0, 50.0, 60.0)
-NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 
 
 def profile(runs, lags, **kw) -> list:

@@ -72,8 +72,10 @@ def format_pooled(doc: dict) -> str:
                     f"position with their lattice's period {period:g} (two harmonics)"]
     lag = (doc.get("shared") or {}).get("viscous_lag")
     if lag:
-        time = {"lj": "τ", "si": "s"}.get(doc.get("units"), "")
-        out += ["", f"the viscous force lagging the shear rate by {lag:g} {time} (a Maxwell film "
+        from filmfriction.analysis.files.trace import unit
+
+        out += ["", f"the viscous force lagging the shear rate by {lag:g} "
+                    f"{unit(doc['units'], 'time')} (a Maxwell film "
                     f"relaxing from 0 at each yield): B is its steady coefficient"]
     out += ["", f"{len(doc['runs'])} runs, {doc['slips']} slips:"]
     out += [f"  {r['run_dir']}: {r['slips']} slips, seed {r['seed']}" for r in doc["runs"]]
