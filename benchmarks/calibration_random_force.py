@@ -11,7 +11,7 @@ sampled every 0.25 τ, V = 0.1 σ/τ; the film re-freezes where the spring force
 to 24 ε/σ, as Klein's and the viscous control's, or the wall stops once it has fallen
 to 34; ``--freeze-only``: at the freeze alone), the film pushing the wall with the controls' random force
 (:mod:`~filmfriction.analysis.groundtruth.random_force`) of each named process of
-:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` (none, ``MD_NOISE``,
+:mod:`~filmfriction.analysis.groundtruth.film_noise` (none, ``MD_NOISE``,
 ``RESIDUAL_AS_NOISE``), fitted by :func:`~filmfriction.analysis.calibration.slipfit.fit_slips` as
 ``filmfriction calibrate`` fits a run (the slips after the start-up one; no jackknife).
 Per noise: the mean estimate with its standard error over the replicas (the bias), the
@@ -27,7 +27,7 @@ import sys
 import numpy as np
 
 from filmfriction.analysis.calibration.slipfit import fit_slips
-from filmfriction.analysis.groundtruth import slip_law_controls as controls
+from filmfriction.analysis.groundtruth import film_noise, slip_law_controls as controls
 from filmfriction.analysis.groundtruth.random_force import slide
 
 NOISES = ("none", "MD_NOISE", "RESIDUAL_AS_NOISE")
@@ -106,7 +106,7 @@ def main(argv=None) -> int:
         return 2
     for name in a.noises:
         noise = ({"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
-                 if name == "none" else getattr(controls, name))
+                 if name == "none" else getattr(film_noise, name))
         n = 1 if name == "none" else a.replicas
         runs = replica_runs(noise, n, a.slips, a.kinetic_force, a.damping, a.freeze_only)
         if a.slip_ends:

@@ -8,6 +8,8 @@
   known F_k and B, and the slip fit's score on them;
 * :mod:`~filmfriction.analysis.groundtruth.slip_law_controls` — the slip-law verdict's
   positive and negative controls and its power;
+* :mod:`~filmfriction.analysis.groundtruth.film_noise` — the film's random force of the
+  controls, calibrated to the MD at each slider's scale;
 * :mod:`~filmfriction.analysis.groundtruth.random_force` — a driven slider whose film's
   random force moves the wall (the controls' noise as an MD wall has it).
 

@@ -22,7 +22,7 @@ u an Ornstein–Uhlenbeck velocity: sampled every ``dt`` it is AR(1) of rms
 independent such terms, one per pair of the two sequences).  So the
 residual of the integrated equation of motion over M, ∫ξ dt/M over a slip, is
 u(t) − u(t_yield): the noise the MD's was measured as
-(:data:`~filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE`), here a
+(:data:`~filmfriction.analysis.groundtruth.film_noise.MD_NOISE`), here a
 force that moves the wall.  The wall's thermal rattling (``rattle``, white at the
 sampling) is a vibration faster than the sampling, of bounded amplitude
 (rattle/ω ≪ the sampled Δx): it is added to the sampled velocity only.

@@ -7,7 +7,7 @@ laws here are slid in the reduced model at the Klein-similar MD scene's scale
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
 Each replica's film pushes the wall with the MD's noise as a random force ξ = M·du/dt, u the
-velocity noise of :data:`MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
+velocity noise of :data:`~.film_noise.MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
 calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`): the wall's
 position and velocity respond to it, as an MD wall's do, and the residual of the integrated
 equation of motion over M, ∫ξ dt/M, is u. The slips are fitted as the driven analysis fits them, as
@@ -52,52 +52,17 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
+from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE,
+                         STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "STIFF_REGISTRY_NOISE", "scaled", "SCALE", "Scale", "SCALES", "LIGHT_B",
-           "LIGHT_NOISE", "scale_named", "CONTROLS",
+__all__ = ["SCALE", "Scale", "SCALES", "LIGHT_B", "scale_named", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
 #: The Klein-similar scene's slider and sampling (LJ units).
 SCALE = {"spring_constant": 2.0, "mass": 30.0, "dt": 0.25, "static_force": 48.0}
-
-#: The film's random force of the controls, calibrated to the MD (LJ units; the keywords of
-#: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of 0.45 σ/τ
-#: rms and correlation 0.9 per 0.25 τ (2.4 τ), the wall's rattling white at
-#: √(kT/M) = 0.15 σ/τ.  On the 47 slips of three ``sfb-similar`` runs of 2.8 M steps
-#: (f952bc8) and on 40 random-force replicas of the ``viscous`` control, measured alike
-#: (:mod:`~filmfriction.analysis.groundtruth.md_noise`, each slip 2.5 τ off its ends):
-#:
-#: * the wall's velocity changes over 0.25, 1, 2 τ by 0.29, 0.33, 0.36 σ/τ rms in the MD,
-#:   0.28, 0.34, 0.34 in the replicas;
-#: * the residual of F_k + B·v with Δt², Δt³ fitted besides (the part faster than the
-#:   slip): MD 0.229 ± 0.007 σ/τ, autocorrelation 0.19, −0.03, −0.05 at 0.25, 1, 2 τ;
-#:   replicas 0.223, 0.23, −0.07, −0.08;
-#: * the plain residual of F_k + B·v: MD 0.69 ± 0.05 σ/τ, 0.78, 0.57, 0.38; replicas 0.34,
-#:   0.61, 0.27, 0.04.  No process of this family gives the MD's (the fit takes up the
-#:   slow part of a force that moves the wall; a u large enough for the rms, 1.9 σ/τ,
-#:   makes the wall jitter twice as much as the MD's): the rest of the MD's residual is
-#:   a shape as long as the slip, half of it common to all slips, that F_k + B·v misses.
-#:
-#: ``python benchmarks/slip_law/md_noise_calibration.py RUN …`` (docs/results/slip-law.md, "The
-#: MD's noise").
-MD_NOISE = {"velocity_noise": 0.45, "velocity_correlation": 0.9, "rattle": 0.15}
-
-#: The MD's plain residual taken as u itself (0.75 σ/τ, 0.9 per 0.25 τ, rattling 0.25):
-#: the wall jitters 1.6 times as much as the MD's (0.46, 0.56, 0.58 σ/τ over 0.25, 1,
-#: 2 τ).  Kept for comparison.
-RESIDUAL_AS_NOISE = {"velocity_noise": 0.75, "velocity_correlation": 0.9, "rattle": 0.25}
-
-
-def scaled(noise: dict, factor: float) -> dict:
-    """``noise`` with its amplitudes (u's rms, the rattling) times ``factor``, its
-    correlations kept."""
-    return {k: (v if k == "velocity_correlation" else
-                tuple(factor * x for x in v) if isinstance(v, (tuple, list)) else factor * v)
-            for k, v in noise.items()}
-
 
 @dataclass(frozen=True)
 class Scale:
@@ -110,7 +75,9 @@ class Scale:
     at ``slip_velocity`` split F_k = (1 − share)·F, B = share·F/v, and the rest of the
     keywords.  ``chunk``: replicas slid at a time (memory), 0 all at once.  ``film_mass``:
     the mass of the MD film the scale stands for (its atoms, 1 m each), which the fits are
-    given as the MD's are (the most a co-moving mass can be); None: not given."""
+    given as the MD's are (the most a co-moving mass can be); None: not given.
+    ``registry_noise``: the film's noise beside the walls' registry force, for controls that
+    carry one (:mod:`~filmfriction.analysis.groundtruth.film_noise`); None: not calibrated."""
 
     name: str
     spring_constant: float
@@ -124,6 +91,7 @@ class Scale:
     mount_damping: float = 0.0
     chunk: int = 0
     film_mass: float | None = None
+    registry_noise: dict | None = None
 
     def law(self, name: str, share: float | None = None,
             weakening: tuple[float, float] | None = None, law: str = "melting",
@@ -184,18 +152,6 @@ class Scale:
 #: mixes        F_k + B·v of viscous share s of F = 27 ε/σ at 0.017 σ/τ (the runs' F̄ and v̄),
 #:              re-sticking at F_b = STIFF_BACKWARD or once slowed to STIFF_STOP
 STIFF_B = 2.0 * math.sqrt(8.0 * 1e5)
-#: The film's random force at the heavy slider's scale, calibrated as :data:`MD_NOISE` on the
-#: 50 slips of six ``sfb-thick-stiff`` runs against 40 replicas of the stiff ``viscous``
-#: control: u an AR(1) of 0.0042 σ/τ rms, 0.993 per 0.25 τ (36 τ), no rattling (the heavy
-#: wall's thermal motion is slow).  Its fast residual (with Δt², Δt³: 0.00284, the MD's 0.00287
-#: ± 0.00012) and jitter over 16 τ are the MD's read without the walls' registry force, which
-#: it therefore carries as noise (docs/results/slip-law.md, "Controls at the heavy slider's scale").
-STIFF_NOISE = {"velocity_noise": 0.0042, "velocity_correlation": 0.993, "rattle": 0.0}
-#: The same beside the registry force: u 0.0028 σ/τ at 0.993, the residuals of the MD (ten
-#: runs, 89 slips) and of replicas whose mix carries 20 ε/σ at 1.1 σ read with the registry's
-#: terms (fast residual 0.00161, the MD's 0.00158 ± 0.00007: docs/results/slip-law.md, "The
-#: MD's noise beside the registry").  The noise of controls that carry a registry force.
-STIFF_REGISTRY_NOISE = scaled(STIFF_NOISE, 2 / 3)
 STIFF_BACKWARD = 8.0
 STIFF_STOP = 0.004
 
@@ -224,20 +180,6 @@ STIFF_STOP = 0.004
 #: ``period``: the noise-free slip cycle's length (measured on :func:`random_force_runs`'
 #: noise-free runs) or a little more.
 M1E4_B = 2.0 * math.sqrt(8.0 * 1e4)
-#: The film's random force at M = 10⁴, calibrated as :data:`STIFF_NOISE` on the 137 analysed
-#: slips of the ten M = 10⁴ runs (seeds 1–5, 8–12; 40 replicas of this scale's ``viscous``
-#: control, measured alike, 10 slips each; a grid of u 0.018–0.026 σ/τ at 0.98–0.998 per
-#: sample scanned before, 20 replicas each): u an AR(1) of 0.024 σ/τ rms and correlation
-#: 0.99 per 0.25 τ (25 τ), no rattling (√(kT/M) = 0.0079 σ/τ white would make the wall jitter
-#: 10 times the MD's over 0.25 τ).  The residual with Δt², Δt³ fitted besides (0.0103, the
-#: MD's 0.0102 ± 0.0003), the plain residual (0.0124, the MD's 0.0126 ± 0.0004) and its mean
-#: shape's share (0.09, the MD's 0.09) are the MD's, the wall's velocity change over 8 τ
-#: 1.06 times the MD's (0.0186 for 0.0176 σ/τ); over 0.25, 1, 4 τ the replicas' wall
-#: jitters 3.0, 1.9 and 1.3 times the MD's and their residual is less correlated at 1–4 τ
-#: (0.75, 0.23 for the MD's 0.91, 0.44): below the slip's tenth (≈ 11 τ) the MD's wall is
-#: smoother than any process of this family (docs/results/slip-law.md, "Controls at the
-#: M = 10⁴ scale of the K = 8 film").
-M1E4_NOISE = {"velocity_noise": 0.024, "velocity_correlation": 0.99, "rattle": 0.0}
 M1E4_BACKWARD = 15.0
 M1E4_STOP = 0.011
 
@@ -251,22 +193,6 @@ M1E4_STOP = 0.011
 #: The Coulomb control's F_k is 8 ε/σ under F̄ (as the M = 10⁴ scale's 27 is 5 under its 32),
 #: re-sticking where the wall stops.  The noise: :data:`LIGHT_NOISE`.
 LIGHT_B = {1e2: 2.0 * math.sqrt(8.0 * 1e2), 1e3: 2.0 * math.sqrt(8.0 * 1e3)}
-#: The film's random force at M = 10² and 10³, calibrated as :data:`M1E4_NOISE` on the MD's
-#: analysed slips of 20 s or longer (93 of the 20 M = 10² runs', 111 of the 8 M = 10³ runs')
-#: against 40 replicas of the scale's mix of viscous share 0.26 (0.25) whose film carries
-#: m_c = 179 m (243 m), the one law's readings (without it the slips are too brief to
-#: measure): u an AR(1) of 0.3 σ/τ rms, 0.94 per 0.25 τ (4 τ) at M = 10²: the wall's
-#: velocity change over 0.25, 1, 2 τ 0.102, 0.188, 0.241 σ/τ (MD 0.103, 0.197, 0.216), the
-#: residual 0.193 (MD 0.190 ± 0.007), with Δt², Δt³ fitted besides 0.125 (MD 0.127); u of
-#: 0.1 σ/τ, 0.98 (12 τ) at M = 10³: 0.020, 0.039, 0.074 over 0.25, 1, 4 τ (MD 0.012, 0.034,
-#: 0.077), residual 0.043 (MD 0.049 ± 0.002), 0.034 with Δt², Δt³ (MD 0.038): as at the
-#: heavier scales the MD's wall is smoother over the shortest lags.
-#: ``python benchmarks/slip_law/md_noise_calibration.py RUN… --scale m1e2 --share 0.26
-#: --comoving-mass 179 --lags 1 4 8 16 --noise U RHO 0`` (m1e3: 0.25, 243, lags 1 4 16 32).
-LIGHT_NOISE = {1e2: {"velocity_noise": 0.3, "velocity_correlation": 0.94, "rattle": 0.0},
-               1e3: {"velocity_noise": 0.1, "velocity_correlation": 0.98, "rattle": 0.0}}
-
-
 #: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
 #: (336 atoms, 1 m each), and of the Klein-similar scene's (224).
 THICK_FILM_MASS, KLEIN_FILM_MASS = 336.0, 224.0
@@ -284,7 +210,8 @@ def _light_scale(name, mass, velocity, damping, static, backward, force, slip_ve
         mix=dict(film_force=force, slip_velocity=slip_velocity, backward_force=backward,
                  stop_velocity=slip_velocity / 4, armed_below=armed, initial_force=backward,
                  period=period),
-        mount_damping=damping, chunk=10, film_mass=THICK_FILM_MASS)
+        mount_damping=damping, chunk=10, film_mass=THICK_FILM_MASS,
+        registry_noise=LIGHT_REGISTRY_NOISE.get(mass))
 
 
 #: The scales of the random-force controls, by name.
@@ -330,7 +257,8 @@ SCALES = {
         mix=dict(film_force=27.0, slip_velocity=0.017, backward_force=STIFF_BACKWARD,
                  stop_velocity=STIFF_STOP, armed_below=27.0, initial_force=STIFF_BACKWARD,
                  period=2500.0),
-        mount_damping=34.0, chunk=10, film_mass=THICK_FILM_MASS),
+        mount_damping=34.0, chunk=10, film_mass=THICK_FILM_MASS,
+        registry_noise=STIFF_REGISTRY_NOISE),
     "m1e4": Scale(
         "m1e4", 8.0, 1e4, 0.25, 45.0, 0.0079,
         M1E4_NOISE,
@@ -344,7 +272,8 @@ SCALES = {
         mix=dict(film_force=32.0, slip_velocity=0.045, backward_force=M1E4_BACKWARD,
                  stop_velocity=M1E4_STOP, armed_below=27.0, initial_force=M1E4_BACKWARD,
                  period=700.0),
-        mount_damping=10.7, chunk=10, film_mass=THICK_FILM_MASS),
+        mount_damping=10.7, chunk=10, film_mass=THICK_FILM_MASS,
+        registry_noise=M1E4_REGISTRY_NOISE),
     "m1e2": _light_scale("m1e2", 1e2, 0.079, 1.07, 57.0, 20.0, 40.0, 0.34, 41.0, 100.0),
     "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
 }

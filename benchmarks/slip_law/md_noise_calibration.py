@@ -11,7 +11,7 @@ of random-force replicas, measured the same way (docs/results/slip-law.md, "The 
 For the runs' analysed slips pooled, and for the random-force replicas of the ``viscous``
 control (:func:`~filmfriction.analysis.groundtruth.md_noise.replica_slips`, seed 0) at each
 process of :data:`PROCESSES` (the named ones of
-:mod:`~filmfriction.analysis.groundtruth.slip_law_controls` and the u whose plain residual
+:mod:`~filmfriction.analysis.groundtruth.film_noise` and the u whose plain residual
 has the MD's rms): the rms of the wall velocity's change over 0.25, 1, 2 τ; the residual's
 rms (mean over the slips ± its standard error) and autocorrelation at 0.25, 1, 2, 4 τ, with
 F_k + B·v fitted (``trend 1``; and the share of its variance the slips' mean shape carries,
@@ -46,7 +46,8 @@ from filmfriction.analysis.groundtruth.md_noise import (common_shape_share, incr
                                                         residual_statistics, residuals, run_slips,
                                                         slip_velocities)
 from filmfriction.analysis.groundtruth.md_noise import LAGS
-from filmfriction.analysis.groundtruth.slip_law_controls import MD_NOISE, RESIDUAL_AS_NOISE, SCALES
+from filmfriction.analysis.groundtruth.film_noise import MD_NOISE, RESIDUAL_AS_NOISE
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 
 PROCESSES = {"MD_NOISE": MD_NOISE, "RESIDUAL_AS_NOISE": RESIDUAL_AS_NOISE,
              "the plain residual's rms": {"velocity_noise": 1.9, "velocity_correlation": 0.95,

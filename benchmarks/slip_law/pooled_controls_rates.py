@@ -50,7 +50,8 @@ import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
 from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS, NOISE_FREE
-from filmfriction.analysis.groundtruth.slip_law_controls import SCALES, scaled
+from filmfriction.analysis.groundtruth.film_noise import scaled
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 from filmfriction.analysis.slip_law.slip_law import VERDICTS, loop_step_branch
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import JACKKNIFE, fit_pooled_ensemble

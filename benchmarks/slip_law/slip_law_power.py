@@ -7,7 +7,7 @@
 integrated equation of motion) and prints how far the wall's velocity strays from
 the fitted law's (rms) and the autocorrelation of that residual at 0.25, 1, 2, 4 τ
 (:mod:`~filmfriction.analysis.groundtruth.md_noise`; the calibration of
-:data:`filmfriction.analysis.groundtruth.slip_law_controls.MD_NOISE` on it and on the
+:data:`filmfriction.analysis.groundtruth.film_noise.MD_NOISE` on it and on the
 wall's jitter is ``benchmarks/slip_law/md_noise_calibration.py``).
 
 Without it: for each control law (:data:`~filmfriction.analysis.groundtruth.slip_law_controls.CONTROLS`)
@@ -31,8 +31,9 @@ import numpy as np
 
 from filmfriction.analysis.groundtruth.md_noise import residual_statistics, run_residuals
 from filmfriction.analysis.slip_law.slip_law import ONE_LAW, RESOLVED_SIGMAS, VERDICTS, sigmas
-from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, MD_NOISE, control_fits,
-                                                                 dynamical_fits, scaled)
+from filmfriction.analysis.groundtruth.film_noise import MD_NOISE, scaled
+from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, control_fits,
+                                                                 dynamical_fits)
 
 REPLICAS = 40
 QUIET = scaled(MD_NOISE, 0.1)

@@ -14,7 +14,7 @@ velocity (a Coulomb control's sign flips), which the slip-law fit cannot carry.
 ``--control SHARE``: one pool of ``--runs`` runs of the heavy slider's Coulomb + viscous mix
 of that viscous share with the registry force of ``--corrugation``
 (:func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs`, law spread 0.15,
-seed 0), at ``slip_law_controls.STIFF_REGISTRY_NOISE`` (``--noise-free``: none), re-sticking
+seed 0), at ``film_noise.STIFF_REGISTRY_NOISE`` (``--noise-free``: none), re-sticking
 at the scale's stop velocity or ``--stop-velocity`` (negative: once the wall recoils that fast).
 """
 from __future__ import annotations
@@ -69,8 +69,8 @@ def main(argv=None) -> int:
             ap.error(f"--stop-velocity {a.stop_velocity}: finite")
         from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
         from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
-        from filmfriction.analysis.groundtruth.slip_law_controls import (SCALES,
-                                                                         STIFF_REGISTRY_NOISE)
+        from filmfriction.analysis.groundtruth.film_noise import STIFF_REGISTRY_NOISE
+        from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
         sc = SCALES["stiff"]
         if a.stop_velocity is not None:
             sc = replace(sc, mix={**sc.mix, "stop_velocity": a.stop_velocity})

@@ -23,11 +23,10 @@ of ``--runs`` runs of the heavy slider's Coulomb + viscous mix of viscous share 
 viscous force lags by TAU (0: no lag, the negative control) (``SCALES["stiff"]``, each run its own yield force and film as in
 :mod:`~filmfriction.analysis.groundtruth.pooled_controls`), with the walls' registry force
 of ``--corrugation`` (fitted at its period) and the noise beside it
-(``slip_law_controls.STIFF_REGISTRY_NOISE`` times ``--noise-scale``), re-sticking at
+(the scale's ``registry_noise``, :mod:`~filmfriction.analysis.groundtruth.film_noise`, times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
-``--scale m1e4`` (``m1e3``): the M = 10⁴ (10³) slider's scale instead, whose noise beside the registry is given
-as ``--noise U RHO`` (u's rms and its correlation per sample; it overrides the stiff one
-at either scale); the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
+``--scale m1e4`` (``m1e3``, ``m1e2``): the M = 10⁴ (10³, 10²) slider's scale instead;
+``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise; the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
 velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
 τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
@@ -44,8 +43,8 @@ import numpy as np
 
 from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
 from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
-from filmfriction.analysis.groundtruth.slip_law_controls import (STIFF_REGISTRY_NOISE, SCALES,
-                                                                 scaled)
+from filmfriction.analysis.groundtruth.film_noise import scaled
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
 from filmfriction.analysis.slip_law.slip_law_pooled import fit_pooled_ensemble
 
@@ -112,7 +111,7 @@ def control(args) -> int:
     period = args.corrugation[1]
     kw = dict(mass=sc.mass, film_mass=sc.film_mass, mount_damping=sc.mount_damping,
               min_window_time=MD_NOISE_TIME, registry_period=period)
-    noise = scaled(STIFF_REGISTRY_NOISE if args.noise is None else
+    noise = scaled(sc.registry_noise if args.noise is None else
                    {"velocity_noise": args.noise[0], "velocity_correlation": args.noise[1],
                     "rattle": 0.0}, args.noise_scale)
     print(f"controls at the {args.scale} scale: share {share:g} (F_k {fk:.2f}, B {b:.1f}) "
@@ -166,7 +165,7 @@ def main(argv=None) -> int:
     ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97],
                     metavar=("DF", "L", "PHI"))
     ap.add_argument("--stop-velocity", type=float, default=-0.0025)
-    ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3"), default="stiff")
+    ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3", "m1e2"), default="stiff")
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
@@ -183,6 +182,9 @@ def main(argv=None) -> int:
             ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
         if a.noise is not None and not (a.noise[0] >= 0 and 0 <= a.noise[1] < 1):
             ap.error(f"--noise {a.noise}: U >= 0, RHO in [0, 1)")
+        if a.noise is None and SCALES[a.scale].registry_noise is None:
+            ap.error(f"--scale {a.scale}: its noise beside the registry is not calibrated; "
+                     "give --noise U RHO")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

@@ -1,5 +1,5 @@
 """The MD's noise measured on slips (analysis/groundtruth/md_noise.py) and the controls' process
-calibrated to it (slip_law_controls.MD_NOISE).
+calibrated to it (film_noise.MD_NOISE).
 
 The MD's numbers are those of ``python benchmarks/slip_law/md_noise_calibration.py`` on the 47 slips of
 three ``sfb-similar`` runs of 2.8 M steps (docs/results/slip-law.md, "The MD's noise"); the
@@ -13,8 +13,9 @@ import pytest
 from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_slips,
                                                         residual_statistics, residuals,
                                                         slip_velocities)
-from filmfriction.analysis.groundtruth.slip_law_controls import (MD_NOISE, RESIDUAL_AS_NOISE,
-                                                              STIFF_NOISE, STIFF_REGISTRY_NOISE)
+from filmfriction.analysis.groundtruth.film_noise import (M1E4_NOISE, M1E4_REGISTRY_NOISE,
+                                                       MD_NOISE, RESIDUAL_AS_NOISE,
+                                                       STIFF_NOISE, STIFF_REGISTRY_NOISE)
 
 #: The MD's: the wall velocity's change over 0.25, 1, 2 τ (rms, σ/τ), and the residual with
 #: Δt², Δt³ fitted besides (rms ± its standard error over the slips).
@@ -79,11 +80,13 @@ def test_residual_statistics_of_a_known_ar1():
 #: benchmarks/slip_law/md_noise_calibration.py RUN… --scale stiff --share 0.2 --corrugation 20
 #: 1.1 -0.97 --registry-period 1.1``, docs/results/slip-law.md), rms ± its standard error.
 MD_STIFF_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00158, 0.00007)
+#: The same at M = 10⁴: six runs (seeds 1–6), ``--scale m1e4 --share 0.5``.
+MD_M1E4_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00541, 0.00022)
 CORRUGATION = (20.0, 1.1, -0.97)
 
 
-def _stiff_fast_rms(noise, replicas, registry_period):
-    slips = replica_slips(noise, scale="stiff", share=0.2, replicas=replicas, slips=10,
+def _stiff_fast_rms(noise, replicas, registry_period, scale="stiff", share=0.2):
+    slips = replica_slips(noise, scale=scale, share=share, replicas=replicas, slips=10,
                           duration=None, corrugation=CORRUGATION)
     return residual_statistics([r for s in slips for r in residuals(
         s, trend=3, registry_period=registry_period)])["rms"]
@@ -102,3 +105,10 @@ def test_the_stiff_noise_beside_the_registry_is_the_mds_and_the_older_one_too_lo
     assert _stiff_fast_rms(STIFF_REGISTRY_NOISE, 20, 1.1) == pytest.approx(md, abs=3 * err)
     # calibrated without the registry's terms, STIFF_NOISE carries the registry force as noise
     assert _stiff_fast_rms(STIFF_NOISE, 20, 1.1) > md + 6 * err
+
+
+def test_the_m1e4_noise_beside_the_registry_is_the_mds_and_the_older_one_too_loud():
+    md, err = MD_M1E4_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(M1E4_REGISTRY_NOISE, 20, 1.1, "m1e4", 0.5) == pytest.approx(
+        md, abs=3 * err)
+    assert _stiff_fast_rms(M1E4_NOISE, 20, 1.1, "m1e4", 0.5) > md + 6 * err

@@ -20,8 +20,9 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from filmfriction.analysis.groundtruth.film_noise import MD_NOISE, scaled
 from filmfriction.analysis.groundtruth.slip_law_controls import (
-    MD_NOISE, control_fits, coulomb_viscous, dynamical_fits, replica_fits, scaled)
+    control_fits, coulomb_viscous, dynamical_fits, replica_fits)
 from filmfriction.analysis.slip_law.slip_law import RESOLVED_SIGMAS, VERDICTS
 
 REPLICAS = 40
