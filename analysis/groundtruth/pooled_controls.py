@@ -56,22 +56,28 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     (:meth:`~filmfriction.analysis.groundtruth.slip_law_controls.Scale.law`); ``lag`` = τ_r:
     the mix with its viscous force lagging the velocity by τ_r (``maxwell``); ``corrugation``
     = (ΔF, λ, φ): the mix with a force ΔF·sin(2π·x/λ + φ) of the wall's position x, the
-    registry of commensurate walls (``corrugated``; every run starts at x = 0, as the MD's
-    runs start from one geometry; ``law_spread`` leaves it alone; with ``lag``, the
-    viscous force lags too).  ``seed``: an int or a tuple of ints."""
+    registry of commensurate walls (``corrugated``, with ``weakening`` ``corrugated-loop``;
+    every run starts at x = 0, as the MD's runs start from one geometry; ``law_spread``
+    leaves it alone; with ``lag``, the viscous force lags too).  ``seed``: an int or a tuple of ints."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
     sc = scale_named(scale)
     law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
+    film = 2                # the film's own parameters, before the registry's
     if corrugation is not None:
-        if law["law"] not in ("coulomb-viscous", "maxwell") or len(corrugation) != 3:
+        if len(corrugation) != 3 or (weakening is not None and loop_law == "maxwell"):
             raise ValueError(f"corrugation = {corrugation!r}: (ΔF, λ, φ), on a Coulomb + "
-                             "viscous mix without a loop (with a lag or not)")
-        law |= {"law": "corrugated",
-                "parameters": law["parameters"][:2] + tuple(float(c) for c in corrugation)
-                + (float(lag or 0.0),)}
+                             "viscous mix (with a lag or not; a loop melting or slip-"
+                             "weakening)")
+        reg = tuple(float(c) for c in corrugation) + (float(lag or 0.0),)
+        if weakening is None:
+            law |= {"law": "corrugated", "parameters": law["parameters"][:2] + reg}
+        else:
+            film = 4
+            law |= {"law": "corrugated-loop", "parameters": law["parameters"][:4] + reg
+                    + (float(loop_law == "melting"),)}
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
     rng = np.random.default_rng(key + [7919])
@@ -85,7 +91,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
             par = par[:2] + (par[2] * max(fs - par[0], 0.0),) + par[3:]
         if corrugation is not None:
             # the registry is the walls' (one geometry for every run), not the film's
-            par = par[:2] + law["parameters"][2:]
+            par = par[:film] + law["parameters"][film:]
         r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
                   stiffness=sc.spring_constant,
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,

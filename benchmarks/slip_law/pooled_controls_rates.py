@@ -257,10 +257,10 @@ def main(argv=None) -> int:
             args.loop and args.loop[0] != "slip-weakening")):
         ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and with --loop only "
                  "slip-weakening")
-    if args.corrugation and (args.loop or not all(
+    if args.corrugation and ((args.loop and args.loop[0] == "maxwell") or not all(
             map(math.isfinite, args.corrugation)) or not args.corrugation[1] > 0):
         ap.error(f"--corrugation {args.corrugation!r}: finite, LAMBDA > 0, and not with "
-                 "--loop")
+                 "--loop maxwell")
     if args.registry_period is not None and not (math.isfinite(args.registry_period)
                                                  and args.registry_period > 0):
         ap.error(f"--registry-period {args.registry_period!r}: a period > 0, finite")

@@ -5,6 +5,7 @@ on MD runs or on controls of a known lag.
     python benchmarks/slip_law/viscous_lag_profile.py --control SHARE TAU [--replicas 40]
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
+        [--loop LAW W D]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -26,7 +27,13 @@ of ``--corrugation`` (fitted at its period) and the noise beside it
 (the scale's ``registry_noise``, :mod:`~filmfriction.analysis.groundtruth.film_noise`, times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
 ``--scale m1e4`` (``m1e3``, ``m1e2``): the M = 10⁴ (10³, 10²) slider's scale instead;
-``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise; the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
+``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
+``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
+``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
+``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
+or not (a melting film's viscous force cannot lag: TAU 0); besides τ̂, the loop step at the
+grid point nearest it, for the pools whose m_c does not cross, m_c at τ_r = 0 in its
+errors, and over all pools the one law's m_c and the loop step at the grid's first τ_r; the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
 velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
 τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
@@ -106,7 +113,9 @@ def control(args) -> int:
     share, tau = args.control
     base = SCALES[args.scale]
     sc = replace(base, mix={**base.mix, "stop_velocity": args.stop_velocity})
-    law = sc.law("x", share, None, "melting", tau or None)
+    loop = None if args.loop is None else (float(args.loop[1]), float(args.loop[2]))
+    loop_law = "melting" if args.loop is None else args.loop[0]
+    law = sc.law("x", share, loop, loop_law, tau or None)
     fk, b = law["parameters"][:2]
     period = args.corrugation[1]
     kw = dict(mass=sc.mass, film_mass=sc.film_mass, mount_damping=sc.mount_damping,
@@ -116,31 +125,52 @@ def control(args) -> int:
                     "rattle": 0.0}, args.noise_scale)
     print(f"controls at the {args.scale} scale: share {share:g} (F_k {fk:.2f}, B {b:.1f}) "
           f"lagging by {tau:g} τ, "
-          f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
+          + ("" if loop is None else f"a {loop_law} loop {loop[0]:g} over {loop[1]:g}, ")
+          + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}\n")
 
     def pool(k, noise_, scale=sc):
         rs, vd = pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
                              law_spread=args.law_spread, lag=tau or None,
+                             weakening=loop, loop_law=loop_law,
                              corrugation=tuple(args.corrugation), seed=(0, k))
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
     print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
           + table(args.lags, pool(0, NOISE_FREE, base)), flush=True)
-    taus, errs, bs = [], [], []
+    taus, errs, bs, steps, mc0, first = [], [], [], [], [], []
     for k in range(args.replicas):
         fits = pool(k, noise)
+        o = fits[0].one_law
+        first.append((o.comoving_mass / o.comoving_mass_stderr, fits[0].loop_step,
+                      fits[0].loop_step / fits[0].loop_step_stderr))
         t, e = crossing(args.lags, fits)
         taus.append(t)
         errs.append(e)
         if math.isfinite(t):
-            bs.append(fits[int(np.argmin(np.abs(np.asarray(args.lags) - t)))].one_law.damping)
-    taus, errs = np.array(taus), np.array(errs)
+            near = fits[int(np.argmin(np.abs(np.asarray(args.lags) - t)))]
+            bs.append(near.one_law.damping)
+            steps.append((near.loop_step, near.loop_step_stderr))
+        else:
+            o = fits[0].one_law
+            mc0.append(o.comoving_mass / o.comoving_mass_stderr)
+    taus, errs, first = np.array(taus), np.array(errs), np.array(first)
     ok = np.isfinite(taus)
+    print(f"\nat τ_r = {args.lags[0]:g}, over the {args.replicas} pools: the one law's m_c "
+          f"{first[:, 0].mean():+.1f} errors (sd {first[:, 0].std():.1f}; ≤ −2 in "
+          f"{int((first[:, 0] <= -2).sum())}), the loop step {first[:, 1].mean():+.2f} ε/σ "
+          f"(sd {first[:, 1].std():.2f}; ≥ +2 errors in {int((first[:, 2] >= 2).sum())})")
+    if mc0:
+        print(f"{len(mc0)} pools whose m_c does not cross zero on the grid: m_c at τ_r = "
+              f"{args.lags[0]:g} {np.mean(mc0):+.1f} errors (sd {np.std(mc0):.1f})")
     if not ok.any():
-        print(f"\n{args.replicas} pools: m_c crosses zero on the grid in none")
+        print(f"{args.replicas} pools: m_c crosses zero on the grid in none")
         return 0
+    st = np.array(steps)
+    print(f"the loop step at the grid point nearest τ̂: {st[:, 0].mean():+.2f} ε/σ (sd "
+          f"{st[:, 0].std():.2f}; ≥ +2 errors in {int((st[:, 0] >= 2 * st[:, 1]).sum())} of "
+          f"{len(st)})")
     sd = taus[ok].std(ddof=1) if ok.sum() > 1 else math.nan
     bse = np.std(bs, ddof=1) / math.sqrt(len(bs)) if len(bs) > 1 else math.nan
     print(f"\n{args.replicas} pools: m_c crosses zero in {ok.sum()}; τ̂ {taus[ok].mean():.1f} "
@@ -167,6 +197,7 @@ def main(argv=None) -> int:
     ap.add_argument("--stop-velocity", type=float, default=-0.0025)
     ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3", "m1e2"), default="stiff")
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
+    ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
@@ -185,6 +216,16 @@ def main(argv=None) -> int:
         if a.noise is None and SCALES[a.scale].registry_noise is None:
             ap.error(f"--scale {a.scale}: its noise beside the registry is not calibrated; "
                      "give --noise U RHO")
+        if a.loop is not None:
+            try:
+                w, d = float(a.loop[1]), float(a.loop[2])
+            except ValueError:
+                w = d = math.nan
+            if a.loop[0] not in ("melting", "slip-weakening") or not (
+                    0 <= w <= 1 and math.isfinite(d) and d > 0) or (
+                    a.loop[0] == "melting" and tau > 0):
+                ap.error(f"--loop {' '.join(a.loop)}: LAW melting or slip-weakening (melting "
+                         "with TAU 0 only), W in [0, 1], D > 0")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

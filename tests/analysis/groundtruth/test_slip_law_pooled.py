@@ -322,7 +322,7 @@ def test_the_registry_term_takes_a_corrugated_films_periodic_force_off_its_law()
     with pytest.raises(ValueError, match="registry_period"):
         fit_pooled_ensemble(plain, drive_velocity=v, registry_period=0.0, **kw)
     with pytest.raises(ValueError, match="corrugation"):
-        pooled_runs("coulomb", 3, 2, share=0.2, weakening=(0.5, 0.3), loop_law="slip-weakening",
+        pooled_runs("coulomb", 3, 2, share=0.2, weakening=(0.5, 30.0), loop_law="maxwell",
                     corrugation=(1.0, 1.1, 0.0))
 
 
@@ -373,8 +373,12 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
             (floor, [], "RUN_DIR… or --control"),
             (rates, ["--registry-period", "-1"], "--registry-period -1.0"),
             (rates, ["--corrugation", "1", "0", "0"], "LAMBDA > 0"),
-            (rates, ["--corrugation", "1", "1.1", "0", "--loop", "melting", "0.5", "0.01"],
-             "not with --loop")):
+            (rates, ["--corrugation", "1", "1.1", "0", "--loop", "maxwell", "0.5", "10"],
+             "not with --loop maxwell"),
+            (lag, ["--control", "0.5", "30", "--loop", "melting", "0.5", "0.01"],
+             "melting with TAU 0 only"),
+            (lag, ["--control", "0.5", "0", "--loop", "slip-weakening", "2", "0.3"],
+             "W in [0, 1]")):
         with pytest.raises(SystemExit) as stop:
             main(argv)
         assert stop.value.code == 2
