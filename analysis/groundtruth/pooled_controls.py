@@ -31,11 +31,18 @@ from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
 from .random_force import slide
 from .slip_law_controls import Scale, scale_named
 
-__all__ = ["pooled_runs", "pooled_fits", "STATIC_SPREAD"]
+__all__ = ["pooled_runs", "pooled_fits", "STATIC_SPREAD", "SLIP_ENDS"]
 
 #: The runs' yield forces spread uniformly within ± this share of the scale's (the MD's six
 #: K = 8 runs: 30–60 ε/σ about 45).
 STATIC_SPREAD = 0.3
+#: Where a control's slip ends in its table: ``slider``, where the slider re-sticks (its stop
+#: velocity, or a recoil that fast); ``force-minimum``, at the lowest spring force between
+#: its yield and that re-stick, where the MD's detector ends a slip
+#: (:func:`~filmfriction.analysis.stickslip.detect_slips`: the running minimum before the
+#: force rises again), so that a rest of the wall before the slider re-sticks is left out
+#: as the MD's slips leave it.
+SLIP_ENDS = ("slider", "force-minimum")
 
 
 def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,
@@ -44,7 +51,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 comoving_mass: float = 0.0, weakening: tuple[float, float] | None = None,
                 loop_law: str = "melting", lag: float | None = None,
                 corrugation: tuple[float, float, float] | None = None,
-                seed=0) -> tuple[list[RunSlips], float]:
+                seed=0, slip_end: str = "slider") -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
     them, and the drive velocity.  ``comoving_mass``: the film's mass m_c the slipping wall
@@ -58,10 +65,13 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     = (ΔF, λ, φ): the mix with a force ΔF·sin(2π·x/λ + φ) of the wall's position x, the
     registry of commensurate walls (``corrugated``, with ``weakening`` ``corrugated-loop``;
     every run starts at x = 0, as the MD's runs start from one geometry; ``law_spread``
-    leaves it alone; with ``lag``, the viscous force lags too).  ``seed``: an int or a tuple of ints."""
+    leaves it alone; with ``lag``, the viscous force lags too).  ``seed``: an int or a tuple
+    of ints.  ``slip_end``: one of :data:`SLIP_ENDS`."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
+    if slip_end not in SLIP_ENDS:
+        raise ValueError(f"slip_end = {slip_end!r}: one of {', '.join(SLIP_ENDS)}")
     sc = scale_named(scale)
     law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
@@ -97,7 +107,11 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,
                   seed=tuple(key + [g]), mount_damping=sc.mount_damping,
                   comoving_mass=comoving_mass, **noise)[0]
-        tab = cycle_table(r["time"], r["spring_force"], r["yield_index"], r["stick_index"],
+        ends = r["stick_index"]
+        if slip_end == "force-minimum":
+            ends = np.array([y + int(np.argmin(r["spring_force"][y:s + 1]))
+                             for y, s in zip(r["yield_index"], ends)], int)
+        tab = cycle_table(r["time"], r["spring_force"], r["yield_index"], ends,
                           spring_constant=sc.spring_constant,
                           wall_position=r["wall_position"])[1:slips + 1]
         out.append(RunSlips(r["time"], r["spring_force"], r["wall_velocity"], tab,
@@ -111,7 +125,7 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                 noise: dict | None = None, comoving_mass: float = 0.0,
                 weakening: tuple[float, float] | None = None, loop_law: str = "melting",
                 lag: float | None = None, corrugation=None, seed: int = 0,
-                jackknife: str = "runs",
+                jackknife: str = "runs", slip_end: str = "slider",
                 registry_period: float | None = None) -> list[FilmForceFit]:
     """The pooled fit (the jackknife over ``jackknife``: ``runs`` or ``slips``; with the
     registry's force of period ``registry_period``) of ``replicas`` replicas of
@@ -123,7 +137,8 @@ def pooled_fits(name: str, replicas: int, runs: int = 6, slips: int = 8, *,
                                    static_spread=static_spread, law_spread=law_spread,
                                    noise=noise, comoving_mass=comoving_mass,
                                    weakening=weakening, loop_law=loop_law, lag=lag,
-                                   corrugation=corrugation, seed=(seed, k))
+                                   corrugation=corrugation, seed=(seed, k),
+                                   slip_end=slip_end)
         out.append(fit_pooled_ensemble(rs, mass=sc.mass, drive_velocity=velocity,
                                        film_mass=sc.film_mass,
                                        mount_damping=sc.mount_damping,

@@ -5,7 +5,7 @@ on MD runs or on controls of a known lag.
     python benchmarks/slip_law/viscous_lag_profile.py --control SHARE TAU [--replicas 40]
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
-        [--loop LAW W D]
+        [--loop LAW W D] [--slip-end force-minimum]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -32,7 +32,9 @@ of ``--corrugation`` (fitted at its period) and the noise beside it
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
 or not (a melting film's viscous force cannot lag: TAU 0); besides τ̂, the loop step at the
-grid point nearest it, for the pools whose m_c does not cross, m_c at τ_r = 0 in its
+grid point nearest it; ``--slip-end force-minimum``: each slip ends at its lowest spring
+force, where the MD's detector ends one, not where the slider re-sticks
+(:data:`~filmfriction.analysis.groundtruth.pooled_controls.SLIP_ENDS`); for the pools whose m_c does not cross, m_c at τ_r = 0 in its
 errors, and over all pools the one law's m_c and the loop step at the grid's first τ_r; the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
 velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
@@ -48,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.pooled_controls import SLIP_ENDS, pooled_runs
 from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.film_noise import scaled
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
@@ -127,12 +129,13 @@ def control(args) -> int:
           f"lagging by {tau:g} τ, "
           + ("" if loop is None else f"a {loop_law} loop {loop[0]:g} over {loop[1]:g}, ")
           + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
-          f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}\n")
+          f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
+          f"slip ends: {args.slip_end}\n")
 
     def pool(k, noise_, scale=sc):
         rs, vd = pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
                              law_spread=args.law_spread, lag=tau or None,
-                             weakening=loop, loop_law=loop_law,
+                             weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
                              corrugation=tuple(args.corrugation), seed=(0, k))
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
@@ -198,6 +201,7 @@ def main(argv=None) -> int:
     ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3", "m1e2"), default="stiff")
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
+    ap.add_argument("--slip-end", choices=SLIP_ENDS, default="slider")
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")

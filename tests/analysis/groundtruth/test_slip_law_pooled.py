@@ -390,3 +390,24 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
     assert lag([str(tmp_path)] * 3) == 1 and stalls([str(tmp_path)]) == 1
     err = capsys.readouterr().err
     assert "viscous_lag_profile:" in err and "slip_stalls:" in err and "Traceback" not in err
+
+
+def test_a_controls_slip_can_end_where_the_mds_detector_ends_one():
+    # re-sticking on a recoil, a control's wall rests before its slider re-sticks: ended at
+    # the lowest spring force instead, the slip leaves that rest out, as the MD's detector
+    # (the running minimum before the force rises again) leaves out the MD's
+    sc = replace(STIFF, mix={**STIFF.mix, "stop_velocity": -0.0025})
+    kw = dict(share=0.5, scale=sc, noise=STIFF.registry_noise, corrugation=(20.0, 1.1, -0.97),
+              seed=(0, 0))
+    slider, _ = pooled_runs("x", 3, 4, **kw)
+    minimum, _ = pooled_runs("x", 3, 4, slip_end="force-minimum", **kw)
+    moved = []
+    for a, b in zip(slider, minimum):
+        np.testing.assert_array_equal(a.table.yield_index, b.table.yield_index)
+        for y, s, e in zip(a.table.yield_index, a.table.stick_index, b.table.stick_index):
+            assert y < e <= s
+            assert a.spring_force[e] == a.spring_force[y:s + 1].min()
+            moved.append(a.time[s] - a.time[e])
+    assert np.median(moved) > 1.0          # a rest of the wall is cut off most slips' ends
+    with pytest.raises(ValueError, match="slip_end"):
+        pooled_runs("x", 3, 2, share=0.5, slip_end="detector")
