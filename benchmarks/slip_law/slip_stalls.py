@@ -3,7 +3,7 @@ controls with the walls' registry force.
 
     python benchmarks/slip_law/slip_stalls.py RUN… [--below 0.002] [--window 10]
     python benchmarks/slip_law/slip_stalls.py --control SHARE [--noise-free] [--runs 10]
-        [--slips 9] [--corrugation 20 1.1 -0.97] [--stop-velocity V]
+        [--slips 9] [--corrugation 20 1.1 -0.97] [--stop-velocity V] [--loop LAW W D]
 
 Within each slip (its yield to its re-stick, ``--window`` τ off each end), the wall's velocity
 averaged over ``--window`` τ; a stall is a stretch where that stays below ``--below`` (σ/τ);
@@ -15,7 +15,9 @@ velocity (a Coulomb control's sign flips), which the slip-law fit cannot carry.
 of that viscous share with the registry force of ``--corrugation``
 (:func:`~filmfriction.analysis.groundtruth.pooled_controls.pooled_runs`, law spread 0.15,
 seed 0), at ``film_noise.STIFF_REGISTRY_NOISE`` (``--noise-free``: none), re-sticking
-at the scale's stop velocity or ``--stop-velocity`` (negative: once the wall recoils that fast).
+at the scale's stop velocity or ``--stop-velocity`` (negative: once the wall recoils that fast);
+``--loop LAW W D``: the mix with a yield loop besides (``melting`` or ``slip-weakening``, as
+``viscous_lag_profile.py --loop``).
 """
 from __future__ import annotations
 
@@ -55,6 +57,7 @@ def main(argv=None) -> int:
     ap.add_argument("--slips", type=int, default=9)
     ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97])
     ap.add_argument("--stop-velocity", type=float, default=None)
+    ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
     a = ap.parse_args(argv)
     if (a.control is None) == (not a.runs_dirs):
         ap.error("RUN… or --control SHARE (one of them)")
@@ -67,6 +70,17 @@ def main(argv=None) -> int:
             ap.error(f"--corrugation {a.corrugation}: finite, L > 0")
         if a.stop_velocity is not None and not math.isfinite(a.stop_velocity):
             ap.error(f"--stop-velocity {a.stop_velocity}: finite")
+        loop = {}
+        if a.loop is not None:
+            try:
+                loop = {"weakening": (float(a.loop[1]), float(a.loop[2])), "loop_law": a.loop[0]}
+            except ValueError:
+                loop = {"weakening": (math.nan, math.nan)}
+            w, d = loop["weakening"]
+            if a.loop[0] not in ("melting", "slip-weakening") or not (
+                    0 <= w <= 1 and math.isfinite(d) and d > 0):
+                ap.error(f"--loop {' '.join(a.loop)}: LAW melting or slip-weakening, W in "
+                         "[0, 1], D > 0")
         from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
         from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
         from filmfriction.analysis.groundtruth.film_noise import STIFF_REGISTRY_NOISE
@@ -76,8 +90,9 @@ def main(argv=None) -> int:
             sc = replace(sc, mix={**sc.mix, "stop_velocity": a.stop_velocity})
         runs, _ = pooled_runs("x", a.runs, a.slips, share=a.control, law_spread=0.15, scale=sc,
                               noise=NOISE_FREE if a.noise_free else STIFF_REGISTRY_NOISE,
-                              corrugation=tuple(a.corrugation))
+                              corrugation=tuple(a.corrugation), **loop)
         what = (f"control share {a.control:g}, registry force {a.corrugation}, "
+                + (f"a {a.loop[0]} loop {a.loop[1]} over {a.loop[2]}, " if loop else "")
                 + ("noise-free" if a.noise_free else "STIFF_REGISTRY_NOISE")
                 + f", stop velocity {sc.mix['stop_velocity']:g}")
     else:
