@@ -38,10 +38,10 @@ __all__ = ["pooled_runs", "pooled_fits", "STATIC_SPREAD", "SLIP_ENDS"]
 STATIC_SPREAD = 0.3
 #: Where a control's slip ends in its table: ``slider``, where the slider re-sticks (its stop
 #: velocity, or a recoil that fast); ``force-minimum``, at the lowest spring force between
-#: its yield and that re-stick, where the MD's detector ends a slip
+#: its yield and that re-stick, an approximation of where the MD's detector ends a slip
 #: (:func:`~filmfriction.analysis.stickslip.detect_slips`: the running minimum before the
-#: force rises again), so that a rest of the wall before the slider re-sticks is left out
-#: as the MD's slips leave it.
+#: force rises again by more than its threshold), so that a rest of the wall before the
+#: slider re-sticks is left out as the MD's slips leave it.
 SLIP_ENDS = ("slider", "force-minimum")
 
 
@@ -77,10 +77,12 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     period = law.pop("period")
     film = 2                # the film's own parameters, before the registry's
     if corrugation is not None:
-        if len(corrugation) != 3 or (weakening is not None and loop_law == "maxwell"):
-            raise ValueError(f"corrugation = {corrugation!r}: (ΔF, λ, φ), on a Coulomb + "
-                             "viscous mix (with a lag or not; a loop melting or slip-"
-                             "weakening)")
+        if share is None or len(corrugation) != 3 or (weakening is not None
+                                                       and loop_law == "maxwell"):
+            raise ValueError(f"corrugation = {corrugation!r} (control {name!r}, share "
+                             f"{share!r}, loop law {loop_law!r}): (ΔF, λ, φ), on a Coulomb + "
+                             "viscous mix of a share (with a lag or not; with a loop, "
+                             "melting or slip-weakening)")
         reg = tuple(float(c) for c in corrugation) + (float(lag or 0.0),)
         if weakening is None:
             law |= {"law": "corrugated", "parameters": law["parameters"][:2] + reg}

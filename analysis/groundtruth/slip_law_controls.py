@@ -7,8 +7,8 @@ laws here are slid in the reduced model at the Klein-similar MD scene's scale
 drive is faster than the scene's 0.02 σ/τ (0.1, or 0.3 for the weakening law),
 which shortens the sticks and leaves the slips (at ~1 σ/τ) nearly as they are.
 Each replica's film pushes the wall with the MD's noise as a random force ξ = M·du/dt, u the
-velocity noise of :data:`~.film_noise.MD_NOISE` (:mod:`~filmfriction.analysis.groundtruth.random_force`;
-calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`): the wall's
+velocity noise of :data:`~.film_noise.MD_NOISE`
+(:mod:`~filmfriction.analysis.groundtruth.random_force`; calibrated on the MD's slips, :mod:`~filmfriction.analysis.groundtruth.md_noise`): the wall's
 position and velocity respond to it, as an MD wall's do, and the residual of the integrated
 equation of motion over M, ∫ξ dt/M, is u. The slips are fitted as the driven analysis fits them, as
 their mean (:func:`~filmfriction.analysis.slip_law.slip_law_cycles.fit_cycle_ensemble`, each slip
@@ -52,8 +52,8 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
-from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE,
-                         STIFF_REGISTRY_NOISE)
+from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE,
+                         MD_NOISE, STIFF_NOISE, STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 

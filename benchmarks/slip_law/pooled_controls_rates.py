@@ -28,7 +28,8 @@ D``: the shares' mixes with a yield loop (``melting``, ``slip-weakening`` or ``m
 their viscous force lagging the velocity by TAU (``maxwell``; with ``--loop slip-weakening``,
 ``maxwell-weakening``); ``--corrugation DF LAMBDA PHI``: the mixes with a force
 periodic in the wall's position (``corrugated``, the registry of commensurate walls; with
-``--lag``, lagging too);
+``--lag``, lagging too; with ``--loop melting`` or ``slip-weakening``, ``corrugated-loop``;
+not with ``--loop maxwell``);
 ``--registry-period LAMBDA``: every fit (the truth's too) with a force of that period
 fitted beside the law (the MD's runs of aligned walls are: ``registry_period``); ``--stop-velocity``: the mixes
 re-stick at that velocity once armed (negative: once the wall recoils that fast; the truth

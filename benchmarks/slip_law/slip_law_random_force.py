@@ -43,7 +43,8 @@ from scipy.integrate import cumulative_trapezoid
 from filmfriction.analysis.groundtruth.md_noise import replica_residuals, residual_statistics
 from filmfriction.analysis.groundtruth.random_force import slide
 from filmfriction.analysis.groundtruth.film_noise import MD_NOISE, RESIDUAL_AS_NOISE
-from filmfriction.analysis.groundtruth.slip_law_controls import CONTROLS, SCALE, SCALES, control_fits
+from filmfriction.analysis.groundtruth.slip_law_controls import (CONTROLS, SCALE, SCALES,
+                                                                 control_fits)
 from filmfriction.analysis.slip_law.slip_law import RESOLVED_SIGMAS, VERDICTS, fit_film_force
 from filmfriction.reduced_model.cycles import cycle_table
 

@@ -88,9 +88,14 @@ def main(argv=None) -> int:
         sc = SCALES["stiff"]
         if a.stop_velocity is not None:
             sc = replace(sc, mix={**sc.mix, "stop_velocity": a.stop_velocity})
-        runs, _ = pooled_runs("x", a.runs, a.slips, share=a.control, law_spread=0.15, scale=sc,
-                              noise=NOISE_FREE if a.noise_free else STIFF_REGISTRY_NOISE,
-                              corrugation=tuple(a.corrugation), **loop)
+        try:
+            runs, _ = pooled_runs("x", a.runs, a.slips, share=a.control, law_spread=0.15,
+                                  scale=sc,
+                                  noise=NOISE_FREE if a.noise_free else STIFF_REGISTRY_NOISE,
+                                  corrugation=tuple(a.corrugation), **loop)
+        except ValueError as exc:
+            print(f"slip_stalls: {exc}", file=sys.stderr)
+            return 1
         what = (f"control share {a.control:g}, registry force {a.corrugation}, "
                 + (f"a {a.loop[0]} loop {a.loop[1]} over {a.loop[2]}, " if loop else "")
                 + ("noise-free" if a.noise_free else "STIFF_REGISTRY_NOISE")

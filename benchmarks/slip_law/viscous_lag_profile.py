@@ -233,7 +233,11 @@ def main(argv=None) -> int:
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")
-        return control(a)
+        try:
+            return control(a)
+        except ValueError as exc:      # a law the spread made impossible (D or τ_r <= 0)
+            print(f"viscous_lag_profile: {exc}", file=sys.stderr)
+            return 1
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:
         ap.error(f"RUN without trace.csv: {', '.join(missing)}")

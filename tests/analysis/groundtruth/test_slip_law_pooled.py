@@ -411,3 +411,35 @@ def test_a_controls_slip_can_end_where_the_mds_detector_ends_one():
     assert np.median(moved) > 1.0          # a rest of the wall is cut off most slips' ends
     with pytest.raises(ValueError, match="slip_end"):
         pooled_runs("x", 3, 2, share=0.5, slip_end="detector")
+
+
+def test_a_corrugated_loop_control_keeps_the_walls_registry_and_gives_each_run_its_loop(
+        monkeypatch):
+    # each run: its own film (F_k, B, W, D spread), its loop's ΔF = W·(F_s − F_k) of its own
+    # yield force, and the walls' registry, lag and loop kind as given (one geometry)
+    import filmfriction.analysis.groundtruth.pooled_controls as pc
+    made = []
+    real = pc.slide
+
+    def spy(**kw):
+        made.append(kw)
+        return real(**{**kw, "duration": 50.0})
+    monkeypatch.setattr(pc, "slide", spy)
+    kw = dict(share=0.5, corrugation=(20.0, 1.1, -0.97), noise=QUIET)
+    pc.pooled_runs("x", 3, 1, weakening=(0.5, 0.3), loop_law="slip-weakening", lag=12.0, **kw)
+    pc.pooled_runs("x", 3, 1, weakening=(0.5, 0.005), loop_law="melting", **kw)
+    pc.pooled_runs("x", 4, 1, weakening=(0.5, 0.3), loop_law="slip-weakening", lag=12.0,
+                   law_spread=0.1, **kw)
+    assert len(made) == 10 and {k["law"] for k in made} == {"corrugated-loop"}
+    for k in made[:6]:
+        p = k["parameters"]
+        assert p[:2] == pytest.approx((13.5, 0.5 * 27.0 / 0.017))
+        assert p[2] == pytest.approx(0.5 * (k["static_force"] - 13.5))
+        assert p[3] in (0.3, 0.005)
+    for k in made:
+        assert k["parameters"][4:7] == (20.0, 1.1, -0.97)
+    assert {k["parameters"][7:] for k in made[:3] + made[6:]} == {(12.0, 0.0)}
+    assert {k["parameters"][7:] for k in made[3:6]} == {(0.0, 1.0)}
+    assert len({k["parameters"][3] for k in made[6:]}) == 4        # the films spread
+    with pytest.raises(ValueError, match="corrugation"):
+        pc.pooled_runs("weakening", 3, 1, corrugation=(20.0, 1.1, 0.0))
