@@ -399,16 +399,22 @@ def test_a_controls_slip_can_end_where_the_mds_detector_ends_one():
     sc = replace(STIFF, mix={**STIFF.mix, "stop_velocity": -0.0025})
     kw = dict(share=0.5, scale=sc, noise=STIFF.registry_noise, corrugation=(20.0, 1.1, -0.97),
               seed=(0, 0))
+    from filmfriction.analysis.stickslip import detect_slips
     slider, _ = pooled_runs("x", 3, 4, **kw)
     minimum, _ = pooled_runs("x", 3, 4, slip_end="force-minimum", **kw)
-    moved = []
+    to_slider, to_minimum = [], []
     for a, b in zip(slider, minimum):
         np.testing.assert_array_equal(a.table.yield_index, b.table.yield_index)
+        found = detect_slips(a.time, a.spring_force)       # the MD's detector, on the trace
+        ys, ss = np.asarray(found.yield_index), np.asarray(found.stick_index)
         for y, s, e in zip(a.table.yield_index, a.table.stick_index, b.table.stick_index):
             assert y < e <= s
-            assert a.spring_force[e] == a.spring_force[y:s + 1].min()
-            moved.append(a.time[s] - a.time[e])
-    assert np.median(moved) > 1.0          # a rest of the wall is cut off most slips' ends
+            detected = ss[np.argmin(np.abs(ys - y))]
+            to_slider.append(abs(detected - s))
+            to_minimum.append(abs(detected - e))
+    # the detector ends the slips where their force is lowest (to a sample; a few it ends
+    # earlier, at a stall), most of them well before the slider re-sticks
+    assert np.median(to_minimum) <= 2 and np.median(to_slider) > 40
     with pytest.raises(ValueError, match="slip_end"):
         pooled_runs("x", 3, 2, share=0.5, slip_end="detector")
 
