@@ -147,7 +147,7 @@ def _bingham_reading(rows) -> str:
                  "rejected there; at M = 10⁵ (Bi 32–57, ten runs) it reads `inconclusive`: "
                  "read as one law the slips carry a viscous term ≈ 20 times a bulk film's "
                  "beside a kinetic force at 2.3–3.5 σ, and a viscous force that lags the slip "
-                 "by ≈ 25 τ (a lag that appears between M = 10³ and 10⁴ and grows with M: no "
+                 "by ≈ 25 τ (a lag that appears between M = 10³ and 3×10³ and grows with M: no "
                  "relaxation time of the film), with a yield-loop step left that no control "
                  "reproduces. Neither reading of the dispute is established at the highest "
                  "Bi reached: the film's force is a kinetic friction beside a viscous term "
