@@ -73,14 +73,14 @@ def main(argv=None) -> int:
         loop = {}
         if a.loop is not None:
             try:
-                loop = {"weakening": (float(a.loop[1]), float(a.loop[2])), "loop_law": a.loop[0]}
+                w, d = float(a.loop[1]), float(a.loop[2])
             except ValueError:
-                loop = {"weakening": (math.nan, math.nan)}
-            w, d = loop["weakening"]
+                w = d = math.nan
             if a.loop[0] not in ("melting", "slip-weakening") or not (
                     0 <= w <= 1 and math.isfinite(d) and d > 0):
                 ap.error(f"--loop {' '.join(a.loop)}: LAW melting or slip-weakening, W in "
                          "[0, 1], D > 0")
+            loop = {"weakening": (w, d), "loop_law": a.loop[0]}
         from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
         from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
         from filmfriction.analysis.groundtruth.film_noise import STIFF_REGISTRY_NOISE

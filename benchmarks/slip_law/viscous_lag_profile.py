@@ -142,7 +142,7 @@ def control(args) -> int:
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
     print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
           + table(args.lags, pool(0, NOISE_FREE, base)), flush=True)
-    taus, errs, bs, steps, mc0, first = [], [], [], [], [], []
+    taus, errs, bs, steps, first = [], [], [], [], []
     for k in range(args.replicas):
         fits = pool(k, noise)
         o = fits[0].one_law
@@ -155,17 +155,15 @@ def control(args) -> int:
             near = fits[int(np.argmin(np.abs(np.asarray(args.lags) - t)))]
             bs.append(near.one_law.damping)
             steps.append((near.loop_step, near.loop_step_stderr))
-        else:
-            o = fits[0].one_law
-            mc0.append(o.comoving_mass / o.comoving_mass_stderr)
     taus, errs, first = np.array(taus), np.array(errs), np.array(first)
     ok = np.isfinite(taus)
     print(f"\nat τ_r = {args.lags[0]:g}, over the {args.replicas} pools: the one law's m_c "
           f"{first[:, 0].mean():+.1f} errors (sd {first[:, 0].std():.1f}; ≤ −2 in "
           f"{int((first[:, 0] <= -2).sum())}), the loop step {first[:, 1].mean():+.2f} ε/σ "
           f"(sd {first[:, 1].std():.2f}; ≥ +2 errors in {int((first[:, 2] >= 2).sum())})")
-    if mc0:
-        print(f"{len(mc0)} pools whose m_c does not cross zero on the grid: m_c at τ_r = "
+    mc0 = first[~ok, 0]             # the pools whose m_c does not cross
+    if mc0.size:
+        print(f"{mc0.size} pools whose m_c does not cross zero on the grid: m_c at τ_r = "
               f"{args.lags[0]:g} {np.mean(mc0):+.1f} errors (sd {np.std(mc0):.1f})")
     if not ok.any():
         print(f"{args.replicas} pools: m_c crosses zero on the grid in none")
