@@ -22,7 +22,7 @@ from __future__ import annotations
 
 __all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "STIFF_NOISE", "STIFF_REGISTRY_NOISE",
            "M1E4_NOISE", "M1E4_REGISTRY_NOISE", "LIGHT_NOISE",
-           "LIGHT_REGISTRY_NOISE"]
+           "LIGHT_REGISTRY_NOISE", "M3E3_NOISE", "M3E3_REGISTRY_NOISE"]
 
 #: The film's random force of the controls, calibrated to the MD (LJ units; the keywords of
 #: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of 0.45 σ/τ
@@ -118,3 +118,18 @@ LIGHT_NOISE = {1e2: {"velocity_noise": 0.3, "velocity_correlation": 0.94, "rattl
 #: wall jittering more than the MD's): kept, the fast residual a little low at M = 10²
 #: (docs/results/slip-law.md, "A viscous force that lags").
 LIGHT_REGISTRY_NOISE = {mass: dict(noise) for mass, noise in LIGHT_NOISE.items()}
+
+#: The film's random force at M = 3×10³, calibrated as :data:`M1E4_NOISE` on the 118 analysed
+#: slips of the mass ladder's eight M = 3×10³ runs against 40 replicas of the scale's mix of
+#: share 0.5: read without the registry's terms u an AR(1) of 0.07 σ/τ rms, 0.99 per 0.25 τ
+#: (25 τ): fast residual (with Δt², Δt³) 0.0212 for the MD's 0.0207 ± 0.0006 σ/τ, plain 0.0257 for 0.0257 (u 0.05
+#: and 0.08 give 0.0159 and 0.0237).  Beside the registry force (replicas carrying 20 ε/σ at
+#: 1.1 σ, every residual read with the registry's terms) u 0.05 at 0.99: 0.0128 ± 0.0002 for
+#: the MD's 0.0131 ± 0.0005 (u 0.035 gives 0.0095); the wall's velocity change over 0.25, 1,
+#: 4, 8 τ 0.0071, 0.0144, 0.0294, 0.0399 σ/τ for the MD's 0.0038, 0.0115, 0.0316, 0.0457 (its
+#: wall smoother over the shortest lags, as at the other scales).
+#: ``python benchmarks/slip_law/md_noise_calibration.py RUN… --scale m3e3 --replicas 40
+#: --lags 1 4 16 32 64 --share 0.5 [--corrugation 20 1.1 -0.97 --registry-period 1.1]
+#: --noise U 0.99 0`` (docs/results/slip-law.md, "A viscous force that lags").
+M3E3_NOISE = {"velocity_noise": 0.07, "velocity_correlation": 0.99, "rattle": 0.0}
+M3E3_REGISTRY_NOISE = {"velocity_noise": 0.05, "velocity_correlation": 0.99, "rattle": 0.0}

@@ -91,13 +91,21 @@ def residual_statistics(residuals, lags=LAGS) -> dict:
     if not rs:
         raise ValueError("no slip long enough to measure a residual")
     rms = np.array([r.std() for r in rs])
-    acf = np.array([[(r[:r.size - k] @ r[k:]) / (r @ r) for k in lags] for r in rs])
+    # a lag as long as a slip's residual has no pair in it: that slip leaves that lag out
+    acf = np.array([[(r[:r.size - k] @ r[k:]) / (r @ r) if k < r.size else math.nan
+                     for k in lags] for r in rs]).reshape(len(rs), len(lags))
     n = len(rs)
-    se = (lambda a: a.std(axis=0, ddof=1) / math.sqrt(n)) if n > 1 else (
-        lambda a: np.full(np.shape(a)[1:], math.nan))
-    return {"slips": n, "rms": float(rms.mean()), "rms_stderr": float(se(rms)),
+
+    def se(a):
+        cols = [c[np.isfinite(c)] for c in np.atleast_2d(np.asarray(a).T)]
+        return np.array([c.std(ddof=1) / math.sqrt(c.size) if c.size > 1 else math.nan
+                         for c in cols])
+
+    mean_acf = [float(c[np.isfinite(c)].mean()) if np.isfinite(c).any() else math.nan
+                for c in acf.T]
+    return {"slips": n, "rms": float(rms.mean()), "rms_stderr": float(se(rms)[0]),
             "per_slip_rms": rms.tolist(), "lags": list(lags),
-            "autocorrelation": acf.mean(axis=0).tolist(),
+            "autocorrelation": mean_acf,
             "autocorrelation_stderr": np.atleast_1d(se(acf)).tolist()}
 
 

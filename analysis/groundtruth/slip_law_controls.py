@@ -53,7 +53,8 @@ from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
 from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE,
-                         MD_NOISE, STIFF_NOISE, STIFF_REGISTRY_NOISE)
+                         M3E3_NOISE, M3E3_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE,
+                         STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
@@ -192,16 +193,19 @@ M1E4_STOP = 0.011
 #: spread by ± 20 % (the MD's runs: 47–66 ε/σ at M = 10², 10–90 %).
 #: The Coulomb control's F_k is 8 ε/σ under F̄ (as the M = 10⁴ scale's 27 is 5 under its 32),
 #: re-sticking where the wall stops.  The noise: :data:`LIGHT_NOISE`.
-LIGHT_B = {1e2: 2.0 * math.sqrt(8.0 * 1e2), 1e3: 2.0 * math.sqrt(8.0 * 1e3)}
+#: M = 3×10³ (V = 0.0144 σ/τ, γM = 5.88 m/τ; yields ≈ 46 (34–60), re-sticks ≈ 20 (14–26)
+#: ε/σ, slips of 65 τ (46–120) at ≈ 0.061 σ/τ; F̄ 33.5 ε/σ: the rung's eight runs, 10–90 %),
+#: the rung between, as these, with its own noise (:data:`~.film_noise.M3E3_NOISE`).
+LIGHT_B = {m: 2.0 * math.sqrt(8.0 * m) for m in (1e2, 1e3, 3e3)}
 #: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
 #: (336 atoms, 1 m each), and of the Klein-similar scene's (224).
 THICK_FILM_MASS, KLEIN_FILM_MASS = 336.0, 224.0
 
 
 def _light_scale(name, mass, velocity, damping, static, backward, force, slip_velocity,
-                 armed, period) -> Scale:
+                 armed, period, noise=None, registry_noise=None) -> Scale:
     return Scale(
-        name, 8.0, mass, 0.25, static, velocity, LIGHT_NOISE[mass],
+        name, 8.0, mass, 0.25, static, velocity, noise or LIGHT_NOISE[mass],
         laws={"coulomb": dict(law="linear", parameters=(force - 8.0, 0.0),
                               armed_below=force - 8.0, initial_force=backward, period=period),
               "viscous": dict(law="linear", parameters=(0.0, LIGHT_B[mass]),
@@ -211,7 +215,7 @@ def _light_scale(name, mass, velocity, damping, static, backward, force, slip_ve
                  stop_velocity=slip_velocity / 4, armed_below=armed, initial_force=backward,
                  period=period),
         mount_damping=damping, chunk=10, film_mass=THICK_FILM_MASS,
-        registry_noise=LIGHT_REGISTRY_NOISE.get(mass))
+        registry_noise=registry_noise or LIGHT_REGISTRY_NOISE.get(mass))
 
 
 #: The scales of the random-force controls, by name.
@@ -276,6 +280,8 @@ SCALES = {
         registry_noise=M1E4_REGISTRY_NOISE),
     "m1e2": _light_scale("m1e2", 1e2, 0.079, 1.07, 57.0, 20.0, 40.0, 0.34, 41.0, 100.0),
     "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
+    "m3e3": _light_scale("m3e3", 3e3, 0.0144, 5.88, 46.0, 20.0, 33.5, 0.061, 32.3, 420.0,
+                         M3E3_NOISE, M3E3_REGISTRY_NOISE),
 }
 
 

@@ -26,7 +26,8 @@ viscous force lags by TAU (0: no lag, the negative control) (``SCALES["stiff"]``
 of ``--corrugation`` (fitted at its period) and the noise beside it
 (the scale's ``registry_noise``, :mod:`~filmfriction.analysis.groundtruth.film_noise`, times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
-``--scale m1e4`` (``m1e3``, ``m1e2``): the M = 10⁴ (10³, 10²) slider's scale instead;
+``--scale m1e4`` (``m3e3``, ``m1e3``, ``m1e2``): the M = 10⁴ (3×10³, 10³, 10²) slider's scale
+instead;
 ``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
@@ -196,7 +197,7 @@ def main(argv=None) -> int:
     ap.add_argument("--corrugation", nargs=3, type=float, default=[20.0, 1.1, -0.97],
                     metavar=("DF", "L", "PHI"))
     ap.add_argument("--stop-velocity", type=float, default=-0.0025)
-    ap.add_argument("--scale", choices=("stiff", "m1e4", "m1e3", "m1e2"), default="stiff")
+    ap.add_argument("--scale", choices=[s for s in SCALES if s != "klein"], default="stiff")
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
     ap.add_argument("--slip-end", choices=SLIP_ENDS, default="slider")

@@ -14,6 +14,7 @@ from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_s
                                                         residual_statistics, residuals,
                                                         slip_velocities)
 from filmfriction.analysis.groundtruth.film_noise import (M1E4_NOISE, M1E4_REGISTRY_NOISE,
+                                                       M3E3_NOISE, M3E3_REGISTRY_NOISE,
                                                        MD_NOISE, RESIDUAL_AS_NOISE,
                                                        STIFF_NOISE, STIFF_REGISTRY_NOISE)
 
@@ -75,6 +76,19 @@ def test_residual_statistics_of_a_known_ar1():
         residual_statistics([])
 
 
+def test_a_lag_longer_than_a_slip_leaves_that_slip_out_of_that_lag():
+    # a brief slip has no pair at a long lag: it is left out there, kept at the short ones
+    rng = np.random.default_rng(2)
+    long_, short = rng.normal(size=(3, 400)), rng.normal(size=30)
+    s = residual_statistics([*long_, short], lags=(1, 64))
+    alone = residual_statistics(list(long_), lags=(64,))
+    assert s["slips"] == 4 and s["rms"] == pytest.approx(
+        np.mean([r.std() for r in [*long_, short]]))
+    assert s["autocorrelation"][1] == pytest.approx(alone["autocorrelation"][0])
+    assert s["autocorrelation_stderr"][1] == pytest.approx(alone["autocorrelation_stderr"][0])
+    assert math.isnan(residual_statistics([short], lags=(64,))["autocorrelation"][0])
+
+
 #: The MD's fast residual (with Δt², Δt³) at the heavy slider's scale read with the walls'
 #: registry force fitted besides: ten ``sfb-thick-stiff`` runs, 89 slips (``python
 #: benchmarks/slip_law/md_noise_calibration.py RUN… --scale stiff --share 0.2 --corrugation 20
@@ -82,6 +96,8 @@ def test_residual_statistics_of_a_known_ar1():
 MD_STIFF_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00158, 0.00007)
 #: The same at M = 10⁴: six runs (seeds 1–6), ``--scale m1e4 --share 0.5``.
 MD_M1E4_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00541, 0.00022)
+#: The same at M = 3×10³: the mass ladder's eight runs, ``--scale m3e3 --share 0.5``.
+MD_M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0131, 0.0005)
 CORRUGATION = (20.0, 1.1, -0.97)
 
 
@@ -112,3 +128,10 @@ def test_the_m1e4_noise_beside_the_registry_is_the_mds_and_the_older_one_too_lou
     assert _stiff_fast_rms(M1E4_REGISTRY_NOISE, 20, 1.1, "m1e4", 0.5) == pytest.approx(
         md, abs=3 * err)
     assert _stiff_fast_rms(M1E4_NOISE, 20, 1.1, "m1e4", 0.5) > md + 6 * err
+
+
+def test_the_m3e3_noise_beside_the_registry_is_the_mds_and_the_plain_one_too_loud():
+    md, err = MD_M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(M3E3_REGISTRY_NOISE, 20, 1.1, "m3e3", 0.5) == pytest.approx(
+        md, abs=3 * err)
+    assert _stiff_fast_rms(M3E3_NOISE, 20, 1.1, "m3e3", 0.5) > md + 6 * err
