@@ -21,6 +21,8 @@ Example
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from filmfriction.reduced_model.cycles import cycle_table
@@ -28,10 +30,10 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import FilmForceFit
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME
 from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
-from .random_force import slide
+from .random_force import LOOP_LAWS, slide
 from .slip_law_controls import Scale, scale_named
 
-__all__ = ["pooled_runs", "pooled_fits", "STATIC_SPREAD", "SLIP_ENDS"]
+__all__ = ["pooled_runs", "pooled_fits", "yield_loop", "STATIC_SPREAD", "SLIP_ENDS"]
 
 #: The runs' yield forces spread uniformly within ± this share of the scale's (the MD's six
 #: K = 8 runs: 30–60 ε/σ about 45).
@@ -43,6 +45,24 @@ STATIC_SPREAD = 0.3
 #: force rises again by more than its threshold), so that a rest of the wall before the
 #: slider re-sticks is left out as the MD's slips leave it.
 SLIP_ENDS = ("slider", "force-minimum")
+
+
+def yield_loop(law: str, w, d, laws=LOOP_LAWS) -> tuple[str, float, float]:
+    """A yield loop as the benchmarks' ``--loop LAW W D`` gives it, checked: (``law``, W, D)
+    with W (a share of the yield's excess over F_k) in [0, 1] and D > 0, finite (the
+    distance, velocity or time it fades over), ``law`` one of ``laws``; ValueError
+    otherwise.
+
+    >>> yield_loop("slip-weakening", "0.5", "2")
+    ('slip-weakening', 0.5, 2.0)
+    """
+    try:
+        w, d = float(w), float(d)
+    except (TypeError, ValueError):
+        w = d = math.nan
+    if law not in laws or not (0 <= w <= 1 and math.isfinite(d) and d > 0):
+        raise ValueError(f"LAW {' or '.join(laws)}, W in [0, 1], D > 0")
+    return law, w, d
 
 
 def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,

@@ -49,8 +49,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs
-from filmfriction.analysis.groundtruth.random_force import LOOP_LAWS, NOISE_FREE
+from filmfriction.analysis.groundtruth.pooled_controls import STATIC_SPREAD, pooled_runs, yield_loop
+from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.film_noise import scaled
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 from filmfriction.analysis.slip_law.slip_law import VERDICTS, loop_step_branch
@@ -248,12 +248,9 @@ def main(argv=None) -> int:
                  f"({', '.join(SCALES[args.scale].laws)})")
     if args.loop:
         try:
-            w, d = float(args.loop[1]), float(args.loop[2])
-        except ValueError:
-            w = d = math.nan
-        if args.loop[0] not in LOOP_LAWS or not (0 <= w <= 1 and d > 0):
-            ap.error(f"--loop {' '.join(args.loop)}: LAW {' or '.join(LOOP_LAWS)}, "
-                     "0 <= W <= 1, D > 0")
+            yield_loop(*args.loop)
+        except ValueError as exc:
+            ap.error(f"--loop {' '.join(args.loop)}: {exc}")
     if args.lag is not None and (not (math.isfinite(args.lag) and args.lag > 0) or (
             args.loop and args.loop[0] != "slip-weakening")):
         ap.error(f"--lag {args.lag!r}: a relaxation time > 0, finite, and with --loop only "

@@ -71,17 +71,13 @@ def main(argv=None) -> int:
         if a.stop_velocity is not None and not math.isfinite(a.stop_velocity):
             ap.error(f"--stop-velocity {a.stop_velocity}: finite")
         loop = {}
+        from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs, yield_loop
         if a.loop is not None:
             try:
-                w, d = float(a.loop[1]), float(a.loop[2])
-            except ValueError:
-                w = d = math.nan
-            if a.loop[0] not in ("melting", "slip-weakening") or not (
-                    0 <= w <= 1 and math.isfinite(d) and d > 0):
-                ap.error(f"--loop {' '.join(a.loop)}: LAW melting or slip-weakening, W in "
-                         "[0, 1], D > 0")
-            loop = {"weakening": (w, d), "loop_law": a.loop[0]}
-        from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+                law, w, d = yield_loop(*a.loop, laws=("melting", "slip-weakening"))
+            except ValueError as exc:
+                ap.error(f"--loop {' '.join(a.loop)}: {exc}")
+            loop = {"weakening": (w, d), "loop_law": law}
         from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
         from filmfriction.analysis.groundtruth.film_noise import STIFF_REGISTRY_NOISE
         from filmfriction.analysis.groundtruth.slip_law_controls import SCALES

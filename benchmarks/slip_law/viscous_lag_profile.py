@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.groundtruth.pooled_controls import SLIP_ENDS, pooled_runs
+from filmfriction.analysis.groundtruth.pooled_controls import SLIP_ENDS, pooled_runs, yield_loop
 from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.film_noise import scaled
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
@@ -221,14 +221,11 @@ def main(argv=None) -> int:
                      "give --noise U RHO")
         if a.loop is not None:
             try:
-                w, d = float(a.loop[1]), float(a.loop[2])
-            except ValueError:
-                w = d = math.nan
-            if a.loop[0] not in ("melting", "slip-weakening") or not (
-                    0 <= w <= 1 and math.isfinite(d) and d > 0) or (
-                    a.loop[0] == "melting" and tau > 0):
-                ap.error(f"--loop {' '.join(a.loop)}: LAW melting or slip-weakening (melting "
-                         "with TAU 0 only), W in [0, 1], D > 0")
+                yield_loop(*a.loop, laws=("melting", "slip-weakening"))
+            except ValueError as exc:
+                ap.error(f"--loop {' '.join(a.loop)}: {exc}")
+            if a.loop[0] == "melting" and tau > 0:
+                ap.error(f"--loop {' '.join(a.loop)}: melting with TAU 0 only")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

@@ -194,7 +194,7 @@ def test_the_pooled_controls_benchmark_refuses_bad_input_before_any_compute(benc
                                                                             capsys):
     main = benchmark_module("slip_law/pooled_controls_rates").main
     for argv, said in ((["--loop", "wobble", "0.5", "1"], "LAW melting or slip-weakening"),
-                       (["--loop", "melting", "2", "1"], "0 <= W <= 1"),
+                       (["--loop", "melting", "2", "1"], "W in [0, 1]"),
                        (["--stop-velocity", "nan"], "--stop-velocity nan: finite or -inf"),
                        (["--lag", "0"], "--lag 0.0: a relaxation time > 0"),
                        (["--lag", "5", "--loop", "melting", "0.5", "0.01"], "only slip-weakening")):
