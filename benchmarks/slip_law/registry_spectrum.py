@@ -2,7 +2,9 @@
 position, slip by slip, from MD runs.
 
     python benchmarks/slip_law/registry_spectrum.py RUN_DIR... [--periods 0.55 1.1 ...]
-        [--window 20]
+        [--window 20] [--branches]
+    python benchmarks/slip_law/registry_spectrum.py --control SCALE RUNS SLIPS [--lag TAU]
+        [--pools 3] [--window 5]
 
 Commensurate walls pass a force that repeats with their lattice's period along the slide:
 the film's force during a slip is then F_k + B·v plus a periodic function of the wall's
@@ -16,28 +18,42 @@ lattice shows in the first; one locked to the yield, in the second; a period tha
 neither reads the noise's level).  Then the line fitted with 0–3 harmonics of the runs'
 registry period (``trace_parameters.registry_period``, the walls' spacing for aligned
 walls): F_k, B, each harmonic's amplitude and phase (A·sin(2πhx/λ + φ)) and the residual's
-rms.
+rms.  ``--branches``: besides, the line and two harmonics fitted on each part of the
+slips apart (the accelerating and decelerating branches, split at each slip's peak
+velocity; the first and second halves of the distance slid), each ± the jackknife's error
+over the runs: a registry force that depends on the film's state reads differently on them.
+``--control SCALE RUNS SLIPS``: that table for ``--pools`` pools of RUNS random-force runs of
+SLIPS slips at a scale of the controls (the Coulomb + viscous mix of share 0.5, its
+viscous force lagging by ``--lag`` τ, carrying a registry force of constant amplitude,
+20·sin(2π·x/1.1 − 0.97), at the scale's noise beside the registry, re-sticking on a recoil
+at the drive's velocity): what the estimator reads where the truth is one amplitude and
+phase on every part.  The smoothing attenuates the registry's force where a period passes
+in less than a few windows: at a light slider take a window of a fifth of that passage.
 """
 from __future__ import annotations
 
 import argparse
 import math
 import sys
+from dataclasses import replace
 
 import numpy as np
 from scipy.signal import savgol_filter
 
 from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
 
+#: The controls' registry force (ΔF ε/σ, λ σ, φ): the MD's first harmonic at M = 10⁵.
+CONTROL_REGISTRY = (20.0, 1.1, -0.97)
 PERIODS = (0.318, 0.55, 0.635, 0.7, 0.8, 0.953, 1.1, 1.27, 1.5, 1.905, 2.2)
 
 
 def slipping_samples(runs, kw, window: float):
     """The film's force, the wall's position, the distance since the yield and the velocity
-    at every slipping sample of the runs' analysed slips."""
-    out = [], [], [], []
+    at every slipping sample of the runs' analysed slips; besides, each sample's run and
+    whether it is before its slip's peak (smoothed) velocity (the accelerating branch)."""
+    out = [], [], [], [], [], []
     mass, gamma, drive = kw["mass"], kw["mount_damping"], kw["drive_velocity"]
-    for r in runs:
+    for run_no, r in enumerate(runs):
         dt = float(r.time[1] - r.time[0])
         w = max(5, int(window / dt) | 1)
         x = (r.wall_position if r.wall_position is not None
@@ -47,7 +63,11 @@ def slipping_samples(runs, kw, window: float):
         force = savgol_filter(r.spring_force, w, 2) - mass * a - gamma * (v - drive)
         for y, s in zip(r.table.yield_index, r.table.stick_index):
             k = slice(int(y) + w // 2, int(s) - w // 2)
-            for o, q in zip(out, (force[k], x[k], x[k] - x[int(y)], v[k])):
+            n = max(0, k.stop - k.start)
+            peak = int(np.argmax(v[k])) if n else 0
+            for o, q in zip(out, (force[k], x[k], x[k] - x[int(y)], v[k],
+                                  np.full(n, run_no),
+                                  np.arange(n) < peak)):
                 o.append(q)
     return tuple(np.concatenate(o) for o in out)
 
@@ -61,10 +81,35 @@ def harmonic_fit(force, x, v, period: float, harmonics: int):
     return c, float(np.std(force - a @ c))
 
 
+def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: float) -> int:
+    """The branch table of ``pools`` pools of controls whose registry force is constant."""
+    from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+    from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
+
+    sc = SCALES[scale]
+    sc = replace(sc, mix={**sc.mix, "stop_velocity": -sc.drive_velocity})
+    kw = dict(mass=sc.mass, mount_damping=sc.mount_damping, drive_velocity=sc.drive_velocity)
+    print(f"controls at the {scale} scale: share 0.5, the registry force 20·sin(2π·x/1.1 − "
+          f"0.97), lag {lag:g} τ, {runs} runs × {slips} slips, window {window:g} τ")
+    for seed in range(pools):
+        rs, _ = pooled_runs("x", runs, slips, share=0.5, scale=sc, noise=sc.registry_noise,
+                            corrugation=CONTROL_REGISTRY, seed=(seed, 0),
+                            **({"lag": lag} if lag else {}))
+        force, x, slid, v, run_of, acc = slipping_samples(rs, kw, window)
+        print(f"pool {seed + 1}:\n" + branch_table(force, x, v, slid, run_of, acc,
+                                                    CONTROL_REGISTRY[1], len(rs)))
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("runs", nargs="+", metavar="RUN_DIR")
+    ap.add_argument("runs", nargs="*", metavar="RUN_DIR")
+    ap.add_argument("--control", nargs=3, default=None, metavar=("SCALE", "RUNS", "SLIPS"))
+    ap.add_argument("--lag", type=float, default=0.0, help="the controls' viscous lag (τ)")
+    ap.add_argument("--pools", type=int, default=3)
     ap.add_argument("--periods", nargs="+", type=float, default=list(PERIODS))
+    ap.add_argument("--branches", action="store_true",
+                    help="the line and the registry's harmonics on each part of the slips")
     ap.add_argument("--window", type=float, default=20.0,
                     help="the smoothing window of the force and the position (τ)")
     args = ap.parse_args(argv)
@@ -72,13 +117,25 @@ def main(argv=None) -> int:
         ap.error(f"--periods {' '.join(map(str, args.periods))}: each > 0, finite")
     if not (math.isfinite(args.window) and args.window > 0):
         ap.error(f"--window {args.window!r}: > 0, finite")
+    if (args.control is None) == (not args.runs):
+        ap.error("RUN_DIR… or --control SCALE RUNS SLIPS (one of them)")
+    if args.control is not None:
+        from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
+        scale, runs, slips = args.control
+        if (scale not in SCALES or scale == "klein" or not runs.isdigit() or int(runs) < 3
+                or not slips.isdigit() or int(slips) < 1):
+            ap.error(f"--control {' '.join(args.control)}: SCALE one of "
+                     f"{', '.join(s for s in SCALES if s != 'klein')}, RUNS >= 3, SLIPS >= 1")
+        if not (math.isfinite(args.lag) and args.lag >= 0) or args.pools < 1:
+            ap.error(f"--lag {args.lag} >= 0 (τ), --pools {args.pools} >= 1")
+        return control(scale, int(runs), int(slips), args.lag, args.pools, args.window)
     try:
         runs, shared, _ = read_runs(args.runs, analyse=False)
     except ValueError as exc:
         print(f"registry_spectrum: {exc}", file=sys.stderr)
         return 1
     kw = fit_arguments(shared)
-    force, x, slid, v = slipping_samples(runs, kw, args.window)
+    force, x, slid, v, run_of, accelerating = slipping_samples(runs, kw, args.window)
     c, rms = harmonic_fit(force, x, v, 1.0, 0)
     resid = force - (c[0] + c[1] * v)
     print(f"{len(runs)} runs, {sum(len(r.table) for r in runs)} slips, {force.size} slipping "
@@ -97,7 +154,41 @@ def main(argv=None) -> int:
                  f"{math.atan2(c[3 + 2 * k], c[2 + 2 * k]):+.2f} rad" for k in range(h)]
         print(f"  {h} harmonic(s) of λ = {period:g}: F_k {c[0]:.2f}, B {c[1]:.0f}"
               + (f"; amplitudes {', '.join(parts)}" if parts else "") + f"; residual rms {rms:.2f}")
+    if args.branches:
+        print(branch_table(force, x, v, slid, run_of, accelerating, period, len(runs)))
     return 0
+
+
+def _amplitudes(force, x, v, period):
+    c, _ = harmonic_fit(force, x, v, period, 2)
+    return np.array([c[0], c[1], math.hypot(c[2], c[3]), math.atan2(c[3], c[2]),
+                     math.hypot(c[4], c[5])])
+
+
+def branch_table(force, x, v, slid, run_of, accelerating, period, runs) -> str:
+    """The line and two registry harmonics fitted on each part of the slips apart: the
+    accelerating and decelerating branches (split at each slip's peak velocity) and the
+    first and second halves of the distance slid, each ± the jackknife's error over the
+    runs (a registry force that weakens as the film is sheared reads a smaller amplitude
+    on the later part)."""
+    half = np.zeros_like(accelerating)
+    for r in range(runs):
+        m = run_of == r
+        if m.any():
+            half[m] = slid[m] < np.median(slid[m])
+    rows = ["| part of the slips | samples | F_k (ε/σ) | B (m/τ) | first harmonic (ε/σ) | "
+            "its phase (rad) | second harmonic (ε/σ) |", "|---|---|---|---|---|---|---|"]
+    for name, part in (("accelerating branch", accelerating), ("decelerating branch",
+                                                               ~accelerating),
+                       ("first half of the distance slid", half),
+                       ("second half of the distance slid", ~half)):
+        est = _amplitudes(force[part], x[part], v[part], period)
+        loo = np.array([_amplitudes(force[part & (run_of != r)], x[part & (run_of != r)],
+                                    v[part & (run_of != r)], period) for r in range(runs)])
+        err = np.sqrt((runs - 1) / runs * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
+        cells = [f"{e:.{d}f} ± {s:.{d}f}" for e, s, d in zip(est, err, (2, 0, 1, 2, 1))]
+        rows.append(f"| {name} | {int(part.sum())} | " + " | ".join(cells) + " |")
+    return "\n".join(rows)
 
 
 if __name__ == "__main__":

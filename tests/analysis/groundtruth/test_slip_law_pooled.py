@@ -449,3 +449,27 @@ def test_a_corrugated_loop_control_keeps_the_walls_registry_and_gives_each_run_i
     assert len({k["parameters"][3] for k in made[6:]}) == 4        # the films spread
     with pytest.raises(ValueError, match="corrugation"):
         pc.pooled_runs("weakening", 3, 1, corrugation=(20.0, 1.1, 0.0))
+
+
+def test_a_constant_registry_force_reads_alike_on_both_branches(benchmark_module, capsys):
+    # the branch table's ground truth: controls whose registry force is one amplitude and
+    # phase everywhere (20 ε/σ at −0.97 rad) read them alike on the accelerating and the
+    # decelerating branch and on the halves of the distance slid, within their errors; the
+    # smoothing reads the amplitude low (a window of 5 τ at M = 10⁴: within a quarter)
+    main = benchmark_module("slip_law/registry_spectrum").main
+    assert main(["--control", "m1e4", "6", "6", "--pools", "1", "--window", "5"]) == 0
+    rows = [r.split("|")[2:-1] for r in capsys.readouterr().out.splitlines()
+            if r.startswith("| ") and "samples" not in r]
+    cells = [[tuple(map(float, c.split(" ± "))) for c in r[3:5]] for r in rows]
+    assert len(cells) == 4
+    for a, b in (cells[0], cells[1]), (cells[2], cells[3]):
+        for (x, ex), (y, ey) in zip(a, b):        # amplitude, phase
+            assert abs(x - y) < 3 * math.hypot(ex, ey) + 0.02, (a, b)
+    for (amp, _), (phase, _) in cells:
+        assert 15.0 < amp < 21.0 and abs(phase + 0.97) < 0.15, (amp, phase)
+    with pytest.raises(SystemExit):
+        main(["--control", "klein", "6", "6"])
+    assert "SCALE one of" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main([])
+    assert "RUN_DIR… or --control" in capsys.readouterr().err
