@@ -92,10 +92,15 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #: * ``corrugated-loop`` (F_k, B, W, D, ΔF, λ, φ, τ_r, kind): the ``corrugated`` film with a
 #:   yield loop, sign(v)·(F_k + W·exp(−s/D)) + B·v (or ψ) + ΔF·sin(2π·x/λ + φ): kind 0,
 #:   s the distance slid since the yield (``slip-weakening``); kind 1, s the fastest |v| of
-#:   the slip so far (``melting``, without a lag: ψ holds that velocity).
+#:   the slip so far (``melting``, without a lag: ψ holds that velocity);
+#: * ``lagged-registry`` (F_k, B, ΔF, λ, φ, τ_g): sign(v)·F_k + B·v + ΔF·sin(2π·(x − ψ)/λ + φ),
+#:   ψ the distance by which the film's registry trails the wall, relaxing over τ_g
+#:   (dψ/dt = v − ψ/τ_g, 0 at each yield: at rest the film sits in the walls' registry): a
+#:   registry force that follows the wall's position late, by ≈ v·τ_g in a steady slide, less
+#:   while the slip speeds up than while it slows down (τ_g above a third of the step).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
-        "corrugated": 6, "corrugated-loop": 9}
+        "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6}
 #: :func:`slide`'s random-force keywords for none (the noise-free slider).
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
@@ -132,6 +137,9 @@ def _friction(code, p, v, psi, x, x_yield):
         f = p[0] + p[2] * math.exp(-s / p[3])
         return ((f if v >= 0.0 else -f) + (psi if p[7] > 0.0 else p[1] * v)
                 + p[4] * math.sin(2.0 * math.pi * x / p[5] + p[6]))
+    if code == 10:
+        return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
+                + p[2] * math.sin(2.0 * math.pi * (x - psi) / p[3] + p[4]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -149,6 +157,8 @@ def _state_rate(code, p, v, psi):
         return (p[1] * v - psi) / p[5]
     if code == 9 and p[7] > 0.0:
         return (p[1] * v - psi) / p[7]
+    if code == 10:
+        return v - psi / p[5]
     return 0.0
 
 
@@ -211,7 +221,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
-                        if code == 4 or code == 5 or code == 7 or code == 8 or code == 9:
+                        if code == 4 or code == 5 or code >= 7:
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
@@ -287,6 +297,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                          "period λ (the fourth, sixth) must be > 0, the lag τ_r (the eighth) "
                          ">= 0, the kind (the ninth) 0 (slip-weakening) or 1 (melting, "
                          "without a lag)")
+    if law == "lagged-registry" and not (p[3] > 0 and p[5] > 0):
+        raise ValueError(f"parameters = {parameters!r}: the registry's period λ and its lag "
+                         "τ_g (the fourth, sixth) must be > 0")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

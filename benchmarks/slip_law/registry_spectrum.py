@@ -4,7 +4,7 @@ position, slip by slip, from MD runs.
     python benchmarks/slip_law/registry_spectrum.py RUN_DIR... [--periods 0.55 1.1 ...]
         [--window 20] [--branches]
     python benchmarks/slip_law/registry_spectrum.py --control SCALE RUNS SLIPS [--lag TAU]
-        [--pools 3] [--window 5]
+        [--registry-lag TAU_G] [--pools 3] [--window 5]
 
 Commensurate walls pass a force that repeats with their lattice's period along the slide:
 the film's force during a slip is then F_k + B·v plus a periodic function of the wall's
@@ -27,7 +27,9 @@ SLIPS slips at a scale of the controls (the Coulomb + viscous mix of share 0.5, 
 viscous force lagging by ``--lag`` τ, carrying a registry force of constant amplitude,
 20·sin(2π·x/1.1 − 0.97), at the scale's noise beside the registry, re-sticking on a recoil
 at the drive's velocity): what the estimator reads where the truth is one amplitude and
-phase on every part.  The smoothing attenuates the registry's force where a period passes
+phase on every part; ``--registry-lag TAU_G``: that force trailing the wall's position,
+relaxing over TAU_G (``lagged-registry`` of
+:mod:`~filmfriction.analysis.groundtruth.random_force`).  The smoothing attenuates the registry's force where a period passes
 in less than a few windows: at a light slider take a window of a fifth of that passage.
 """
 from __future__ import annotations
@@ -81,7 +83,8 @@ def harmonic_fit(force, x, v, period: float, harmonics: int):
     return c, float(np.std(force - a @ c))
 
 
-def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: float) -> int:
+def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: float,
+            registry_lag: float | None = None) -> int:
     """The branch table of ``pools`` pools of controls whose registry force is constant."""
     from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
     from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
@@ -90,11 +93,13 @@ def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: f
     sc = replace(sc, mix={**sc.mix, "stop_velocity": -sc.drive_velocity})
     kw = dict(mass=sc.mass, mount_damping=sc.mount_damping, drive_velocity=sc.drive_velocity)
     print(f"controls at the {scale} scale: share 0.5, the registry force 20·sin(2π·x/1.1 − "
-          f"0.97), lag {lag:g} τ, {runs} runs × {slips} slips, window {window:g} τ")
+          f"0.97)" + ("" if registry_lag is None else f" trailing the wall over "
+                       f"{registry_lag:g} τ") + f", lag {lag:g} τ, {runs} runs × {slips} slips, "
+          f"window {window:g} τ")
     for seed in range(pools):
         rs, _ = pooled_runs("x", runs, slips, share=0.5, scale=sc, noise=sc.registry_noise,
                             corrugation=CONTROL_REGISTRY, seed=(seed, 0),
-                            **({"lag": lag} if lag else {}))
+                            registry_lag=registry_lag, **({"lag": lag} if lag else {}))
         force, x, slid, v, run_of, acc = slipping_samples(rs, kw, window)
         print(f"pool {seed + 1}:\n" + branch_table(force, x, v, slid, run_of, acc,
                                                     CONTROL_REGISTRY[1], len(rs)))
@@ -107,6 +112,8 @@ def main(argv=None) -> int:
     ap.add_argument("--control", nargs=3, default=None, metavar=("SCALE", "RUNS", "SLIPS"))
     ap.add_argument("--lag", type=float, default=0.0, help="the controls' viscous lag (τ)")
     ap.add_argument("--pools", type=int, default=3)
+    ap.add_argument("--registry-lag", type=float, default=None, metavar="TAU_G",
+                    help="the controls' registry force trails the wall over TAU_G (τ)")
     ap.add_argument("--periods", nargs="+", type=float, default=list(PERIODS))
     ap.add_argument("--branches", action="store_true",
                     help="the line and the registry's harmonics on each part of the slips")
@@ -128,7 +135,11 @@ def main(argv=None) -> int:
                      f"{', '.join(s for s in SCALES if s != 'klein')}, RUNS >= 3, SLIPS >= 1")
         if not (math.isfinite(args.lag) and args.lag >= 0) or args.pools < 1:
             ap.error(f"--lag {args.lag} >= 0 (τ), --pools {args.pools} >= 1")
-        return control(scale, int(runs), int(slips), args.lag, args.pools, args.window)
+        if args.registry_lag is not None and (args.lag or not (
+                math.isfinite(args.registry_lag) and args.registry_lag > 0)):
+            ap.error(f"--registry-lag {args.registry_lag}: a time > 0 (τ), without --lag")
+        return control(scale, int(runs), int(slips), args.lag, args.pools, args.window,
+                       args.registry_lag)
     try:
         runs, shared, _ = read_runs(args.runs, analyse=False)
     except ValueError as exc:

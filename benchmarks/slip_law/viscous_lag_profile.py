@@ -5,7 +5,7 @@ on MD runs or on controls of a known lag.
     python benchmarks/slip_law/viscous_lag_profile.py --control SHARE TAU [--replicas 40]
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
-        [--loop LAW W D] [--slip-end force-minimum]
+        [--loop LAW W D] [--slip-end force-minimum] [--registry-lag TAU_G]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -29,6 +29,8 @@ of ``--corrugation`` (fitted at its period) and the noise beside it
 ``--scale m1e4`` (``m3e3``, ``m1e3``, ``m1e2``): the M = 10⁴ (3×10³, 10³, 10²) slider's scale
 instead;
 ``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
+``--registry-lag TAU_G``: the registry force
+trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, no loop);
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
@@ -129,6 +131,8 @@ def control(args) -> int:
     print(f"controls at the {args.scale} scale: share {share:g} (F_k {fk:.2f}, B {b:.1f}) "
           f"lagging by {tau:g} τ, "
           + ("" if loop is None else f"a {loop_law} loop {loop[0]:g} over {loop[1]:g}, ")
+          + ("" if args.registry_lag is None else
+             f"the registry trailing the wall over {args.registry_lag:g} τ, ")
           + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
           f"slip ends: {args.slip_end}\n")
@@ -137,7 +141,8 @@ def control(args) -> int:
         rs, vd = pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
                              law_spread=args.law_spread, lag=tau or None,
                              weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
-                             corrugation=tuple(args.corrugation), seed=(0, k))
+                             corrugation=tuple(args.corrugation), seed=(0, k),
+                             registry_lag=args.registry_lag)
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
@@ -201,6 +206,7 @@ def main(argv=None) -> int:
     ap.add_argument("--noise", nargs=2, type=float, default=None, metavar=("U", "RHO"))
     ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
     ap.add_argument("--slip-end", choices=SLIP_ENDS, default="slider")
+    ap.add_argument("--registry-lag", type=float, default=None, metavar="TAU_G")
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
@@ -226,6 +232,10 @@ def main(argv=None) -> int:
                 ap.error(f"--loop {' '.join(a.loop)}: {exc}")
             if a.loop[0] == "melting" and tau > 0:
                 ap.error(f"--loop {' '.join(a.loop)}: melting with TAU 0 only")
+        if a.registry_lag is not None and (not (math.isfinite(a.registry_lag)
+                                                and a.registry_lag > 0) or tau > 0 or a.loop):
+            ap.error(f"--registry-lag {a.registry_lag}: a time > 0 (τ), with TAU 0 and no "
+                     "--loop")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

@@ -284,3 +284,38 @@ def test_a_lagging_film_reads_as_a_negative_comoving_mass():
     lagged, plain = one_law(12.0), one_law(0.0)
     assert lagged.comoving_mass == pytest.approx(-473.0 * 12.0, rel=0.15), lagged.comoving_mass
     assert abs(plain.comoving_mass) < 100.0, plain.comoving_mass
+
+
+def test_a_lagged_registrys_first_slip_is_the_ode():
+    # the registry force at the film's registry y = x − ψ, which trails the wall
+    # (dy/dt = (x − y)/τ_g, y = x at the yield): the first slip, from x = 0, is solve_ivp's
+    # with y a state of its own
+    fk, b, df, lam, phi, tau_g = 36.0, 2.0, 4.0, 1.1, 0.5, 1.5
+    run = slide("lagged-registry", (fk, b, df, lam, phi, tau_g), mass=M, stiffness=K,
+                drive_velocity=0.1, static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
+    y, s = run["yield_index"], run["stick_index"]
+    assert y.size >= 1
+    rhs = lambda t, q: [q[1], (FS + K * (0.1 * t - q[0]) - fk - b * q[1]
+                               - df * math.sin(2 * math.pi * q[2] / lam + phi)) / M,
+                        (q[0] - q[2]) / tau_g]
+    stop = lambda t, q: q[1] if t > 1.0 else 1.0
+    stop.terminal, stop.direction = True, -1
+    ode = solve_ivp(rhs, (0, 300), [0.0, 1e-12, 0.0], events=stop, rtol=1e-10, atol=1e-12,
+                    max_step=0.05)
+    x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
+    a, c = y[0], s[0]
+    assert x[c + 1] - x[a] == pytest.approx(ode.y_events[0][0][0], rel=2e-3)
+    # the sampled peak (every 0.25 τ) of a velocity the registry ripples
+    assert v[a:c + 1].max() == pytest.approx(ode.y[1].max(), rel=5e-3)
+    assert t[c + 1] - t[a] == pytest.approx(ode.t_events[0][0], abs=0.5)
+    # and a registry that barely trails (τ_g 10⁻³ τ, the step 0.6 of it) is the
+    # ``corrugated`` film's
+    kw = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=400.0,
+              dt=0.25, substeps=400)
+    near = slide("lagged-registry", (fk, b, df, lam, phi, 1e-3), **kw)[0]
+    plain = slide("corrugated", (fk, b, df, lam, phi, 0.0), **kw)[0]
+    np.testing.assert_array_equal(near["stick_index"], plain["stick_index"])
+    # (to the lag's own trail, v·τ_g ≈ 1.3e-3 σ at the slips' speed)
+    np.testing.assert_allclose(near["wall_position"], plain["wall_position"], atol=4e-3)
+    with pytest.raises(ValueError, match="τ_g"):
+        slide("lagged-registry", (fk, b, df, lam, phi, 0.0), **kw)

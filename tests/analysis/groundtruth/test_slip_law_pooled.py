@@ -367,6 +367,9 @@ def test_the_registry_benchmarks_refuse_bad_input_before_any_compute(benchmark_m
             (lag, ["--control", "0.5", "-1"], "TAU >= 0"),
             (lag, ["--control", "0.5", "30", "--lags", "10", "5"], "increasing"),
             (lag, [], "RUN… or --control"),
+            (lag, ["--control", "0.5", "30", "--registry-lag", "5"], "--registry-lag 5.0"),
+            (spectrum, ["--control", "m1e4", "6", "6", "--lag", "3", "--registry-lag", "5"],
+             "without --lag"),
             (spectrum, [str(tmp_path), "--periods", "0"], "--periods 0.0: each > 0"),
             (spectrum, [str(tmp_path), "--window", "nan"], "--window nan"),
             (floor, ["--control", "4", "2", "--floors", "0.3", "0.1"], "increasing"),
@@ -473,3 +476,25 @@ def test_a_constant_registry_force_reads_alike_on_both_branches(benchmark_module
     with pytest.raises(SystemExit):
         main([])
     assert "RUN_DIR… or --control" in capsys.readouterr().err
+
+
+def test_a_registry_that_trails_the_wall_reads_ahead_and_weaker_while_the_slip_speeds_up(
+        benchmark_module, capsys):
+    # ``lagged-registry`` controls (τ_g 5 τ at M = 10⁴): the film's registry trails the wall
+    # by less while the slip speeds up than while it slows, so the branch table reads the
+    # accelerating branch's phase ahead and its first harmonic weaker, and the whole phase
+    # behind the constant registry's −0.97 rad by ≈ 2π·v̄·τ_g/λ
+    main = benchmark_module("slip_law/registry_spectrum").main
+    assert main(["--control", "m1e4", "12", "13", "--pools", "1", "--window", "5",
+                 "--registry-lag", "5"]) == 0
+    rows = [r.split("|")[2:-1] for r in capsys.readouterr().out.splitlines()
+            if r.startswith("| ") and "samples" not in r]
+    (a_acc, _), (p_acc, _) = [tuple(map(float, c.split(" ± "))) for c in rows[0][3:5]]
+    (a_dec, _), (p_dec, _) = [tuple(map(float, c.split(" ± "))) for c in rows[1][3:5]]
+    assert p_acc > p_dec and a_acc < a_dec, rows
+    assert p_dec < -0.97 - 0.5
+    with pytest.raises(ValueError, match="registry_lag"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, registry_lag=5.0)
+    with pytest.raises(ValueError, match="registry_lag"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    registry_lag=5.0, lag=10.0)
