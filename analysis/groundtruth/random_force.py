@@ -97,7 +97,8 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #:   ψ the distance by which the film's registry trails the wall, relaxing over τ_g
 #:   (dψ/dt = v − ψ/τ_g, 0 at each yield: at rest the film sits in the walls' registry): a
 #:   registry force that follows the wall's position late, by ≈ v·τ_g in a steady slide, less
-#:   while the slip speeds up than while it slows down (τ_g above a third of the step).
+#:   while the slip speeds up than while it slows down (τ_g no shorter than the integration
+#:   step, dt/substeps: the step must resolve the trail's relaxation).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
         "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6}
@@ -221,7 +222,8 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
-                        if code == 4 or code == 5 or code >= 7:
+                        if (code == 4 or code == 5 or code == 7 or code == 8 or code == 9
+                                or code == 10):
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
@@ -300,6 +302,11 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
     if law == "lagged-registry" and not (p[3] > 0 and p[5] > 0):
         raise ValueError(f"parameters = {parameters!r}: the registry's period λ and its lag "
                          "τ_g (the fourth, sixth) must be > 0")
+    if law == "lagged-registry" and dt / max(int(substeps), 1) > p[5]:
+        raise ValueError(f"parameters = {parameters!r}: the registry's lag τ_g = {p[5]!r} is "
+                         f"shorter than the integration step dt/substeps = "
+                         f"{dt / max(int(substeps), 1)!r}, which would not resolve it (take "
+                         f"substeps >= {math.ceil(dt / p[5])})")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

@@ -109,7 +109,8 @@ def table(law: str, share, args) -> None:
     kw = dict(share=share, static_spread=args.static_spread, law_spread=args.law_spread,
               scale=sc)
     if share is not None and args.loop:
-        kw |= {"loop_law": args.loop[0], "weakening": tuple(map(float, args.loop[1:]))}
+        law, w, d = yield_loop(*args.loop)
+        kw |= {"loop_law": law, "weakening": (w, d)}
     if share is not None and args.lag is not None:
         kw["lag"] = args.lag
     if share is not None and args.corrugation:

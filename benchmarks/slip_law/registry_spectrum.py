@@ -51,9 +51,18 @@ PERIODS = (0.318, 0.55, 0.635, 0.7, 0.8, 0.953, 1.1, 1.27, 1.5, 1.905, 2.2)
 
 def slipping_samples(runs, kw, window: float):
     """The film's force, the wall's position, the distance since the yield and the velocity
-    at every slipping sample of the runs' analysed slips; besides, each sample's run and
-    whether it is before its slip's peak (smoothed) velocity (the accelerating branch)."""
-    out = [], [], [], [], [], []
+    at every slipping sample of the runs' analysed slips."""
+    out = [], [], [], []
+    for run_no, r, k, y, w, force, x, v in _slips(runs, kw, window):
+        for o, q in zip(out, (force[k], x[k], x[k] - x[int(y)], v[k])):
+            o.append(q)
+    return tuple(np.concatenate(o) for o in out)
+
+
+def _slips(runs, kw, window: float):
+    """Per analysed slip: the run's number and record, the slip's slipping samples (half a
+    window off each end), its yield, the window in samples and the run's smoothed film
+    force, position and velocity."""
     mass, gamma, drive = kw["mass"], kw["mount_damping"], kw["drive_velocity"]
     for run_no, r in enumerate(runs):
         dt = float(r.time[1] - r.time[0])
@@ -64,14 +73,36 @@ def slipping_samples(runs, kw, window: float):
         a = savgol_filter(x, w, 2, deriv=2, delta=dt)
         force = savgol_filter(r.spring_force, w, 2) - mass * a - gamma * (v - drive)
         for y, s in zip(r.table.yield_index, r.table.stick_index):
-            k = slice(int(y) + w // 2, int(s) - w // 2)
-            n = max(0, k.stop - k.start)
-            peak = int(np.argmax(v[k])) if n else 0
-            for o, q in zip(out, (force[k], x[k], x[k] - x[int(y)], v[k],
-                                  np.full(n, run_no),
-                                  np.arange(n) < peak)):
-                o.append(q)
-    return tuple(np.concatenate(o) for o in out)
+            yield run_no, r, slice(int(y) + w // 2, int(s) - w // 2), y, w, force, x, v
+
+
+def branch_samples(runs, kw, window: float, period: float) -> dict:
+    """The slipping samples as :func:`branch_table` fits them: the film's force, the
+    velocity and the registry's two harmonics at the wall's position smoothed as the force
+    is (``cols``), each sample's run, whether it is before its slip's peak velocity (the
+    velocity smoothed over five windows, so that the registry's ripple does not place the
+    peak) and whether it is in the first half of its slip's own distance."""
+    out = {k: [] for k in ("force", "v", "cols", "run", "accelerating", "first_half")}
+    for run_no, r, k, y, w, force, x, v in _slips(runs, kw, window):
+        dt = float(r.time[1] - r.time[0])
+        if "smooth" not in out or out["smooth"][0] != run_no:
+            slow = savgol_filter(x, min(5 * w, x.size - (1 - x.size % 2)) | 1, 2, deriv=1,
+                                 delta=dt)
+            cols = np.column_stack([savgol_filter(f(2 * math.pi * h * x / period), w, 2)
+                                    for h in (1, 2) for f in (np.sin, np.cos)])
+            out["smooth"] = (run_no, slow, cols)
+        _, slow, cols = out["smooth"]
+        n = max(0, k.stop - k.start)
+        if n == 0:
+            continue
+        slid = x[k] - x[int(y)]
+        for key, q in (("force", force[k]), ("v", v[k]), ("cols", cols[k]),
+                       ("run", np.full(n, run_no)),
+                       ("accelerating", np.arange(n) < int(np.argmax(slow[k]))),
+                       ("first_half", slid < 0.5 * slid[-1])):
+            out[key].append(q)
+    out.pop("smooth", None)
+    return {key: np.concatenate(q) for key, q in out.items()}
 
 
 def harmonic_fit(force, x, v, period: float, harmonics: int):
@@ -100,9 +131,8 @@ def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: f
         rs, _ = pooled_runs("x", runs, slips, share=0.5, scale=sc, noise=sc.registry_noise,
                             corrugation=CONTROL_REGISTRY, seed=(seed, 0),
                             registry_lag=registry_lag, **({"lag": lag} if lag else {}))
-        force, x, slid, v, run_of, acc = slipping_samples(rs, kw, window)
-        print(f"pool {seed + 1}:\n" + branch_table(force, x, v, slid, run_of, acc,
-                                                    CONTROL_REGISTRY[1], len(rs)))
+        print(f"pool {seed + 1}:\n" + branch_table(
+            branch_samples(rs, kw, window, CONTROL_REGISTRY[1]), len(rs)))
     return 0
 
 
@@ -129,8 +159,11 @@ def main(argv=None) -> int:
     if args.control is not None:
         from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
         scale, runs, slips = args.control
-        if (scale not in SCALES or scale == "klein" or not runs.isdigit() or int(runs) < 3
-                or not slips.isdigit() or int(slips) < 1):
+        try:
+            runs, slips = int(runs), int(slips)
+        except ValueError:
+            runs = slips = 0
+        if scale not in SCALES or scale == "klein" or runs < 3 or slips < 1:
             ap.error(f"--control {' '.join(args.control)}: SCALE one of "
                      f"{', '.join(s for s in SCALES if s != 'klein')}, RUNS >= 3, SLIPS >= 1")
         if not (math.isfinite(args.lag) and args.lag >= 0) or args.pools < 1:
@@ -138,15 +171,17 @@ def main(argv=None) -> int:
         if args.registry_lag is not None and (args.lag or not (
                 math.isfinite(args.registry_lag) and args.registry_lag > 0)):
             ap.error(f"--registry-lag {args.registry_lag}: a time > 0 (τ), without --lag")
-        return control(scale, int(runs), int(slips), args.lag, args.pools, args.window,
+        return control(scale, runs, slips, args.lag, args.pools, args.window,
                        args.registry_lag)
+    if args.lag or args.registry_lag is not None or args.pools != 3:
+        ap.error("--lag, --registry-lag and --pools are the controls' (with --control)")
     try:
         runs, shared, _ = read_runs(args.runs, analyse=False)
     except ValueError as exc:
         print(f"registry_spectrum: {exc}", file=sys.stderr)
         return 1
     kw = fit_arguments(shared)
-    force, x, slid, v, run_of, accelerating = slipping_samples(runs, kw, args.window)
+    force, x, slid, v = slipping_samples(runs, kw, args.window)
     c, rms = harmonic_fit(force, x, v, 1.0, 0)
     resid = force - (c[0] + c[1] * v)
     print(f"{len(runs)} runs, {sum(len(r.table) for r in runs)} slips, {force.size} slipping "
@@ -157,7 +192,8 @@ def main(argv=None) -> int:
               f"distance since the yield {abs(amp[1]):5.2f}")
     period = shared.get("registry_period")
     if period is None:
-        print("the runs record no registry period (twisted walls, or not an MD run)")
+        print("the runs record no registry period (twisted walls, or not an MD run)"
+              + ("; no --branches table without one" if args.branches else ""))
         return 0
     for h in range(4):
         c, rms = harmonic_fit(force, x, v, period, h)
@@ -166,39 +202,51 @@ def main(argv=None) -> int:
         print(f"  {h} harmonic(s) of λ = {period:g}: F_k {c[0]:.2f}, B {c[1]:.0f}"
               + (f"; amplitudes {', '.join(parts)}" if parts else "") + f"; residual rms {rms:.2f}")
     if args.branches:
-        print(branch_table(force, x, v, slid, run_of, accelerating, period, len(runs)))
+        print(branch_table(branch_samples(runs, kw, args.window, period), len(runs)))
     return 0
 
 
-def _amplitudes(force, x, v, period):
-    c, _ = harmonic_fit(force, x, v, period, 2)
-    return np.array([c[0], c[1], math.hypot(c[2], c[3]), math.atan2(c[3], c[2]),
-                     math.hypot(c[4], c[5])])
+def _amplitudes(force, v, cols, phase_near=None):
+    """F_k, B, the first harmonic's amplitude and phase, the second's amplitude, fitted on
+    the samples (the phase within π of ``phase_near`` when given)."""
+    c, *_ = np.linalg.lstsq(np.column_stack([np.ones_like(v), v, cols]), force, rcond=None)
+    phase = math.atan2(c[3], c[2])
+    if phase_near is not None:
+        phase += 2 * math.pi * round((phase_near - phase) / (2 * math.pi))
+    return np.array([c[0], c[1], math.hypot(c[2], c[3]), phase, math.hypot(c[4], c[5])])
 
 
-def branch_table(force, x, v, slid, run_of, accelerating, period, runs) -> str:
-    """The line and two registry harmonics fitted on each part of the slips apart: the
-    accelerating and decelerating branches (split at each slip's peak velocity) and the
-    first and second halves of the distance slid, each ± the jackknife's error over the
-    runs (a registry force that weakens as the film is sheared reads a smaller amplitude
-    on the later part)."""
-    half = np.zeros_like(accelerating)
-    for r in range(runs):
-        m = run_of == r
-        if m.any():
-            half[m] = slid[m] < np.median(slid[m])
+def branch_table(samples: dict, runs: int) -> str:
+    """The line and two registry harmonics fitted on each part of the slips apart (the
+    accelerating and decelerating branches; the first and second halves of each slip's
+    distance), and the differences between the two parts of each split, each ± the
+    jackknife's error over the runs (of the difference itself, the two parts sharing their
+    runs)."""
+    f, v, cols, run = (samples[k] for k in ("force", "v", "cols", "run"))
+
+    def fit(part, near=None):
+        est = _amplitudes(f[part], v[part], cols[part], near)
+        loo = np.array([_amplitudes(f[part & (run != r)], v[part & (run != r)],
+                                    cols[part & (run != r)], est[3]) for r in range(runs)])
+        return est, loo
+
+    def err(loo):
+        return np.sqrt((runs - 1) / runs * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
+
     rows = ["| part of the slips | samples | F_k (ε/σ) | B (m/τ) | first harmonic (ε/σ) | "
             "its phase (rad) | second harmonic (ε/σ) |", "|---|---|---|---|---|---|---|"]
-    for name, part in (("accelerating branch", accelerating), ("decelerating branch",
-                                                               ~accelerating),
-                       ("first half of the distance slid", half),
-                       ("second half of the distance slid", ~half)):
-        est = _amplitudes(force[part], x[part], v[part], period)
-        loo = np.array([_amplitudes(force[part & (run_of != r)], x[part & (run_of != r)],
-                                    v[part & (run_of != r)], period) for r in range(runs)])
-        err = np.sqrt((runs - 1) / runs * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
-        cells = [f"{e:.{d}f} ± {s:.{d}f}" for e, s, d in zip(est, err, (2, 0, 1, 2, 1))]
-        rows.append(f"| {name} | {int(part.sum())} | " + " | ".join(cells) + " |")
+    digits = (2, 0, 1, 2, 1)
+    for names, first in ((("accelerating branch", "decelerating branch"),
+                          samples["accelerating"]),
+                         (("first half of the slip's distance", "second half"),
+                          samples["first_half"])):
+        a, la = fit(first)
+        b, lb = fit(~first, a[3])
+        for name, part, est, loo in ((names[0], first, a, la), (names[1], ~first, b, lb)):
+            rows.append(f"| {name} | {int(part.sum())} | " + " | ".join(
+                f"{e:.{d}f} ± {s:.{d}f}" for e, s, d in zip(est, err(loo), digits)) + " |")
+        rows.append(f"| {names[0].split()[0]} − {names[1].split()[0]} | | " + " | ".join(
+            f"{e:+.{d}f} ± {s:.{d}f}" for e, s, d in zip(a - b, err(la - lb), digits)) + " |")
     return "\n".join(rows)
 
 

@@ -34,6 +34,8 @@ def run_state(run: Path, before: float) -> dict:
     trace = np.genfromtxt(run / "trace.csv", delimiter=",", names=True)
     cycles = np.genfromtxt(run / "analysis_cycles.csv", delimiter=",", names=True)
     t = trace["time"]
+    if t.size < 2:
+        raise ValueError(f"a trace of {t.size} sample(s)")
     w = max(1, int(round(before / (t[1] - t[0]))))
     rise, dilation, duration = [], [], []
     for i, j in zip(np.atleast_1d(cycles["yield_index"]).astype(int),
@@ -72,7 +74,13 @@ def main(argv=None) -> int:
         return 2
     by_mass = defaultdict(list)
     for r in a.runs:
-        s = run_state(r, a.before)
+        try:
+            s = run_state(r, a.before)
+        except (KeyError, ValueError, TypeError, IndexError) as exc:
+            print(f"slip_film_state: {r}: not a run's analysis this reads (the slider's mass "
+                  f"in analysis.json, a trace of time, film_temperature and gap): {exc!r}",
+                  file=sys.stderr)
+            return 1
         by_mass[s["mass"]].append(s)
     print("| M (m) | runs | slips | film temperature rise over the slip (ε/k) | gap's dilation "
           "(σ) | median slip (τ) | shear planes' shares (bottom → top) | shear location |\n"
@@ -84,9 +92,10 @@ def main(argv=None) -> int:
         planes = (", ".join(f"{x:.2f}" for x in np.mean(jumps, axis=0)) if jumps
                   and len({len(j) for j in jumps}) == 1 else "–")
         locs = ", ".join(f"{k} {n}" for k, n in Counter(s["location"] for s in ss).items())
+        dur = get("duration")
         print(f"| {mass:g} | {len(ss)} | {len(get('rise'))} | {_mean(get('rise'))} | "
-              f"{_mean(get('dilation'))} | {np.median(get('duration')):.0f} | {planes} | "
-              f"{locs} |")
+              f"{_mean(get('dilation'))} | {np.median(dur) if dur else math.nan:.0f} | "
+              f"{planes} | {locs} |")
     return 0
 
 

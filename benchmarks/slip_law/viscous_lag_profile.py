@@ -118,8 +118,10 @@ def control(args) -> int:
     share, tau = args.control
     base = SCALES[args.scale]
     sc = replace(base, mix={**base.mix, "stop_velocity": args.stop_velocity})
-    loop = None if args.loop is None else (float(args.loop[1]), float(args.loop[2]))
-    loop_law = "melting" if args.loop is None else args.loop[0]
+    loop_law, loop = "melting", None
+    if args.loop is not None:
+        loop_law, *loop = yield_loop(*args.loop, laws=("melting", "slip-weakening"))
+        loop = tuple(loop)
     law = sc.law("x", share, loop, loop_law, tau or None)
     fk, b = law["parameters"][:2]
     period = args.corrugation[1]
@@ -244,6 +246,8 @@ def main(argv=None) -> int:
         except ValueError as exc:      # a law the spread made impossible (D or τ_r <= 0)
             print(f"viscous_lag_profile: {exc}", file=sys.stderr)
             return 1
+    if a.registry_lag is not None:
+        ap.error("--registry-lag is the controls' (with --control)")
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:
         ap.error(f"RUN without trace.csv: {', '.join(missing)}")

@@ -54,3 +54,13 @@ def test_the_film_state_benchmark_refuses_runs_not_analysed(benchmark_module, ca
     with pytest.raises(SystemExit):
         main([str(tmp_path), "--before", "0"])
     assert "--before 0.0" in capsys.readouterr().err
+
+
+def test_the_film_state_benchmark_says_which_run_it_cannot_read(benchmark_module, capsys,
+                                                                tmp_path):
+    main = benchmark_module("slip_law/slip_film_state").main
+    run = _run(tmp_path / "a", 1000.0, 0.02, 0.05)
+    (tmp_path / "a" / "analysis.json").write_text("{}")          # no slider's mass
+    assert main([run]) == 1
+    err = capsys.readouterr().err
+    assert "slip_film_state:" in err and "Traceback" not in err and run in err

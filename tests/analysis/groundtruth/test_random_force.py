@@ -319,3 +319,6 @@ def test_a_lagged_registrys_first_slip_is_the_ode():
     np.testing.assert_allclose(near["wall_position"], plain["wall_position"], atol=4e-3)
     with pytest.raises(ValueError, match="τ_g"):
         slide("lagged-registry", (fk, b, df, lam, phi, 0.0), **kw)
+    # a lag the integration step does not resolve (RK4 would blow the trail up): refused
+    with pytest.raises(ValueError, match="shorter than the integration step"):
+        slide("lagged-registry", (fk, b, df, lam, phi, 0.1), **{**kw, "substeps": 1})
