@@ -53,16 +53,16 @@ def slipping_samples(runs, kw, window: float):
     """The film's force, the wall's position, the distance since the yield and the velocity
     at every slipping sample of the runs' analysed slips."""
     out = [], [], [], []
-    for run_no, r, k, y, w, force, x, v in _slips(runs, kw, window):
+    for _, _, k, y, _, force, x, v in _slips(runs, kw, window):
         for o, q in zip(out, (force[k], x[k], x[k] - x[int(y)], v[k])):
             o.append(q)
     return tuple(np.concatenate(o) for o in out)
 
 
 def _slips(runs, kw, window: float):
-    """Per analysed slip: the run's number and record, the slip's slipping samples (half a
-    window off each end), its yield, the window in samples and the run's smoothed film
-    force, position and velocity."""
+    """Per analysed slip: the run's number and sampling interval, the slip's slipping
+    samples (half a window off each end), its yield, the window in samples and the run's
+    smoothed film force, position and velocity."""
     mass, gamma, drive = kw["mass"], kw["mount_damping"], kw["drive_velocity"]
     for run_no, r in enumerate(runs):
         dt = float(r.time[1] - r.time[0])
@@ -73,7 +73,7 @@ def _slips(runs, kw, window: float):
         a = savgol_filter(x, w, 2, deriv=2, delta=dt)
         force = savgol_filter(r.spring_force, w, 2) - mass * a - gamma * (v - drive)
         for y, s in zip(r.table.yield_index, r.table.stick_index):
-            yield run_no, r, slice(int(y) + w // 2, int(s) - w // 2), y, w, force, x, v
+            yield run_no, dt, slice(int(y) + w // 2, int(s) - w // 2), y, w, force, x, v
 
 
 def branch_samples(runs, kw, window: float, period: float) -> dict:
@@ -83,15 +83,15 @@ def branch_samples(runs, kw, window: float, period: float) -> dict:
     velocity smoothed over five windows, so that the registry's ripple does not place the
     peak) and whether it is in the first half of its slip's own distance."""
     out = {k: [] for k in ("force", "v", "cols", "run", "accelerating", "first_half")}
-    for run_no, r, k, y, w, force, x, v in _slips(runs, kw, window):
-        dt = float(r.time[1] - r.time[0])
-        if "smooth" not in out or out["smooth"][0] != run_no:
+    smooth = {}                 # per run: the slow velocity and the smoothed harmonics
+    for run_no, dt, k, y, w, force, x, v in _slips(runs, kw, window):
+        if run_no not in smooth:
             slow = savgol_filter(x, min(5 * w, x.size - (1 - x.size % 2)) | 1, 2, deriv=1,
                                  delta=dt)
             cols = np.column_stack([savgol_filter(f(2 * math.pi * h * x / period), w, 2)
                                     for h in (1, 2) for f in (np.sin, np.cos)])
-            out["smooth"] = (run_no, slow, cols)
-        _, slow, cols = out["smooth"]
+            smooth = {run_no: (slow, cols)}
+        slow, cols = smooth[run_no]
         n = max(0, k.stop - k.start)
         if n == 0:
             continue
@@ -101,7 +101,6 @@ def branch_samples(runs, kw, window: float, period: float) -> dict:
                        ("accelerating", np.arange(n) < int(np.argmax(slow[k]))),
                        ("first_half", slid < 0.5 * slid[-1])):
             out[key].append(q)
-    out.pop("smooth", None)
     return {key: np.concatenate(q) for key, q in out.items()}
 
 
