@@ -72,6 +72,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 loop_law: str = "melting", lag: float | None = None,
                 corrugation: tuple[float, float, float] | None = None,
                 registry_lag: float | None = None,
+                branching: tuple[float, float, float, float, float] | None = None,
                 seed=0, slip_end: str = "slider") -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
@@ -88,7 +89,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     every run starts at x = 0, as the MD's runs start from one geometry; ``law_spread``
     leaves it alone; with ``lag``, the viscous force lags too); ``registry_lag`` = τ_g: that
     registry force following the wall's position late, relaxing over τ_g
-    (``lagged-registry``; not with a loop or a viscous lag).  ``seed``: an int or a tuple
+    (``lagged-registry``; not with a loop or a viscous lag); ``branching`` = (ΔF₂, φ₂, w₁,
+    w₂, δφ): that registry force with a second harmonic, both weighted by the slip's branch
+    (``branching-registry``; not with a loop, a viscous lag or ``registry_lag``).  ``seed``: an int or a tuple
     of ints.  ``slip_end``: one of :data:`SLIP_ENDS`."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
@@ -107,7 +110,14 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                              "viscous mix of a share (with a lag or not; with a loop, "
                              "melting or slip-weakening)")
         reg = tuple(float(c) for c in corrugation) + (float(lag or 0.0),)
-        if registry_lag is not None:
+        if branching is not None:
+            if (weakening is not None or lag or registry_lag is not None
+                    or len(branching) != 5):
+                raise ValueError(f"branching = {branching!r}: (ΔF₂, φ₂, w₁, w₂, δφ), without "
+                                 "a loop, a viscous lag or a registry lag")
+            law |= {"law": "branching-registry", "parameters": law["parameters"][:2]
+                    + reg[:3] + tuple(float(c) for c in branching)}
+        elif registry_lag is not None:
             if weakening is not None or lag or not (math.isfinite(registry_lag)
                                                     and registry_lag > 0):
                 raise ValueError(f"registry_lag = {registry_lag!r}: a time > 0, finite, "
@@ -120,8 +130,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
             film = 4
             law |= {"law": "corrugated-loop", "parameters": law["parameters"][:4] + reg
                     + (float(loop_law == "melting"),)}
-    elif registry_lag is not None:
-        raise ValueError(f"registry_lag = {registry_lag!r}: only with a corrugation")
+    elif registry_lag is not None or branching is not None:
+        raise ValueError(f"registry_lag = {registry_lag!r}, branching = {branching!r}: only "
+                         "with a corrugation")
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
     rng = np.random.default_rng(key + [7919])

@@ -98,10 +98,19 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #:   (dψ/dt = v − ψ/τ_g, 0 at each yield: at rest the film sits in the walls' registry): a
 #:   registry force that follows the wall's position late, by ≈ v·τ_g in a steady slide, less
 #:   while the slip speeds up than while it slows down (τ_g no shorter than the integration
-#:   step, dt/substeps: the step must resolve the trail's relaxation).
+#:   step, dt/substeps: the step must resolve the trail's relaxation);
+#: * ``branching-registry`` (F_k, B, ΔF₁, λ, φ₁, ΔF₂, φ₂, w₁, w₂, δφ): sign(v)·F_k + B·v
+#:   + ΔF₁·(1 − w₁·r)·sin(θ + φ₁ + δφ·r) + ΔF₂·(1 + w₂·r)·sin(2θ + φ₂), θ = 2π·x/λ,
+#:   r = |v|/ψ with ψ the fastest |v| of the slip so far (0 at each yield): r = 1 while the
+#:   slip speeds up and falls to 0 as it slows down, so a registry force of two harmonics
+#:   whose amplitudes and phase differ between the accelerating and the decelerating branch
+#:   of the slip at one velocity (w₁ > 0: the first harmonic weaker while accelerating;
+#:   w₂ > 0: the second stronger; δφ > 0: the phase ahead), each amplitude ≥ 0 throughout
+#:   (w₁ ≤ 1, w₂ ≥ −1).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
-        "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6}
+        "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6,
+        "branching-registry": 10}
 #: :func:`slide`'s random-force keywords for none (the noise-free slider).
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
@@ -141,6 +150,13 @@ def _friction(code, p, v, psi, x, x_yield):
     if code == 10:
         return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
                 + p[2] * math.sin(2.0 * math.pi * (x - psi) / p[3] + p[4]))
+    if code == 11:
+        top = max(psi, abs(v))
+        r = abs(v) / top if top > 0.0 else 1.0
+        theta = 2.0 * math.pi * x / p[3]
+        return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
+                + p[2] * (1.0 - p[7] * r) * math.sin(theta + p[4] + p[9] * r)
+                + p[5] * (1.0 + p[8] * r) * math.sin(2.0 * theta + p[6]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -212,7 +228,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         ns += 1
                     else:
                         v = vn
-                        if code == 5 or (code == 9 and p[8] == 1.0):
+                        if code == 5 or code == 11 or (code == 9 and p[8] == 1.0):
                             psi = max(psi, abs(v))
                 else:
                     # stuck: at rest, the state aging
@@ -223,7 +239,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         slipping, v = True, start_v
                         x_yield = x
                         if (code == 4 or code == 5 or code == 7 or code == 8 or code == 9
-                                or code == 10):
+                                or code == 10 or code == 11):
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
@@ -307,6 +323,12 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                          f"shorter than the integration step dt/substeps = "
                          f"{dt / max(int(substeps), 1)!r}, which would not resolve it (take "
                          f"substeps >= {math.ceil(dt / p[5])})")
+    if law == "branching-registry" and not (p[3] > 0 and p[2] >= 0 and p[5] >= 0
+                                            and p[7] <= 1 and p[8] >= -1):
+        raise ValueError(f"parameters = {parameters!r}: the registry's period λ (the fourth) "
+                         "must be > 0, the amplitudes ΔF₁, ΔF₂ (the third, sixth) >= 0, "
+                         "w₁ (the eighth) <= 1 and w₂ (the ninth) >= -1 (no amplitude "
+                         "below 0)")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

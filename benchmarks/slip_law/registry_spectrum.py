@@ -4,7 +4,7 @@ position, slip by slip, from MD runs.
     python benchmarks/slip_law/registry_spectrum.py RUN_DIR... [--periods 0.55 1.1 ...]
         [--window 20] [--branches]
     python benchmarks/slip_law/registry_spectrum.py --control SCALE RUNS SLIPS [--lag TAU]
-        [--registry-lag TAU_G] [--pools 3] [--window 5]
+        [--registry-lag TAU_G | --branching DF2 PHI2 W1 W2 DPHI] [--pools 3] [--window 5]
 
 Commensurate walls pass a force that repeats with their lattice's period along the slide:
 the film's force during a slip is then F_k + B·v plus a periodic function of the wall's
@@ -25,11 +25,14 @@ over the runs: a registry force that depends on the film's state reads different
 ``--control SCALE RUNS SLIPS``: that table for ``--pools`` pools of RUNS random-force runs of
 SLIPS slips at a scale of the controls (the Coulomb + viscous mix of share 0.5, its
 viscous force lagging by ``--lag`` τ, carrying a registry force of constant amplitude,
-20·sin(2π·x/1.1 − 0.97), at the scale's noise beside the registry, re-sticking on a recoil
+``--corrugation`` DF·sin(2π·x/L + PHI), by default 20·sin(2π·x/1.1 − 0.97), at the scale's noise beside the registry, re-sticking on a recoil
 at the drive's velocity): what the estimator reads where the truth is one amplitude and
 phase on every part; ``--registry-lag TAU_G``: that force trailing the wall's position,
 relaxing over TAU_G (``lagged-registry`` of
-:mod:`~filmfriction.analysis.groundtruth.random_force`).  The smoothing attenuates the registry's force where a period passes
+:mod:`~filmfriction.analysis.groundtruth.random_force`); ``--branching DF2 PHI2 W1 W2 DPHI``:
+with a second harmonic DF2·sin(4π·x/1.1 + PHI2), the first harmonic's amplitude times
+1 − W1·r and its phase plus DPHI·r, the second's times 1 + W2·r, r = |v|/(the slip's fastest
+|v| so far): 1 while the slip speeds up, falling to 0 as it slows (``branching-registry``).  The smoothing attenuates the registry's force where a period passes
 in less than a few windows: at a light slider take a window of a fifth of that passage.
 """
 from __future__ import annotations
@@ -114,25 +117,36 @@ def harmonic_fit(force, x, v, period: float, harmonics: int):
 
 
 def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: float,
-            registry_lag: float | None = None) -> int:
-    """The branch table of ``pools`` pools of controls whose registry force is constant."""
+            registry_lag: float | None = None, branching=None,
+            corrugation=CONTROL_REGISTRY) -> int:
+    """The branch table of ``pools`` pools of controls whose registry force is constant
+    (or trails the wall, or is weighted by the slip's branch)."""
     from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
     from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
 
     sc = SCALES[scale]
     sc = replace(sc, mix={**sc.mix, "stop_velocity": -sc.drive_velocity})
     kw = dict(mass=sc.mass, mount_damping=sc.mount_damping, drive_velocity=sc.drive_velocity)
-    print(f"controls at the {scale} scale: share 0.5, the registry force 20·sin(2π·x/1.1 − "
-          f"0.97)" + ("" if registry_lag is None else f" trailing the wall over "
-                       f"{registry_lag:g} τ") + f", lag {lag:g} τ, {runs} runs × {slips} slips, "
+    df, lam, phi = corrugation
+    print(f"controls at the {scale} scale: share 0.5, the registry force "
+          f"{df:g}·sin(2π·x/{lam:g} {'+' if phi >= 0 else '−'} {abs(phi):g})" + ("" if registry_lag is None else f" trailing the wall over "
+                       f"{registry_lag:g} τ") + ("" if branching is None else
+                                                    f", branching (ΔF₂, φ₂, w₁, w₂, δφ) = "
+                                                    f"{tuple(branching)}") + f", lag {lag:g} τ, {runs} runs × {slips} slips, "
           f"window {window:g} τ")
     for seed in range(pools):
         rs, _ = pooled_runs("x", runs, slips, share=0.5, scale=sc, noise=sc.registry_noise,
-                            corrugation=CONTROL_REGISTRY, seed=(seed, 0),
-                            registry_lag=registry_lag, **({"lag": lag} if lag else {}))
+                            corrugation=tuple(corrugation), seed=(seed, 0),
+                            registry_lag=registry_lag, branching=branching,
+                            **({"lag": lag} if lag else {}))
         print(f"pool {seed + 1}:\n" + branch_table(
-            branch_samples(rs, kw, window, CONTROL_REGISTRY[1]), len(rs)))
+            branch_samples(rs, kw, window, lam), len(rs)))
     return 0
+
+
+def _branching_ok(b) -> bool:
+    """(ΔF₂, φ₂, w₁, w₂, δφ) finite, with no amplitude below 0."""
+    return all(map(math.isfinite, b)) and b[0] >= 0 and b[2] <= 1 and b[3] >= -1
 
 
 def main(argv=None) -> int:
@@ -143,6 +157,12 @@ def main(argv=None) -> int:
     ap.add_argument("--pools", type=int, default=3)
     ap.add_argument("--registry-lag", type=float, default=None, metavar="TAU_G",
                     help="the controls' registry force trails the wall over TAU_G (τ)")
+    ap.add_argument("--branching", nargs=5, type=float, default=None,
+                    metavar=("DF2", "PHI2", "W1", "W2", "DPHI"),
+                    help="the controls' registry with a second harmonic, weighted by the "
+                         "slip's branch (branching-registry)")
+    ap.add_argument("--corrugation", nargs=3, type=float, default=list(CONTROL_REGISTRY),
+                    metavar=("DF", "L", "PHI"), help="the controls' registry force")
     ap.add_argument("--periods", nargs="+", type=float, default=list(PERIODS))
     ap.add_argument("--branches", action="store_true",
                     help="the line and the registry's harmonics on each part of the slips")
@@ -170,10 +190,20 @@ def main(argv=None) -> int:
         if args.registry_lag is not None and (args.lag or not (
                 math.isfinite(args.registry_lag) and args.registry_lag > 0)):
             ap.error(f"--registry-lag {args.registry_lag}: a time > 0 (τ), without --lag")
+        if args.branching is not None and (args.lag or args.registry_lag is not None
+                                           or not _branching_ok(args.branching)):
+            ap.error(f"--branching {' '.join(map(str, args.branching))}: finite, DF2 >= 0, "
+                     "W1 <= 1, W2 >= -1, without --lag or --registry-lag")
+        if not (all(map(math.isfinite, args.corrugation)) and args.corrugation[0] >= 0
+                and args.corrugation[1] > 0):
+            ap.error(f"--corrugation {' '.join(map(str, args.corrugation))}: finite, DF >= 0, "
+                     "L > 0")
         return control(scale, runs, slips, args.lag, args.pools, args.window,
-                       args.registry_lag)
-    if args.lag or args.registry_lag is not None or args.pools != 3:
-        ap.error("--lag, --registry-lag and --pools are the controls' (with --control)")
+                       args.registry_lag, args.branching, args.corrugation)
+    if (args.lag or args.registry_lag is not None or args.branching is not None
+            or args.pools != 3 or args.corrugation != list(CONTROL_REGISTRY)):
+        ap.error("--lag, --registry-lag, --branching, --corrugation and --pools are the "
+                 "controls' (with --control)")
     try:
         runs, shared, _ = read_runs(args.runs, analyse=False)
     except ValueError as exc:

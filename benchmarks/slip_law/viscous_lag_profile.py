@@ -6,6 +6,7 @@ on MD runs or on controls of a known lag.
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
         [--loop LAW W D] [--slip-end force-minimum] [--registry-lag TAU_G]
+        [--branching DF2 PHI2 W1 W2 DPHI]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -31,6 +32,10 @@ instead;
 ``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
 ``--registry-lag TAU_G``: the registry force
 trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, no loop);
+``--branching DF2 PHI2 W1 W2 DPHI``: the registry force with a second harmonic
+DF2·sin(4π·x/L + PHI2), the first's amplitude times 1 − W1·r and phase plus DPHI·r, the
+second's times 1 + W2·r, r = |v|/(the slip's fastest |v| so far), 1 while the slip speeds up
+(``branching-registry``; TAU 0, no loop, no registry lag);
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
@@ -135,6 +140,8 @@ def control(args) -> int:
           + ("" if loop is None else f"a {loop_law} loop {loop[0]:g} over {loop[1]:g}, ")
           + ("" if args.registry_lag is None else
              f"the registry trailing the wall over {args.registry_lag:g} τ, ")
+          + ("" if args.branching is None else
+             f"branching (ΔF₂, φ₂, w₁, w₂, δφ) = {tuple(args.branching)}, ")
           + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
           f"slip ends: {args.slip_end}\n")
@@ -144,7 +151,8 @@ def control(args) -> int:
                              law_spread=args.law_spread, lag=tau or None,
                              weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
                              corrugation=tuple(args.corrugation), seed=(0, k),
-                             registry_lag=args.registry_lag)
+                             registry_lag=args.registry_lag,
+                             branching=None if args.branching is None else tuple(args.branching))
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
@@ -209,6 +217,8 @@ def main(argv=None) -> int:
     ap.add_argument("--loop", nargs=3, default=None, metavar=("LAW", "W", "D"))
     ap.add_argument("--slip-end", choices=SLIP_ENDS, default="slider")
     ap.add_argument("--registry-lag", type=float, default=None, metavar="TAU_G")
+    ap.add_argument("--branching", nargs=5, type=float, default=None,
+                    metavar=("DF2", "PHI2", "W1", "W2", "DPHI"))
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
@@ -238,6 +248,12 @@ def main(argv=None) -> int:
                                                 and a.registry_lag > 0) or tau > 0 or a.loop):
             ap.error(f"--registry-lag {a.registry_lag}: a time > 0 (τ), with TAU 0 and no "
                      "--loop")
+        b = a.branching
+        if b is not None and not (all(map(math.isfinite, b)) and b[0] >= 0 and b[2] <= 1
+                                  and b[3] >= -1 and tau == 0 and not a.loop
+                                  and a.registry_lag is None):
+            ap.error(f"--branching {' '.join(map(str, b))}: finite, DF2 >= 0, W1 <= 1, "
+                     "W2 >= -1; with TAU 0, no --loop, no --registry-lag")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")
@@ -246,8 +262,8 @@ def main(argv=None) -> int:
         except ValueError as exc:      # a law the spread made impossible (D or τ_r <= 0)
             print(f"viscous_lag_profile: {exc}", file=sys.stderr)
             return 1
-    if a.registry_lag is not None:
-        ap.error("--registry-lag is the controls' (with --control)")
+    if a.registry_lag is not None or a.branching is not None:
+        ap.error("--registry-lag and --branching are the controls' (with --control)")
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:
         ap.error(f"RUN without trace.csv: {', '.join(missing)}")

@@ -322,3 +322,62 @@ def test_a_lagged_registrys_first_slip_is_the_ode():
     # a lag the integration step does not resolve (RK4 would blow the trail up): refused
     with pytest.raises(ValueError, match="shorter than the integration step"):
         slide("lagged-registry", (fk, b, df, lam, phi, 0.1), **{**kw, "substeps": 1})
+
+
+def test_a_branching_registrys_first_slip_is_the_ode():
+    # the registry's harmonics weighted by r = |v|/(the slip's fastest |v| so far): the
+    # first slip is solve_ivp's in pieces, r = 1 while the velocity is at its running
+    # maximum (until the acceleration turns negative), r = v/v_max after (until v passes
+    # v_max again, or stops)
+    fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi = 36.0, 2.0, 4.0, 1.1, 0.5, 2.0, -1.5, \
+        0.4, 0.6, 0.3
+    par = (fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi)
+    run = slide("branching-registry", par, mass=M, stiffness=K, drive_velocity=0.1,
+                static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
+
+    def rhs(r):
+        def f(t, q):
+            th = 2 * math.pi * q[0] / lam
+            reg = (df1 * (1 - w1 * r(q)) * math.sin(th + phi1 + dphi * r(q))
+                   + df2 * (1 + w2 * r(q)) * math.sin(2 * th + phi2))
+            return [q[1], (FS + K * (0.1 * t - q[0]) - fk - b * q[1] - reg) / M]
+        return f
+    t0, q0, vmax, pieces = 0.0, [0.0, 1e-12], 0.0, 0
+    ode = dict(rtol=1e-10, atol=1e-12, max_step=0.05)
+    while True:
+        pieces += 1
+        rising = rhs(lambda q: 1.0)
+        peak = lambda t, q, t0=t0: rising(t, q)[1] if t > t0 + 1e-6 or t0 == 0 else 1.0
+        peak.terminal, peak.direction = True, -1
+        up = solve_ivp(rising, (t0, 300), q0, events=peak, **ode)
+        t0, q0 = up.t_events[0][0], list(up.y_events[0][0])
+        vmax = q0[1]
+        stop = lambda t, q, t0=t0: q[1] if t > t0 + 1e-6 else 1.0
+        again = lambda t, q, m=vmax: q[1] - m * (1 + 1e-9)
+        stop.terminal, again.terminal, stop.direction, again.direction = True, True, -1, 1
+        down = solve_ivp(rhs(lambda q, m=vmax: q[1] / m), (t0, 300), q0,
+                         events=(stop, again), **ode)
+        if down.t_events[0].size:
+            end, x_end = down.t_events[0][0], down.y_events[0][0][0]
+            break
+        t0, q0 = down.t_events[1][0], list(down.y_events[1][0])
+    assert pieces > 1      # the registry ripples the velocity past its peak: several maxima
+    x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
+    a, c = run["yield_index"][0], run["stick_index"][0]
+    # (to 10⁻⁵: the branch weights move the slip's end by 10⁻³ of it)
+    assert x[c + 1] - x[a] == pytest.approx(x_end, rel=1e-5)
+    assert t[c + 1] - t[a] == pytest.approx(end, abs=0.5)
+    # no branch difference and no second harmonic: the ``corrugated`` film, step for step
+    kw = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=400.0,
+              dt=0.25, substeps=8)
+    flat = slide("branching-registry", (fk, b, df1, lam, phi1, 0.0, phi2, 0.0, 0.0, 0.0),
+                 **kw)[0]
+    plain = slide("corrugated", (fk, b, df1, lam, phi1, 0.0), **kw)[0]
+    np.testing.assert_array_equal(flat["wall_position"], plain["wall_position"])
+    # and the branch weights change the slip
+    assert not np.array_equal(run["wall_position"], plain["wall_position"])
+    for bad in ((fk, b, df1, lam, phi1, df2, phi2, 1.5, w2, dphi),
+                (fk, b, df1, lam, phi1, df2, phi2, w1, -1.5, dphi),
+                (fk, b, df1, 0.0, phi1, df2, phi2, w1, w2, dphi)):
+        with pytest.raises(ValueError, match="no amplitude below 0"):
+            slide("branching-registry", bad, **kw)

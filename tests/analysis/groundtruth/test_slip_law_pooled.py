@@ -510,3 +510,28 @@ def test_a_registry_that_trails_the_wall_reads_its_phase_behind_and_ahead_while_
     with pytest.raises(ValueError, match="registry_lag"):
         pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
                     registry_lag=5.0, lag=10.0)
+
+
+def test_a_registry_weighted_by_the_slips_branch_reads_weaker_and_ahead_while_speeding_up(
+        benchmark_module, capsys):
+    # ``branching-registry`` controls at M = 10⁴ against the same pool with a constant
+    # registry: a first harmonic 0.4 weaker and 1 rad ahead and a second harmonic
+    # (10 ε/σ) twice as strong while the slip speeds up read so on the branch table (the
+    # constant registry's differences within 2.5 ε/σ, 0.15 rad: the test above)
+    main = benchmark_module("slip_law/registry_spectrum").main
+    argv = ["--control", "m1e4", "12", "13", "--pools", "1", "--window", "5"]
+    constant = _branch_differences(main, capsys, argv)
+    branching = _branch_differences(main, capsys, argv + ["--branching", "10", "-1.58", "0.4",
+                                                          "1.0", "1.0"])
+    diff, const = branching[2], constant[2]
+    assert diff[2][0] < const[2][0] - 3.0, (diff, const)          # the first harmonic
+    assert diff[3][0] > const[3][0] + 0.2, (diff, const)          # its phase
+    assert diff[4][0] > 3.0, diff                                 # the second harmonic
+    with pytest.raises(ValueError, match="branching"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, branching=(10.0, 0.0, 0.3, 0.5, 0.5))
+    with pytest.raises(ValueError, match="branching"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    branching=(10.0, 0.0, 0.3, 0.5, 0.5), registry_lag=5.0)
+    with pytest.raises(SystemExit):
+        main(argv + ["--branching", "10", "0", "1.5", "0", "0"])
+    assert "W1 <= 1" in capsys.readouterr().err
