@@ -6,6 +6,9 @@
 * :mod:`.hexatic` — :class:`~.hexatic.HexaticOrder`: in-plane bond-orientational order
   ψ6 of each layer per frame, to contrast stick (crystalline, |ψ6| high) with slip
   (shear melted, |ψ6| low), from a Verlet list of in-plane neighbours;
+* :mod:`.slip_planes` — :class:`~.slip_planes.LayerDisplacement`: each layer's and each
+  wall's mean position along the slide per frame; :func:`~.slip_planes.active_plane`: the
+  plane (wall | layer or layer | layer) that carries the slide at each frame;
 * :mod:`.trajectory_reader` — a run's DCD trajectory opened with times in τ, and its
   atoms picked by type.
 

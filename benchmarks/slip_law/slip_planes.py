@@ -1,0 +1,144 @@
+"""Where MD runs' films slide during their slips, plane by plane, grouped by the slider's mass.
+
+    python benchmarks/slip_law/slip_planes.py RUN… [--window 2]
+
+Each RUN is an analysed run directory with a trajectory (``dump_every`` set: its
+``trajectory.dcd`` and ``topology.data``, its ``analysis_cycles.csv``).  The film's layers
+come from its density profile; each frame's layer positions along the slide and the walls'
+(:class:`~filmfriction.analysis.structure.slip_planes.LayerDisplacement`) give each plane's
+share of the wall's slide, and the plane carrying most of it at each frame
+(:func:`~filmfriction.analysis.structure.slip_planes.active_plane`, velocities over
+``--window`` τ).  Per analysed slip, from the frame at its yield to the frame after its
+re-stick: each plane's share of the slip's distance (the planes numbered from the bottom
+wall | first layer, 0, to the last layer | top wall); the largest share (1: the slip is one
+plane's); the accelerating and decelerating parts apart (split at the peak of the top wall's
+velocity smoothed over five windows) and whether their largest shares sit on different
+planes; and the changes of the active plane while the wall moves faster than a fifth of its
+peak (a change counted once the new plane has held for a window).  Printed per slider mass M
+(the runs' ``source.parameters.mass``): runs, slips, their median duration and distance, the
+planes' shares averaged over the slips, the mean largest share (its standard error over the
+slips), the share of slips whose two parts slide on different planes, and the changes per
+slip and per σ slid.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from filmfriction.analysis.structure.slip_planes import LayerDisplacement, active_plane
+from filmfriction.analysis.structure.trajectory_reader import (film_layers, frame_steps,
+                                                               select_types)
+from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
+
+
+def _changes(plane, hold: int) -> int:
+    """Changes of ``plane`` along the frames, a new plane counted once it holds ``hold``."""
+    n, current, run_of, last = 0, int(plane[0]), 0, None
+    for p in plane[1:]:
+        if p == current:
+            run_of, last = 0, None
+            continue
+        run_of = run_of + 1 if p == last else 1
+        last = p
+        if run_of >= hold:
+            n, current, run_of, last = n + 1, int(p), 0, None
+    return n
+
+
+def run_planes(run: Path, window: float) -> dict:
+    """One run's slips: each one's plane shares (whole, accelerating, decelerating part),
+    its active-plane changes, duration and distance; the run's mass."""
+    analysis = json.loads((run / "analysis.json").read_text())
+    u, film, prof = film_layers(run / "topology.data", run / "trajectory.dcd", FILM_TYPES,
+                                step=10)
+    disp = LayerDisplacement(film, select_types(u, BOTTOM_WALL_TYPES),
+                             select_types(u, TOP_WALL_TYPES),
+                             prof.results.layers["edges"]).run()
+    walls = disp.results.wall_x
+    x = np.column_stack([walls[:, 0], disp.results.layer_x, walls[:, 1]])
+    if not np.all(np.isfinite(x)):
+        raise ValueError(f"{run}: a layer is empty in some frame (the film left its layers)")
+    steps = frame_steps(u)
+    trace = np.genfromtxt(run / "trace.csv", delimiter=",", names=True)
+    cycles = np.genfromtxt(run / "analysis_cycles.csv", delimiter=",", names=True)
+    if steps is None or steps.size < 3:
+        raise ValueError(f"{run}: the trajectory carries no frame steps, or fewer than 3")
+    dt = float(np.interp(steps[1], trace["step"], trace["time"])
+               - np.interp(steps[0], trace["step"], trace["time"]))
+    plane, _ = active_plane(x, dt, window)
+    w = max(3, int(round(window / dt)) | 1)
+    slow = savgol_filter(walls[:, 1], min(5 * w | 1, x.shape[0] - (1 - x.shape[0] % 2)), 2,
+                         deriv=1, delta=dt)
+    out = []
+    for y, s in zip(np.atleast_1d(cycles["yield_index"]).astype(int),
+                    np.atleast_1d(cycles["stick_index"]).astype(int)):
+        a = int(np.searchsorted(steps, trace["step"][y]))
+        b = int(np.searchsorted(steps, trace["step"][s])) + 1
+        if b >= x.shape[0] or b - a < 4:
+            continue
+        k = a + int(np.argmax(slow[a:b]))
+        parts = {}
+        for name, (i, j) in (("whole", (a, b)), ("accelerating", (a, k)),
+                             ("decelerating", (k, b))):
+            dx = np.diff(x[j] - x[i])
+            parts[name] = dx / dx.sum() if j > i and dx.sum() > 0 else None
+        moving = slow[a:b] > 0.2 * slow[a:b].max()
+        out.append({**parts, "changes": _changes(plane[a:b][moving], w) if moving.any() else 0,
+                    "distance": float(x[b, -1] - x[a, -1]), "duration": float((b - a) * dt)})
+    return {"mass": float(analysis["source"]["parameters"]["mass"]), "slips": out}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("runs", nargs="+", type=Path, metavar="RUN")
+    ap.add_argument("--window", type=float, default=2.0,
+                    help="the window of the planes' velocities (τ)")
+    args = ap.parse_args(argv)
+    if not (math.isfinite(args.window) and args.window > 0):
+        ap.error(f"--window {args.window!r}: > 0, finite (τ)")
+    missing = [str(r) for r in args.runs if not all(
+        (r / f).is_file() for f in ("analysis.json", "analysis_cycles.csv", "trace.csv",
+                                    "trajectory.dcd", "topology.data"))]
+    if missing:
+        ap.error("RUN without an analysis, a trace or a trajectory (run with dump_every "
+                 f"set): {', '.join(missing)}")
+    by_mass = defaultdict(list)
+    try:
+        for run in args.runs:
+            r = run_planes(run, args.window)
+            by_mass[r["mass"]].append(r["slips"])
+    except ValueError as exc:
+        print(f"slip_planes: {exc}", file=sys.stderr)
+        return 1
+    print("| M (m) | runs | slips | median slip (τ; σ) | planes' shares of the slip, bottom wall "
+          "→ top wall | largest share | two parts on different planes | active-plane changes "
+          "per slip; per σ |\n|---|---|---|---|---|---|---|---|")
+    for mass in sorted(by_mass):
+        slips = [s for run in by_mass[mass] for s in run]
+        if not slips:
+            continue
+        share = np.array([s["whole"] for s in slips])
+        top = share.max(axis=1)
+        both = [s for s in slips if s["accelerating"] is not None
+                and s["decelerating"] is not None]
+        differ = sum(int(np.argmax(s["accelerating"]) != np.argmax(s["decelerating"]))
+                     for s in both)
+        ch = np.array([s["changes"] for s in slips], float)
+        dist = np.array([s["distance"] for s in slips])
+        print(f"| {mass:g} | {len(by_mass[mass])} | {len(slips)} | "
+              f"{np.median([s['duration'] for s in slips]):.0f}; {np.median(dist):.2f} | "
+              f"{' '.join(f'{q:.2f}' for q in share.mean(axis=0))} | {top.mean():.2f} ± "
+              f"{top.std(ddof=1) / math.sqrt(top.size) if top.size > 1 else math.nan:.2f} | "
+              f"{differ} of {len(both)} | {ch.mean():.2f}; {ch.sum() / dist.sum():.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
