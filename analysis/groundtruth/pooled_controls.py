@@ -73,6 +73,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 corrugation: tuple[float, float, float] | None = None,
                 registry_lag: float | None = None,
                 branching: tuple[float, float, float, float, float] | None = None,
+                lag_distance: float | None = None,
                 seed=0, slip_end: str = "slider") -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
@@ -91,7 +92,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     registry force following the wall's position late, relaxing over τ_g
     (``lagged-registry``; not with a loop or a viscous lag); ``branching`` = (ΔF₂, φ₂, w₁,
     w₂, δφ): that registry force with a second harmonic, both weighted by the slip's branch
-    (``branching-registry``; not with a loop, a viscous lag or ``registry_lag``).  ``seed``: an int or a tuple
+    (``branching-registry``; not with a loop, a viscous lag or ``registry_lag``);
+    ``lag_distance`` = d: the viscous force lagging by the slip distance d, not a time
+    (``distance-lag``; with the corrugation alone).  ``seed``: an int or a tuple
     of ints.  ``slip_end``: one of :data:`SLIP_ENDS`."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
@@ -110,7 +113,15 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                              "viscous mix of a share (with a lag or not; with a loop, "
                              "melting or slip-weakening)")
         reg = tuple(float(c) for c in corrugation) + (float(lag or 0.0),)
-        if branching is not None:
+        if lag_distance is not None:
+            if (weakening is not None or lag or registry_lag is not None
+                    or branching is not None
+                    or not (math.isfinite(lag_distance) and lag_distance > 0)):
+                raise ValueError(f"lag_distance = {lag_distance!r}: a distance > 0, finite, "
+                                 "without a loop, a viscous lag, a registry lag or branching")
+            law |= {"law": "distance-lag", "parameters": law["parameters"][:2] + reg[:3]
+                    + (float(lag_distance),)}
+        elif branching is not None:
             if (weakening is not None or lag or registry_lag is not None
                     or len(branching) != 5):
                 raise ValueError(f"branching = {branching!r}: (ΔF₂, φ₂, w₁, w₂, δφ), without "
@@ -130,9 +141,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
             film = 4
             law |= {"law": "corrugated-loop", "parameters": law["parameters"][:4] + reg
                     + (float(loop_law == "melting"),)}
-    elif registry_lag is not None or branching is not None:
-        raise ValueError(f"registry_lag = {registry_lag!r}, branching = {branching!r}: only "
-                         "with a corrugation")
+    elif registry_lag is not None or branching is not None or lag_distance is not None:
+        raise ValueError(f"registry_lag = {registry_lag!r}, branching = {branching!r}, "
+                         f"lag_distance = {lag_distance!r}: only with a corrugation")
     noise = sc.noise if noise is None else noise
     key = list(seed) if isinstance(seed, (tuple, list)) else [seed]
     rng = np.random.default_rng(key + [7919])

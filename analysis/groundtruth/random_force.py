@@ -106,11 +106,15 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #:   whose amplitudes and phase differ between the accelerating and the decelerating branch
 #:   of the slip at one velocity (w₁ > 0: the first harmonic weaker while accelerating;
 #:   w₂ > 0: the second stronger; δφ > 0: the phase ahead), each amplitude ≥ 0 throughout
-#:   (w₁ ≤ 1, w₂ ≥ −1).
+#:   (w₁ ≤ 1, w₂ ≥ −1);
+#: * ``distance-lag`` (F_k, B, ΔF, λ, φ, d): sign(v)·F_k + ψ + ΔF·sin(2π·x/λ + φ), ψ the
+#:   film's viscous force relaxing to B·v over a slip distance d (dψ/dt = |v|·(B·v − ψ)/d,
+#:   0 at each yield): the ``corrugated`` film whose viscous force lags by a distance, not
+#:   a time (a lag of d/|v|: long where the slip is slow, short at its peak).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
         "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6,
-        "branching-registry": 10}
+        "branching-registry": 10, "distance-lag": 6}
 #: :func:`slide`'s random-force keywords for none (the noise-free slider).
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
@@ -157,6 +161,9 @@ def _friction(code, p, v, psi, x, x_yield):
         return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
                 + p[2] * (1.0 - p[7] * r) * math.sin(theta + p[4] + p[9] * r)
                 + p[5] * (1.0 + p[8] * r) * math.sin(2.0 * theta + p[6]))
+    if code == 12:
+        return ((p[0] if v >= 0.0 else -p[0]) + psi
+                + p[2] * math.sin(2.0 * math.pi * x / p[3] + p[4]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -176,6 +183,8 @@ def _state_rate(code, p, v, psi):
         return (p[1] * v - psi) / p[7]
     if code == 10:
         return v - psi / p[5]
+    if code == 12:
+        return abs(v) * (p[1] * v - psi) / p[5]
     return 0.0
 
 
@@ -239,7 +248,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         slipping, v = True, start_v
                         x_yield = x
                         if (code == 4 or code == 5 or code == 7 or code == 8 or code == 9
-                                or code == 10 or code == 11):
+                                or code == 10 or code == 11 or code == 12):
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
@@ -329,6 +338,9 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                          "must be > 0, the amplitudes ΔF₁, ΔF₂ (the third, sixth) >= 0, "
                          "w₁ (the eighth) <= 1 and w₂ (the ninth) >= -1 (no amplitude "
                          "below 0)")
+    if law == "distance-lag" and not (p[3] > 0 and p[5] > 0):
+        raise ValueError(f"parameters = {parameters!r}: the registry's period λ and the lag's "
+                         "distance d (the fourth, sixth) must be > 0")
     if law == "maxwell-weakening" and not p[4] > 0:
         raise ValueError(f"parameters = {parameters!r}: the relaxation time τ_r (the fifth) "
                          "must be > 0")

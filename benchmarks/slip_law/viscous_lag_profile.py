@@ -6,7 +6,7 @@ on MD runs or on controls of a known lag.
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
         [--loop LAW W D] [--slip-end force-minimum] [--registry-lag TAU_G]
-        [--branching DF2 PHI2 W1 W2 DPHI]
+        [--branching DF2 PHI2 W1 W2 DPHI] [--lag-distance D]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -35,7 +35,8 @@ trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, n
 ``--branching DF2 PHI2 W1 W2 DPHI``: the registry force with a second harmonic
 DF2·sin(4π·x/L + PHI2), the first's amplitude times 1 − W1·r and phase plus DPHI·r, the
 second's times 1 + W2·r, r = |v|/(the slip's fastest |v| so far), 1 while the slip speeds up
-(``branching-registry``; TAU 0, no loop, no registry lag);
+(``branching-registry``; TAU 0, no loop, no registry lag); ``--lag-distance D``: the viscous
+force lagging by the slip distance D (σ), not a time (``distance-lag``; TAU 0, alone);
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
@@ -142,6 +143,8 @@ def control(args) -> int:
              f"the registry trailing the wall over {args.registry_lag:g} τ, ")
           + ("" if args.branching is None else
              f"branching (ΔF₂, φ₂, w₁, w₂, δφ) = {tuple(args.branching)}, ")
+          + ("" if args.lag_distance is None else
+             f"the viscous force lagging by {args.lag_distance:g} σ of slide, ")
           + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
           f"slip ends: {args.slip_end}\n")
@@ -152,7 +155,8 @@ def control(args) -> int:
                              weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
                              corrugation=tuple(args.corrugation), seed=(0, k),
                              registry_lag=args.registry_lag,
-                             branching=None if args.branching is None else tuple(args.branching))
+                             branching=None if args.branching is None else tuple(args.branching),
+                             lag_distance=args.lag_distance)
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
@@ -219,6 +223,7 @@ def main(argv=None) -> int:
     ap.add_argument("--registry-lag", type=float, default=None, metavar="TAU_G")
     ap.add_argument("--branching", nargs=5, type=float, default=None,
                     metavar=("DF2", "PHI2", "W1", "W2", "DPHI"))
+    ap.add_argument("--lag-distance", type=float, default=None, metavar="D")
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
@@ -254,6 +259,11 @@ def main(argv=None) -> int:
                                   and a.registry_lag is None):
             ap.error(f"--branching {' '.join(map(str, b))}: finite, DF2 >= 0, W1 <= 1, "
                      "W2 >= -1; with TAU 0, no --loop, no --registry-lag")
+        d = a.lag_distance
+        if d is not None and not (math.isfinite(d) and d > 0 and tau == 0 and not a.loop
+                                  and a.registry_lag is None and b is None):
+            ap.error(f"--lag-distance {d}: a distance > 0 (σ); with TAU 0, no --loop, "
+                     "--registry-lag or --branching")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")
@@ -262,8 +272,9 @@ def main(argv=None) -> int:
         except ValueError as exc:      # a law the spread made impossible (D or τ_r <= 0)
             print(f"viscous_lag_profile: {exc}", file=sys.stderr)
             return 1
-    if a.registry_lag is not None or a.branching is not None:
-        ap.error("--registry-lag and --branching are the controls' (with --control)")
+    if a.registry_lag is not None or a.branching is not None or a.lag_distance is not None:
+        ap.error("--registry-lag, --branching and --lag-distance are the controls' (with "
+                 "--control)")
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:
         ap.error(f"RUN without trace.csv: {', '.join(missing)}")

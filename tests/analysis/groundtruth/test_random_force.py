@@ -381,3 +381,30 @@ def test_a_branching_registrys_first_slip_is_the_ode():
                 (fk, b, df1, 0.0, phi1, df2, phi2, w1, w2, dphi)):
         with pytest.raises(ValueError, match="no amplitude below 0"):
             slide("branching-registry", bad, **kw)
+
+
+def test_a_viscous_force_lagging_by_a_distance_is_the_ode():
+    # ψ relaxes to B·v over the slip distance d (dψ/dt = |v|·(B·v − ψ)/d, ψ = 0 at the
+    # yield): the first slip is solve_ivp's with ψ a state of its own, and a lag of a
+    # distance moves the slip's end where a lag of the time d/v̄ moves it otherwise
+    fk, b, df, lam, phi, d = 36.0, 6.0, 4.0, 1.1, 0.5, 0.5
+    kw = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=400.0,
+              dt=0.25, substeps=8)
+    run = slide("distance-lag", (fk, b, df, lam, phi, d), **kw)[0]
+    rhs = lambda t, q: [q[1], (FS + K * (0.1 * t - q[0]) - fk - q[2]
+                               - df * math.sin(2 * math.pi * q[0] / lam + phi)) / M,
+                        abs(q[1]) * (b * q[1] - q[2]) / d]
+    stop = lambda t, q: q[1] if t > 1.0 else 1.0
+    stop.terminal, stop.direction = True, -1
+    ode = solve_ivp(rhs, (0, 300), [0.0, 1e-12, 0.0], events=stop, rtol=1e-10, atol=1e-12,
+                    max_step=0.05)
+    x, t = run["wall_position"], run["time"]
+    a, c = run["yield_index"][0], run["stick_index"][0]
+    assert x[c + 1] - x[a] == pytest.approx(ode.y_events[0][0][0], rel=1e-4)
+    assert t[c + 1] - t[a] == pytest.approx(ode.t_events[0][0], abs=0.5)
+    vbar = ode.y_events[0][0][0] / ode.t_events[0][0]
+    in_time = slide("corrugated", (fk, b, df, lam, phi, d / vbar), **kw)[0]
+    # (the lag in time d/v̄ ends the slip 0.08 σ, 10⁻² of it, away: 100 times the tolerance)
+    assert abs(in_time["wall_position"][c + 1] - x[c + 1]) > 0.05
+    with pytest.raises(ValueError, match="distance d"):
+        slide("distance-lag", (fk, b, df, lam, phi, 0.0), **kw)
