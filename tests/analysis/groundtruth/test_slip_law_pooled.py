@@ -535,3 +535,34 @@ def test_a_registry_weighted_by_the_slips_branch_reads_weaker_and_ahead_while_sp
     with pytest.raises(SystemExit):
         main(argv + ["--branching", "10", "0", "1.5", "0", "0"])
     assert "W1 <= 1" in capsys.readouterr().err
+
+
+def test_a_viscous_force_lagging_by_a_distance_reads_as_a_time_lag_of_that_distance_over_v(
+        benchmark_module):
+    # ``distance-lag`` controls (d = 0.3 σ), noise-free, at M = 10⁵ and 10⁴: the lag profile
+    # reads each as a time lag τ̂ of about d over the slips' mean velocity, so τ̂ differs
+    # between the scales as 1/v̄ (a lag in time would read one τ̂ at both)
+    vlp = benchmark_module("slip_law/viscous_lag_profile")
+    lags = [0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0]
+    tau, speed = {}, {}
+    for name in ("stiff", "m1e4"):
+        sc = SCALES[name]
+        rs, vd = pooled_runs("x", 4, 4, share=0.5, scale=sc, noise=QUIET,
+                             corrugation=(20.0, 1.1, -0.97), lag_distance=0.3)
+        fits = vlp.profile(rs, lags, mass=sc.mass, drive_velocity=vd, film_mass=sc.film_mass,
+                           mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME,
+                           registry_period=1.1)
+        tau[name] = vlp.crossing(lags, fits)[0]
+        slips = [(r.wall_position[s] - r.wall_position[y], r.time[s] - r.time[y]) for r in rs
+                 for y, s in zip(r.table.yield_index, r.table.stick_index)]
+        speed[name] = sum(d for d, _ in slips) / sum(t for _, t in slips)
+    # (τ̂·v̄ 0.31 and 0.33 σ; τ̂ 20 and 9.5 τ)
+    for name in tau:
+        assert 0.5 * 0.3 < tau[name] * speed[name] < 1.2 * 0.3, (tau, speed)
+    assert tau["stiff"] / tau["m1e4"] == pytest.approx(speed["m1e4"] / speed["stiff"],
+                                                       rel=0.3), (tau, speed)
+    with pytest.raises(ValueError, match="lag_distance"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, lag_distance=0.3)
+    with pytest.raises(ValueError, match="lag_distance"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    lag_distance=0.3, lag=10.0)
