@@ -1,6 +1,6 @@
 """Where MD runs' films slide during their slips, plane by plane, grouped by the slider's mass.
 
-    python benchmarks/slip_law/slip_planes.py RUN… [--window 2]
+    python benchmarks/slip_law/slip_planes.py RUN… [--window 2] [--psi6]
 
 Each RUN is an analysed run directory with a trajectory (``dump_every`` set: its
 ``trajectory.dcd`` and ``topology.data``, its ``analysis_cycles.csv``).  The film's layers
@@ -18,7 +18,10 @@ peak (a change counted once the new plane has held for a window).  Printed per s
 (the runs' ``source.parameters.mass``): runs, slips, their median duration and distance, the
 planes' shares averaged over the slips, the mean largest share (its standard error over the
 slips), the share of slips whose two parts slide on different planes, and the changes per
-slip and per σ slid.
+slip and per σ slid.  ``--psi6``: besides, each layer's in-plane order ψ6
+(:class:`~filmfriction.analysis.structure.hexatic.HexaticOrder`) averaged over the 20 frames
+before each slip and over its accelerating and decelerating parts, per mass its lowest and
+highest layer (a film that shear-melts in its slips loses it there).
 """
 from __future__ import annotations
 
@@ -52,7 +55,7 @@ def _changes(plane, hold: int) -> int:
     return n
 
 
-def run_planes(run: Path, window: float) -> dict:
+def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
     """One run's slips: each one's plane shares (whole, accelerating, decelerating part),
     its active-plane changes, duration and distance; the run's mass."""
     analysis = json.loads((run / "analysis.json").read_text())
@@ -61,6 +64,10 @@ def run_planes(run: Path, window: float) -> dict:
     disp = LayerDisplacement(film, select_types(u, BOTTOM_WALL_TYPES),
                              select_types(u, TOP_WALL_TYPES),
                              prof.results.layers["edges"]).run()
+    order = None
+    if psi6:
+        from filmfriction.analysis.structure.hexatic import HexaticOrder
+        order = HexaticOrder(film, prof.results.layers["edges"]).run().results.psi6
     walls = disp.results.wall_x
     x = np.column_stack([walls[:, 0], disp.results.layer_x, walls[:, 1]])
     if not np.all(np.isfinite(x)):
@@ -89,6 +96,10 @@ def run_planes(run: Path, window: float) -> dict:
                              ("decelerating", (k, b))):
             dx = np.diff(x[j] - x[i])
             parts[name] = dx / dx.sum() if j > i and dx.sum() > 0 else None
+        if order is not None:
+            for name, (i, j) in (("before", (max(0, a - 20), a)), ("acc_psi6", (a, k + 1)),
+                                 ("dec_psi6", (k, b + 1))):
+                parts[name] = order[i:j].mean(axis=0) if j > i else None
         moving = slow[a:b] > 0.2 * slow[a:b].max()
         out.append({**parts, "changes": _changes(plane[a:b][moving], w) if moving.any() else 0,
                     "distance": float(x[b, -1] - x[a, -1]), "duration": float((b - a) * dt)})
@@ -100,6 +111,7 @@ def main(argv=None) -> int:
     ap.add_argument("runs", nargs="+", type=Path, metavar="RUN")
     ap.add_argument("--window", type=float, default=2.0,
                     help="the window of the planes' velocities (τ)")
+    ap.add_argument("--psi6", action="store_true", help="each layer's ψ6 before and in the slips")
     args = ap.parse_args(argv)
     if not (math.isfinite(args.window) and args.window > 0):
         ap.error(f"--window {args.window!r}: > 0, finite (τ)")
@@ -112,7 +124,7 @@ def main(argv=None) -> int:
     by_mass = defaultdict(list)
     try:
         for run in args.runs:
-            r = run_planes(run, args.window)
+            r = run_planes(run, args.window, args.psi6)
             by_mass[r["mass"]].append(r["slips"])
     except ValueError as exc:
         print(f"slip_planes: {exc}", file=sys.stderr)
@@ -137,6 +149,17 @@ def main(argv=None) -> int:
               f"{' '.join(f'{q:.2f}' for q in share.mean(axis=0))} | {top.mean():.2f} ± "
               f"{top.std(ddof=1) / math.sqrt(top.size) if top.size > 1 else math.nan:.2f} | "
               f"{differ} of {len(both)} | {ch.mean():.2f}; {ch.sum() / dist.sum():.2f} |")
+    if args.psi6:
+        print("\n| M (m) | ψ6 before the slips: lowest, highest layer | accelerating part | "
+              "decelerating part |\n|---|---|---|---|")
+        for mass in sorted(by_mass):
+            slips = [s for run in by_mass[mass] for s in run]
+            cells = []
+            for key in ("before", "acc_psi6", "dec_psi6"):
+                q = np.array([s[key] for s in slips if s.get(key) is not None])
+                cells.append(f"{q.mean(axis=0).min():.3f}, {q.mean(axis=0).max():.3f}"
+                             if q.size else "–")
+            print(f"| {mass:g} | " + " | ".join(cells) + " |")
     return 0
 
 

@@ -35,11 +35,11 @@ def test_each_layers_displacement_follows_its_velocity(tmp_path):
         active_plane(np.zeros((10, 1)), 0.5, 2.0)
 
 
-def _run(tmp_path, mass):
+def _run(tmp_path, mass, melt_frames=()):
     """A run directory of that film: one slip over the whole trajectory."""
     tmp_path.mkdir()
     layered_film(tmp_path, layers=3, frames=40, nsavc=100, thermal=0.02,
-                 plane_velocity=VELOCITY)
+                 plane_velocity=VELOCITY, melt_frames=melt_frames)
     steps = 50 * np.arange(79)
     (tmp_path / "trace.csv").write_text("time,step\n" + "\n".join(
         f"{0.005 * s:g},{s}" for s in steps) + "\n")
@@ -66,3 +66,20 @@ def test_the_slips_planes_grouped_by_mass(tmp_path, benchmark_module, capsys):
     with pytest.raises(SystemExit):
         main([str(tmp_path)])
     assert "without an analysis" in capsys.readouterr().err
+
+
+def test_the_slips_in_plane_order_by_mass(tmp_path, benchmark_module, capsys):
+    # ``--psi6``: a crystalline film keeps ψ6 ≈ 1 before and in its slip; one whose layers
+    # are randomised in plane from the slip's yield on (shear-melted) loses it in the slip
+    main = benchmark_module("slip_law/slip_planes").main
+    a = _run(tmp_path / "a", 1000.0)
+    b = _run(tmp_path / "b", 3000.0, melt_frames=range(1, 40))
+    assert main([str(a), str(b), "--psi6"]) == 0
+    out = capsys.readouterr().out.split("ψ6 before the slips")[1]
+    rows = {r.split("|")[1].strip(): [c.strip() for c in r.split("|")[2:-1]]
+            for r in out.splitlines() if r.startswith("| 1000 |") or r.startswith("| 3000 |")}
+    crystal, melted = rows["1000"], rows["3000"]
+    for cell in crystal + melted[:1]:
+        assert min(map(float, cell.split(", "))) > 0.9, (crystal, melted)
+    for cell in melted[1:]:
+        assert max(map(float, cell.split(", "))) < 0.5, melted
