@@ -94,7 +94,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     w₂, δφ): that registry force with a second harmonic, both weighted by the slip's branch
     (``branching-registry``; not with a loop, a viscous lag or ``registry_lag``);
     ``lag_distance`` = d: the viscous force lagging by the slip distance d, not a time
-    (``distance-lag``; with the corrugation alone).  ``seed``: an int or a tuple
+    (``distance-lag``; with ``branching``, ``distance-lag-branching``).  ``seed``: an int or a tuple
     of ints.  ``slip_end``: one of :data:`SLIP_ENDS`."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
@@ -115,12 +115,14 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
         reg = tuple(float(c) for c in corrugation) + (float(lag or 0.0),)
         if lag_distance is not None:
             if (weakening is not None or lag or registry_lag is not None
-                    or branching is not None
-                    or not (math.isfinite(lag_distance) and lag_distance > 0)):
+                    or not (math.isfinite(lag_distance) and lag_distance > 0)
+                    or (branching is not None and len(branching) != 5)):
                 raise ValueError(f"lag_distance = {lag_distance!r}: a distance > 0, finite, "
-                                 "without a loop, a viscous lag, a registry lag or branching")
-            law |= {"law": "distance-lag", "parameters": law["parameters"][:2] + reg[:3]
-                    + (float(lag_distance),)}
+                                 "without a loop, a viscous lag or a registry lag (with "
+                                 "branching = (ΔF₂, φ₂, w₁, w₂, δφ) or none)")
+            law |= {"law": "distance-lag" if branching is None else "distance-lag-branching",
+                    "parameters": law["parameters"][:2] + reg[:3] + (float(lag_distance),)
+                    + (() if branching is None else tuple(float(c) for c in branching))}
         elif branching is not None:
             if (weakening is not None or lag or registry_lag is not None
                     or len(branching) != 5):

@@ -110,11 +110,16 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #: * ``distance-lag`` (F_k, B, ΔF, λ, φ, d): sign(v)·F_k + ψ + ΔF·sin(2π·x/λ + φ), ψ the
 #:   film's viscous force relaxing to B·v over a slip distance d (dψ/dt = |v|·(B·v − ψ)/d,
 #:   0 at each yield): the ``corrugated`` film whose viscous force lags by a distance, not
-#:   a time (a lag of d/|v|: long where the slip is slow, short at its peak).
+#:   a time (a lag of d/|v|: long where the slip is slow, short at its peak);
+#: * ``distance-lag-branching`` (F_k, B, ΔF₁, λ, φ₁, d, ΔF₂, φ₂, w₁, w₂, δφ): that film
+#:   with the ``branching-registry``'s force in place of its registry, sign(v)·F_k + ψ
+#:   + ΔF₁·(1 − w₁·r)·sin(θ + φ₁ + δφ·r) + ΔF₂·(1 + w₂·r)·sin(2θ + φ₂) (r from the slip's
+#:   fastest |v| so far, kept beside ψ).
 LAWS = {"linear": 2, "coulomb-viscous": 2, "weakening": 3, "rate-state": 5,
         "slip-weakening": 4, "melting": 4, "maxwell": 4, "maxwell-weakening": 5,
         "corrugated": 6, "corrugated-loop": 9, "lagged-registry": 6,
-        "branching-registry": 10, "distance-lag": 6}
+        "branching-registry": 10, "distance-lag": 6,
+        "distance-lag-branching": 11}
 #: :func:`slide`'s random-force keywords for none (the noise-free slider).
 NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: The laws with a yield loop, (F_k, B, ΔF, D) each: ΔF fades over D since the yield (a
@@ -124,7 +129,7 @@ _CODE = {name: k for k, name in enumerate(LAWS)}
 
 
 @njit(cache=True)
-def _friction(code, p, v, psi, x, x_yield):
+def _friction(code, p, v, psi, x, x_yield, top):
     if code == 0:
         return p[0] + p[1] * v
     if code == 1:
@@ -164,6 +169,13 @@ def _friction(code, p, v, psi, x, x_yield):
     if code == 12:
         return ((p[0] if v >= 0.0 else -p[0]) + psi
                 + p[2] * math.sin(2.0 * math.pi * x / p[3] + p[4]))
+    if code == 13:
+        fastest = max(top, abs(v))
+        r = abs(v) / fastest if fastest > 0.0 else 1.0
+        theta = 2.0 * math.pi * x / p[3]
+        return ((p[0] if v >= 0.0 else -p[0]) + psi
+                + p[2] * (1.0 - p[8] * r) * math.sin(theta + p[4] + p[10] * r)
+                + p[6] * (1.0 + p[9] * r) * math.sin(2.0 * theta + p[7]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -183,7 +195,7 @@ def _state_rate(code, p, v, psi):
         return (p[1] * v - psi) / p[7]
     if code == 10:
         return v - psi / p[5]
-    if code == 12:
+    if code == 12 or code == 13:
         return abs(v) * (p[1] * v - psi) / p[5]
     return 0.0
 
@@ -193,7 +205,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
          psi0, h, n_sub, du, out_x, out_v, yields, sticks, counts):
     samples, reps = out_x.shape
     for r in range(reps):
-        x, v, psi, x_yield = 0.0, 0.0, psi0, 0.0
+        x, v, psi, x_yield, top = 0.0, 0.0, psi0, 0.0, 0.0
         slipping, armed = False, False
         ny, ns = 0, 0
         for i in range(samples):
@@ -203,20 +215,20 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                 t = (i * n_sub + j) * h
                 if slipping:
                     xi = mass * du[i * n_sub + j, r] / h
-                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi, x, x_yield)
+                    a1 = (k * (xd0 + vd * t - x) - _friction(code, p, v, psi, x, x_yield, top)
                           - gamma * (v - vd) + xi) / mass
                     p1 = _state_rate(code, p, v, psi)
                     x2, v2, s2 = x + 0.5 * h * v, v + 0.5 * h * a1, psi + 0.5 * h * p1
                     a2 = (k * (xd0 + vd * (t + 0.5 * h) - x2)
-                          - _friction(code, p, v2, s2, x2, x_yield) - gamma * (v2 - vd) + xi) / mass
+                          - _friction(code, p, v2, s2, x2, x_yield, top) - gamma * (v2 - vd) + xi) / mass
                     p2 = _state_rate(code, p, v2, s2)
                     x3, v3, s3 = x + 0.5 * h * v2, v + 0.5 * h * a2, psi + 0.5 * h * p2
                     a3 = (k * (xd0 + vd * (t + 0.5 * h) - x3)
-                          - _friction(code, p, v3, s3, x3, x_yield) - gamma * (v3 - vd) + xi) / mass
+                          - _friction(code, p, v3, s3, x3, x_yield, top) - gamma * (v3 - vd) + xi) / mass
                     p3 = _state_rate(code, p, v3, s3)
                     x4, v4, s4 = x + h * v3, v + h * a3, psi + h * p3
                     a4 = (k * (xd0 + vd * (t + h) - x4)
-                          - _friction(code, p, v4, s4, x4, x_yield) - gamma * (v4 - vd) + xi) / mass
+                          - _friction(code, p, v4, s4, x4, x_yield, top) - gamma * (v4 - vd) + xi) / mass
                     p4 = _state_rate(code, p, v4, s4)
                     x = x + h * (v + 2 * v2 + 2 * v3 + v4) / 6
                     vn = v + h * (a1 + 2 * a2 + 2 * a3 + a4) / 6
@@ -239,19 +251,21 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         v = vn
                         if code == 5 or code == 11 or (code == 9 and p[8] == 1.0):
                             psi = max(psi, abs(v))
+                        top = max(top, abs(v))     # the slip's fastest |v| so far
                 else:
                     # stuck: at rest, the state aging
                     psi = psi + h * _state_rate(code, p, 0.0, psi)
                     force = k * (xd0 + vd * (t + h) - x)
-                    thr = static if code != 3 else _friction(code, p, start_v, psi, x, x)
+                    thr = static if code != 3 else _friction(code, p, start_v, psi, x, x, 0.0)
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
                         if (code == 4 or code == 5 or code == 7 or code == 8 or code == 9
-                                or code == 10 or code == 11 or code == 12):
+                                or code == 10 or code == 11 or code == 12 or code == 13):
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield
+                        top = 0.0
                         if ny < yields.shape[1]:
                             yields[r, ny] = i
                         ny += 1
@@ -338,6 +352,12 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                          "must be > 0, the amplitudes ΔF₁, ΔF₂ (the third, sixth) >= 0, "
                          "w₁ (the eighth) <= 1 and w₂ (the ninth) >= -1 (no amplitude "
                          "below 0)")
+    if law == "distance-lag-branching" and not (p[3] > 0 and p[5] > 0 and p[2] >= 0
+                                                and p[6] >= 0 and p[8] <= 1 and p[9] >= -1):
+        raise ValueError(f"parameters = {parameters!r}: the registry's period λ and the lag's "
+                         "distance d (the fourth, sixth) must be > 0, the amplitudes ΔF₁, ΔF₂ "
+                         "(the third, seventh) >= 0, w₁ (the ninth) <= 1 and w₂ (the tenth) "
+                         ">= -1 (no amplitude below 0)")
     if law == "distance-lag" and not (p[3] > 0 and p[5] > 0):
         raise ValueError(f"parameters = {parameters!r}: the registry's period λ and the lag's "
                          "distance d (the fourth, sixth) must be > 0")

@@ -36,7 +36,8 @@ trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, n
 DF2·sin(4π·x/L + PHI2), the first's amplitude times 1 − W1·r and phase plus DPHI·r, the
 second's times 1 + W2·r, r = |v|/(the slip's fastest |v| so far), 1 while the slip speeds up
 (``branching-registry``; TAU 0, no loop, no registry lag); ``--lag-distance D``: the viscous
-force lagging by the slip distance D (σ), not a time (``distance-lag``; TAU 0, alone);
+force lagging by the slip distance D (σ), not a time (``distance-lag``; TAU 0; with
+``--branching``, ``distance-lag-branching``);
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
@@ -261,9 +262,9 @@ def main(argv=None) -> int:
                      "W2 >= -1; with TAU 0, no --loop, no --registry-lag")
         d = a.lag_distance
         if d is not None and not (math.isfinite(d) and d > 0 and tau == 0 and not a.loop
-                                  and a.registry_lag is None and b is None):
-            ap.error(f"--lag-distance {d}: a distance > 0 (σ); with TAU 0, no --loop, "
-                     "--registry-lag or --branching")
+                                  and a.registry_lag is None):
+            ap.error(f"--lag-distance {d}: a distance > 0 (σ); with TAU 0, no --loop or "
+                     "--registry-lag")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")

@@ -324,25 +324,21 @@ def test_a_lagged_registrys_first_slip_is_the_ode():
         slide("lagged-registry", (fk, b, df, lam, phi, 0.1), **{**kw, "substeps": 1})
 
 
-def test_a_branching_registrys_first_slip_is_the_ode():
-    # the registry's harmonics weighted by r = |v|/(the slip's fastest |v| so far): the
-    # first slip is solve_ivp's in pieces, r = 1 while the velocity is at its running
-    # maximum (until the acceleration turns negative), r = v/v_max after (until v passes
-    # v_max again, or stops)
-    fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi = 36.0, 2.0, 4.0, 1.1, 0.5, 2.0, -1.5, \
-        0.4, 0.6, 0.3
-    par = (fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi)
-    run = slide("branching-registry", par, mass=M, stiffness=K, drive_velocity=0.1,
-                static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
-
+def _branching_first_slip(df1, lam, phi1, df2, phi2, w1, w2, dphi, film, q0):
+    """The first slip of a branch-weighted registry solved by solve_ivp in pieces: r = 1
+    while the velocity is at its running maximum (until the acceleration turns negative),
+    r = v/v_max after (until v passes v_max again, or stops).  ``film(t, q)``: the film's
+    force besides the registry and the extra states' rates; ``q0``: x, v and those states at
+    the yield.  Returns (the slip's end time, its distance, the number of pieces)."""
     def rhs(r):
         def f(t, q):
             th = 2 * math.pi * q[0] / lam
             reg = (df1 * (1 - w1 * r(q)) * math.sin(th + phi1 + dphi * r(q))
                    + df2 * (1 + w2 * r(q)) * math.sin(2 * th + phi2))
-            return [q[1], (FS + K * (0.1 * t - q[0]) - fk - b * q[1] - reg) / M]
+            force, rates = film(t, q)
+            return [q[1], (FS + K * (0.1 * t - q[0]) - force - reg) / M] + rates
         return f
-    t0, q0, vmax, pieces = 0.0, [0.0, 1e-12], 0.0, 0
+    t0, pieces = 0.0, 0
     ode = dict(rtol=1e-10, atol=1e-12, max_step=0.05)
     while True:
         pieces += 1
@@ -358,9 +354,20 @@ def test_a_branching_registrys_first_slip_is_the_ode():
         down = solve_ivp(rhs(lambda q, m=vmax: q[1] / m), (t0, 300), q0,
                          events=(stop, again), **ode)
         if down.t_events[0].size:
-            end, x_end = down.t_events[0][0], down.y_events[0][0][0]
-            break
+            return down.t_events[0][0], down.y_events[0][0][0], pieces
         t0, q0 = down.t_events[1][0], list(down.y_events[1][0])
+
+
+def test_a_branching_registrys_first_slip_is_the_ode():
+    # the registry's harmonics weighted by r = |v|/(the slip's fastest |v| so far)
+    fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi = 36.0, 2.0, 4.0, 1.1, 0.5, 2.0, -1.5, \
+        0.4, 0.6, 0.3
+    par = (fk, b, df1, lam, phi1, df2, phi2, w1, w2, dphi)
+    run = slide("branching-registry", par, mass=M, stiffness=K, drive_velocity=0.1,
+                static_force=FS, duration=400.0, dt=0.25, substeps=8)[0]
+    end, x_end, pieces = _branching_first_slip(
+        df1, lam, phi1, df2, phi2, w1, w2, dphi,
+        lambda t, q: (fk + b * q[1], []), [0.0, 1e-12])
     assert pieces > 1      # the registry ripples the velocity past its peak: several maxima
     x, v, t = run["wall_position"], run["wall_velocity"], run["time"]
     a, c = run["yield_index"][0], run["stick_index"][0]
@@ -408,3 +415,31 @@ def test_a_viscous_force_lagging_by_a_distance_is_the_ode():
     assert abs(in_time["wall_position"][c + 1] - x[c + 1]) > 0.05
     with pytest.raises(ValueError, match="distance d"):
         slide("distance-lag", (fk, b, df, lam, phi, 0.0), **kw)
+
+
+def test_a_lag_in_distance_beside_a_branching_registry_is_the_ode():
+    # ``distance-lag-branching``: the viscous force ψ lagging by a slip distance and the
+    # branch-weighted registry together; the first slip is solve_ivp's in pieces with ψ a
+    # state of its own, and without weights and second harmonic the law is ``distance-lag``
+    fk, b, df1, lam, phi1, d, df2, phi2, w1, w2, dphi = 36.0, 6.0, 4.0, 1.1, 0.5, 0.5, 2.0, \
+        -1.5, 0.4, 0.6, 0.3
+    kw = dict(mass=M, stiffness=K, drive_velocity=0.1, static_force=FS, duration=400.0,
+              dt=0.25, substeps=8)
+    run = slide("distance-lag-branching", (fk, b, df1, lam, phi1, d, df2, phi2, w1, w2, dphi),
+                **kw)[0]
+    end, x_end, pieces = _branching_first_slip(
+        df1, lam, phi1, df2, phi2, w1, w2, dphi,
+        lambda t, q: (fk + q[2], [abs(q[1]) * (b * q[1] - q[2]) / d]), [0.0, 1e-12, 0.0])
+    assert pieces > 1
+    x, t = run["wall_position"], run["time"]
+    a, c = run["yield_index"][0], run["stick_index"][0]
+    assert x[c + 1] - x[a] == pytest.approx(x_end, rel=1e-4)
+    assert t[c + 1] - t[a] == pytest.approx(end, abs=0.5)
+    flat = slide("distance-lag-branching", (fk, b, df1, lam, phi1, d, 0.0, phi2, 0.0, 0.0,
+                                            0.0), **kw)[0]
+    plain = slide("distance-lag", (fk, b, df1, lam, phi1, d), **kw)[0]
+    np.testing.assert_array_equal(flat["wall_position"], plain["wall_position"])
+    assert abs(plain["wall_position"][c + 1] - x[c + 1]) > 1e-2
+    with pytest.raises(ValueError, match="no amplitude below 0"):
+        slide("distance-lag-branching", (fk, b, df1, lam, phi1, d, df2, phi2, 1.5, w2, dphi),
+              **kw)
