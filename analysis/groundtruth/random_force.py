@@ -126,6 +126,8 @@ NOISE_FREE = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
 #: distance, a velocity, a time).
 LOOP_LAWS = ("melting", "slip-weakening", "maxwell")
 _CODE = {name: k for k, name in enumerate(LAWS)}
+#: Where the branch-weighted laws keep ΔF₁, ΔF₂, w₁ and w₂ among their parameters.
+_BRANCH_WEIGHTS = {"branching-registry": (2, 5, 7, 8), "distance-lag-branching": (2, 6, 8, 9)}
 
 
 @njit(cache=True)
@@ -346,18 +348,15 @@ def slide(law: str, parameters, *, mass: float, stiffness: float, drive_velocity
                          f"shorter than the integration step dt/substeps = "
                          f"{dt / max(int(substeps), 1)!r}, which would not resolve it (take "
                          f"substeps >= {math.ceil(dt / p[5])})")
-    if law == "branching-registry" and not (p[3] > 0 and p[2] >= 0 and p[5] >= 0
-                                            and p[7] <= 1 and p[8] >= -1):
-        raise ValueError(f"parameters = {parameters!r}: the registry's period λ (the fourth) "
-                         "must be > 0, the amplitudes ΔF₁, ΔF₂ (the third, sixth) >= 0, "
-                         "w₁ (the eighth) <= 1 and w₂ (the ninth) >= -1 (no amplitude "
-                         "below 0)")
-    if law == "distance-lag-branching" and not (p[3] > 0 and p[5] > 0 and p[2] >= 0
-                                                and p[6] >= 0 and p[8] <= 1 and p[9] >= -1):
-        raise ValueError(f"parameters = {parameters!r}: the registry's period λ and the lag's "
-                         "distance d (the fourth, sixth) must be > 0, the amplitudes ΔF₁, ΔF₂ "
-                         "(the third, seventh) >= 0, w₁ (the ninth) <= 1 and w₂ (the tenth) "
-                         ">= -1 (no amplitude below 0)")
+    if law in _BRANCH_WEIGHTS:
+        a1, a2, w1, w2 = (p[k] for k in _BRANCH_WEIGHTS[law])
+        lagged = law == "distance-lag-branching"
+        if not (p[3] > 0 and (p[5] > 0 or not lagged) and a1 >= 0 and a2 >= 0 and w1 <= 1
+                and w2 >= -1):
+            raise ValueError(f"parameters = {parameters!r}: the registry's period λ (the "
+                             "fourth)" + (" and the lag's distance d (the sixth)" if lagged
+                                          else "") + " must be > 0, the amplitudes ΔF₁, ΔF₂ "
+                             ">= 0, w₁ <= 1 and w₂ >= -1 (no amplitude below 0)")
     if law == "distance-lag" and not (p[3] > 0 and p[5] > 0):
         raise ValueError(f"parameters = {parameters!r}: the registry's period λ and the lag's "
                          "distance d (the fourth, sixth) must be > 0")

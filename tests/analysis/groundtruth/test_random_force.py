@@ -443,3 +443,6 @@ def test_a_lag_in_distance_beside_a_branching_registry_is_the_ode():
     with pytest.raises(ValueError, match="no amplitude below 0"):
         slide("distance-lag-branching", (fk, b, df1, lam, phi1, d, df2, phi2, 1.5, w2, dphi),
               **kw)
+    with pytest.raises(ValueError, match="lag's distance d"):
+        slide("distance-lag-branching", (fk, b, df1, lam, phi1, 0.0, df2, phi2, w1, w2, dphi),
+              **kw)
