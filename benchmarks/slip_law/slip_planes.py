@@ -18,7 +18,8 @@ peak (a change counted once the new plane has held for a window).  Printed per s
 (the runs' ``source.parameters.mass``): runs, slips, their median duration and distance, the
 planes' shares averaged over the slips, the mean largest share (its standard error over the
 slips), the share of slips whose two parts slide on different planes, and the changes per
-slip and per σ slid.  ``--psi6``: besides, each layer's in-plane order ψ6
+slip and per σ slid, and the median distance the wall slides between two changes (one plane
+sliding; λ = 1.1 σ is the walls' registry period along the slide).  ``--psi6``: besides, each layer's in-plane order ψ6
 (:class:`~filmfriction.analysis.structure.hexatic.HexaticOrder`) averaged over the 20 frames
 before each slip and over its accelerating and decelerating parts, per mass its lowest and
 highest layer (a film that shear-melts in its slips loses it there).
@@ -41,18 +42,20 @@ from filmfriction.analysis.structure.trajectory_reader import (film_layers, fram
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
 
-def _changes(plane, hold: int) -> int:
-    """Changes of ``plane`` along the frames, a new plane counted once it holds ``hold``."""
-    n, current, run_of, last = 0, int(plane[0]), 0, None
-    for p in plane[1:]:
+def _hops(plane, hold: int) -> list[int]:
+    """Where ``plane`` changes along the frames: the first frame of each new plane that holds
+    ``hold`` frames."""
+    hops, current, run_of, last = [], int(plane[0]), 0, None
+    for i, p in enumerate(plane[1:], 1):
         if p == current:
             run_of, last = 0, None
             continue
         run_of = run_of + 1 if p == last else 1
         last = p
         if run_of >= hold:
-            n, current, run_of, last = n + 1, int(p), 0, None
-    return n
+            hops.append(i - hold + 1)
+            current, run_of, last = int(p), 0, None
+    return hops
 
 
 def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
@@ -100,8 +103,10 @@ def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
             for name, (i, j) in (("before", (max(0, a - 20), a)), ("acc_psi6", (a, k + 1)),
                                  ("dec_psi6", (k, b + 1))):
                 parts[name] = order[i:j].mean(axis=0) if j > i else None
-        moving = slow[a:b] > 0.2 * slow[a:b].max()
-        out.append({**parts, "changes": _changes(plane[a:b][moving], w) if moving.any() else 0,
+        moving = a + np.flatnonzero(slow[a:b] > 0.2 * slow[a:b].max())
+        hops = moving[_hops(plane[moving], w)] if moving.size else np.array([], int)
+        out.append({**parts, "changes": len(hops),
+                    "between": np.diff(x[hops, -1]).tolist(),
                     "distance": float(x[b, -1] - x[a, -1]), "duration": float((b - a) * dt)})
     return {"mass": float(analysis["source"]["parameters"]["mass"]), "slips": out}
 
@@ -131,7 +136,8 @@ def main(argv=None) -> int:
         return 1
     print("| M (m) | runs | slips | median slip (τ; σ) | planes' shares of the slip, bottom wall "
           "→ top wall | largest share | two parts on different planes | active-plane changes "
-          "per slip; per σ |\n|---|---|---|---|---|---|---|---|")
+          "per slip; per σ | slide between changes: median (quartiles) σ |\n"
+          "|---|---|---|---|---|---|---|---|---|")
     for mass in sorted(by_mass):
         slips = [s for run in by_mass[mass] for s in run]
         if not slips:
@@ -144,11 +150,14 @@ def main(argv=None) -> int:
                      for s in both)
         ch = np.array([s["changes"] for s in slips], float)
         dist = np.array([s["distance"] for s in slips])
+        between = np.array([d for s in slips for d in s["between"]])
         print(f"| {mass:g} | {len(by_mass[mass])} | {len(slips)} | "
               f"{np.median([s['duration'] for s in slips]):.0f}; {np.median(dist):.2f} | "
               f"{' '.join(f'{q:.2f}' for q in share.mean(axis=0))} | {top.mean():.2f} ± "
               f"{top.std(ddof=1) / math.sqrt(top.size) if top.size > 1 else math.nan:.2f} | "
-              f"{differ} of {len(both)} | {ch.mean():.2f}; {ch.sum() / dist.sum():.2f} |")
+              f"{differ} of {len(both)} | {ch.mean():.2f}; {ch.sum() / dist.sum():.2f} | "
+              + (f"{np.median(between):.2f} ({np.percentile(between, 25):.2f}–"
+                 f"{np.percentile(between, 75):.2f})" if between.size else "–") + " |")
     if args.psi6:
         print("\n| M (m) | ψ6 before the slips: lowest, highest layer | accelerating part | "
               "decelerating part |\n|---|---|---|---|")

@@ -63,6 +63,7 @@ def test_the_slips_planes_grouped_by_mass(tmp_path, benchmark_module, capsys):
                                                                        abs=0.02)
         assert float(cells[5].split(" ± ")[0]) == pytest.approx(0.8, abs=0.02)
         assert cells[7].startswith("0.00;")        # one plane throughout: no change
+        assert cells[8] == "–"                     # and no slide between changes
     with pytest.raises(SystemExit):
         main([str(tmp_path)])
     assert "without an analysis" in capsys.readouterr().err
@@ -83,3 +84,11 @@ def test_the_slips_in_plane_order_by_mass(tmp_path, benchmark_module, capsys):
         assert min(map(float, cell.split(", "))) > 0.9, (crystal, melted)
     for cell in melted[1:]:
         assert max(map(float, cell.split(", "))) < 0.5, melted
+
+
+def test_a_change_of_plane_counts_once_the_new_plane_holds(benchmark_module):
+    hops = benchmark_module("slip_law/slip_planes")._hops
+    # plane 1 from frame 3 (held); a one-frame flicker back to 0 at 7 is not a change; plane 2
+    # from frame 11
+    assert hops([0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 2, 2, 2], 3) == [3, 11]
+    assert hops([0, 1, 0, 1, 0, 1], 2) == []
