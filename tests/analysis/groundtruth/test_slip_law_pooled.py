@@ -566,3 +566,19 @@ def test_a_viscous_force_lagging_by_a_distance_reads_as_a_time_lag_of_that_dista
     with pytest.raises(ValueError, match="lag_distance"):
         pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
                     lag_distance=0.3, lag=10.0)
+
+
+def test_the_lag_profiles_new_control_options_refuse_bad_input_before_any_compute(
+        benchmark_module, capsys):
+    main = benchmark_module("slip_law/viscous_lag_profile").main
+    for argv, said in ((["--control", "0.5", "0", "--lag-distance", "-1"], "--lag-distance"),
+                       (["--control", "0.5", "10", "--lag-distance", "0.3"], "TAU 0"),
+                       (["--control", "0.5", "10", "--branching", "8", "0", "0.3", "0.5", "0"],
+                        "--branching"),
+                       (["--control", "0.5", "0", "--branching", "8", "0", "2", "0.5", "0"],
+                        "W1 <= 1"),
+                       (["/nonexistent-run", "--lag-distance", "0.3"], "controls'")):
+        with pytest.raises(SystemExit):
+            main(argv)
+        err = capsys.readouterr().err
+        assert said in err and "Traceback" not in err, (argv, err)
