@@ -1,5 +1,5 @@
 """Which plane of the film slides (analysis/structure/slip_planes.py) and the slips' planes by
-slider mass (benchmarks/slip_law/slip_planes.py), on films of known plane velocities."""
+slider mass (benchmarks/slip_law/sliding_planes.py), on films of known plane velocities."""
 from __future__ import annotations
 
 import json
@@ -50,7 +50,7 @@ def _run(tmp_path, mass, melt_frames=()):
 
 
 def test_the_slips_planes_grouped_by_mass(tmp_path, benchmark_module, capsys):
-    main = benchmark_module("slip_law/slip_planes").main
+    main = benchmark_module("slip_law/sliding_planes").main
     a, b = _run(tmp_path / "a", 1000.0), _run(tmp_path / "b", 3000.0)
     assert main([str(a), str(b)]) == 0
     rows = [r for r in capsys.readouterr().out.splitlines() if r.startswith("| 1000 |")
@@ -72,7 +72,7 @@ def test_the_slips_planes_grouped_by_mass(tmp_path, benchmark_module, capsys):
 def test_the_slips_in_plane_order_by_mass(tmp_path, benchmark_module, capsys):
     # ``--psi6``: a crystalline film keeps ψ6 ≈ 1 before and in its slip; one whose layers
     # are randomised in plane from the slip's yield on (shear-melted) loses it in the slip
-    main = benchmark_module("slip_law/slip_planes").main
+    main = benchmark_module("slip_law/sliding_planes").main
     a = _run(tmp_path / "a", 1000.0)
     b = _run(tmp_path / "b", 3000.0, melt_frames=range(1, 40))
     assert main([str(a), str(b), "--psi6"]) == 0
@@ -87,7 +87,7 @@ def test_the_slips_in_plane_order_by_mass(tmp_path, benchmark_module, capsys):
 
 
 def test_a_change_of_plane_counts_once_the_new_plane_holds(benchmark_module):
-    hops = benchmark_module("slip_law/slip_planes")._hops
+    hops = benchmark_module("slip_law/sliding_planes")._hops
     # plane 1 from frame 3 (held); a one-frame flicker back to 0 at 7 is not a change; plane 2
     # from frame 11
     assert hops([0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 2, 2, 2], 3) == [3, 11]

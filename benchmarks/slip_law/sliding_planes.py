@@ -1,6 +1,6 @@
 """Where MD runs' films slide during their slips, plane by plane, grouped by the slider's mass.
 
-    python benchmarks/slip_law/slip_planes.py RUN… [--window 2] [--psi6]
+    python benchmarks/slip_law/sliding_planes.py RUN… [--window 2] [--psi6]
 
 Each RUN is an analysed run directory with a trajectory (``dump_every`` set: its
 ``trajectory.dcd`` and ``topology.data``, its ``analysis_cycles.csv``).  The film's layers
@@ -132,7 +132,7 @@ def main(argv=None) -> int:
             r = run_planes(run, args.window, args.psi6)
             by_mass[r["mass"]].append(r["slips"])
     except ValueError as exc:
-        print(f"slip_planes: {exc}", file=sys.stderr)
+        print(f"sliding_planes: {exc}", file=sys.stderr)
         return 1
     print("| M (m) | runs | slips | median slip (τ; σ) | planes' shares of the slip, bottom wall "
           "→ top wall | largest share | two parts on different planes | active-plane changes "

@@ -1,0 +1,139 @@
+"""The walls' registry force and the lag of the film's viscous force, read on controls of known
+kind: a registry constant, trailing the wall or weighted by the slip's branch
+(benchmarks/slip_law/registry_spectrum.py --branches), and a viscous force that lags by a
+slip distance (benchmarks/slip_law/viscous_lag_profile.py).  The MD read against them:
+docs/results/slip-law.md, "The registry force on each branch of the slip" and "A viscous
+force that lags by a distance, not a time".
+"""
+import pytest
+
+from filmfriction.analysis.groundtruth.pooled_controls import pooled_runs
+from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
+from filmfriction.analysis.slip_law.slip_law_cycles import MD_NOISE_TIME
+
+QUIET = {"velocity_noise": 0.0, "velocity_correlation": 0.0, "rattle": 0.0}
+STIFF = SCALES["stiff"]
+
+
+def _branch_differences(main, capsys, argv):
+    """The branch table's rows (accelerating − decelerating, first − second half) of each
+    pool: F_k, B, the first harmonic, its phase, the second harmonic."""
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    rows = [r for r in out.splitlines() if r.startswith("| ") and "samples" not in r]
+    cells = [[tuple(map(float, c.split(" ± "))) for c in r.split("|")[3:-1]] for r in rows]
+    return cells
+
+
+def test_a_constant_registry_force_reads_nearly_alike_on_both_branches(benchmark_module,
+                                                                        capsys):
+    # the branch table's ground truth: controls whose registry force is one amplitude and
+    # phase everywhere (20 ε/σ at −0.97 rad, the rung's size at M = 10⁴) read the first
+    # harmonic on the accelerating and the decelerating branch within 2 ε/σ and 0.15 rad of
+    # each other (the controls' spread the MD's differences are read against), the
+    # decelerating branch's phase within 0.1 rad of the truth and its amplitude low (the
+    # smoothing of the force over 5 τ), and the halves of the slips as alike
+    main = benchmark_module("slip_law/registry_spectrum").main
+    cells = _branch_differences(main, capsys, ["--control", "m1e4", "12", "13", "--pools",
+                                               "1", "--window", "5"])
+    acc, dec, branches, first, second, halves = cells
+    for diff in (branches, halves):
+        assert abs(diff[2][0]) < 2.5 and abs(diff[3][0]) < 0.15, diff
+    assert 14.0 < dec[2][0] < 20.0 and abs(dec[3][0] + 0.97) < 0.1, dec
+    with pytest.raises(SystemExit):
+        main(["--control", "klein", "6", "6"])
+    assert "SCALE one of" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main([])
+    assert "RUN_DIR… or --control" in capsys.readouterr().err
+
+
+def test_a_registry_that_trails_the_wall_reads_its_phase_behind_and_ahead_while_speeding_up(
+        benchmark_module, capsys):
+    # ``lagged-registry`` controls (τ_g 5 τ at M = 10⁴) against the same pool with the
+    # registry in step: the film's registry trails the wall by ≈ v·τ_g, so the whole phase
+    # reads ≈ 2π·v̄·τ_g/λ behind −0.97 rad, and by less while the slip speeds up than while it
+    # slows, so the accelerating branch's phase reads further ahead of the decelerating's
+    main = benchmark_module("slip_law/registry_spectrum").main
+    argv = ["--control", "m1e4", "12", "13", "--pools", "1", "--window", "5"]
+    in_step = _branch_differences(main, capsys, argv)
+    trailing = _branch_differences(main, capsys, argv + ["--registry-lag", "5"])
+    assert trailing[1][3][0] < -0.97 - 0.5, trailing[1]
+    assert trailing[2][3][0] > in_step[2][3][0], (trailing[2], in_step[2])
+    with pytest.raises(ValueError, match="registry_lag"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, registry_lag=5.0)
+    with pytest.raises(ValueError, match="registry_lag"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    registry_lag=5.0, lag=10.0)
+
+
+def test_a_registry_weighted_by_the_slips_branch_reads_weaker_and_ahead_while_speeding_up(
+        benchmark_module, capsys):
+    # ``branching-registry`` controls at M = 10⁴ against the same pool with a constant
+    # registry: a first harmonic 0.4 weaker and 1 rad ahead and a second harmonic
+    # (10 ε/σ) twice as strong while the slip speeds up read so on the branch table (the
+    # constant registry's differences within 2.5 ε/σ, 0.15 rad: the test above)
+    main = benchmark_module("slip_law/registry_spectrum").main
+    argv = ["--control", "m1e4", "12", "13", "--pools", "1", "--window", "5"]
+    constant = _branch_differences(main, capsys, argv)
+    branching = _branch_differences(main, capsys, argv + ["--branching", "10", "-1.58", "0.4",
+                                                          "1.0", "1.0"])
+    diff, const = branching[2], constant[2]
+    assert diff[2][0] < const[2][0] - 3.0, (diff, const)          # the first harmonic
+    assert diff[3][0] > const[3][0] + 0.2, (diff, const)          # its phase
+    assert diff[4][0] > 3.0, diff                                 # the second harmonic
+    with pytest.raises(ValueError, match="branching"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, branching=(10.0, 0.0, 0.3, 0.5, 0.5))
+    with pytest.raises(ValueError, match="branching"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    branching=(10.0, 0.0, 0.3, 0.5, 0.5), registry_lag=5.0)
+    with pytest.raises(SystemExit):
+        main(argv + ["--branching", "10", "0", "1.5", "0", "0"])
+    assert "W1 <= 1" in capsys.readouterr().err
+
+
+def test_a_viscous_force_lagging_by_a_distance_reads_as_a_time_lag_of_that_distance_over_v(
+        benchmark_module):
+    # ``distance-lag`` controls (d = 0.3 σ), noise-free, at M = 10⁵ and 10⁴: the lag profile
+    # reads each as a time lag τ̂ of about d over the slips' mean velocity, so τ̂ differs
+    # between the scales as 1/v̄ (a lag in time would read one τ̂ at both)
+    vlp = benchmark_module("slip_law/viscous_lag_profile")
+    lags = [0.0, 2.0, 4.0, 6.0, 8.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0]
+    tau, speed = {}, {}
+    for name in ("stiff", "m1e4"):
+        sc = SCALES[name]
+        rs, vd = pooled_runs("x", 4, 4, share=0.5, scale=sc, noise=QUIET,
+                             corrugation=(20.0, 1.1, -0.97), lag_distance=0.3)
+        fits = vlp.profile(rs, lags, mass=sc.mass, drive_velocity=vd, film_mass=sc.film_mass,
+                           mount_damping=sc.mount_damping, min_window_time=MD_NOISE_TIME,
+                           registry_period=1.1)
+        tau[name] = vlp.crossing(lags, fits)[0]
+        slips = [(r.wall_position[s] - r.wall_position[y], r.time[s] - r.time[y]) for r in rs
+                 for y, s in zip(r.table.yield_index, r.table.stick_index)]
+        speed[name] = sum(d for d, _ in slips) / sum(t for _, t in slips)
+    # (τ̂·v̄ 0.31 and 0.33 σ; τ̂ 20 and 9.5 τ)
+    for name in tau:
+        assert 0.5 * 0.3 < tau[name] * speed[name] < 1.2 * 0.3, (tau, speed)
+    assert tau["stiff"] / tau["m1e4"] == pytest.approx(speed["m1e4"] / speed["stiff"],
+                                                       rel=0.3), (tau, speed)
+    with pytest.raises(ValueError, match="lag_distance"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, lag_distance=0.3)
+    with pytest.raises(ValueError, match="lag_distance"):
+        pooled_runs("x", 3, 2, share=0.5, scale=STIFF, corrugation=(20.0, 1.1, -0.97),
+                    lag_distance=0.3, lag=10.0)
+
+
+def test_the_lag_profiles_new_control_options_refuse_bad_input_before_any_compute(
+        benchmark_module, capsys):
+    main = benchmark_module("slip_law/viscous_lag_profile").main
+    for argv, said in ((["--control", "0.5", "0", "--lag-distance", "-1"], "--lag-distance"),
+                       (["--control", "0.5", "10", "--lag-distance", "0.3"], "TAU 0"),
+                       (["--control", "0.5", "10", "--branching", "8", "0", "0.3", "0.5", "0"],
+                        "--branching"),
+                       (["--control", "0.5", "0", "--branching", "8", "0", "2", "0.5", "0"],
+                        "W1 <= 1"),
+                       (["/nonexistent-run", "--lag-distance", "0.3"], "controls'")):
+        with pytest.raises(SystemExit):
+            main(argv)
+        err = capsys.readouterr().err
+        assert said in err and "Traceback" not in err, (argv, err)
