@@ -33,7 +33,8 @@ from ..slip_law.slip_law_pooled import RunSlips, fit_pooled_ensemble
 from .random_force import LOOP_LAWS, slide
 from .slip_law_controls import Scale, scale_named
 
-__all__ = ["pooled_runs", "pooled_fits", "yield_loop", "STATIC_SPREAD", "SLIP_ENDS"]
+__all__ = ["pooled_runs", "pooled_fits", "yield_loop", "branch_weights", "STATIC_SPREAD",
+           "SLIP_ENDS"]
 
 #: The runs' yield forces spread uniformly within ± this share of the scale's (the MD's six
 #: K = 8 runs: 30–60 ε/σ about 45).
@@ -63,6 +64,21 @@ def yield_loop(law: str, w, d, laws=LOOP_LAWS) -> tuple[str, float, float]:
     if law not in laws or not (0 <= w <= 1 and math.isfinite(d) and d > 0):
         raise ValueError(f"LAW {' or '.join(laws)}, W in [0, 1], D > 0")
     return law, w, d
+
+
+def branch_weights(values) -> tuple[float, ...]:
+    """A branch-weighted registry as the benchmarks' ``--branching DF2 PHI2 W1 W2 DPHI``
+    gives it, checked: (ΔF₂, φ₂, w₁, w₂, δφ) finite, with no amplitude below 0 (ΔF₂ >= 0,
+    w₁ <= 1, w₂ >= -1); ValueError otherwise.
+
+    >>> branch_weights([10, -1.58, 0.3, 0.7, 0.6])
+    (10.0, -1.58, 0.3, 0.7, 0.6)
+    """
+    b = tuple(float(c) for c in values)
+    if len(b) != 5 or not (all(map(math.isfinite, b)) and b[0] >= 0 and b[2] <= 1
+                           and b[3] >= -1):
+        raise ValueError("five values, finite, DF2 >= 0, W1 <= 1, W2 >= -1")
+    return b
 
 
 def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = None,

@@ -101,7 +101,7 @@ __all__ = ["slide", "LAWS", "LOOP_LAWS", "NOISE_FREE"]
 #:   step, dt/substeps: the step must resolve the trail's relaxation);
 #: * ``branching-registry`` (F_k, B, ΔF₁, λ, φ₁, ΔF₂, φ₂, w₁, w₂, δφ): sign(v)·F_k + B·v
 #:   + ΔF₁·(1 − w₁·r)·sin(θ + φ₁ + δφ·r) + ΔF₂·(1 + w₂·r)·sin(2θ + φ₂), θ = 2π·x/λ,
-#:   r = |v|/ψ with ψ the fastest |v| of the slip so far (0 at each yield): r = 1 while the
+#:   r = |v| over the fastest |v| of the slip so far (0 at each yield): r = 1 while the
 #:   slip speeds up and falls to 0 as it slows down, so a registry force of two harmonics
 #:   whose amplitudes and phase differ between the accelerating and the decelerating branch
 #:   of the slip at one velocity (w₁ > 0: the first harmonic weaker while accelerating;
@@ -128,6 +128,17 @@ LOOP_LAWS = ("melting", "slip-weakening", "maxwell")
 _CODE = {name: k for k, name in enumerate(LAWS)}
 #: Where the branch-weighted laws keep ΔF₁, ΔF₂, w₁ and w₂ among their parameters.
 _BRANCH_WEIGHTS = {"branching-registry": (2, 5, 7, 8), "distance-lag-branching": (2, 6, 8, 9)}
+
+
+@njit(cache=True)
+def _branched_registry(x, v, top, df1, lam, phi1, df2, phi2, w1, w2, dphi):
+    """The branch-weighted registry force at x (``branching-registry``): r = |v| over the
+    slip's fastest |v| so far (``top``), 1 while the slip speeds up."""
+    fastest = max(top, abs(v))
+    r = abs(v) / fastest if fastest > 0.0 else 1.0
+    theta = 2.0 * math.pi * x / lam
+    return (df1 * (1.0 - w1 * r) * math.sin(theta + phi1 + dphi * r)
+            + df2 * (1.0 + w2 * r) * math.sin(2.0 * theta + phi2))
 
 
 @njit(cache=True)
@@ -162,22 +173,15 @@ def _friction(code, p, v, psi, x, x_yield, top):
         return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
                 + p[2] * math.sin(2.0 * math.pi * (x - psi) / p[3] + p[4]))
     if code == 11:
-        top = max(psi, abs(v))
-        r = abs(v) / top if top > 0.0 else 1.0
-        theta = 2.0 * math.pi * x / p[3]
         return ((p[0] if v >= 0.0 else -p[0]) + p[1] * v
-                + p[2] * (1.0 - p[7] * r) * math.sin(theta + p[4] + p[9] * r)
-                + p[5] * (1.0 + p[8] * r) * math.sin(2.0 * theta + p[6]))
+                + _branched_registry(x, v, top, p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9]))
     if code == 12:
         return ((p[0] if v >= 0.0 else -p[0]) + psi
                 + p[2] * math.sin(2.0 * math.pi * x / p[3] + p[4]))
     if code == 13:
-        fastest = max(top, abs(v))
-        r = abs(v) / fastest if fastest > 0.0 else 1.0
-        theta = 2.0 * math.pi * x / p[3]
         return ((p[0] if v >= 0.0 else -p[0]) + psi
-                + p[2] * (1.0 - p[8] * r) * math.sin(theta + p[4] + p[10] * r)
-                + p[6] * (1.0 + p[9] * r) * math.sin(2.0 * theta + p[7]))
+                + _branched_registry(x, v, top, p[2], p[3], p[4], p[6], p[7], p[8], p[9],
+                                     p[10]))
     return p[1] * math.asinh(v / (2.0 * p[4]) * math.exp((p[0] + p[2] * psi) / p[1]))
 
 
@@ -251,7 +255,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                         ns += 1
                     else:
                         v = vn
-                        if code == 5 or code == 11 or (code == 9 and p[8] == 1.0):
+                        if code == 5 or (code == 9 and p[8] == 1.0):
                             psi = max(psi, abs(v))
                         top = max(top, abs(v))     # the slip's fastest |v| so far
                 else:
@@ -262,8 +266,7 @@ def _run(code, p, mass, k, vd, xd0, gamma, static, start_v, stop_v, backward, ar
                     if force >= thr:
                         slipping, v = True, start_v
                         x_yield = x
-                        if (code == 4 or code == 5 or code == 7 or code == 8 or code == 9
-                                or code == 10 or code == 11 or code == 12 or code == 13):
+                        if code == 4 or code == 5 or code >= 7:
                             psi = 0.0       # the slip's state starts at each yield
                         elif code == 6:
                             psi = p[2]      # the stress the film still holds at the yield

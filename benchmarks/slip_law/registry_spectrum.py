@@ -25,15 +25,15 @@ over the runs: a registry force that depends on the film's state reads different
 ``--control SCALE RUNS SLIPS``: that table for ``--pools`` pools of RUNS random-force runs of
 SLIPS slips at a scale of the controls (the Coulomb + viscous mix of share 0.5, its
 viscous force lagging by ``--lag`` τ, carrying a registry force of constant amplitude,
-``--corrugation`` DF·sin(2π·x/L + PHI), by default 20·sin(2π·x/1.1 − 0.97), at the scale's noise beside the registry, re-sticking on a recoil
-at the drive's velocity): what the estimator reads where the truth is one amplitude and
+``--corrugation`` DF·sin(2π·x/L + PHI), by default 20·sin(2π·x/1.1 − 0.97), at the scale's
+noise beside the registry, re-sticking on a recoil at the drive's velocity): what the estimator reads where the truth is one amplitude and
 phase on every part; ``--registry-lag TAU_G``: that force trailing the wall's position,
 relaxing over TAU_G (``lagged-registry`` of
 :mod:`~filmfriction.analysis.groundtruth.random_force`); ``--branching DF2 PHI2 W1 W2 DPHI``:
 with a second harmonic DF2·sin(4π·x/1.1 + PHI2), the first harmonic's amplitude times
 1 − W1·r and its phase plus DPHI·r, the second's times 1 + W2·r, r = |v|/(the slip's fastest
-|v| so far): 1 while the slip speeds up, falling to 0 as it slows (``branching-registry``).  The smoothing attenuates the registry's force where a period passes
-in less than a few windows: at a light slider take a window of a fifth of that passage.
+|v| so far): 1 while the slip speeds up, falling to 0 as it slows (``branching-registry``).
+The smoothing attenuates the registry's force where a period passes in less than a few windows: at a light slider take a window of a fifth of that passage.
 """
 from __future__ import annotations
 
@@ -128,12 +128,14 @@ def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: f
     sc = replace(sc, mix={**sc.mix, "stop_velocity": -sc.drive_velocity})
     kw = dict(mass=sc.mass, mount_damping=sc.mount_damping, drive_velocity=sc.drive_velocity)
     df, lam, phi = corrugation
-    print(f"controls at the {scale} scale: share 0.5, the registry force "
-          f"{df:g}·sin(2π·x/{lam:g} {'+' if phi >= 0 else '−'} {abs(phi):g})" + ("" if registry_lag is None else f" trailing the wall over "
-                       f"{registry_lag:g} τ") + ("" if branching is None else
-                                                    f", branching (ΔF₂, φ₂, w₁, w₂, δφ) = "
-                                                    f"{tuple(branching)}") + f", lag {lag:g} τ, {runs} runs × {slips} slips, "
-          f"window {window:g} τ")
+    what = (f"the registry force {df:g}·sin(2π·x/{lam:g} {'+' if phi >= 0 else '−'} "
+            f"{abs(phi):g})")
+    if registry_lag is not None:
+        what += f" trailing the wall over {registry_lag:g} τ"
+    if branching is not None:
+        what += f", branching (ΔF₂, φ₂, w₁, w₂, δφ) = {tuple(branching)}"
+    print(f"controls at the {scale} scale: share 0.5, {what}, lag {lag:g} τ, {runs} runs × "
+          f"{slips} slips, window {window:g} τ")
     for seed in range(pools):
         rs, _ = pooled_runs("x", runs, slips, share=0.5, scale=sc, noise=sc.registry_noise,
                             corrugation=tuple(corrugation), seed=(seed, 0),
@@ -142,11 +144,6 @@ def control(scale: str, runs: int, slips: int, lag: float, pools: int, window: f
         print(f"pool {seed + 1}:\n" + branch_table(
             branch_samples(rs, kw, window, lam), len(rs)))
     return 0
-
-
-def _branching_ok(b) -> bool:
-    """(ΔF₂, φ₂, w₁, w₂, δφ) finite, with no amplitude below 0."""
-    return all(map(math.isfinite, b)) and b[0] >= 0 and b[2] <= 1 and b[3] >= -1
 
 
 def main(argv=None) -> int:
@@ -190,10 +187,14 @@ def main(argv=None) -> int:
         if args.registry_lag is not None and (args.lag or not (
                 math.isfinite(args.registry_lag) and args.registry_lag > 0)):
             ap.error(f"--registry-lag {args.registry_lag}: a time > 0 (τ), without --lag")
-        if args.branching is not None and (args.lag or args.registry_lag is not None
-                                           or not _branching_ok(args.branching)):
-            ap.error(f"--branching {' '.join(map(str, args.branching))}: finite, DF2 >= 0, "
-                     "W1 <= 1, W2 >= -1, without --lag or --registry-lag")
+        if args.branching is not None:
+            from filmfriction.analysis.groundtruth.pooled_controls import branch_weights
+            try:
+                branch_weights(args.branching)
+            except ValueError as exc:
+                ap.error(f"--branching {' '.join(map(str, args.branching))}: {exc}")
+            if args.lag or args.registry_lag is not None:
+                ap.error("--branching: without --lag or --registry-lag")
         if not (all(map(math.isfinite, args.corrugation)) and args.corrugation[0] >= 0
                 and args.corrugation[1] > 0):
             ap.error(f"--corrugation {' '.join(map(str, args.corrugation))}: finite, DF >= 0, "

@@ -60,7 +60,8 @@ from pathlib import Path
 
 import numpy as np
 
-from filmfriction.analysis.groundtruth.pooled_controls import SLIP_ENDS, pooled_runs, yield_loop
+from filmfriction.analysis.groundtruth.pooled_controls import (SLIP_ENDS, branch_weights,
+                                                                pooled_runs, yield_loop)
 from filmfriction.analysis.groundtruth.random_force import NOISE_FREE
 from filmfriction.analysis.groundtruth.film_noise import scaled
 from filmfriction.analysis.groundtruth.slip_law_controls import SCALES
@@ -156,7 +157,8 @@ def control(args) -> int:
                              weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
                              corrugation=tuple(args.corrugation), seed=(0, k),
                              registry_lag=args.registry_lag,
-                             branching=None if args.branching is None else tuple(args.branching),
+                             branching=(None if args.branching is None
+                                        else branch_weights(args.branching)),
                              lag_distance=args.lag_distance)
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
@@ -254,12 +256,13 @@ def main(argv=None) -> int:
                                                 and a.registry_lag > 0) or tau > 0 or a.loop):
             ap.error(f"--registry-lag {a.registry_lag}: a time > 0 (τ), with TAU 0 and no "
                      "--loop")
-        b = a.branching
-        if b is not None and not (all(map(math.isfinite, b)) and b[0] >= 0 and b[2] <= 1
-                                  and b[3] >= -1 and tau == 0 and not a.loop
-                                  and a.registry_lag is None):
-            ap.error(f"--branching {' '.join(map(str, b))}: finite, DF2 >= 0, W1 <= 1, "
-                     "W2 >= -1; with TAU 0, no --loop, no --registry-lag")
+        if a.branching is not None:
+            try:
+                branch_weights(a.branching)
+            except ValueError as exc:
+                ap.error(f"--branching {' '.join(map(str, a.branching))}: {exc}")
+            if tau > 0 or a.loop or a.registry_lag is not None:
+                ap.error("--branching: with TAU 0, no --loop, no --registry-lag")
         d = a.lag_distance
         if d is not None and not (math.isfinite(d) and d > 0 and tau == 0 and not a.loop
                                   and a.registry_lag is None):
