@@ -2,9 +2,9 @@
 
 ``preview``, ``standard`` and ``reference`` change only numerical knobs (time
 step, run length, trace interval, lateral box) and never the physics of the
-scene: when the box grows, the spring constant and the wall mass grow with
-the area so that the drive per area, hence the slip distance and the period,
-stay the same; when the time step changes, step counts are rescaled so that
+scene: when the box grows, the spring constant, the wall mass and the
+start-up preload grow with the area so that the drive per area, hence the slip
+distance and the period, stay the same; when the time step changes, step counts are rescaled so that
 the simulated times stay the same.  The cutoff is part of the model (the film
 yields at a different stress without the LJ attraction), so no preset
 changes it.
@@ -44,7 +44,8 @@ class Fidelity:
     trace_every_tau : float or None
         Trace interval [tau]; None keeps the scene's.
     area_factor : tuple of int
-        Multiplies cells_x and cells_y; K and M scale with the area.
+        Multiplies cells_x and cells_y; K, M and the preload force scale with
+        the area.
     """
 
     name: str
@@ -114,6 +115,8 @@ def preset(name: str, base: dict | None = None) -> dict:
 
     steps("slide_steps", f.slide_factor)
     steps("equilibrate_steps", f.equilibrate_factor)
+    if p["preload_steps"]:
+        steps("preload_steps", 1.0)   # the ramp's time, not its steps, is the scene's
     if f.trace_every_tau is not None:
         every = max(1, int(round(f.trace_every_tau / dt)))
         if every != p["trace_every"]:
@@ -127,4 +130,6 @@ def preset(name: str, base: dict | None = None) -> dict:
         out["cells_x"], out["cells_y"] = p["cells_x"] * ax, p["cells_y"] * ay
         out["spring_constant"] = p["spring_constant"] * ax * ay
         out["wall_mass"] = p["wall_mass"] * ax * ay
+        if p["preload_force"] > 0.0:   # a force on the whole wall: per area it is the scene's
+            out["preload_force"] = p["preload_force"] * ax * ay
     return out

@@ -93,6 +93,19 @@ def test_presets_are_valid_for_every_scene(name):
             f.slide_factor * base["slide_steps"] * base["timestep"], rel=1e-4)
 
 
+def test_reference_preset_keeps_the_drive_per_area_of_a_preloaded_scene():
+    # sfb-thick-stiff loads its spring by a ramp at start-up: on 4x the area the ramp's
+    # force per area, like K and M per area, must stay the scene's, and its time too
+    base = load("sfb-thick-stiff").parameters
+    resolved = load("sfb-thick-stiff", fidelity.preset("reference", base)).parameters
+    area = resolved["cells_x"] * resolved["cells_y"] / (base["cells_x"] * base["cells_y"])
+    assert area == 4
+    for key in ("spring_constant", "wall_mass", "preload_force"):
+        assert resolved[key] == pytest.approx(area * base[key])
+    assert resolved["preload_steps"] * resolved["timestep"] == pytest.approx(
+        base["preload_steps"] * base["timestep"])
+
+
 def test_standard_preset_is_the_default_scene():
     assert fidelity.preset("standard") == {}
     assert fidelity.preset("standard", load("stick-slip").parameters) == {}
