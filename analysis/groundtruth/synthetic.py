@@ -391,19 +391,22 @@ def layered_film(directory, *, layers=3, nx=12, ny=7, spacing=1.1, wall_planes=2
     return top, traj
 
 
-def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0):
+def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0, scale=1.0):
     """A run directory in the MD runner's format (LJ units), from a Klein-type
     spring-block trace: ``trace.csv`` with every contract column (the energy
     ledger closes exactly), ``run.json`` and, optionally, a trajectory whose
-    steps match the trace's ``step`` column.  Returns the directory."""
+    steps match the trace's ``step`` column.  ``scale``: a contact ``scale`` times
+    larger of the same film (area, spring, mass, damping and forces times ``scale``:
+    the same motion, the same forces per area; the noise stays the trace's).
+    Returns the directory."""
     import json
     from pathlib import Path
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    k, m, b, v = 8.0, 500.0, 40.0, 0.01
+    k, m, b, v = 8.0 * scale, 500.0 * scale, 40.0 * scale, 0.01
     tr = klein_trace(spring_constant=k, mass=m, damping=b, drive_velocity=v,
-                     static_force=3.0, backward_force=1.0, cycles=4, dt=dt_trace,
+                     static_force=3.0 * scale, backward_force=1.0 * scale, cycles=4, dt=dt_trace,
                      noise=0.01, seed=seed)
     t = tr["time"]
     n = t.size
@@ -424,7 +427,7 @@ def run_directory(directory, *, layers=3, trajectory=True, dt_trace=0.5, seed=0)
             "potential_energy": np.full(n, -100.0), "kinetic_energy": kinetic,
             "spring_energy": spring}
     write_csv(directory / TRACE_FILE, cols)
-    area = 12 * 1.1 * 7 * np.sqrt(3) * 1.1
+    area = 12 * 1.1 * 7 * np.sqrt(3) * 1.1 * scale
     # run.json as the runner writes it: the film's thickness comes from the gap column
     run = {"status": "done",
            "scene": {"name": "synthetic", "parameters": {"film_layers": layers,
