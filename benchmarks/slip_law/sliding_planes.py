@@ -1,6 +1,6 @@
 """Where MD runs' films slide during their slips, plane by plane, grouped by the slider's mass.
 
-    python benchmarks/slip_law/sliding_planes.py RUN… [--window 2] [--psi6]
+    python benchmarks/slip_law/sliding_planes.py RUN… [--window 2] [--psi6] [--hop-force]
 
 Each RUN is an analysed run directory with a trajectory (``dump_every`` set: its
 ``trajectory.dcd`` and ``topology.data``, its ``analysis_cycles.csv``).  The film's layers
@@ -22,7 +22,13 @@ slip and per σ slid, and the median distance the wall slides between two change
 sliding; λ = 1.1 σ is the walls' registry period along the slide).  ``--psi6``: besides, each layer's in-plane order ψ6
 (:class:`~filmfriction.analysis.structure.hexatic.HexaticOrder`) averaged over the 20 frames
 before each slip and over its accelerating and decelerating parts, per mass its lowest and
-highest layer (a film that shear-melts in its slips loses it there).
+highest layer (a film that shear-melts in its slips loses it there).  ``--hop-force``: the
+film's force on the wall (its equation of motion, the force and the wall's motion smoothed
+over the window) at the changes of plane, per mass
+(:func:`~filmfriction.analysis.structure.plane_hops.hop_force`: the bump within 0.1 σ of a
+change less its level 0.3–0.55 σ away, after a smooth law and the walls' registry fitted on
+all slipping samples; its error by the bootstrap over the slips; the same at uniformly drawn
+positions and at the changes moved by whole registry periods).
 """
 from __future__ import annotations
 
@@ -36,32 +42,21 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import savgol_filter
 
+from filmfriction.analysis.slip_law.slip_law import film_force
+from filmfriction.analysis.structure.plane_hops import hop_force, plane_changes
 from filmfriction.analysis.structure.slip_planes import LayerDisplacement, active_plane
 from filmfriction.analysis.structure.trajectory_reader import (film_layers, frame_steps,
                                                                select_types)
 from filmfriction.md_inputs.contract import BOTTOM_WALL_TYPES, FILM_TYPES, TOP_WALL_TYPES
 
 
-def _hops(plane, hold: int) -> list[int]:
-    """Where ``plane`` changes along the frames: the first frame of each new plane that holds
-    ``hold`` frames."""
-    hops, current, run_of, last = [], int(plane[0]), 0, None
-    for i, p in enumerate(plane[1:], 1):
-        if p == current:
-            run_of, last = 0, None
-            continue
-        run_of = run_of + 1 if p == last else 1
-        last = p
-        if run_of >= hold:
-            hops.append(i - hold + 1)
-            current, run_of, last = int(p), 0, None
-    return hops
-
-
-def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
+def run_planes(run: Path, window: float, psi6: bool = False, force: bool = False) -> dict:
     """One run's slips: each one's plane shares (whole, accelerating, decelerating part),
-    its active-plane changes, duration and distance; the run's mass."""
+    its active-plane changes, duration and distance, and its slipping samples for the force
+    at the changes (with ``force``: wall position, film force and velocity smoothed over the
+    window, the changes' wall positions); the run's mass and registry period."""
     analysis = json.loads((run / "analysis.json").read_text())
+    params = json.loads((run / "run.json").read_text())["trace_parameters"] if force else {}
     u, film, prof = film_layers(run / "topology.data", run / "trajectory.dcd", FILM_TYPES,
                                 step=10)
     disp = LayerDisplacement(film, select_types(u, BOTTOM_WALL_TYPES),
@@ -84,6 +79,14 @@ def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
                - np.interp(steps[0], trace["step"], trace["time"]))
     plane, _ = active_plane(x, dt, window)
     w = max(3, int(round(window / dt)) | 1)
+    t = trace["time"]
+    wt = max(5, int(round(window / (t[1] - t[0]))) | 1)     # the window in trace samples
+    if force:
+        xw = trace["wall_position"]
+        vw = savgol_filter(xw, wt, 2, deriv=1, delta=t[1] - t[0])
+        fw = film_force(t, savgol_filter(trace["spring_force"], wt, 2), vw,
+                        mass=params["mass"], drive_velocity=params["drive_velocity"],
+                        mount_damping=params.get("mount_damping") or 0.0)
     slow = savgol_filter(walls[:, 1], min(5 * w | 1, x.shape[0] - (1 - x.shape[0] % 2)), 2,
                          deriv=1, delta=dt)
     out = []
@@ -104,11 +107,15 @@ def run_planes(run: Path, window: float, psi6: bool = False) -> dict:
                                  ("dec_psi6", (k, b + 1))):
                 parts[name] = order[i:j].mean(axis=0) if j > i else None
         moving = a + np.flatnonzero(slow[a:b] > 0.2 * slow[a:b].max())
-        hops = moving[_hops(plane[moving], w)] if moving.size else np.array([], int)
-        out.append({**parts, "changes": len(hops),
+        hops = moving[plane_changes(plane[moving], w)] if moving.size else np.array([], int)
+        k_in = np.arange(y + wt // 2, s - wt // 2)
+        samples = (xw[k_in], fw[k_in], vw[k_in], np.interp(steps[hops], trace["step"], xw)) \
+            if force and k_in.size >= 5 else None
+        out.append({**parts, "changes": len(hops), "force": samples,
                     "between": np.diff(x[hops, -1]).tolist(),
                     "distance": float(x[b, -1] - x[a, -1]), "duration": float((b - a) * dt)})
-    return {"mass": float(analysis["source"]["parameters"]["mass"]), "slips": out}
+    return {"mass": float(analysis["source"]["parameters"]["mass"]), "slips": out,
+            "registry_period": params.get("registry_period")}
 
 
 def main(argv=None) -> int:
@@ -117,6 +124,8 @@ def main(argv=None) -> int:
     ap.add_argument("--window", type=float, default=2.0,
                     help="the window of the planes' velocities (τ)")
     ap.add_argument("--psi6", action="store_true", help="each layer's ψ6 before and in the slips")
+    ap.add_argument("--hop-force", action="store_true",
+                    help="the film force's bump at the changes of plane, against nulls")
     args = ap.parse_args(argv)
     if not (math.isfinite(args.window) and args.window > 0):
         ap.error(f"--window {args.window!r}: > 0, finite (τ)")
@@ -126,11 +135,12 @@ def main(argv=None) -> int:
     if missing:
         ap.error("RUN without an analysis, a trace or a trajectory (run with dump_every "
                  f"set): {', '.join(missing)}")
-    by_mass = defaultdict(list)
+    by_mass, period = defaultdict(list), {}
     try:
         for run in args.runs:
-            r = run_planes(run, args.window, args.psi6)
+            r = run_planes(run, args.window, args.psi6, args.hop_force)
             by_mass[r["mass"]].append(r["slips"])
+            period[r["mass"]] = r["registry_period"]
     except ValueError as exc:
         print(f"sliding_planes: {exc}", file=sys.stderr)
         return 1
@@ -169,6 +179,19 @@ def main(argv=None) -> int:
                 cells.append(f"{q.mean(axis=0).min():.3f}, {q.mean(axis=0).max():.3f}"
                              if q.size else "–")
             print(f"| {mass:g} | " + " | ".join(cells) + " |")
+    if args.hop_force:
+        print("\n| M (m) | slips, changes | bump at the changes (ε/σ) | random positions: mean "
+              "(sd); share ≥ | phase-matched positions: mean (sd); share ≥ |\n|---|---|---|---|---|")
+        for mass in sorted(by_mass):
+            slips = [s["force"] for run in by_mass[mass] for s in run if s["force"] is not None]
+            if len(slips) < 2 or not any(len(s[3]) for s in slips):
+                print(f"| {mass:g} | {len(slips)}, {sum(len(s[3]) for s in slips)} | – | – | – |")
+                continue
+            h = hop_force(slips, registry_period=period[mass])
+            nulls = [f"{n.mean:+.2f} ({n.sd:.2f}); {n.share_at_or_above:.3f}" if n else "–"
+                     for n in (h.random, h.phase_matched)]
+            print(f"| {mass:g} | {h.slips}, {h.changes} | {h.bump:+.2f} ± {h.stderr:.2f} | "
+                  + " | ".join(nulls) + " |")
     return 0
 
 

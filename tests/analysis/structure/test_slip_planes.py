@@ -41,8 +41,10 @@ def _run(tmp_path, mass, melt_frames=()):
     layered_film(tmp_path, layers=3, frames=40, nsavc=100, thermal=0.02,
                  plane_velocity=VELOCITY, melt_frames=melt_frames)
     steps = 50 * np.arange(79)
-    (tmp_path / "trace.csv").write_text("time,step\n" + "\n".join(
-        f"{0.005 * s:g},{s}" for s in steps) + "\n")
+    (tmp_path / "trace.csv").write_text("time,step,wall_position,spring_force\n" + "\n".join(
+        f"{0.005 * s:g},{s},{0.005 * s:g},1.0" for s in steps) + "\n")
+    (tmp_path / "run.json").write_text(json.dumps({"trace_parameters": {
+        "mass": mass, "drive_velocity": 1.0, "mount_damping": 0.0, "registry_period": 1.1}}))
     (tmp_path / "analysis_cycles.csv").write_text("yield_index,stick_index\n2,70\n")
     (tmp_path / "analysis.json").write_text(json.dumps(
         {"source": {"parameters": {"mass": mass}}}))
@@ -64,6 +66,11 @@ def test_the_slips_planes_grouped_by_mass(tmp_path, benchmark_module, capsys):
         assert float(cells[5].split(" ± ")[0]) == pytest.approx(0.8, abs=0.02)
         assert cells[7].startswith("0.00;")        # one plane throughout: no change
         assert cells[8] == "–"                     # and no slide between changes
+    # the force at the changes: one plane throughout, no change to read it at
+    assert main([str(a), str(b), "--hop-force"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    rows = out[out.index(next(r for r in out if "bump at the changes" in r)) + 2:]
+    assert [r.split("|")[2].strip() for r in rows] == ["1, 0", "1, 0"]
     with pytest.raises(SystemExit):
         main([str(tmp_path)])
     assert "without an analysis" in capsys.readouterr().err
@@ -85,10 +92,3 @@ def test_the_slips_in_plane_order_by_mass(tmp_path, benchmark_module, capsys):
     for cell in melted[1:]:
         assert max(map(float, cell.split(", "))) < 0.5, melted
 
-
-def test_a_change_of_plane_counts_once_the_new_plane_holds(benchmark_module):
-    hops = benchmark_module("slip_law/sliding_planes")._hops
-    # plane 1 from frame 3 (held); a one-frame flicker back to 0 at 7 is not a change; plane 2
-    # from frame 11
-    assert hops([0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 2, 2, 2], 3) == [3, 11]
-    assert hops([0, 1, 0, 1, 0, 1], 2) == []
