@@ -148,7 +148,7 @@ def _bingham_reading(rows) -> str:
                  "each term at about 4 σ (ten runs read `inconclusive`): a "
                  "kinetic force about half the film's mean force beside a viscous term ≈ 17 "
                  "times a bulk film's, and a viscous force that lags the slip by ≈ 22 τ (a lag "
-                 "absent at M = 10³, resolved at 3×10³ and 10⁴ against controls of their "
+                 "absent at M = 10³ and 2×10³, resolved at 3×10³ and 10⁴ against controls of their "
                  "scales: no relaxation time of the film; at all three it reads as one "
                  "lag in slide of ≈ 0.25 σ, or one share of the slip's own time), with a yield-loop step left (4 σ) that this "
                  "lag and the walls' registry force, weaker while a slip speeds up than "
