@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from filmfriction.analysis.calibration.slip_law_runs import pooled_slip_law, to_document
+from filmfriction.analysis.files.cycles_csv import read_cycles_csv
 
 
 def _groups(items: list[str]) -> dict[str, list[Path]]:
@@ -61,11 +62,9 @@ def run_row(run: Path) -> dict:
     rj = json.loads((run / "run.json").read_text())
     aj = json.loads((run / "analysis.json").read_text())
     area = rj["trace_parameters"]["area"]
-    rows = (run / aj["cycles_csv"]).read_text().splitlines() if aj.get("cycles_csv") else []
-    first = None
-    if len(rows) > 1:
-        head = rows[0].split(",")
-        first = float(rows[1].split(",")[head.index("static_force")])
+    yields = read_cycles_csv(run / aj["cycles_csv"]).get("static_force", []) \
+        if aj.get("cycles_csv") else []
+    first = float(yields[0]) if len(yields) else None
     later = aj.get("slips", {}).get("static_force", {}).get("mean")
     change = aj.get("film_state_change") or {}
     law = aj.get("slip_law", {})
