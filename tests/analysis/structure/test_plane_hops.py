@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.signal import lfilter
 
 from filmfriction.analysis.structure.plane_hops import hop_force, plane_changes
 
@@ -35,7 +36,7 @@ def _slips(rng, *, step=0.0, registry_spike=0.0, locked=False, n=30, noise=3.0):
 
 def test_a_force_that_steps_at_the_changes_reads_its_step_beyond_both_nulls():
     r = hop_force(_slips(np.random.default_rng(1), step=6.0), registry_period=LAMBDA,
-                  draws=100, resamples=100)
+                  draws=100)
     assert r.changes == 120 and r.slips == 30
     assert r.bump == pytest.approx(6.0, abs=3 * r.stderr) and r.stderr < 1.0
     assert r.random.share_at_or_above == 0.0 and r.phase_matched.share_at_or_above == 0.0
@@ -45,8 +46,7 @@ def test_a_force_that_steps_at_the_changes_reads_its_step_beyond_both_nulls():
 
 
 def test_no_step_at_the_changes_reads_none():
-    r = hop_force(_slips(np.random.default_rng(2)), registry_period=LAMBDA, draws=100,
-                  resamples=100)
+    r = hop_force(_slips(np.random.default_rng(2)), registry_period=LAMBDA, draws=100)
     assert abs(r.bump) < 3 * r.stderr
     assert r.random.share_at_or_above > 0.02 and r.phase_matched.share_at_or_above > 0.02
 
@@ -57,7 +57,7 @@ def test_a_registry_force_locked_with_the_changes_reads_in_the_phase_matched_nul
     # of the same phase without a change read it too (the two harmonics take most of the
     # peak; what they leave is the bump)
     r = hop_force(_slips(np.random.default_rng(3), registry_spike=6.0, locked=True),
-                  registry_period=LAMBDA, draws=100, resamples=100)
+                  registry_period=LAMBDA, draws=100)
     assert r.bump > 5 * r.stderr and r.random.share_at_or_above < 0.01
     assert r.phase_matched.mean == pytest.approx(r.bump, abs=3 * r.phase_matched.sd)
     assert r.phase_matched.share_at_or_above > 0.05
@@ -74,3 +74,28 @@ def test_refusals_and_plane_changes():
     # from frame 11
     assert plane_changes([0, 0, 0, 1, 1, 1, 1, 0, 1, 1, 1, 2, 2, 2, 2], 3) == [3, 11]
     assert plane_changes([0, 1, 0, 1, 0, 1], 2) == []
+
+
+def test_the_bumps_error_covers_the_true_step_at_the_nominal_rate():
+    # 150 realisations of 12 slips whose force steps by 4 at each change, the noise
+    # correlated within a slip (AR(1), 0.9 a sample) and an offset per slip: the
+    # jackknife's ± 1 and ± 1.96 errors cover the step in ≈ 68 % and 95 % of them
+    # (binomial sd 3.8 % and 1.8 % at 150); no bias beyond a third of an error
+    z = []
+    for k in range(150):
+        rng = np.random.default_rng(500 + k)
+        slips = []
+        for _ in range(12):
+            x = np.linspace(0.0, 6.0, 400)
+            v = 0.3 * np.sin(np.pi * x / 6.0)
+            hops = np.sort(rng.uniform(0.6, 5.4, 4))
+            e = lfilter([np.sqrt(1 - 0.81)], [1.0, -0.9], rng.normal(0.0, 3.0, x.size))
+            f = 20 + 40 * v + 8 * np.sin(2 * np.pi * x / LAMBDA) + e + rng.normal(0.0, 2.0)
+            f += 4.0 * (np.abs(x[:, None] - hops).min(axis=1) < 0.1)
+            slips.append((x, f, v, hops))
+        r = hop_force(slips, registry_period=LAMBDA, draws=2, seed=k)
+        z.append((r.bump - 4.0) / r.stderr)
+    z = np.asarray(z)
+    assert 0.57 <= np.mean(np.abs(z) < 1.0) <= 0.79
+    assert 0.90 <= np.mean(np.abs(z) < 1.96) <= 0.99
+    assert abs(z.mean()) < 0.3
