@@ -53,7 +53,8 @@ from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
 from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE,
-                         M3E3_NOISE, M3E3_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE,
+                         K16M3E3_REGISTRY_NOISE, M3E3_NOISE, M3E3_REGISTRY_NOISE, MD_NOISE,
+                         STIFF_NOISE,
                          STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
@@ -196,6 +197,10 @@ M1E4_STOP = 0.011
 #: M = 3×10³ (V = 0.0144 σ/τ, γM = 5.88 m/τ; yields ≈ 46 (34–60), re-sticks ≈ 20 (14–26)
 #: ε/σ, slips of 65 τ (46–120) at ≈ 0.061 σ/τ; F̄ 33.5 ε/σ: the rung's eight runs, 10–90 %),
 #: the rung between, as these, with its own noise (:data:`~.film_noise.M3E3_NOISE`).
+#: ``k16m3e3``: the M = 3×10³ slider on a spring twice as stiff, K = 16 (V = 0.0102 σ/τ,
+#: γM = 8.31 m/τ; yields ≈ 52 (36–61), re-sticks ≈ 14 (7–21) ε/σ, slips of 49 τ (34–87) at
+#: ≈ 0.058 σ/τ; F̄ 33.3 ε/σ: that rung's eight runs, 10–90 %), its noise beside the registry
+#: calibrated on them (:data:`~.film_noise.K16M3E3_REGISTRY_NOISE`), alone the K = 8 rung's.
 LIGHT_B = {m: 2.0 * math.sqrt(8.0 * m) for m in (1e2, 1e3, 3e3)}
 #: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
 #: (336 atoms, 1 m each), and of the Klein-similar scene's (224).
@@ -203,12 +208,14 @@ THICK_FILM_MASS, KLEIN_FILM_MASS = 336.0, 224.0
 
 
 def _light_scale(name, mass, velocity, damping, static, backward, force, slip_velocity,
-                 armed, period, noise=None, registry_noise=None) -> Scale:
+                 armed, period, noise=None, registry_noise=None,
+                 spring_constant=8.0) -> Scale:
     return Scale(
-        name, 8.0, mass, 0.25, static, velocity, noise or LIGHT_NOISE[mass],
+        name, spring_constant, mass, 0.25, static, velocity, noise or LIGHT_NOISE[mass],
         laws={"coulomb": dict(law="linear", parameters=(force - 8.0, 0.0),
                               armed_below=force - 8.0, initial_force=backward, period=period),
-              "viscous": dict(law="linear", parameters=(0.0, LIGHT_B[mass]),
+              "viscous": dict(law="linear",
+                              parameters=(0.0, 2.0 * math.sqrt(spring_constant * mass)),
                               backward_force=backward, stop_velocity=-math.inf,
                               initial_force=backward, period=period)},
         mix=dict(film_force=force, slip_velocity=slip_velocity, backward_force=backward,
@@ -282,6 +289,8 @@ SCALES = {
     "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
     "m3e3": _light_scale("m3e3", 3e3, 0.0144, 5.88, 46.0, 20.0, 33.5, 0.061, 32.3, 420.0,
                          M3E3_NOISE, M3E3_REGISTRY_NOISE),
+    "k16m3e3": _light_scale("k16m3e3", 3e3, 0.0102, 8.31, 52.0, 14.0, 33.3, 0.058, 37.1,
+                            400.0, M3E3_NOISE, K16M3E3_REGISTRY_NOISE, spring_constant=16.0),
 }
 
 
