@@ -59,7 +59,7 @@ from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REG
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
-__all__ = ["SCALE", "Scale", "SCALES", "LIGHT_B", "scale_named", "CONTROLS",
+__all__ = ["SCALE", "Scale", "SCALES", "scale_named", "CONTROLS",
            "control_trace", "coulomb_viscous", "replica_fits",
            "random_force_runs", "dynamical_fits", "control_fits", "verdict_rates", "RATE_STATE_CREEP"]
 
@@ -201,7 +201,8 @@ M1E4_STOP = 0.011
 #: γM = 8.31 m/τ; yields ≈ 52 (36–61), re-sticks ≈ 14 (7–21) ε/σ, slips of 49 τ (34–87) at
 #: ≈ 0.058 σ/τ; F̄ 33.3 ε/σ: that rung's eight runs, 10–90 %), its noise beside the registry
 #: calibrated on them (:data:`~.film_noise.K16M3E3_REGISTRY_NOISE`), alone the K = 8 rung's.
-LIGHT_B = {m: 2.0 * math.sqrt(8.0 * m) for m in (1e2, 1e3, 3e3)}
+#: Their viscous controls: Klein's Eq. 1 with ζ = 1, B = 2√(KM).
+#:
 #: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
 #: (336 atoms, 1 m each), and of the Klein-similar scene's (224).
 THICK_FILM_MASS, KLEIN_FILM_MASS = 336.0, 224.0

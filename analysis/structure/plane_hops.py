@@ -167,10 +167,11 @@ def hop_force(slips, *, registry_period: float | None, near: float = 0.1,
         _, res = _fit_law([bases[j] for j in keep], [forces[j] for j in keep],
                           normals.sum(0) - normals[i], moments.sum(0) - moments[i])
         loo.append(_bump([data[j] for j in keep], res, [data[j][3] for j in keep], near, wing))
+    # a slip whose removal leaves no sample near a change (or none in the wing) leaves the
+    # jackknife undefined: no error then, rather than one over fewer slips
     loo = np.asarray(loo)
-    loo = loo[np.isfinite(loo)]
     stderr = (float(np.sqrt((loo.size - 1) / loo.size * np.sum((loo - loo.mean()) ** 2)))
-              if loo.size > 1 else np.nan)
+              if np.all(np.isfinite(loo)) else np.nan)
     rng = np.random.default_rng(seed)
 
     def null(draw) -> NullBump:

@@ -15,6 +15,7 @@ from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_s
                                                         slip_velocities)
 from filmfriction.analysis.groundtruth.film_noise import (M1E4_NOISE, M1E4_REGISTRY_NOISE,
                                                        M3E3_NOISE, M3E3_REGISTRY_NOISE,
+                                                       K16M3E3_REGISTRY_NOISE,
                                                        MD_NOISE, RESIDUAL_AS_NOISE,
                                                        STIFF_NOISE, STIFF_REGISTRY_NOISE)
 
@@ -98,6 +99,8 @@ MD_STIFF_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00158, 0.00007)
 MD_M1E4_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00541, 0.00022)
 #: The same at M = 3×10³: the mass ladder's eight runs, ``--scale m3e3 --share 0.5``.
 MD_M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0131, 0.0005)
+#: The same at M = 3×10³ on K = 16: that rung's eight runs, ``--scale k16m3e3 --share 0.5``.
+MD_K16M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0112, 0.0004)
 CORRUGATION = (20.0, 1.1, -0.97)
 
 
@@ -135,3 +138,13 @@ def test_the_m3e3_noise_beside_the_registry_is_the_mds_and_the_plain_one_too_lou
     assert _stiff_fast_rms(M3E3_REGISTRY_NOISE, 20, 1.1, "m3e3", 0.5) == pytest.approx(
         md, abs=3 * err)
     assert _stiff_fast_rms(M3E3_NOISE, 20, 1.1, "m3e3", 0.5) > md + 6 * err
+
+
+def test_the_k16m3e3_noise_beside_the_registry_is_the_mds():
+    # the same film on a spring twice as stiff: its own calibration, which the K = 8 rung's
+    # (u 0.05) misses low and a noise of 0.7 times its rms misses by far
+    md, err = MD_K16M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(K16M3E3_REGISTRY_NOISE, 20, 1.1, "k16m3e3", 0.5) == pytest.approx(
+        md, abs=3 * err)
+    quiet = {**K16M3E3_REGISTRY_NOISE, "velocity_noise": 0.7 * 0.055}
+    assert _stiff_fast_rms(quiet, 20, 1.1, "k16m3e3", 0.5) < md - 6 * err

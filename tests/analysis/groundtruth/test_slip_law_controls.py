@@ -173,7 +173,10 @@ def test_the_cycle_ensemble_refuses_too_few_slips():
     ("m1e4", "", 0.3, "mixed", 22.4, 213.3),
     ("m3e3", "coulomb", None, "kinetic", 25.5, 0.0),
     ("m3e3", "viscous", None, "viscous", 0.0, 309.8),
-    ("m3e3", "", 0.5, "mixed", 16.75, 274.6)])
+    ("m3e3", "", 0.5, "mixed", 16.75, 274.6),
+    ("k16m3e3", "coulomb", None, "kinetic", 25.3, 0.0),
+    ("k16m3e3", "viscous", None, "viscous", 0.0, 438.2),
+    ("k16m3e3", "", 0.5, "mixed", 16.65, 287.1)])
 def test_heavy_scale_noise_free_controls_give_their_law_back(scale, name, share, verdict,
                                                              kinetic, damping):
     # the slider's mount dashpot is the fit's: the law comes back exactly
@@ -198,13 +201,13 @@ def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
     assert not any(f.verdict == "viscous" for f in fits), Counter(f.verdict for f in fits)
 
 
-# --- the M = 1e4 and 3e3 scales' periods
+# --- the M = 1e4 and 3e3 (K = 8 and 16) scales' periods
 
 @pytest.mark.parametrize("scale, name, share", [
     *(("m1e4", n, s) for n, s in (("coulomb", None), ("weakening", None), ("viscous", None),
                                   ("", 0.0), ("", 0.3), ("", 1.0))),
-    *(("m3e3", n, s) for n, s in (("coulomb", None), ("viscous", None), ("", 0.0),
-                                  ("", 0.5), ("", 1.0)))])
+    *((sc, n, s) for sc in ("m3e3", "k16m3e3")
+      for n, s in (("coulomb", None), ("viscous", None), ("", 0.0), ("", 0.5), ("", 1.0)))])
 def test_periods_hold_a_noise_free_cycle(scale, name, share):
     # ``period`` is a slip cycle's length or a little more (the mixes' one period, the
     # longest of their shares'; at M = 3×10³ one period for every law, the Coulomb
