@@ -23,7 +23,7 @@ from __future__ import annotations
 __all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "STIFF_NOISE", "STIFF_REGISTRY_NOISE",
            "M1E4_NOISE", "M1E4_REGISTRY_NOISE", "LIGHT_NOISE",
            "LIGHT_REGISTRY_NOISE", "M3E3_NOISE", "M3E3_REGISTRY_NOISE",
-           "K16M3E3_REGISTRY_NOISE"]
+           "K16M3E3_REGISTRY_NOISE", "M25E3_REGISTRY_NOISE"]
 
 #: The film's random force of the controls, calibrated to the MD (LJ units; the keywords of
 #: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of 0.45 σ/τ
@@ -140,3 +140,7 @@ M3E3_REGISTRY_NOISE = {"velocity_noise": 0.05, "velocity_correlation": 0.99, "ra
 #: residual of 0.0109 ± 0.0001 for the MD's 0.0112 ± 0.0004 σ/τ, plain 0.0137 for 0.0146
 #: (u 0.05: 0.0102, u 0.06: 0.0117); ``--scale k16m3e3``, the rest as above.
 K16M3E3_REGISTRY_NOISE = {"velocity_noise": 0.055, "velocity_correlation": 0.99, "rattle": 0.0}
+#: The film at M = 2.5×10³ (K = 8), calibrated alike on the 220 slips of that rung's sixteen
+#: runs beside the registry force: u 0.055 at 0.99 leaves a fast residual of 0.0140 ± 0.0002
+#: for the MD's 0.0139 ± 0.0003 σ/τ (u 0.06: 0.0148); ``--scale m25e3``.
+M25E3_REGISTRY_NOISE = {"velocity_noise": 0.055, "velocity_correlation": 0.99, "rattle": 0.0}

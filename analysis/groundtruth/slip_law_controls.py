@@ -52,10 +52,9 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
-from .film_noise import (LIGHT_NOISE, LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE,
-                         K16M3E3_REGISTRY_NOISE, M3E3_NOISE, M3E3_REGISTRY_NOISE, MD_NOISE,
-                         STIFF_NOISE,
-                         STIFF_REGISTRY_NOISE)
+from .film_noise import (K16M3E3_REGISTRY_NOISE, LIGHT_NOISE, LIGHT_REGISTRY_NOISE,
+                         M1E4_NOISE, M1E4_REGISTRY_NOISE, M25E3_REGISTRY_NOISE, M3E3_NOISE,
+                         M3E3_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE, STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 
@@ -197,6 +196,9 @@ M1E4_STOP = 0.011
 #: M = 3×10³ (V = 0.0144 σ/τ, γM = 5.88 m/τ; yields ≈ 46 (34–60), re-sticks ≈ 20 (14–26)
 #: ε/σ, slips of 65 τ (46–120) at ≈ 0.061 σ/τ; F̄ 33.5 ε/σ: the rung's eight runs, 10–90 %),
 #: the rung between, as these, with its own noise (:data:`~.film_noise.M3E3_NOISE`).
+#: ``m25e3``: M = 2.5×10³ (V = 0.0158 σ/τ, γM = 5.375 m/τ; yields ≈ 47 (36–59), re-sticks
+#: ≈ 19 (10–25) ε/σ, slips of 64 τ (42–108) at ≈ 0.076 σ/τ; F̄ 32.2 ε/σ: that rung's sixteen
+#: runs), its noise beside the registry calibrated on them, alone the M = 3×10³ rung's.
 #: ``k16m3e3``: the M = 3×10³ slider on a spring twice as stiff, K = 16 (V = 0.0102 σ/τ,
 #: γM = 8.31 m/τ; yields ≈ 52 (36–61), re-sticks ≈ 14 (7–21) ε/σ, slips of 49 τ (34–87) at
 #: ≈ 0.058 σ/τ; F̄ 33.3 ε/σ: that rung's eight runs, 10–90 %), its noise beside the registry
@@ -290,6 +292,8 @@ SCALES = {
     "m1e3": _light_scale("m1e3", 1e3, 0.025, 3.4, 50.0, 22.0, 35.0, 0.11, 35.5, 250.0),
     "m3e3": _light_scale("m3e3", 3e3, 0.0144, 5.88, 46.0, 20.0, 33.5, 0.061, 32.3, 420.0,
                          M3E3_NOISE, M3E3_REGISTRY_NOISE),
+    "m25e3": _light_scale("m25e3", 2.5e3, 0.0158, 5.375, 47.0, 19.0, 32.2, 0.076, 33.1, 420.0,
+                          M3E3_NOISE, M25E3_REGISTRY_NOISE),
     "k16m3e3": _light_scale("k16m3e3", 3e3, 0.0102, 8.31, 52.0, 14.0, 33.3, 0.058, 37.1,
                             400.0, M3E3_NOISE, K16M3E3_REGISTRY_NOISE, spring_constant=16.0),
 }

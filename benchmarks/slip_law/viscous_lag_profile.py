@@ -28,7 +28,7 @@ of ``--corrugation`` (fitted at its period) and the noise beside it
 (the scale's ``registry_noise``, :mod:`~filmfriction.analysis.groundtruth.film_noise`, times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
 ``--scale m1e4`` (``m3e3``, ``m1e3``, ``m1e2``): the M = 10⁴ (3×10³, 10³, 10²) slider's scale
-instead (``k16m3e3``: M = 3×10³ on K = 16);
+instead (``m25e3``: M = 2.5×10³; ``k16m3e3``: M = 3×10³ on K = 16);
 ``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
 ``--registry-lag TAU_G``: the registry force
 trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, no loop);

@@ -16,6 +16,7 @@ from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_s
 from filmfriction.analysis.groundtruth.film_noise import (M1E4_NOISE, M1E4_REGISTRY_NOISE,
                                                        M3E3_NOISE, M3E3_REGISTRY_NOISE,
                                                        K16M3E3_REGISTRY_NOISE,
+                                                       M25E3_REGISTRY_NOISE,
                                                        MD_NOISE, RESIDUAL_AS_NOISE,
                                                        STIFF_NOISE, STIFF_REGISTRY_NOISE)
 
@@ -101,6 +102,8 @@ MD_M1E4_FAST_RESIDUAL_BESIDE_REGISTRY = (0.00541, 0.00022)
 MD_M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0131, 0.0005)
 #: The same at M = 3×10³ on K = 16: that rung's eight runs, ``--scale k16m3e3 --share 0.5``.
 MD_K16M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0112, 0.0004)
+#: The same at M = 2.5×10³: that rung's sixteen runs, ``--scale m25e3 --share 0.5``.
+MD_M25E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0139, 0.0003)
 CORRUGATION = (20.0, 1.1, -0.97)
 
 
@@ -148,3 +151,11 @@ def test_the_k16m3e3_noise_beside_the_registry_is_the_mds():
         md, abs=3 * err)
     quiet = {**K16M3E3_REGISTRY_NOISE, "velocity_noise": 0.7 * 0.055}
     assert _stiff_fast_rms(quiet, 20, 1.1, "k16m3e3", 0.5) < md - 6 * err
+
+
+def test_the_m25e3_noise_beside_the_registry_is_the_mds():
+    md, err = MD_M25E3_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(M25E3_REGISTRY_NOISE, 20, 1.1, "m25e3", 0.5) == pytest.approx(
+        md, abs=3 * err)
+    loud = {**M25E3_REGISTRY_NOISE, "velocity_noise": 1.4 * 0.055}
+    assert _stiff_fast_rms(loud, 20, 1.1, "m25e3", 0.5) > md + 6 * err
