@@ -264,7 +264,8 @@ def test_the_scales_film_masses_are_their_scenes_films():
     # the MD scene each scale stands for (its atoms at 1 m each), as an MD run records it
     from filmfriction.workflows.md.scene import load
 
-    for scene, scales in (("sfb-thick-stiff", ("stiff", "m1e4", "m3e3", "m1e2", "m1e3", "k16m3e3", "m25e3")),
+    for scene, scales in (("sfb-thick-stiff", ("stiff", "m1e4", "m3e3", "m1e2", "m1e3",
+                                               "k16m3e3", "m25e3")),
                           ("sfb-similar", ("klein",))):
         atoms = load(scene).derived()["film_atoms"]
         for name in scales:
