@@ -154,7 +154,8 @@ def hop_force(slips, *, registry_period: float | None, near: float = 0.1,
     forces = [d[1] for d in data]
     normals = np.array([a.T @ a for a in bases])
     moments = np.array([a.T @ f for a, f in zip(bases, forces)])
-    coef, residual = _fit_law(bases, forces, normals.sum(0), moments.sum(0))
+    normal, moment = normals.sum(0), moments.sum(0)
+    coef, residual = _fit_law(bases, forces, normal, moment)
 
     def bump(positions):
         return _bump(data, residual, positions, near, wing)
@@ -165,7 +166,7 @@ def hop_force(slips, *, registry_period: float | None, near: float = 0.1,
     for i in range(len(data)):
         keep = [j for j in range(len(data)) if j != i]
         _, res = _fit_law([bases[j] for j in keep], [forces[j] for j in keep],
-                          normals.sum(0) - normals[i], moments.sum(0) - moments[i])
+                          normal - normals[i], moment - moments[i])
         loo.append(_bump([data[j] for j in keep], res, [data[j][3] for j in keep], near, wing))
     # a slip whose removal leaves no sample near a change (or none in the wing) leaves the
     # jackknife undefined: no error then, rather than one over fewer slips

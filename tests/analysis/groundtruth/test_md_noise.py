@@ -144,8 +144,8 @@ def test_the_m3e3_noise_beside_the_registry_is_the_mds_and_the_plain_one_too_lou
 
 
 def test_the_k16m3e3_noise_beside_the_registry_is_the_mds():
-    # the same film on a spring twice as stiff: its own calibration, which the K = 8 rung's
-    # (u 0.05) misses low and a noise of 0.7 times its rms misses by far
+    # the same film on a spring twice as stiff: its own calibration, which a noise of 0.7
+    # times its rms misses by far
     md, err = MD_K16M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
     assert _stiff_fast_rms(K16M3E3_REGISTRY_NOISE, 20, 1.1, "k16m3e3", 0.5) == pytest.approx(
         md, abs=3 * err)
