@@ -23,7 +23,7 @@ from __future__ import annotations
 __all__ = ["MD_NOISE", "RESIDUAL_AS_NOISE", "scaled", "STIFF_NOISE", "STIFF_REGISTRY_NOISE",
            "M1E4_NOISE", "M1E4_REGISTRY_NOISE", "LIGHT_NOISE",
            "LIGHT_REGISTRY_NOISE", "M3E3_NOISE", "M3E3_REGISTRY_NOISE",
-           "K16M3E3_REGISTRY_NOISE", "M25E3_REGISTRY_NOISE"]
+           "K16M3E3_REGISTRY_NOISE", "M25E3_REGISTRY_NOISE", "K4M3E3_REGISTRY_NOISE"]
 
 #: The film's random force of the controls, calibrated to the MD (LJ units; the keywords of
 #: :func:`~filmfriction.analysis.groundtruth.random_force.slide`): u an AR(1) of 0.45 σ/τ
@@ -144,3 +144,9 @@ K16M3E3_REGISTRY_NOISE = {"velocity_noise": 0.055, "velocity_correlation": 0.99,
 #: runs beside the registry force: u 0.055 at 0.99 leaves a fast residual of 0.0140 ± 0.0002
 #: for the MD's 0.0139 ± 0.0003 σ/τ (u 0.06: 0.0148); ``--scale m25e3``.
 M25E3_REGISTRY_NOISE = {"velocity_noise": 0.055, "velocity_correlation": 0.99, "rattle": 0.0}
+#: The film at M = 3×10³ on a spring half as stiff (K = 4), calibrated alike on the 154 slips of
+#: that rung's sixteen runs beside the registry force, against replicas of its mix of share 0.3
+#: (the rung's own viscous share): u 0.043 at 0.99 leaves a fast residual of 0.0140 ± 0.0002
+#: for the MD's 0.0140 ± 0.0004 σ/τ, plain 0.0173 for 0.0175 (u 0.04: 0.0130, u 0.05: 0.0156);
+#: ``--scale k4m3e3 --share 0.3``, the rest as above.
+K4M3E3_REGISTRY_NOISE = {"velocity_noise": 0.043, "velocity_correlation": 0.99, "rattle": 0.0}

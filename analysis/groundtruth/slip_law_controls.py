@@ -52,7 +52,7 @@ from filmfriction.reduced_model.cycles import cycle_table
 from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
-from .film_noise import (K16M3E3_REGISTRY_NOISE, LIGHT_NOISE, LIGHT_REGISTRY_NOISE,
+from .film_noise import (K4M3E3_REGISTRY_NOISE, K16M3E3_REGISTRY_NOISE, LIGHT_NOISE, LIGHT_REGISTRY_NOISE,
                          M1E4_NOISE, M1E4_REGISTRY_NOISE, M25E3_REGISTRY_NOISE, M3E3_NOISE,
                          M3E3_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE, STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
@@ -203,6 +203,11 @@ M1E4_STOP = 0.011
 #: γM = 8.31 m/τ; yields ≈ 52 (36–61), re-sticks ≈ 14 (7–21) ε/σ, slips of 49 τ (34–87) at
 #: ≈ 0.058 σ/τ; F̄ 33.3 ε/σ: that rung's eight runs, 10–90 %), its noise beside the registry
 #: calibrated on them (:data:`~.film_noise.K16M3E3_REGISTRY_NOISE`), alone the K = 8 rung's.
+#: ``k4m3e3``: the same slider on a spring half as stiff, K = 4 (V = 0.0144 σ/τ, γM = 4.16
+#: m/τ; yields ≈ 45 (32–56), re-sticks ≈ 23 (17–28) ε/σ, slips of 90 τ (51–154) and 6.5 σ
+#: (2.8–11) at ≈ 0.079 σ/τ; F̄ 33.4 ε/σ: that rung's sixteen runs), its noise calibrated on
+#: them against its mix of share 0.3 (the rung's viscous share; the others' is 0.5), one
+#: period for every law, the Coulomb control's cycle (750 τ) the longest.
 #: Their viscous controls: Klein's Eq. 1 with ζ = 1, B = 2√(KM).
 #:
 #: The mass of the six-layer film of ``sfb-thick-stiff`` and the K = 8 mass ladder's rungs
@@ -296,6 +301,8 @@ SCALES = {
                           M3E3_NOISE, M25E3_REGISTRY_NOISE),
     "k16m3e3": _light_scale("k16m3e3", 3e3, 0.0102, 8.31, 52.0, 14.0, 33.3, 0.058, 37.1,
                             400.0, M3E3_NOISE, K16M3E3_REGISTRY_NOISE, spring_constant=16.0),
+    "k4m3e3": _light_scale("k4m3e3", 3e3, 0.0144, 4.158, 45.0, 23.0, 33.4, 0.079, 31.5,
+                           900.0, M3E3_NOISE, K4M3E3_REGISTRY_NOISE, spring_constant=4.0),
 }
 
 

@@ -28,7 +28,7 @@ of ``--corrugation`` (fitted at its period) and the noise beside it
 (the scale's ``registry_noise``, :mod:`~filmfriction.analysis.groundtruth.film_noise`, times ``--noise-scale``), re-sticking at
 ``--stop-velocity`` (negative: once the wall recoils that fast, the MD-like end); printed:
 ``--scale m1e4`` (``m3e3``, ``m1e3``, ``m1e2``): the M = 10⁴ (3×10³, 10³, 10²) slider's scale
-instead (``m25e3``: M = 2.5×10³; ``k16m3e3``: M = 3×10³ on K = 16);
+instead (``m25e3``: M = 2.5×10³; ``k16m3e3``, ``k4m3e3``: M = 3×10³ on K = 16, 4);
 ``--noise U RHO`` (u's rms and its correlation per sample) overrides the scale's noise;
 ``--registry-lag TAU_G``: the registry force
 trailing the wall's position, relaxing over TAU_G (``lagged-registry``; TAU 0, no loop);
@@ -46,7 +46,8 @@ grid point nearest it; ``--slip-end force-minimum``: each slip ends at its lowes
 force, where the MD's detector ends one, not where the slider re-sticks
 (:data:`~filmfriction.analysis.groundtruth.pooled_controls.SLIP_ENDS`); for the pools whose m_c does not cross, m_c at τ_r = 0 in its
 errors, and over all pools the one law's m_c and the loop step at the grid's first τ_r; the noise-free profile of the first pool's runs (re-sticking at the scale's own stop
-velocity: noise-free the wall does not recoil), then over the pools τ̂'s mean, its scatter
+velocity: noise-free the wall does not recoil; or, where a strong loop keeps a noise-free
+run sliding, why there is none), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
 τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
 """
@@ -163,8 +164,13 @@ def control(args) -> int:
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
+    # (a strong loop can keep a noise-free run sliding: then that run's message instead)
+    try:
+        quiet = table(args.lags, pool(0, NOISE_FREE, base))
+    except ValueError as exc:
+        quiet = f"(none: {exc})\n"
     print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
-          + table(args.lags, pool(0, NOISE_FREE, base)), flush=True)
+          + quiet, flush=True)
     taus, errs, bs, steps, first = [], [], [], [], []
     for k in range(args.replicas):
         fits = pool(k, noise)

@@ -16,6 +16,7 @@ from filmfriction.analysis.groundtruth.md_noise import (increment_rms, replica_s
 from filmfriction.analysis.groundtruth.film_noise import (M1E4_NOISE, M1E4_REGISTRY_NOISE,
                                                        M3E3_NOISE, M3E3_REGISTRY_NOISE,
                                                        K16M3E3_REGISTRY_NOISE,
+                                                       K4M3E3_REGISTRY_NOISE,
                                                        M25E3_REGISTRY_NOISE,
                                                        MD_NOISE, RESIDUAL_AS_NOISE,
                                                        STIFF_NOISE, STIFF_REGISTRY_NOISE)
@@ -104,6 +105,8 @@ MD_M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0131, 0.0005)
 MD_K16M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0112, 0.0004)
 #: The same at M = 2.5×10³: that rung's sixteen runs, ``--scale m25e3 --share 0.5``.
 MD_M25E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0139, 0.0003)
+#: The same at M = 3×10³ on K = 4: that rung's sixteen runs, ``--scale k4m3e3 --share 0.3``.
+MD_K4M3E3_FAST_RESIDUAL_BESIDE_REGISTRY = (0.0140, 0.0004)
 CORRUGATION = (20.0, 1.1, -0.97)
 
 
@@ -159,3 +162,13 @@ def test_the_m25e3_noise_beside_the_registry_is_the_mds():
         md, abs=3 * err)
     loud = {**M25E3_REGISTRY_NOISE, "velocity_noise": 1.4 * 0.055}
     assert _stiff_fast_rms(loud, 20, 1.1, "m25e3", 0.5) > md + 6 * err
+
+
+def test_the_k4m3e3_noise_beside_the_registry_is_the_mds():
+    # the softer spring's rung, against replicas of its own viscous share (0.3): its own
+    # calibration, which a noise of 1.3 times its rms misses by far
+    md, err = MD_K4M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
+    assert _stiff_fast_rms(K4M3E3_REGISTRY_NOISE, 20, 1.1, "k4m3e3", 0.3) == pytest.approx(
+        md, abs=3 * err)
+    loud = {**K4M3E3_REGISTRY_NOISE, "velocity_noise": 1.3 * 0.043}
+    assert _stiff_fast_rms(loud, 20, 1.1, "k4m3e3", 0.3) > md + 6 * err

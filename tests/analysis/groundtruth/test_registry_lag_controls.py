@@ -139,3 +139,17 @@ def test_a_registry_control_refuses_what_its_law_cannot_carry(kw, said):
     # each needs the walls' registry, and none carries a viscous lag in time beside it
     with pytest.raises(ValueError, match=said):
         pooled_runs("x", 3, 2, share=0.5, scale=STIFF, **kw)
+
+
+def test_a_loop_that_keeps_a_noise_free_run_sliding_leaves_the_noisy_pools_read(
+        benchmark_module, capsys):
+    # the K = 4 rung's loop (slip-weakening 0.5 over 6 σ): noise-free, one run of the first
+    # pool never re-sticks; the profile says so in the noise-free table's place and reads the
+    # noisy pools, where the random force ends each slip
+    main = benchmark_module("slip_law/viscous_lag_profile").main
+    assert main(["--control", "0.3", "0", "--loop", "slip-weakening", "0.5", "6", "--scale",
+                 "k4m3e3", "--stop-velocity=-0.0144", "--runs", "16", "--slips", "10",
+                 "--replicas", "1", "--lags", "0", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "(none: run 15: no slip relaxes the spring" in out
+    assert "over the 1 pools: the one law's m_c" in out

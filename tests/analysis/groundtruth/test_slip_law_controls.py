@@ -177,6 +177,9 @@ def test_the_cycle_ensemble_refuses_too_few_slips():
     ("k16m3e3", "coulomb", None, "kinetic", 25.3, 0.0),
     ("k16m3e3", "viscous", None, "viscous", 0.0, 438.2),
     ("k16m3e3", "", 0.5, "mixed", 16.65, 287.1),
+    ("k4m3e3", "coulomb", None, "kinetic", 25.4, 0.0),
+    ("k4m3e3", "viscous", None, "viscous", 0.0, 219.1),
+    ("k4m3e3", "", 0.3, "mixed", 23.38, 126.8),
     ("m25e3", "viscous", None, "viscous", 0.0, 282.8),
     ("m25e3", "", 0.5, "mixed", 16.1, 211.8)])
 def test_heavy_scale_noise_free_controls_give_their_law_back(scale, name, share, verdict,
@@ -203,12 +206,12 @@ def test_stiff_coulomb_slips_are_never_viscous_at_the_stiff_noise():
     assert not any(f.verdict == "viscous" for f in fits), Counter(f.verdict for f in fits)
 
 
-# --- the M = 1e4, 3e3 (K = 8 and 16) and 2.5e3 scales' periods
+# --- the M = 1e4, 3e3 (K = 8, 16 and 4) and 2.5e3 scales' periods
 
 @pytest.mark.parametrize("scale, name, share", [
     *(("m1e4", n, s) for n, s in (("coulomb", None), ("weakening", None), ("viscous", None),
                                   ("", 0.0), ("", 0.3), ("", 1.0))),
-    *((sc, n, s) for sc in ("m3e3", "k16m3e3", "m25e3")
+    *((sc, n, s) for sc in ("m3e3", "k16m3e3", "k4m3e3", "m25e3")
       for n, s in (("coulomb", None), ("viscous", None), ("", 0.0), ("", 0.5), ("", 1.0)))])
 def test_periods_hold_a_noise_free_cycle(scale, name, share):
     # ``period`` is a slip cycle's length or a little more (the mixes' one period, the

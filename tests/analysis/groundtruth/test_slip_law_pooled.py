@@ -265,7 +265,7 @@ def test_the_scales_film_masses_are_their_scenes_films():
     from filmfriction.workflows.md.scene import load
 
     for scene, scales in (("sfb-thick-stiff", ("stiff", "m1e4", "m3e3", "m1e2", "m1e3",
-                                               "k16m3e3", "m25e3")),
+                                               "k16m3e3", "k4m3e3", "m25e3")),
                           ("sfb-similar", ("klein",))):
         atoms = load(scene).derived()["film_atoms"]
         for name in scales:
