@@ -7,6 +7,7 @@ on MD runs or on controls of a known lag.
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
         [--loop LAW W D] [--slip-end force-minimum] [--registry-lag TAU_G]
         [--branching DF2 PHI2 W1 W2 DPHI] [--lag-distance D]
+    (either form) [--split velocity]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
 yield: the ``maxwell`` film of :mod:`filmfriction.analysis.groundtruth.random_force`) is
@@ -49,7 +50,11 @@ errors, and over all pools the one law's m_c and the loop step at the grid's fir
 velocity: noise-free the wall does not recoil; or, where a strong loop keeps a noise-free
 run sliding, why there is none), then over the pools τ̂'s mean, its scatter
 and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid point nearest
-τ̂ (mean ± its standard error) against the law's.  Seeds fixed: counts deterministic.
+τ̂ (mean ± its standard error) against the law's.  ``--split velocity``: the slips split
+at the pool's median slip velocity (slide over duration), each half profiled on its own: on
+MD runs each half's table, τ̂ and τ̂·v̄ and the difference slow − fast; on controls, over the
+pools, each half's τ̂ and the difference (a lag fixed in time or in slide leaves it ≈ 0 at
+these scales: docs/results/slip-law.md).  Seeds fixed: counts deterministic.
 """
 from __future__ import annotations
 
@@ -106,6 +111,36 @@ def table(lags, fits) -> str:
     return "\n".join(rows)
 
 
+def split_by_velocity(runs) -> list:
+    """The runs' slips split at the pool's median slip velocity (each slip's slide over its
+    duration): [(slow half's runs, its mean slip velocity), (fast half's …)], each run with
+    its own slips of that half (a run left without one dropped)."""
+    speeds = [r.table.slip_distance / r.table.slip_duration for r in runs]
+    cut = float(np.median(np.concatenate(speeds)))
+    halves = []
+    for slow in (True, False):
+        kept = [(replace(r, table=r.table[np.flatnonzero((v <= cut) == slow)]),
+                 v[(v <= cut) == slow]) for r, v in zip(runs, speeds)]
+        kept = [(r, v) for r, v in kept if v.size]
+        halves.append(([r for r, _ in kept], float(np.mean(np.concatenate([v for _, v in kept])))))
+    return halves
+
+
+def split_md(args, runs, fit_kw) -> int:
+    """The profile of each half of ``split_by_velocity``, τ̂ and τ̂·v̄ of each."""
+    out = []
+    for label, (rs, v) in zip(("slow", "fast"), split_by_velocity(runs)):
+        fits = profile(rs, args.lags, **fit_kw)
+        tau, err = crossing(args.lags, fits)
+        out.append((tau, err))
+        print(f"the {label} half: {len(rs)} runs, {sum(len(r.table) for r in rs)} slips, "
+              f"mean slip velocity {v:.4f} σ/τ\n{table(args.lags, fits)}"
+              + (f"; τ̂·v̄ {tau * v:.2f} σ\n" if math.isfinite(tau) else "\n"))
+    (ts, es), (tf, ef) = out
+    print(f"τ̂ slow − fast: {ts - tf:+.1f} ± {math.hypot(es, ef):.1f} τ")
+    return 0
+
+
 def md(args) -> int:
     from filmfriction.analysis.calibration.slip_law_runs import fit_arguments, read_runs
 
@@ -113,6 +148,8 @@ def md(args) -> int:
         runs, shared, _ = read_runs(args.runs_dirs, analyse=False)
         if args.no_registry:
             shared = {**shared, "registry_period": None}
+        if args.split:
+            return split_md(args, runs, fit_arguments(shared))
         fits = profile(runs, args.lags, **fit_arguments(shared))
     except ValueError as exc:
         print(f"viscous_lag_profile: {exc}", file=sys.stderr)
@@ -152,16 +189,22 @@ def control(args) -> int:
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
           f"slip ends: {args.slip_end}\n")
 
+    def runs_of(k, noise_, scale=sc):
+        return pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
+                           law_spread=args.law_spread, lag=tau or None,
+                           weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
+                           corrugation=tuple(args.corrugation), seed=(0, k),
+                           registry_lag=args.registry_lag,
+                           branching=(None if args.branching is None
+                                      else branch_weights(args.branching)),
+                           lag_distance=args.lag_distance)
+
     def pool(k, noise_, scale=sc):
-        rs, vd = pooled_runs("x", args.runs, args.slips, share=share, scale=scale, noise=noise_,
-                             law_spread=args.law_spread, lag=tau or None,
-                             weakening=loop, loop_law=loop_law, slip_end=args.slip_end,
-                             corrugation=tuple(args.corrugation), seed=(0, k),
-                             registry_lag=args.registry_lag,
-                             branching=(None if args.branching is None
-                                        else branch_weights(args.branching)),
-                             lag_distance=args.lag_distance)
+        rs, vd = runs_of(k, noise_, scale)
         return profile(rs, args.lags, drive_velocity=vd, **kw)
+
+    if args.split:
+        return split_control(args, lambda k: runs_of(k, noise), kw)
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
     # (a strong loop can keep a noise-free run sliding: then that run's message instead)
@@ -211,6 +254,31 @@ def control(args) -> int:
     return 0
 
 
+def split_control(args, runs_of, kw) -> int:
+    """Over the pools: τ̂ of each half of ``split_by_velocity`` and their difference."""
+    rows = []
+    for k in range(args.replicas):
+        rs, vd = runs_of(k)
+        row = []
+        for half, v in split_by_velocity(rs):
+            row += [*crossing(args.lags, profile(half, args.lags, drive_velocity=vd, **kw)), v]
+        rows.append(row)
+    r = np.array(rows)
+    both = np.isfinite(r[:, 0]) & np.isfinite(r[:, 3])
+    d = r[both, 0] - r[both, 3]
+    print(f"split at each pool's median slip velocity, over the {args.replicas} pools: mean slip "
+          f"velocity {r[:, 2].mean():.4f} (slow half) and {r[:, 5].mean():.4f} σ/τ (fast); "
+          f"m_c crosses zero in {int(np.isfinite(r[:, 0]).sum())} and "
+          f"{int(np.isfinite(r[:, 3]).sum())}, in both in {int(both.sum())}")
+    if both.sum() > 1:
+        print(f"where both cross: τ̂ {r[both, 0].mean():.1f} (sd {r[both, 0].std(ddof=1):.1f}) "
+              f"and {r[both, 3].mean():.1f} (sd {r[both, 3].std(ddof=1):.1f}) τ; slow − fast "
+              f"{d.mean():+.1f} (sd {d.std(ddof=1):.1f}; median error "
+              f"{np.median(np.hypot(r[both, 1], r[both, 4])):.1f}) τ; > 0 in "
+              f"{int((d > 0).sum())} of {int(both.sum())}")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs_dirs", nargs="*", type=Path, metavar="RUN")
@@ -233,6 +301,7 @@ def main(argv=None) -> int:
     ap.add_argument("--branching", nargs=5, type=float, default=None,
                     metavar=("DF2", "PHI2", "W1", "W2", "DPHI"))
     ap.add_argument("--lag-distance", type=float, default=None, metavar="D")
+    ap.add_argument("--split", choices=("velocity",), default=None)
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
         ap.error(f"--lags {a.lags}: increasing, each >= 0 (τ)")
