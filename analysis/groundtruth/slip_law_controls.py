@@ -205,7 +205,8 @@ M1E4_STOP = 0.011
 #: calibrated on them (:data:`~.film_noise.K16M3E3_REGISTRY_NOISE`), alone the K = 8 rung's.
 #: ``k4m3e3``: the same slider on a spring half as stiff, K = 4 (V = 0.0144 σ/τ, γM = 4.16
 #: m/τ; yields ≈ 45 (32–56), re-sticks ≈ 23 (17–28) ε/σ, slips of 90 τ (51–154) and 6.5 σ
-#: (2.8–11) at ≈ 0.079 σ/τ; F̄ 33.4 ε/σ: that rung's sixteen runs), its noise calibrated on
+#: (2.8–11) at ≈ 0.079 σ/τ; F̄ 33.4 ε/σ: that rung's sixteen runs, their start-up slips
+#: among them; without them yields ≈ 42), its noise calibrated on
 #: them against its mix of share 0.3 (the rung's viscous share; the others' is 0.5), one
 #: period for every law, the Coulomb control's cycle (750 τ) the longest.
 #: Their viscous controls: Klein's Eq. 1 with ζ = 1, B = 2√(KM).

@@ -130,14 +130,20 @@ def split_md(args, runs, fit_kw) -> int:
     """The profile of each half of ``split_by_velocity``, τ̂ and τ̂·v̄ of each."""
     out = []
     for label, (rs, v) in zip(("slow", "fast"), split_by_velocity(runs)):
-        fits = profile(rs, args.lags, **fit_kw)
+        try:
+            fits = profile(rs, args.lags, **fit_kw)
+        except ValueError as exc:      # too few runs or slips left in the half
+            print(f"the {label} half: {len(rs)} runs, mean slip velocity {v:.4f} σ/τ: not "
+                  f"fitted ({exc})\n")
+            return 0
         tau, err = crossing(args.lags, fits)
         out.append((tau, err))
         print(f"the {label} half: {len(rs)} runs, {sum(len(r.table) for r in rs)} slips, "
               f"mean slip velocity {v:.4f} σ/τ\n{table(args.lags, fits)}"
               + (f"; τ̂·v̄ {tau * v:.2f} σ\n" if math.isfinite(tau) else "\n"))
     (ts, es), (tf, ef) = out
-    print(f"τ̂ slow − fast: {ts - tf:+.1f} ± {math.hypot(es, ef):.1f} τ")
+    if math.isfinite(ts - tf):
+        print(f"τ̂ slow − fast: {ts - tf:+.1f} ± {math.hypot(es, ef):.1f} τ")
     return 0
 
 
@@ -211,6 +217,8 @@ def control(args) -> int:
     try:
         quiet = table(args.lags, pool(0, NOISE_FREE, base))
     except ValueError as exc:
+        if args.loop is None:
+            raise
         quiet = f"(none: {exc})\n"
     print("noise-free (re-sticking at the scale's stop velocity), the first pool's runs:\n"
           + quiet, flush=True)
@@ -255,26 +263,33 @@ def control(args) -> int:
 
 
 def split_control(args, runs_of, kw) -> int:
-    """Over the pools: τ̂ of each half of ``split_by_velocity`` and their difference."""
+    """Over the pools: each half of ``split_by_velocity``'s m_c at the grid's first τ_r (in
+    its errors), where each crosses zero, τ̂ of each and their difference."""
     rows = []
     for k in range(args.replicas):
         rs, vd = runs_of(k)
         row = []
         for half, v in split_by_velocity(rs):
-            row += [*crossing(args.lags, profile(half, args.lags, drive_velocity=vd, **kw)), v]
+            fits = profile(half, args.lags, drive_velocity=vd, **kw)
+            o = fits[0].one_law
+            row += [*crossing(args.lags, fits), v, o.comoving_mass / o.comoving_mass_stderr]
         rows.append(row)
     r = np.array(rows)
-    both = np.isfinite(r[:, 0]) & np.isfinite(r[:, 3])
-    d = r[both, 0] - r[both, 3]
-    print(f"split at each pool's median slip velocity, over the {args.replicas} pools: mean slip "
-          f"velocity {r[:, 2].mean():.4f} (slow half) and {r[:, 5].mean():.4f} σ/τ (fast); "
-          f"m_c crosses zero in {int(np.isfinite(r[:, 0]).sum())} and "
-          f"{int(np.isfinite(r[:, 3]).sum())}, in both in {int(both.sum())}")
+    cross = np.isfinite(r[:, [0, 4]])
+    both = cross.all(axis=1)
+    print(f"split at each pool's median slip velocity, over the {args.replicas} pools: mean "
+          f"slip velocity {r[:, 2].mean():.4f} (slow half) and {r[:, 6].mean():.4f} σ/τ "
+          f"(fast); the one law's m_c at τ_r = {args.lags[0]:g} {r[:, 3].mean():+.1f} (sd "
+          f"{r[:, 3].std():.1f}; ≤ −2 in {int((r[:, 3] <= -2).sum())}) and {r[:, 7].mean():+.1f} "
+          f"(sd {r[:, 7].std():.1f}; ≤ −2 in {int((r[:, 7] <= -2).sum())}) errors; m_c crosses "
+          f"zero in {int(cross[:, 0].sum())} and {int(cross[:, 1].sum())}, in both in "
+          f"{int(both.sum())}, in the slow half alone in {int((cross[:, 0] & ~cross[:, 1]).sum())}")
     if both.sum() > 1:
+        d = r[both, 0] - r[both, 4]
         print(f"where both cross: τ̂ {r[both, 0].mean():.1f} (sd {r[both, 0].std(ddof=1):.1f}) "
-              f"and {r[both, 3].mean():.1f} (sd {r[both, 3].std(ddof=1):.1f}) τ; slow − fast "
+              f"and {r[both, 4].mean():.1f} (sd {r[both, 4].std(ddof=1):.1f}) τ; slow − fast "
               f"{d.mean():+.1f} (sd {d.std(ddof=1):.1f}; median error "
-              f"{np.median(np.hypot(r[both, 1], r[both, 4])):.1f}) τ; > 0 in "
+              f"{np.median(np.hypot(r[both, 1], r[both, 5])):.1f}) τ; > 0 in "
               f"{int((d > 0).sum())} of {int(both.sum())}")
     return 0
 

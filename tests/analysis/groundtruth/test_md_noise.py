@@ -166,9 +166,9 @@ def test_the_m25e3_noise_beside_the_registry_is_the_mds():
 
 def test_the_k4m3e3_noise_beside_the_registry_is_the_mds():
     # the softer spring's rung, against replicas of its own viscous share (0.3): its own
-    # calibration, which a noise of 1.3 times its rms misses by far
+    # calibration, which a noise of 1.4 times its rms misses by far
     md, err = MD_K4M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
     assert _stiff_fast_rms(K4M3E3_REGISTRY_NOISE, 20, 1.1, "k4m3e3", 0.3) == pytest.approx(
         md, abs=3 * err)
-    loud = {**K4M3E3_REGISTRY_NOISE, "velocity_noise": 1.3 * 0.043}
+    loud = {**K4M3E3_REGISTRY_NOISE, "velocity_noise": 1.4 * 0.043}
     assert _stiff_fast_rms(loud, 20, 1.1, "k4m3e3", 0.3) > md + 6 * err
