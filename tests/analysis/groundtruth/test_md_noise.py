@@ -156,19 +156,14 @@ def test_the_k16m3e3_noise_beside_the_registry_is_the_mds():
     assert _stiff_fast_rms(quiet, 20, 1.1, "k16m3e3", 0.5) < md - 6 * err
 
 
-def test_the_m25e3_noise_beside_the_registry_is_the_mds():
-    md, err = MD_M25E3_FAST_RESIDUAL_BESIDE_REGISTRY
-    assert _stiff_fast_rms(M25E3_REGISTRY_NOISE, 20, 1.1, "m25e3", 0.5) == pytest.approx(
-        md, abs=3 * err)
-    loud = {**M25E3_REGISTRY_NOISE, "velocity_noise": 1.4 * 0.055}
-    assert _stiff_fast_rms(loud, 20, 1.1, "m25e3", 0.5) > md + 6 * err
-
-
-def test_the_k4m3e3_noise_beside_the_registry_is_the_mds():
-    # the softer spring's rung, against replicas of its own viscous share (0.3): its own
-    # calibration, which a noise of 1.4 times its rms misses by far
-    md, err = MD_K4M3E3_FAST_RESIDUAL_BESIDE_REGISTRY
-    assert _stiff_fast_rms(K4M3E3_REGISTRY_NOISE, 20, 1.1, "k4m3e3", 0.3) == pytest.approx(
-        md, abs=3 * err)
-    loud = {**K4M3E3_REGISTRY_NOISE, "velocity_noise": 1.4 * 0.043}
-    assert _stiff_fast_rms(loud, 20, 1.1, "k4m3e3", 0.3) > md + 6 * err
+@pytest.mark.parametrize("scale, share, noise, md", [
+    ("m25e3", 0.5, M25E3_REGISTRY_NOISE, MD_M25E3_FAST_RESIDUAL_BESIDE_REGISTRY),
+    # the softer spring's rung, against replicas of its own viscous share (0.3)
+    ("k4m3e3", 0.3, K4M3E3_REGISTRY_NOISE, MD_K4M3E3_FAST_RESIDUAL_BESIDE_REGISTRY)])
+def test_the_noise_beside_the_registry_is_the_mds_and_a_louder_one_misses(scale, share,
+                                                                          noise, md):
+    # each rung its own calibration, which a noise of 1.4 times its rms misses by far
+    md, err = md
+    assert _stiff_fast_rms(noise, 20, 1.1, scale, share) == pytest.approx(md, abs=3 * err)
+    loud = {**noise, "velocity_noise": 1.4 * noise["velocity_noise"]}
+    assert _stiff_fast_rms(loud, 20, 1.1, scale, share) > md + 6 * err
