@@ -53,8 +53,9 @@ and how many pools' τ̂ ± 2 errors cover TAU, and the one law's B at the grid 
 τ̂ (mean ± its standard error) against the law's.  ``--split velocity``: the slips split
 at the pool's median slip velocity (slide over duration), each half profiled on its own: on
 MD runs each half's table, τ̂ and τ̂·v̄ and the difference slow − fast; on controls, over the
-pools, each half's τ̂ and the difference (a lag fixed in time or in slide leaves it ≈ 0 at
-these scales: docs/results/slip-law.md).  Seeds fixed: counts deterministic.
+pools, each half's m_c and τ̂, how often τ̂ ± 2 errors covers a known lag in time, and the
+difference (a lag fixed in time or in slide leaves it within about one sd of 0 at the
+M = 3×10³ scale: docs/results/slip-law.md).  Seeds fixed: counts deterministic.
 """
 from __future__ import annotations
 
@@ -119,9 +120,9 @@ def split_by_velocity(runs) -> list:
     cut = float(np.median(np.concatenate(speeds)))
     halves = []
     for slow in (True, False):
-        kept = [(replace(r, table=r.table[np.flatnonzero((v <= cut) == slow)]),
-                 v[(v <= cut) == slow]) for r, v in zip(runs, speeds)]
-        kept = [(r, v) for r, v in kept if v.size]
+        masks = [(v <= cut) == slow for v in speeds]
+        kept = [(replace(r, table=r.table[np.flatnonzero(m)]), v[m])
+                for r, v, m in zip(runs, speeds, masks) if m.any()]
         halves.append(([r for r, _ in kept], float(np.mean(np.concatenate([v for _, v in kept])))))
     return halves
 
@@ -264,32 +265,42 @@ def control(args) -> int:
 
 def split_control(args, runs_of, kw) -> int:
     """Over the pools: each half of ``split_by_velocity``'s m_c at the grid's first τ_r (in
-    its errors), where each crosses zero, τ̂ of each and their difference."""
-    rows = []
+    its errors), where each crosses zero, τ̂ of each, how often τ̂ ± 2 errors covers the
+    control's own lag (a lag in time only) and the halves' difference."""
+    tau = args.control[1]
+    halves = ([], [])                  # per half, per pool: τ̂, its error, v̄, m_c / error
     for k in range(args.replicas):
         rs, vd = runs_of(k)
-        row = []
-        for half, v in split_by_velocity(rs):
+        for rows, (half, v) in zip(halves, split_by_velocity(rs)):
             fits = profile(half, args.lags, drive_velocity=vd, **kw)
             o = fits[0].one_law
-            row += [*crossing(args.lags, fits), v, o.comoving_mass / o.comoving_mass_stderr]
-        rows.append(row)
-    r = np.array(rows)
-    cross = np.isfinite(r[:, [0, 4]])
+            rows.append((*crossing(args.lags, fits), v, o.comoving_mass / o.comoving_mass_stderr))
+    slow, fast = (np.array(h) for h in halves)
+    cross = np.isfinite(np.column_stack([slow[:, 0], fast[:, 0]]))
     both = cross.all(axis=1)
+
+    def m_c(h):
+        low = int((h[:, 3] <= -2).sum())
+        return f"{h[:, 3].mean():+.1f} (sd {h[:, 3].std():.1f}; ≤ −2 in {low})"
+
     print(f"split at each pool's median slip velocity, over the {args.replicas} pools: mean "
-          f"slip velocity {r[:, 2].mean():.4f} (slow half) and {r[:, 6].mean():.4f} σ/τ "
-          f"(fast); the one law's m_c at τ_r = {args.lags[0]:g} {r[:, 3].mean():+.1f} (sd "
-          f"{r[:, 3].std():.1f}; ≤ −2 in {int((r[:, 3] <= -2).sum())}) and {r[:, 7].mean():+.1f} "
-          f"(sd {r[:, 7].std():.1f}; ≤ −2 in {int((r[:, 7] <= -2).sum())}) errors; m_c crosses "
-          f"zero in {int(cross[:, 0].sum())} and {int(cross[:, 1].sum())}, in both in "
-          f"{int(both.sum())}, in the slow half alone in {int((cross[:, 0] & ~cross[:, 1]).sum())}")
+          f"slip velocity {slow[:, 2].mean():.4f} (slow half) and {fast[:, 2].mean():.4f} σ/τ "
+          f"(fast); the one law's m_c at τ_r = {args.lags[0]:g} {m_c(slow)} and {m_c(fast)} "
+          f"errors; m_c crosses zero in {int(cross[:, 0].sum())} and {int(cross[:, 1].sum())}, "
+          f"in both in {int(both.sum())}, in the slow half alone in "
+          f"{int((cross[:, 0] & ~cross[:, 1]).sum())}")
+    if tau > 0 and args.lag_distance is None:
+        cover = [int((np.abs(h[c, 0] - tau) <= 2 * h[c, 1]).sum())
+                 for h, c in ((slow, cross[:, 0]), (fast, cross[:, 1]))]
+        print(f"τ̂ ± 2 errors covers the lag of {tau:g} τ in {cover[0]} of "
+              f"{int(cross[:, 0].sum())} (slow half) and {cover[1]} of {int(cross[:, 1].sum())} "
+              f"(fast)")
     if both.sum() > 1:
-        d = r[both, 0] - r[both, 4]
-        print(f"where both cross: τ̂ {r[both, 0].mean():.1f} (sd {r[both, 0].std(ddof=1):.1f}) "
-              f"and {r[both, 4].mean():.1f} (sd {r[both, 4].std(ddof=1):.1f}) τ; slow − fast "
+        d = slow[both, 0] - fast[both, 0]
+        print(f"where both cross: τ̂ {slow[both, 0].mean():.1f} (sd "
+              f"{slow[both, 0].std(ddof=1):.1f}) and {fast[both, 0].mean():.1f} (sd {fast[both, 0].std(ddof=1):.1f}) τ; slow − fast "
               f"{d.mean():+.1f} (sd {d.std(ddof=1):.1f}; median error "
-              f"{np.median(np.hypot(r[both, 1], r[both, 5])):.1f}) τ; > 0 in "
+              f"{np.median(np.hypot(slow[both, 1], fast[both, 1])):.1f}) τ; > 0 in "
               f"{int((d > 0).sum())} of {int(both.sum())}")
     return 0
 
