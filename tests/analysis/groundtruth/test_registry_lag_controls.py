@@ -185,3 +185,18 @@ def test_the_velocity_split_partitions_the_slips_and_reads_a_time_lag_in_the_fas
     slow0, fast0 = (h[0].one_law for h in halves[None])
     assert slow0.comoving_mass < -3 * slow0.comoving_mass_stderr
     assert fast0.comoving_mass > 0
+
+
+def test_the_split_controls_read_each_half_and_its_coverage_of_a_known_lag(benchmark_module,
+                                                                          capsys):
+    # ``--control … --split velocity``: over the pools each half's m_c and τ̂, and how often
+    # each half's τ̂ ± 2 errors covers the control's own lag in time
+    main = benchmark_module("slip_law/viscous_lag_profile").main
+    assert main(["--control", "0.5", "3.7", "--scale", "m3e3", "--stop-velocity=-0.0144",
+                 "--runs", "8", "--slips", "8", "--replicas", "2", "--lags", "0", "2", "4",
+                 "6", "8", "--split", "velocity"]) == 0
+    out = capsys.readouterr().out
+    assert "over the 2 pools: mean slip velocity" in out
+    # the fast half, where the lag marks the one law most (m_c ≤ −2 errors in both pools),
+    # finds it within its errors in both (seeds fixed: deterministic)
+    assert "and 2 of 2 (fast)" in out.split("covers the lag of 3.7 τ in ")[1]
