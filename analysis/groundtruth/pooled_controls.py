@@ -89,7 +89,7 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
                 corrugation: tuple[float, float, float] | None = None,
                 registry_lag: float | None = None,
                 branching: tuple[float, float, float, float, float] | None = None,
-                lag_distance: float | None = None,
+                lag_distance: float | None = None, lag_yield_exponent: float = 0.0,
                 seed=0, slip_end: str = "slider") -> tuple[list[RunSlips], float]:
     """``runs`` runs of control ``name`` (or the Coulomb + viscous law of viscous ``share``)
     at ``scale``, each with its yield force and film (module text), as the pooled fit takes
@@ -110,13 +110,22 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
     w₂, δφ): that registry force with a second harmonic, both weighted by the slip's branch
     (``branching-registry``; not with a loop, a viscous lag or ``registry_lag``);
     ``lag_distance`` = d: the viscous force lagging by the slip distance d, not a time
-    (``distance-lag``; with ``branching``, ``distance-lag-branching``).  ``seed``: an int or a tuple
+    (``distance-lag``; with ``branching``, ``distance-lag-branching``).
+    ``lag_yield_exponent`` = α: each run's lag τ_r·(F̄_s/F_s)^α, F_s its yield force, F̄_s the
+    scale's: a lag longer in the runs that yield weaker, whose slips are the slower (with
+    ``lag``, on the plain or the corrugated mix, without a loop).  ``seed``: an int or a tuple
     of ints.  ``slip_end``: one of :data:`SLIP_ENDS`."""
     if not 0 <= static_spread < 1 or not 0 <= law_spread < 1:
         raise ValueError(f"static_spread = {static_spread!r}, law_spread = {law_spread!r}: "
                          "each in [0, 1)")
     if slip_end not in SLIP_ENDS:
         raise ValueError(f"slip_end = {slip_end!r}: one of {', '.join(SLIP_ENDS)}")
+    if lag_yield_exponent and not (math.isfinite(lag_yield_exponent) and lag
+                                   and weakening is None and registry_lag is None
+                                   and branching is None and lag_distance is None):
+        raise ValueError(f"lag_yield_exponent = {lag_yield_exponent!r}: finite, with a lag "
+                         f"(lag = {lag!r}), without a loop, a registry lag, branching or a "
+                         "lag in distance")
     sc = scale_named(scale)
     law = sc.law(name, share, weakening, loop_law, lag)
     period = law.pop("period")
@@ -176,6 +185,9 @@ def pooled_runs(name: str, runs: int, slips: int = 8, *, share: float | None = N
         if corrugation is not None:
             # the registry is the walls' (one geometry for every run), not the film's
             par = par[:film] + law["parameters"][film:]
+        if lag_yield_exponent:
+            # τ_r is the law's last parameter (``maxwell``, ``corrugated``)
+            par = par[:-1] + (par[-1] * (law["static_force"] / fs) ** lag_yield_exponent,)
         r = slide(**{**law, "static_force": fs, "parameters": par}, mass=sc.mass,
                   stiffness=sc.spring_constant,
                   duration=(slips + 3) * period * 1.3 * (1 + static_spread), dt=sc.dt,

@@ -6,7 +6,7 @@ on MD runs or on controls of a known lag.
         [--runs 10] [--slips 9] [--noise-scale 1.0] [--corrugation 20 1.1 -0.97]
         [--stop-velocity -0.0025] [--lags …] [--scale m1e4 --noise U RHO]
         [--loop LAW W D] [--slip-end force-minimum] [--registry-lag TAU_G]
-        [--branching DF2 PHI2 W1 W2 DPHI] [--lag-distance D]
+        [--branching DF2 PHI2 W1 W2 DPHI] [--lag-distance D] [--lag-yield-exponent A]
     (either form) [--split velocity]
 
 A film whose viscous force relaxes to B·v over τ_r (dψ/dt = (B·v − ψ)/τ_r, ψ = 0 at the
@@ -38,7 +38,9 @@ DF2·sin(4π·x/L + PHI2), the first's amplitude times 1 − W1·r and phase plu
 second's times 1 + W2·r, r = |v|/(the slip's fastest |v| so far), 1 while the slip speeds up
 (``branching-registry``; TAU 0, no loop, no registry lag); ``--lag-distance D``: the viscous
 force lagging by the slip distance D (σ), not a time (``distance-lag``; TAU 0; with
-``--branching``, ``distance-lag-branching``);
+``--branching``, ``distance-lag-branching``); ``--lag-yield-exponent A``: each run's lag
+TAU·(F̄_s/F_s)^A, F_s its yield force (± 30 % about the scale's F̄_s): longer in the runs
+that yield weaker and slip slower, the split's positive control (TAU > 0, no loop);
 ``--loop LAW W D``: the film with a yield loop besides (``melting``, D a velocity, or
 ``slip-weakening``, D a distance; ΔF = W·(F_s − F_k) of each run's yield force, fading over D:
 ``corrugated-loop`` of :mod:`filmfriction.analysis.groundtruth.random_force`), whether it lags
@@ -55,7 +57,8 @@ at the pool's median slip velocity (slide over duration), each half profiled on 
 MD runs each half's table, τ̂ and τ̂·v̄ and the difference slow − fast; on controls, over the
 pools, each half's m_c and τ̂, how often τ̂ ± 2 errors covers a known lag in time, and the
 difference (a lag fixed in time or in slide leaves it within about one sd of 0 at the
-M = 3×10³ scale: docs/results/slip-law.md).  Seeds fixed: counts deterministic.
+M = 3×10³ scale: docs/results/slip-law.md); with ``--lag-yield-exponent``, each half's lag
+at its slips' mean yield force instead of the coverage.  Seeds fixed: counts deterministic.
 """
 from __future__ import annotations
 
@@ -192,6 +195,9 @@ def control(args) -> int:
              f"branching (ΔF₂, φ₂, w₁, w₂, δφ) = {tuple(args.branching)}, ")
           + ("" if args.lag_distance is None else
              f"the viscous force lagging by {args.lag_distance:g} σ of slide, ")
+          + ("" if not args.lag_yield_exponent else
+             f"each run's lag × (F̄_s/F_s)^{args.lag_yield_exponent:g}, F̄_s "
+             f"{law['static_force']:.1f} ε/σ, ")
           + f"registry force {args.corrugation}, noise {noise}, {args.runs} runs x {args.slips} "
           f"slips, stop velocity {args.stop_velocity:g}, law spread {args.law_spread:g}, "
           f"slip ends: {args.slip_end}\n")
@@ -204,14 +210,15 @@ def control(args) -> int:
                            registry_lag=args.registry_lag,
                            branching=(None if args.branching is None
                                       else branch_weights(args.branching)),
-                           lag_distance=args.lag_distance)
+                           lag_distance=args.lag_distance,
+                           lag_yield_exponent=args.lag_yield_exponent)
 
     def pool(k, noise_, scale=sc):
         rs, vd = runs_of(k, noise_, scale)
         return profile(rs, args.lags, drive_velocity=vd, **kw)
 
     if args.split:
-        return split_control(args, lambda k: runs_of(k, noise), kw)
+        return split_control(args, lambda k: runs_of(k, noise), kw, law["static_force"])
 
     # noise-free the wall does not recoil: it re-sticks once slowed to the scale's own stop
     # (a strong loop can keep a noise-free run sliding: then that run's message instead)
@@ -263,18 +270,22 @@ def control(args) -> int:
     return 0
 
 
-def split_control(args, runs_of, kw) -> int:
+def split_control(args, runs_of, kw, static_force) -> int:
     """Over the pools: each half of ``split_by_velocity``'s m_c at the grid's first τ_r (in
     its errors), where each crosses zero, τ̂ of each, how often τ̂ ± 2 errors covers the
-    control's own lag (a lag in time only) and the halves' difference."""
-    tau = args.control[1]
-    halves = ([], [])                  # per half, per pool: τ̂, its error, v̄, m_c / error
+    control's own lag (a lag in time only; with ``--lag-yield-exponent`` each half's lag at
+    its mean yield force instead, ``static_force`` the scale's F̄_s) and the halves'
+    difference."""
+    tau, alpha = args.control[1], args.lag_yield_exponent
+    halves = ([], [])         # per half, per pool: τ̂, its error, v̄, m_c / error, its lag
     for k in range(args.replicas):
         rs, vd = runs_of(k)
         for rows, (half, v) in zip(halves, split_by_velocity(rs)):
             fits = profile(half, args.lags, drive_velocity=vd, **kw)
             o = fits[0].one_law
-            rows.append((*crossing(args.lags, fits), v, o.comoving_mass / o.comoving_mass_stderr))
+            fs = np.mean(np.concatenate([r.table.static_force for r in half]))
+            rows.append((*crossing(args.lags, fits), v, o.comoving_mass / o.comoving_mass_stderr,
+                         tau * (static_force / fs) ** alpha))
     slow, fast = (np.array(h) for h in halves)
     cross = np.isfinite(np.column_stack([slow[:, 0], fast[:, 0]]))
     both = cross.all(axis=1)
@@ -289,7 +300,11 @@ def split_control(args, runs_of, kw) -> int:
           f"errors; m_c crosses zero in {int(cross[:, 0].sum())} and {int(cross[:, 1].sum())}, "
           f"in both in {int(both.sum())}, in the slow half alone in "
           f"{int((cross[:, 0] & ~cross[:, 1]).sum())}")
-    if tau > 0 and args.lag_distance is None:
+    if alpha:
+        print(f"the law's lag at each half's mean yield force: {slow[:, 4].mean():.1f} (slow) "
+              f"and {fast[:, 4].mean():.1f} τ (fast), slow − fast "
+              f"{(slow[:, 4] - fast[:, 4]).mean():+.1f} τ (means over the pools)")
+    elif tau > 0 and args.lag_distance is None:
         cover = [int((np.abs(h[c, 0] - tau) <= 2 * h[c, 1]).sum())
                  for h, c in ((slow, cross[:, 0]), (fast, cross[:, 1]))]
         print(f"τ̂ ± 2 errors covers the lag of {tau:g} τ in {cover[0]} of "
@@ -327,6 +342,7 @@ def main(argv=None) -> int:
     ap.add_argument("--branching", nargs=5, type=float, default=None,
                     metavar=("DF2", "PHI2", "W1", "W2", "DPHI"))
     ap.add_argument("--lag-distance", type=float, default=None, metavar="D")
+    ap.add_argument("--lag-yield-exponent", type=float, default=0.0, metavar="A")
     ap.add_argument("--split", choices=("velocity",), default=None)
     a = ap.parse_args(argv)
     if sorted(a.lags) != a.lags or any(not (math.isfinite(x) and x >= 0) for x in a.lags):
@@ -369,6 +385,11 @@ def main(argv=None) -> int:
                                   and a.registry_lag is None):
             ap.error(f"--lag-distance {d}: a distance > 0 (σ); with TAU 0, no --loop or "
                      "--registry-lag")
+        y = a.lag_yield_exponent
+        if y and not (math.isfinite(y) and tau > 0 and not a.loop and a.registry_lag is None
+                      and a.branching is None and d is None):
+            ap.error(f"--lag-yield-exponent {y}: finite, with TAU > 0, no --loop, "
+                     "--registry-lag, --branching or --lag-distance")
         if not (0 <= a.law_spread < 1 and math.isfinite(a.stop_velocity)):
             ap.error(f"--law-spread {a.law_spread} in [0, 1), --stop-velocity "
                      f"{a.stop_velocity} finite")
@@ -377,9 +398,10 @@ def main(argv=None) -> int:
         except ValueError as exc:      # a law the spread made impossible (D or τ_r <= 0)
             print(f"viscous_lag_profile: {exc}", file=sys.stderr)
             return 1
-    if a.registry_lag is not None or a.branching is not None or a.lag_distance is not None:
-        ap.error("--registry-lag, --branching and --lag-distance are the controls' (with "
-                 "--control)")
+    if (a.registry_lag is not None or a.branching is not None or a.lag_distance is not None
+            or a.lag_yield_exponent):
+        ap.error("--registry-lag, --branching, --lag-distance and --lag-yield-exponent are "
+                 "the controls' (with --control)")
     missing = [str(r) for r in a.runs_dirs if not (r / "trace.csv").is_file()]
     if missing:
         ap.error(f"RUN without trace.csv: {', '.join(missing)}")

@@ -117,6 +117,10 @@ def test_the_lag_profiles_new_control_options_refuse_bad_input_before_any_comput
                         "--branching"),
                        (["--control", "0.5", "0", "--branching", "8", "0", "2", "0.5", "0"],
                         "W1 <= 1"),
+                       (["--control", "0.5", "0", "--lag-yield-exponent", "3"], "TAU > 0"),
+                       (["--control", "0.5", "4", "--lag-yield-exponent", "nan"],
+                        "--lag-yield-exponent nan"),
+                       (["/nonexistent-run", "--lag-yield-exponent", "3"], "controls'"),
                        (["/nonexistent-run", "--lag-distance", "0.3"], "controls'")):
         with pytest.raises(SystemExit):
             main(argv)
@@ -134,7 +138,9 @@ BRANCH = (10.0, 0.0, 0.3, 0.5, 0.5)
     ({"corrugation": (20.0, 1.1, -0.97), "branching": BRANCH, "registry_lag": 5.0},
      "branching"),
     ({"lag_distance": 0.3}, "lag_distance"),
-    ({"corrugation": (20.0, 1.1, -0.97), "lag_distance": 0.3, "lag": 10.0}, "lag_distance")])
+    ({"corrugation": (20.0, 1.1, -0.97), "lag_distance": 0.3, "lag": 10.0}, "lag_distance"),
+    ({"lag_yield_exponent": 3.0}, "lag_yield_exponent"),
+    ({"lag": 4.0, "lag_yield_exponent": 3.0, "weakening": (0.3, 0.5)}, "lag_yield_exponent")])
 def test_a_registry_control_refuses_what_its_law_cannot_carry(kw, said):
     # each needs the walls' registry, and none carries a viscous lag in time beside it
     with pytest.raises(ValueError, match=said):
@@ -200,3 +206,27 @@ def test_the_split_controls_read_each_half_and_its_coverage_of_a_known_lag(bench
     # the fast half, where the lag marks the one law most (m_c ≤ −2 errors in both pools),
     # finds it within its errors in both (seeds fixed: deterministic)
     assert "and 2 of 2 (fast)" in out.split("covers the lag of 3.7 τ in ")[1]
+
+
+def test_a_lag_tied_to_the_yield_force_speeds_the_weak_yields_slips():
+    # ``lag_yield_exponent`` = α: each run's lag τ_r·(F̄_s/F_s)^α.  With one yield force for
+    # every run it is the plain lag, to the sample; with the runs' yields spread (± 30 %,
+    # noise-free, one film law) the weakest-yield run lags longest, and its slips run faster
+    # than under one lag (a lagging viscous force resists the slip's start less) while the
+    # strongest-yield run's, lagging less, run slower: a velocity split files long lags fast
+    import numpy as np
+
+    kw = dict(share=0.5, scale=SCALES["m3e3"], noise=QUIET, law_spread=0.0,
+              corrugation=(20.0, 1.1, -0.97), lag=4.0)
+    same = [pooled_runs("x", 3, 4, static_spread=0.0, lag_yield_exponent=a, **kw)[0]
+            for a in (0.0, 3.0)]
+    for one, tied in zip(*same):
+        np.testing.assert_array_equal(one.spring_force, tied.spring_force)
+    runs = {a: pooled_runs("x", 8, 6, lag_yield_exponent=a, **kw)[0] for a in (0.0, 3.0)}
+    speed = {a: np.array([np.mean(r.table.slip_distance / r.table.slip_duration) for r in rs])
+             for a, rs in runs.items()}
+    yields = np.array([r.table.static_force.mean() for r in runs[0.0]])
+    weak, strong = np.argmin(yields), np.argmax(yields)
+    assert yields[weak] < 0.8 * 46.0 and yields[strong] > 1.2 * 46.0
+    assert speed[3.0][weak] > 1.2 * speed[0.0][weak]
+    assert speed[3.0][strong] < 0.95 * speed[0.0][strong]
