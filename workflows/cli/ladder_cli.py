@@ -69,9 +69,11 @@ def main_plan(args: argparse.Namespace) -> int:
         if r.step_factor != 1:
             steps += f" (the cost model's {r.model_steps} × {r.step_factor:g})"
         cost = (f", {r.run_steps / rate / 60:.0f} min at {rate:g} steps/s" if rate else "")
+        measured = " (measured)" if r.measured_slip_velocity is not None else ""
         print(f"{r.name}: V = {r.drive_velocity:g}, γ = {r.mount_damping:g}, v̄_slip ≈ "
-              f"{r.slip_velocity_estimate:.2g}, {r.slips} slips, {steps}, {r.run_steps} "
-              f"steps a run{cost}" + (" (planned, not run)" if r.planned else ""))
+              f"{r.slip_velocity_estimate:.2g}{measured}, {r.slips} slips, {steps}, "
+              f"{r.run_steps} steps a run{cost}"
+              + (" (not in the campaign: over 30 min a run on 2 cores)" if r.planned else ""))
         print("    " + " ".join(ladder.sweep_command(r, ladder.SEEDS, args.root)))
     runs, steps = ladder.campaign_steps()
     cost = f", {steps / rate / 3600:.1f} h at {rate:g} steps/s" if rate else ""
