@@ -53,8 +53,9 @@ from ..slip_law.slip_law import VERDICTS, FilmForceFit, fit_film_force
 from ..slip_law.slip_law_cycles import MD_NOISE_TIME, fit_cycle_ensemble
 from ..stickslip import detect_slips
 from .film_noise import (K4M3E3_REGISTRY_NOISE, K16M3E3_REGISTRY_NOISE, LIGHT_NOISE,
-                         LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE, M25E3_REGISTRY_NOISE, M3E3_NOISE,
-                         M3E3_REGISTRY_NOISE, MD_NOISE, STIFF_NOISE, STIFF_REGISTRY_NOISE)
+                         LIGHT_REGISTRY_NOISE, M1E4_NOISE, M1E4_REGISTRY_NOISE,
+                         M25E3_REGISTRY_NOISE, M3E3_NOISE, M3E3_REGISTRY_NOISE, MD_NOISE,
+                         STIFF_NOISE, STIFF_REGISTRY_NOISE)
 from .random_force import LOOP_LAWS, slide
 from .synthetic import block_trace, klein_trace, with_wall_noise
 

@@ -313,7 +313,8 @@ def split_control(args, runs_of, kw, static_force) -> int:
     if both.sum() > 1:
         d = slow[both, 0] - fast[both, 0]
         print(f"where both cross: τ̂ {slow[both, 0].mean():.1f} (sd "
-              f"{slow[both, 0].std(ddof=1):.1f}) and {fast[both, 0].mean():.1f} (sd {fast[both, 0].std(ddof=1):.1f}) τ; slow − fast "
+              f"{slow[both, 0].std(ddof=1):.1f}) and {fast[both, 0].mean():.1f} (sd "
+              f"{fast[both, 0].std(ddof=1):.1f}) τ; slow − fast "
               f"{d.mean():+.1f} (sd {d.std(ddof=1):.1f}; median error "
               f"{np.median(np.hypot(slow[both, 1], fast[both, 1])):.1f}) τ; > 0 in "
               f"{int((d > 0).sum())} of {int(both.sum())}")
